@@ -1,0 +1,2 @@
+//! firmware crate (being built, see README.md).
+#![no_std]

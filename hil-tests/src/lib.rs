@@ -1,0 +1,2 @@
+//! hil-tests crate (being built, see README.md).
+

@@ -1,0 +1,2 @@
+//! protocol crate (being built, see README.md).
+#![no_std]
