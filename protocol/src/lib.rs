@@ -1,2 +1,35 @@
-//! protocol crate (being built, see README.md).
+//! CAN messages between the walker's two ankle nodes and a host.
+//!
+//! * Identifiers ([`id`]): 11 bits, message class in the high bits (priority order: emergency
+//!   stop, heel strike, fault, command, parameter acknowledgement, heartbeat, ankle state,
+//!   version), node in the low four bits.
+//! * Payloads: little-endian, byte-aligned, scaled integers with stated units ([`values`]).
+//! * Every layout is defined once, in [`MESSAGES`]; the codec ([`Message::encode`],
+//!   [`Message::decode`]) writes through the same [`signal::SignalSpec`] constants, and the
+//!   DBC file (`protocol/walker.dbc`), the bus-load figure ([`busload`]) and the shared test
+//!   vectors are generated from it.
+//! * `no_std`, no heap, no panics. The `std` feature adds `std::error::Error` impls, the DBC
+//!   renderer and the test vectors; `defmt` adds `defmt::Format` impls.
 #![no_std]
+
+pub mod busload;
+#[cfg(feature = "std")]
+pub mod dbc;
+pub mod error;
+pub mod id;
+pub mod messages;
+pub mod signal;
+pub mod values;
+#[cfg(feature = "std")]
+pub mod vectors;
+
+pub use error::{DecodeError, EncodeError, RangeError};
+pub use id::{CanId, MessageClass, NodeId, Target};
+pub use messages::{
+    spec, AnkleState, Command, CommandKind, FaultEvent, HeelStrike, Heartbeat, Message, ParamAck,
+    RawFrame, Version, BITRATE_BPS, MESSAGES, PROTOCOL_VERSION,
+};
+pub use values::{
+    Angle, AngularRate, FaultCode, FaultFlags, FaultTransition, NodeState, Opcode, ParamId,
+    ParamStatus, ParamValue, ReflexPhase,
+};

@@ -1,0 +1,68 @@
+//! `walker-tools`: generate the DBC file and test vectors, print the bus load.
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+use walker_tools::{generated, repo_root, splice_busload};
+
+#[derive(Parser)]
+#[command(about = "Walker workspace tools")]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Print the DBC file to stdout.
+    Dbc,
+    /// Print the shared test vectors (JSON) to stdout.
+    Vectors,
+    /// Print the bus-load table (Markdown) for the nominal message rates.
+    BusLoad,
+    /// Rewrite every generated file in the repository (DBC, test vectors, docs table).
+    Gen {
+        /// Only check; exit non-zero when a file is stale.
+        #[arg(long)]
+        check: bool,
+    },
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.cmd {
+        Cmd::Dbc => print!("{}", protocol::dbc::render()),
+        Cmd::Vectors => print!("{}", protocol::vectors::render_json()),
+        Cmd::BusLoad => print!("{}", walker_tools::busload_markdown()),
+        Cmd::Gen { check } => {
+            let root = repo_root();
+            let mut stale = Vec::new();
+            let mut files: Vec<(String, String)> = generated()
+                .into_iter()
+                .map(|g| (g.path.to_string(), g.content))
+                .collect();
+            let doc_path = "docs/protocol.md";
+            let doc = std::fs::read_to_string(root.join(doc_path))
+                .with_context(|| format!("reading {doc_path}"))?;
+            let Some(new_doc) = splice_busload(&doc) else {
+                bail!("{doc_path}: bus-load markers missing");
+            };
+            files.push((doc_path.to_string(), new_doc));
+            for (path, content) in files {
+                let full = root.join(&path);
+                let old = std::fs::read_to_string(&full).unwrap_or_default();
+                if old != content {
+                    stale.push(path.clone());
+                    if !check {
+                        std::fs::write(&full, content)
+                            .with_context(|| format!("writing {path}"))?;
+                        eprintln!("wrote {path}");
+                    }
+                }
+            }
+            if check && !stale.is_empty() {
+                bail!("stale generated files: {stale:?}; run `cargo run -p walker-tools -- gen`");
+            }
+        }
+    }
+    Ok(())
+}
