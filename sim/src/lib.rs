@@ -1,1 +1,17 @@
-//! sim
+//! A hybrid multibody engine for passive dynamic walkers, after Wisse, Schwab & van der Linde
+//! (2001), section 3: TMT equations of motion, Meijaard's integrator, Hermite event location,
+//! impact equations, stride function, Newton-Raphson limit cycles and their stability.
+
+pub mod dynamics;
+pub mod events;
+pub mod impact;
+pub mod integrators;
+pub mod kinematics;
+pub mod math;
+pub mod model;
+pub mod relabel;
+pub mod singular_limit;
+pub mod limit_cycle;
+pub mod scene;
+pub mod stride;
+pub mod walker;

@@ -1,0 +1,187 @@
+//! Reduced equations of motion `M̄ q̈ = f̄` by the TMT (virtual power) method, eq. (1)-(9).
+//!
+//! `M̄ = F,qᵀ M F,q` and `f̄ = F,qᵀ (f − M F,qq q̇ q̇)` are summed body by body: for each body,
+//! `F,q` is its c.m. linear Jacobian and angular Jacobian, and `F,qq q̇ q̇` its bias acceleration.
+
+use crate::kinematics::Kinematics;
+use crate::model::{LinkIndex, Model};
+use crate::singular_limit::{solve_limit, LimitSolveError};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// Why the accelerations could not be computed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DynamicsError {
+    /// The reduced mass matrix (or its vanishing-mass limit) is singular.
+    #[error("reduced mass matrix is singular: {0}")]
+    Singular(#[from] LimitSolveError),
+    /// A coordinate or velocity is NaN or infinite.
+    #[error("non-finite state")]
+    NonFinite,
+}
+
+/// The equations of motion workspace: kinematics plus the assembled `M̄`, `f̄`.
+#[derive(Clone, Debug)]
+pub struct Dynamics {
+    /// Kinematics at the last assembly.
+    pub kin: Kinematics,
+    /// `M̄` from bodies of finite mass [kg·m² for angles].
+    pub mass_matrix: DMatrix<f64>,
+    /// `M̄` per unit of infinitesimal mass (the `ε` part).
+    pub mass_matrix_infinitesimal: DMatrix<f64>,
+    /// `f̄` from finite bodies and joint springs/dampers [N·m for angles].
+    pub force: DVector<f64>,
+    /// `f̄` per unit of infinitesimal mass.
+    pub force_infinitesimal: DVector<f64>,
+    jv: DMatrix<f64>,
+    jw: DMatrix<f64>,
+    has_infinitesimal: bool,
+}
+
+impl Dynamics {
+    /// A workspace sized for `model`.
+    pub fn new(model: &Model) -> Self {
+        let n = model.dof();
+        Self {
+            kin: Kinematics::new(model),
+            mass_matrix: DMatrix::zeros(n, n),
+            mass_matrix_infinitesimal: DMatrix::zeros(n, n),
+            force: DVector::zeros(n),
+            force_infinitesimal: DVector::zeros(n),
+            jv: DMatrix::zeros(3, n),
+            jw: DMatrix::zeros(3, n),
+            has_infinitesimal: model.has_infinitesimal_bodies(),
+        }
+    }
+
+    /// Assembles `M̄` and `f̄` at `q`, `q̇`, adding the generalised force `tau_extra`, if any.
+    pub fn assemble(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        tau_extra: Option<&DVector<f64>>,
+    ) {
+        self.kin.update(model, q, qd);
+        self.mass_matrix.fill(0.0);
+        self.mass_matrix_infinitesimal.fill(0.0);
+        self.force.fill(0.0);
+        self.force_infinitesimal.fill(0.0);
+        let g = model.gravity_floor_m_s2;
+        for (i, link) in model.links.iter().enumerate() {
+            let b = &link.body;
+            let has_rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
+            if b.mass_kg == 0.0 && !has_rot {
+                continue;
+            }
+            let li = LinkIndex(i);
+            let p_com = self.kin.position_of(li, &b.p_link_com_m);
+            self.kin.point_jacobian_into(model, li, &p_com, &mut self.jv);
+            let a_bias = self.kin.bias_acceleration_of(li, &p_com);
+            let (mm, ff) = if b.infinitesimal {
+                (&mut self.mass_matrix_infinitesimal, &mut self.force_infinitesimal)
+            } else {
+                (&mut self.mass_matrix, &mut self.force)
+            };
+            // Linear part: m Jvᵀ Jv, Jvᵀ m (g − a_bias).
+            mm.gemm_tr(b.mass_kg, &self.jv, &self.jv, 1.0);
+            ff.gemv_tr(b.mass_kg, &self.jv, &(g - a_bias), 1.0);
+            if has_rot {
+                self.kin.angular_jacobian_into(model, li, &mut self.jw);
+                let r = self.kin.r_floor_link[i];
+                let i_w = r * b.inertia_com_kg_m2 * r.transpose();
+                let w = self.kin.omega_floor_rad_s[i];
+                let torque = -(i_w * self.kin.alpha_bias_rad_s2[i]) - w.cross(&(i_w * w));
+                let iw_jw = DMatrix::from_fn(3, self.jw.ncols(), |r_, c| {
+                    (i_w.row(r_) * self.jw.column(c))[(0, 0)]
+                });
+                mm.gemm_tr(1.0, &self.jw, &iw_jw, 1.0);
+                ff.gemv_tr(1.0, &self.jw, &torque, 1.0);
+            }
+        }
+        for link in &model.links {
+            if let Some(c) = link.coordinate {
+                let jf = &link.joint_force;
+                self.force[c.0] -=
+                    jf.stiffness * (q[c.0] - jf.rest_position) + jf.damping * qd[c.0];
+            }
+        }
+        if let Some(t) = tau_extra {
+            self.force += t;
+        }
+    }
+
+    /// Accelerations `q̈` at `q`, `q̇` with the coordinates where `active` is false held fixed
+    /// (their `q̈` is zero). Assembles first.
+    pub fn accelerations(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        tau_extra: Option<&DVector<f64>>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        self.assemble(model, q, qd, tau_extra);
+        let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
+        let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
+        let f0 = self.force.select_rows(&idx);
+        let x = if self.has_infinitesimal {
+            let m1 = self.mass_matrix_infinitesimal.select_rows(&idx).select_columns(&idx);
+            let f1 = self.force_infinitesimal.select_rows(&idx);
+            solve_limit(&m0, &m1, &f0, &f1, 1e-12)?
+        } else {
+            match m0.clone().cholesky() {
+                Some(ch) => ch.solve(&f0),
+                None => return Err(LimitSolveError::Degenerate { nullity: 1 }.into()),
+            }
+        };
+        let mut qdd = DVector::zeros(q.len());
+        for (k, &i) in idx.iter().enumerate() {
+            qdd[i] = x[k];
+        }
+        if qdd.iter().any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        Ok(qdd)
+    }
+
+    /// Mechanical energy of the finite bodies and joint springs [J], with the potential taken
+    /// relative to the floor origin. Call after `assemble` at the same state.
+    pub fn energy_j(&self, model: &Model, q: &DVector<f64>, qd: &DVector<f64>) -> f64 {
+        let kinetic = 0.5 * qd.dot(&(&self.mass_matrix * qd));
+        let mut potential = 0.0;
+        for (i, link) in model.links.iter().enumerate() {
+            if link.body.infinitesimal {
+                continue;
+            }
+            let p = self.kin.position_of(LinkIndex(i), &link.body.p_link_com_m);
+            potential -= link.body.mass_kg * model.gravity_floor_m_s2.dot(&p);
+            if let Some(c) = link.coordinate {
+                let jf = &link.joint_force;
+                potential += 0.5 * jf.stiffness * (q[c.0] - jf.rest_position).powi(2);
+            }
+        }
+        kinetic + potential
+    }
+
+    /// Angular momentum of the finite bodies about a floor-frame point [kg·m²/s]. Uses the
+    /// kinematics of the last `assemble`.
+    pub fn angular_momentum_about(&self, model: &Model, p_floor_m: &Vector3<f64>) -> Vector3<f64> {
+        let mut h = Vector3::zeros();
+        for (i, link) in model.links.iter().enumerate() {
+            let b = &link.body;
+            if b.infinitesimal {
+                continue;
+            }
+            let li = LinkIndex(i);
+            let p = self.kin.position_of(li, &b.p_link_com_m);
+            let v = self.kin.velocity_of(li, &p);
+            let r = self.kin.r_floor_link[i];
+            let i_w = r * b.inertia_com_kg_m2 * r.transpose();
+            h += (p - p_floor_m).cross(&(v * b.mass_kg)) + i_w * self.kin.omega_floor_rad_s[i];
+        }
+        h
+    }
+}

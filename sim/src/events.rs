@@ -1,0 +1,181 @@
+//! Events as witness functions with a direction rule, located by cubic Hermite interpolation
+//! (eq. 14) and refined by exact integrator steps.
+
+use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem};
+use nalgebra::DVector;
+use serde::Serialize;
+
+/// Which sign change of a witness function triggers its event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// From strictly negative to zero or positive.
+    Rising,
+    /// From strictly positive to zero or negative.
+    Falling,
+}
+
+impl Direction {
+    /// Whether the values at the two ends of a step trigger the event.
+    pub fn triggered(self, g_before: f64, g_after: f64) -> bool {
+        match self {
+            Direction::Rising => g_before < 0.0 && g_after >= 0.0,
+            Direction::Falling => g_before > 0.0 && g_after <= 0.0,
+        }
+    }
+}
+
+/// Tolerances for event location.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EventTolerance {
+    /// Stop refining when the bracket is this narrow [s].
+    pub time_s: f64,
+    /// Or when the witness is this close to zero (its own unit).
+    pub witness: f64,
+    /// Refinement iterations allowed.
+    pub max_iterations: usize,
+}
+
+impl Default for EventTolerance {
+    fn default() -> Self {
+        Self { time_s: 1e-13, witness: 1e-14, max_iterations: 60 }
+    }
+}
+
+/// Cubic Hermite interpolation of `q` (and its derivative) between two samples, eq. (14).
+pub fn hermite(a: &Sample, b: &Sample, t_s: f64) -> (DVector<f64>, DVector<f64>) {
+    let h = b.t_s - a.t_s;
+    let x = (t_s - a.t_s) / h;
+    let (x2, x3) = (x * x, x * x * x);
+    let h00 = 1.0 - 3.0 * x2 + 2.0 * x3;
+    let h10 = (x - 2.0 * x2 + x3) * h;
+    let h01 = 3.0 * x2 - 2.0 * x3;
+    let h11 = (-x2 + x3) * h;
+    let q = &a.q * h00 + &a.qd * h10 + &b.q * h01 + &b.qd * h11;
+    // Derivatives of the basis with respect to t.
+    let d00 = (-6.0 * x + 6.0 * x2) / h;
+    let d10 = 1.0 - 4.0 * x + 3.0 * x2;
+    let d01 = (6.0 * x - 6.0 * x2) / h;
+    let d11 = -2.0 * x + 3.0 * x2;
+    let qd = &a.q * d00 + &a.qd * d10 + &b.q * d01 + &b.qd * d11;
+    (q, qd)
+}
+
+/// Why an event could not be located.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EventError {
+    /// A refinement step failed.
+    #[error(transparent)]
+    Integration(#[from] IntegrationError),
+    /// The refinement did not meet its tolerance within its budget.
+    #[error("event not located within {iterations} iterations (bracket {bracket_s:e} s)")]
+    NotLocated {
+        /// Iterations used.
+        iterations: usize,
+        /// Final bracket width [s].
+        bracket_s: f64,
+    },
+}
+
+/// Finds the crossing of `g` between samples `a` and `b` (with `g(a)`, `g(b)` of opposite
+/// sign): a first estimate on the Hermite interpolant, then the Illinois method on exact
+/// integrator steps from `a`. Returns the sample at the event.
+pub fn locate(
+    integrator: &mut dyn Integrator,
+    sys: &mut dyn SecondOrderSystem,
+    a: &Sample,
+    b: &Sample,
+    g: &mut dyn FnMut(&Sample) -> f64,
+    tol: &EventTolerance,
+) -> Result<Sample, EventError> {
+    let (ga, gb) = (g(a), g(b));
+    // Estimate on the interpolant (eq. 14): bisection, cheap since no dynamics is evaluated.
+    let (mut lo, mut hi) = (a.t_s, b.t_s);
+    let (mut glo, _ghi) = (ga, gb);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        let (q, qd) = hermite(a, b, mid);
+        let gm = g(&Sample { t_s: mid, q, qd });
+        if (gm <= 0.0) == (glo <= 0.0) {
+            lo = mid;
+            glo = gm;
+        } else {
+            hi = mid;
+        }
+        if hi - lo < tol.time_s {
+            break;
+        }
+    }
+    let guess = 0.5 * (lo + hi);
+    // Refinement: Illinois regula falsi on the exact flow, bracketed by [a, b].
+    let (mut t0, mut g0) = (a.t_s, ga);
+    let (mut t1, mut g1) = (b.t_s, gb);
+    let mut best = b.clone();
+    let mut t = guess;
+    let mut side = 0i8;
+    for it in 0..tol.max_iterations {
+        let s = if (t - b.t_s).abs() == 0.0 {
+            b.clone()
+        } else {
+            integrator.step_exact(sys, a, t - a.t_s)?
+        };
+        let gt = g(&s);
+        best = s;
+        if gt.abs() <= tol.witness || (t1 - t0).abs() <= tol.time_s {
+            return Ok(best);
+        }
+        if (gt <= 0.0) == (g0 <= 0.0) {
+            t0 = t;
+            g0 = gt;
+            if side == -1 {
+                g1 *= 0.5;
+            }
+            side = -1;
+        } else {
+            t1 = t;
+            g1 = gt;
+            if side == 1 {
+                g0 *= 0.5;
+            }
+            side = 1;
+        }
+        t = if g1 != g0 { t0 - g0 * (t1 - t0) / (g1 - g0) } else { 0.5 * (t0 + t1) };
+        if !(t > t0.min(t1) && t < t0.max(t1)) {
+            t = 0.5 * (t0 + t1);
+        }
+        if it + 1 == tol.max_iterations {
+            break;
+        }
+    }
+    if (t1 - t0).abs() <= 1e3 * tol.time_s {
+        return Ok(best);
+    }
+    Err(EventError::NotLocated { iterations: tol.max_iterations, bracket_s: (t1 - t0).abs() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_is_exact_for_cubics() {
+        let f = |t: f64| 1.0 + 2.0 * t - t * t + 0.5 * t * t * t;
+        let df = |t: f64| 2.0 - 2.0 * t + 1.5 * t * t;
+        let s = |t: f64| Sample {
+            t_s: t,
+            q: DVector::from_element(1, f(t)),
+            qd: DVector::from_element(1, df(t)),
+        };
+        let (q, qd) = hermite(&s(0.3), &s(1.1), 0.77);
+        assert!((q[0] - f(0.77)).abs() < 1e-14);
+        assert!((qd[0] - df(0.77)).abs() < 1e-13);
+    }
+
+    #[test]
+    fn direction_rules() {
+        assert!(Direction::Falling.triggered(1.0, 0.0));
+        assert!(!Direction::Falling.triggered(0.0, -1.0));
+        assert!(Direction::Rising.triggered(-1.0, 0.0));
+        assert!(!Direction::Rising.triggered(1.0, 2.0));
+    }
+}

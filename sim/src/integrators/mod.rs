@@ -1,0 +1,155 @@
+//! Time integrators for `q̈ = f(q, q̇, t)` behind one interface.
+//!
+//! Every integrator advances a [`SecondOrderSystem`] by one accepted step and can take an
+//! exact step of any smaller size, which the event locator uses to refine event times.
+
+mod dopri5;
+mod meijaard;
+mod rk4;
+
+pub use dopri5::Dopri5;
+pub use meijaard::{Meijaard, StabilityLimit};
+pub use rk4::Rk4;
+
+use crate::dynamics::DynamicsError;
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+
+/// A system of second-order ODEs.
+pub trait SecondOrderSystem {
+    /// Accelerations at `t`, `q`, `q̇`.
+    fn accelerations(
+        &mut self,
+        t_s: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<DVector<f64>, DynamicsError>;
+
+    /// Largest undamped eigenfrequency `λ_max` [rad/s] and its relative damping `β` of the
+    /// linearised system at `q`, `q̇` (for eq. 12). `None` if the system cannot tell.
+    fn stability_limit(
+        &mut self,
+        _t_s: f64,
+        _q: &DVector<f64>,
+        _qd: &DVector<f64>,
+    ) -> Option<StabilityLimit> {
+        None
+    }
+}
+
+/// Positions and velocities at a time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Time [s].
+    pub t_s: f64,
+    /// Generalised coordinates.
+    pub q: DVector<f64>,
+    /// Generalised velocities.
+    pub qd: DVector<f64>,
+}
+
+/// Why a step failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegrationError {
+    /// The equations of motion could not be evaluated.
+    #[error(transparent)]
+    Dynamics(#[from] DynamicsError),
+    /// The fixed step exceeds the stability limit of eq. (12).
+    #[error("step {h_s:e} s exceeds the stability limit h_max = {h_max_s:e} s (λ_max = {lambda_max_rad_s:.3} rad/s, β = {beta:.3})")]
+    StepTooLarge {
+        /// The step [s].
+        h_s: f64,
+        /// The limit [s].
+        h_max_s: f64,
+        /// Largest undamped eigenfrequency [rad/s].
+        lambda_max_rad_s: f64,
+        /// Relative damping of that mode.
+        beta: f64,
+    },
+    /// The adaptive step fell below its floor.
+    #[error("adaptive step size fell to {h_s:e} s at t = {t_s} s")]
+    StepUnderflow {
+        /// The step [s].
+        h_s: f64,
+        /// Time [s].
+        t_s: f64,
+    },
+}
+
+/// Which integrator to use, with its settings. Serialised in reports.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum IntegratorChoice {
+    /// Meijaard's one-evaluation scheme, eq. (11).
+    Meijaard {
+        /// Step [s].
+        h_s: f64,
+        /// Check eq. (12) every this many steps (0: never).
+        check_every: usize,
+    },
+    /// Classical fourth-order Runge-Kutta.
+    Rk4 {
+        /// Step [s].
+        h_s: f64,
+    },
+    /// Dormand-Prince 5(4), adaptive.
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance.
+        atol: f64,
+        /// Largest step [s].
+        h_max_s: f64,
+    },
+}
+
+impl IntegratorChoice {
+    /// Builds the integrator.
+    pub fn build(&self) -> Box<dyn Integrator> {
+        match *self {
+            IntegratorChoice::Meijaard { h_s, check_every } => {
+                Box::new(Meijaard::new(h_s, check_every))
+            }
+            IntegratorChoice::Rk4 { h_s } => Box::new(Rk4::new(h_s)),
+            IntegratorChoice::Dopri5 { rtol, atol, h_max_s } => {
+                Box::new(Dopri5::new(rtol, atol, h_max_s))
+            }
+        }
+    }
+
+    /// A short label for tables.
+    pub fn label(&self) -> String {
+        match self {
+            IntegratorChoice::Meijaard { h_s, .. } => format!("meijaard h={h_s:e}"),
+            IntegratorChoice::Rk4 { h_s } => format!("rk4 h={h_s:e}"),
+            IntegratorChoice::Dopri5 { rtol, .. } => format!("dopri5 rtol={rtol:e}"),
+        }
+    }
+}
+
+/// One integrator: a step chosen by itself, and an exact step of a given size.
+pub trait Integrator {
+    /// Name for reports.
+    fn name(&self) -> &'static str;
+    /// Clears any per-trajectory memory (step-size history, counters). Call at a new start.
+    fn reset(&mut self);
+    /// The step this integrator would take next from `t_s` [s].
+    fn proposed_step_s(&self) -> f64;
+    /// Takes one accepted step from `from` of size at most `h_limit_s`, returning the new sample.
+    fn advance(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        from: &Sample,
+        h_limit_s: f64,
+    ) -> Result<Sample, IntegrationError>;
+    /// Takes one step of exactly `h_s` (no error control; used to refine an event time
+    /// inside the last accepted step).
+    fn step_exact(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        from: &Sample,
+        h_s: f64,
+    ) -> Result<Sample, IntegrationError>;
+    /// Number of right-hand-side evaluations since `reset`.
+    fn evaluations(&self) -> usize;
+}

@@ -1,0 +1,208 @@
+//! Forward kinematics: world poses, velocities and velocity-product ("bias") accelerations of
+//! every link, and the Jacobians `F,q` of the TMT method (eq. 4-7 of the paper).
+
+use crate::math::rotation_about;
+use crate::model::{JointKind, LinkIndex, Model, PointIndex};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+/// The kinematic workspace for one model, refilled by [`Kinematics::update`].
+#[derive(Clone, Debug)]
+pub struct Kinematics {
+    /// Rotation link frame → floor frame.
+    pub r_floor_link: Vec<Matrix3<f64>>,
+    /// Link origin in the floor frame [m].
+    pub p_floor_link_m: Vec<Vector3<f64>>,
+    /// Joint axis in the floor frame (zero for welds).
+    pub axis_floor: Vec<Vector3<f64>>,
+    /// Angular velocity of each link, floor frame [rad/s].
+    pub omega_floor_rad_s: Vec<Vector3<f64>>,
+    /// Velocity of each link origin, floor frame [m/s].
+    pub v_floor_link_m_s: Vec<Vector3<f64>>,
+    /// Angular acceleration with `q̈ = 0` [rad/s²].
+    pub alpha_bias_rad_s2: Vec<Vector3<f64>>,
+    /// Acceleration of each link origin with `q̈ = 0` [m/s²].
+    pub a_bias_link_m_s2: Vec<Vector3<f64>>,
+}
+
+impl Kinematics {
+    /// A workspace sized for `model`.
+    pub fn new(model: &Model) -> Self {
+        let n = model.links.len();
+        Self {
+            r_floor_link: vec![Matrix3::identity(); n],
+            p_floor_link_m: vec![Vector3::zeros(); n],
+            axis_floor: vec![Vector3::zeros(); n],
+            omega_floor_rad_s: vec![Vector3::zeros(); n],
+            v_floor_link_m_s: vec![Vector3::zeros(); n],
+            alpha_bias_rad_s2: vec![Vector3::zeros(); n],
+            a_bias_link_m_s2: vec![Vector3::zeros(); n],
+        }
+    }
+
+    /// Recomputes poses, velocities and bias accelerations for `q`, `q̇`.
+    pub fn update(&mut self, model: &Model, q: &DVector<f64>, qd: &DVector<f64>) {
+        for (i, link) in model.links.iter().enumerate() {
+            let (r_p, p_p, w_p, v_p, al_p, a_p) = match link.parent {
+                Some(p) => (
+                    self.r_floor_link[p.0],
+                    self.p_floor_link_m[p.0],
+                    self.omega_floor_rad_s[p.0],
+                    self.v_floor_link_m_s[p.0],
+                    self.alpha_bias_rad_s2[p.0],
+                    self.a_bias_link_m_s2[p.0],
+                ),
+                None => (
+                    Matrix3::identity(),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                ),
+            };
+            let d = r_p * link.p_parent_joint_m;
+            let o = p_p + d;
+            let v_o = v_p + w_p.cross(&d);
+            let a_o = a_p + al_p.cross(&d) + w_p.cross(&w_p.cross(&d));
+            let (qi, qdi) = match link.coordinate {
+                Some(c) => (q[c.0], qd[c.0]),
+                None => (0.0, 0.0),
+            };
+            match &link.joint {
+                JointKind::Revolute { axis_parent } => {
+                    let a = r_p * axis_parent;
+                    self.axis_floor[i] = a;
+                    self.r_floor_link[i] = r_p * rotation_about(axis_parent, qi);
+                    self.p_floor_link_m[i] = o;
+                    self.omega_floor_rad_s[i] = w_p + a * qdi;
+                    self.v_floor_link_m_s[i] = v_o;
+                    self.alpha_bias_rad_s2[i] = al_p + w_p.cross(&a) * qdi;
+                    self.a_bias_link_m_s2[i] = a_o;
+                }
+                JointKind::Prismatic { axis_parent } => {
+                    let a = r_p * axis_parent;
+                    self.axis_floor[i] = a;
+                    self.r_floor_link[i] = r_p;
+                    let s = a * qi;
+                    self.p_floor_link_m[i] = o + s;
+                    self.omega_floor_rad_s[i] = w_p;
+                    self.v_floor_link_m_s[i] = v_o + w_p.cross(&s) + a * qdi;
+                    self.alpha_bias_rad_s2[i] = al_p;
+                    self.a_bias_link_m_s2[i] = a_o
+                        + al_p.cross(&s)
+                        + w_p.cross(&w_p.cross(&s))
+                        + w_p.cross(&a) * (2.0 * qdi);
+                }
+                JointKind::Weld => {
+                    self.axis_floor[i] = Vector3::zeros();
+                    self.r_floor_link[i] = r_p;
+                    self.p_floor_link_m[i] = o;
+                    self.omega_floor_rad_s[i] = w_p;
+                    self.v_floor_link_m_s[i] = v_o;
+                    self.alpha_bias_rad_s2[i] = al_p;
+                    self.a_bias_link_m_s2[i] = a_o;
+                }
+            }
+        }
+    }
+
+    /// Position in the floor frame of a point given in a link frame [m].
+    pub fn position_of(&self, link: LinkIndex, p_link_m: &Vector3<f64>) -> Vector3<f64> {
+        self.p_floor_link_m[link.0] + self.r_floor_link[link.0] * p_link_m
+    }
+
+    /// Position of a marker point [m].
+    pub fn point_position(&self, model: &Model, point: PointIndex) -> Vector3<f64> {
+        let p = &model.points[point.0];
+        self.position_of(p.link, &p.p_link_m)
+    }
+
+    /// Velocity in the floor frame of a floor-frame point moving with `link` [m/s].
+    pub fn velocity_of(&self, link: LinkIndex, p_floor_m: &Vector3<f64>) -> Vector3<f64> {
+        self.v_floor_link_m_s[link.0]
+            + self.omega_floor_rad_s[link.0].cross(&(p_floor_m - self.p_floor_link_m[link.0]))
+    }
+
+    /// Bias acceleration (`q̈ = 0`) of a floor-frame point moving with `link` [m/s²].
+    pub fn bias_acceleration_of(&self, link: LinkIndex, p_floor_m: &Vector3<f64>) -> Vector3<f64> {
+        let r = p_floor_m - self.p_floor_link_m[link.0];
+        let w = self.omega_floor_rad_s[link.0];
+        self.a_bias_link_m_s2[link.0]
+            + self.alpha_bias_rad_s2[link.0].cross(&r)
+            + w.cross(&w.cross(&r))
+    }
+
+    /// Linear Jacobian `∂v/∂q̇` (3 × n) of a floor-frame point moving with `link`.
+    pub fn point_jacobian(
+        &self,
+        model: &Model,
+        link: LinkIndex,
+        p_floor_m: &Vector3<f64>,
+    ) -> DMatrix<f64> {
+        let mut j = DMatrix::zeros(3, model.dof());
+        self.point_jacobian_into(model, link, p_floor_m, &mut j);
+        j
+    }
+
+    /// As [`Self::point_jacobian`], writing into `j` (3 × n, overwritten).
+    pub fn point_jacobian_into(
+        &self,
+        model: &Model,
+        link: LinkIndex,
+        p_floor_m: &Vector3<f64>,
+        j: &mut DMatrix<f64>,
+    ) {
+        j.fill(0.0);
+        let mut cur = Some(link);
+        while let Some(l) = cur {
+            let lk = &model.links[l.0];
+            if let Some(c) = lk.coordinate {
+                let a = self.axis_floor[l.0];
+                let col = match lk.joint {
+                    JointKind::Revolute { .. } => a.cross(&(p_floor_m - self.p_floor_link_m[l.0])),
+                    _ => a,
+                };
+                j.fixed_view_mut::<3, 1>(0, c.0).copy_from(&col);
+            }
+            cur = lk.parent;
+        }
+    }
+
+    /// Angular Jacobian `∂ω/∂q̇` (3 × n) of `link`.
+    pub fn angular_jacobian(&self, model: &Model, link: LinkIndex) -> DMatrix<f64> {
+        let mut j = DMatrix::zeros(3, model.dof());
+        self.angular_jacobian_into(model, link, &mut j);
+        j
+    }
+
+    /// As [`Self::angular_jacobian`], writing into `j` (3 × n, overwritten).
+    pub fn angular_jacobian_into(&self, model: &Model, link: LinkIndex, j: &mut DMatrix<f64>) {
+        j.fill(0.0);
+        let mut cur = Some(link);
+        while let Some(l) = cur {
+            let lk = &model.links[l.0];
+            if let (Some(c), JointKind::Revolute { .. }) = (lk.coordinate, &lk.joint) {
+                j.fixed_view_mut::<3, 1>(0, c.0).copy_from(&self.axis_floor[l.0]);
+            }
+            cur = lk.parent;
+        }
+    }
+
+    /// Centre of mass of the whole model (infinitesimal bodies excluded) [m].
+    pub fn centre_of_mass(&self, model: &Model) -> Vector3<f64> {
+        let mut sum = Vector3::zeros();
+        let mut m = 0.0;
+        for (i, l) in model.links.iter().enumerate() {
+            if l.body.infinitesimal || l.body.mass_kg == 0.0 {
+                continue;
+            }
+            sum += self.position_of(LinkIndex(i), &l.body.p_link_com_m) * l.body.mass_kg;
+            m += l.body.mass_kg;
+        }
+        if m > 0.0 {
+            sum / m
+        } else {
+            Vector3::zeros()
+        }
+    }
+}

@@ -1,0 +1,149 @@
+//! Periodic gaits: the Newton-Raphson fixed point of the stride function, eq. (24)-(26), and
+//! the stride Jacobian by perturbation, whose eigenvalues decide stability, eq. (27).
+
+use crate::stride::{StrideFailure, StrideOptions, StrideResult};
+use crate::walker::Walker;
+use nalgebra::{Complex, DMatrix, DVector};
+use serde::Serialize;
+
+/// Settings of the fixed-point search.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct NewtonSettings {
+    /// Converged when `|Δv| <` this (∞-norm).
+    pub tolerance: f64,
+    /// Iteration budget.
+    pub max_iterations: usize,
+    /// Perturbation step of the finite-difference Jacobian.
+    pub perturbation: f64,
+    /// Central (true) or forward (false) differences.
+    pub central: bool,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self { tolerance: 1e-11, max_iterations: 30, perturbation: 1e-6, central: true }
+    }
+}
+
+/// Why no fixed point was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NewtonError {
+    /// A stride failed during the search.
+    #[error("stride failed at Newton iteration {iteration}: {failure}")]
+    StrideFailed {
+        /// Iteration.
+        iteration: usize,
+        /// The failure.
+        failure: StrideFailure,
+    },
+    /// The budget ran out.
+    #[error("Newton did not converge in {iterations} iterations (last |Δv| = {last_step:e})")]
+    NotConverged {
+        /// Iterations used.
+        iterations: usize,
+        /// Last correction size.
+        last_step: f64,
+    },
+    /// `I − J` is singular.
+    #[error("I − J is singular at iteration {iteration}")]
+    Singular {
+        /// Iteration.
+        iteration: usize,
+    },
+}
+
+/// A periodic gait.
+#[derive(Clone, Debug)]
+pub struct Gait {
+    /// The fixed point (stride-map vector).
+    pub fixed_point: DVector<f64>,
+    /// The stride Jacobian at the fixed point.
+    pub jacobian: DMatrix<f64>,
+    /// Its eigenvalues.
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// `|S(v) − v|` at the fixed point (∞-norm).
+    pub residual: f64,
+    /// The stride from the fixed point.
+    pub stride: StrideResult,
+}
+
+impl Gait {
+    /// Largest eigenvalue modulus.
+    pub fn max_abs_eigenvalue(&self) -> f64 {
+        self.eigenvalues.iter().map(|z| z.norm()).fold(0.0, f64::max)
+    }
+    /// All eigenvalues strictly inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.max_abs_eigenvalue() < 1.0
+    }
+}
+
+impl Walker {
+    /// The stride function `S(v)` on packed stride-map vectors.
+    pub fn stride_map(&self, v: &DVector<f64>) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+        let (q, qd) = self.unpack(v);
+        let r = self.stride(&q, &qd, StrideOptions::default())?;
+        Ok((self.pack(&r.q_next, &r.qd_next), r))
+    }
+
+    /// The stride Jacobian at `v` by perturbation.
+    pub fn stride_jacobian(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+        settings: &NewtonSettings,
+    ) -> Result<DMatrix<f64>, StrideFailure> {
+        let n = v.len();
+        let d = settings.perturbation;
+        let mut j = DMatrix::zeros(n, n);
+        for k in 0..n {
+            let mut vp = v.clone();
+            vp[k] += d;
+            let sp = self.stride_map(&vp)?.0;
+            let col = if settings.central {
+                let mut vm = v.clone();
+                vm[k] -= d;
+                let sm = self.stride_map(&vm)?.0;
+                (sp - sm) / (2.0 * d)
+            } else {
+                (sp - s_v) / d
+            };
+            j.set_column(k, &col);
+        }
+        Ok(j)
+    }
+
+    /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
+    pub fn find_gait(&self, v0: &DVector<f64>, settings: &NewtonSettings) -> Result<Gait, NewtonError> {
+        let mut v = v0.clone();
+        let n = v.len();
+        let mut last_step = f64::INFINITY;
+        for it in 0..=settings.max_iterations {
+            let fail = |failure| NewtonError::StrideFailed { iteration: it, failure };
+            let (s, stride) = self.stride_map(&v).map_err(fail)?;
+            let r = &s - &v;
+            let j = self.stride_jacobian(&v, &s, settings).map_err(fail)?;
+            if last_step < settings.tolerance {
+                let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
+                return Ok(Gait {
+                    fixed_point: v,
+                    jacobian: j,
+                    eigenvalues,
+                    iterations: it,
+                    residual: r.amax(),
+                    stride,
+                });
+            }
+            if it == settings.max_iterations {
+                break;
+            }
+            let a = DMatrix::identity(n, n) - &j;
+            let dv = a.lu().solve(&r).ok_or(NewtonError::Singular { iteration: it })?;
+            last_step = dv.amax();
+            v += dv;
+        }
+        Err(NewtonError::NotConverged { iterations: settings.max_iterations, last_step })
+    }
+}

@@ -1,0 +1,47 @@
+//! Small rotation helpers shared by kinematics, relabelling and impacts.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Rotation matrix for a rotation of `angle_rad` about the unit vector `axis` (Rodrigues).
+pub fn rotation_about(axis: &Vector3<f64>, angle_rad: f64) -> Matrix3<f64> {
+    let (s, c) = angle_rad.sin_cos();
+    let k = skew(axis);
+    Matrix3::identity() + k * s + k * k * (1.0 - c)
+}
+
+/// The cross-product matrix: `skew(a) * b == a.cross(b)`.
+pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+}
+
+/// Small-angle orientation error `e` such that `R_target ≈ exp([e]×) R_actual` (world frame).
+pub fn orientation_error(r_target: &Matrix3<f64>, r_actual: &Matrix3<f64>) -> Vector3<f64> {
+    let d = r_target * r_actual.transpose();
+    let a = (d - d.transpose()) * 0.5;
+    Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)])
+}
+
+/// The reflection about the sagittal plane (z → −z) in the world frame.
+pub fn sagittal_reflection() -> Matrix3<f64> {
+    Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_about_z_turns_x_toward_y() {
+        let r = rotation_about(&Vector3::z(), std::f64::consts::FRAC_PI_2);
+        assert!((r * Vector3::x() - Vector3::y()).norm() < 1e-15);
+    }
+
+    #[test]
+    fn orientation_error_recovers_small_rotation() {
+        let axis = Vector3::new(1.0, 2.0, -0.5).normalize();
+        let r = rotation_about(&axis, 0.3);
+        let dr = rotation_about(&axis, 1e-6);
+        let e = orientation_error(&(dr * r), &r);
+        assert!((e - axis * 1e-6).norm() < 1e-15);
+    }
+}

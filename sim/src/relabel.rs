@@ -1,0 +1,182 @@
+//! After heel strike the swing foot becomes the stance contact: the state is re-expressed in the
+//! same model with legs swapped (and, for 3D scenes, mirrored about the sagittal plane, eq. 22).
+//!
+//! This is done geometrically, not by a hand-written coordinate map: the old links' floor poses
+//! and velocities are moved to the new contact point, optionally reflected (z → −z), and each
+//! new link named in the correspondence is made to match its old twin by Gauss-Newton on the
+//! joint coordinates (positions) and a least-squares solve (velocities). The residuals are
+//! checked, so an inconsistent correspondence is an error, not a silent wrong state.
+
+use crate::kinematics::Kinematics;
+use crate::math::{orientation_error, sagittal_reflection};
+use crate::model::{CoordIndex, LinkIndex, Model, PointIndex};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+/// Which new link takes the pose of which old link, and the symmetry used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relabel {
+    /// `(new, old)` link pairs whose orientations must agree.
+    pub pairs: Vec<(LinkIndex, LinkIndex)>,
+    /// `(new, old)` marker-point pairs whose positions must agree (link frames of swapped
+    /// links have different origins, so positions are matched at points).
+    pub point_pairs: Vec<(PointIndex, PointIndex)>,
+    /// Reflect about the sagittal plane (3D walkers).
+    pub mirror: bool,
+    /// Root coordinates that are cyclic (heading): reported and then set to zero.
+    pub cyclic: Vec<CoordIndex>,
+    /// Gauss-Newton tolerance on the pose residual [m or rad].
+    pub tolerance: f64,
+    /// Gauss-Newton iteration budget.
+    pub max_iterations: usize,
+}
+
+/// Why the new coordinates could not be found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RelabelError {
+    /// The poses could not be matched: the correspondence is inconsistent with the model.
+    #[error("relabelled poses do not match the model (residual {residual:e} after {iterations} iterations)")]
+    PoseMismatch {
+        /// Final residual norm.
+        residual: f64,
+        /// Iterations used.
+        iterations: usize,
+    },
+    /// The velocities could not be matched.
+    #[error("relabelled velocities do not match the model (residual {residual:e})")]
+    VelocityMismatch {
+        /// Residual norm.
+        residual: f64,
+    },
+}
+
+/// Poses and velocities of every link of a model, in the floor frame.
+#[derive(Clone, Debug)]
+pub struct LinkStates {
+    /// Rotations.
+    pub r: Vec<Matrix3<f64>>,
+    /// Origins [m].
+    pub p: Vec<Vector3<f64>>,
+    /// Angular velocities [rad/s].
+    pub w: Vec<Vector3<f64>>,
+    /// Origin velocities [m/s].
+    pub v: Vec<Vector3<f64>>,
+}
+
+impl LinkStates {
+    /// Takes the link states from a kinematics workspace, dropping the first `skip` links
+    /// (the released-root links of an impact model), and moving the origin to `origin`.
+    pub fn from_kinematics(kin: &Kinematics, skip: usize, origin: &Vector3<f64>) -> Self {
+        Self {
+            r: kin.r_floor_link[skip..].to_vec(),
+            p: kin.p_floor_link_m[skip..].iter().map(|p| p - origin).collect(),
+            w: kin.omega_floor_rad_s[skip..].to_vec(),
+            v: kin.v_floor_link_m_s[skip..].to_vec(),
+        }
+    }
+
+    /// Reflects about the sagittal plane: `R → S R S`, `p → S p`, `ω → −S ω`, `v → S v`.
+    pub fn mirrored(&self) -> Self {
+        let s = sagittal_reflection();
+        Self {
+            r: self.r.iter().map(|r| s * r * s).collect(),
+            p: self.p.iter().map(|p| s * p).collect(),
+            w: self.w.iter().map(|w| -(s * w)).collect(),
+            v: self.v.iter().map(|v| s * v).collect(),
+        }
+    }
+}
+
+/// The relabelled state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relabelled {
+    /// Coordinates in the new labelling (cyclic ones zeroed).
+    pub q: DVector<f64>,
+    /// Velocities in the new labelling.
+    pub qd: DVector<f64>,
+    /// Values the cyclic coordinates had before zeroing [rad].
+    pub cyclic_values: Vec<f64>,
+    /// Gauss-Newton iterations used.
+    pub iterations: usize,
+}
+
+impl Relabel {
+    /// Finds `q`, `q̇` of `model` whose paired links match `old` (already translated and, if
+    /// wanted, mirrored), starting the search at `q_guess`.
+    pub fn solve(
+        &self,
+        model: &Model,
+        old: &LinkStates,
+        q_guess: &DVector<f64>,
+    ) -> Result<Relabelled, RelabelError> {
+        let n = model.dof();
+        let rows = 3 * (self.pairs.len() + self.point_pairs.len());
+        let np = self.pairs.len();
+        let mut kin = Kinematics::new(model);
+        let zero = DVector::zeros(n);
+        let mut q = q_guess.clone();
+        let mut jac = DMatrix::zeros(rows, n);
+        let mut res = DVector::zeros(rows);
+        let mut iterations = 0;
+        // Old point positions and velocities, from the old link states.
+        let old_points: Vec<(Vector3<f64>, Vector3<f64>)> = self
+            .point_pairs
+            .iter()
+            .map(|&(_, op)| {
+                let pt = &model.points[op.0];
+                let l = pt.link.0;
+                let p = old.p[l] + old.r[l] * pt.p_link_m;
+                (p, old.v[l] + old.w[l].cross(&(p - old.p[l])))
+            })
+            .collect();
+        loop {
+            kin.update(model, &q, &zero);
+            for (k, &(new, old_l)) in self.pairs.iter().enumerate() {
+                res.fixed_rows_mut::<3>(3 * k)
+                    .copy_from(&orientation_error(&old.r[old_l.0], &kin.r_floor_link[new.0]));
+                jac.view_mut((3 * k, 0), (3, n)).copy_from(&kin.angular_jacobian(model, new));
+            }
+            for (k, &(np_, _)) in self.point_pairs.iter().enumerate() {
+                let pt = &model.points[np_.0];
+                let p = kin.position_of(pt.link, &pt.p_link_m);
+                res.fixed_rows_mut::<3>(3 * (np + k)).copy_from(&(old_points[k].0 - p));
+                jac.view_mut((3 * (np + k), 0), (3, n))
+                    .copy_from(&kin.point_jacobian(model, pt.link, &p));
+            }
+            let r = res.norm();
+            if r <= self.tolerance {
+                break;
+            }
+            if iterations >= self.max_iterations || !r.is_finite() {
+                return Err(RelabelError::PoseMismatch { residual: r, iterations });
+            }
+            let dq = least_squares(&jac, &res);
+            q += dq;
+            iterations += 1;
+        }
+        // Velocities: J q̇ = [ω of old twins; v of old points] (jac is at the solution).
+        let mut target = DVector::zeros(rows);
+        for (k, &(_, old_l)) in self.pairs.iter().enumerate() {
+            target.fixed_rows_mut::<3>(3 * k).copy_from(&old.w[old_l.0]);
+        }
+        for k in 0..self.point_pairs.len() {
+            target.fixed_rows_mut::<3>(3 * (np + k)).copy_from(&old_points[k].1);
+        }
+        let qd = least_squares(&jac, &target);
+        let vres = (&jac * &qd - &target).norm();
+        if vres > 1e-8 * (1.0 + target.norm()) {
+            return Err(RelabelError::VelocityMismatch { residual: vres });
+        }
+        let mut cyclic_values = Vec::with_capacity(self.cyclic.len());
+        for c in &self.cyclic {
+            cyclic_values.push(q[c.0]);
+            q[c.0] = 0.0;
+        }
+        Ok(Relabelled { q, qd, cyclic_values, iterations })
+    }
+}
+
+fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    let svd = a.clone().svd(true, true);
+    let tol = 1e-12 * svd.singular_values.max().max(1e-300);
+    svd.solve(b, tol).unwrap_or_else(|_| DVector::zeros(a.ncols()))
+}

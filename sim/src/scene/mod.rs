@@ -1,0 +1,436 @@
+//! Scenes: walkers described in TOML files with documented, unit-named parameters.
+//!
+//! Built-in scenes live in `sim/scenes/` and are compiled in; `--scene` also accepts a path
+//! to a scene file of the same schema ([`file::SceneFile`]).
+
+pub mod expr;
+pub mod file;
+
+use crate::events::{Direction, EventTolerance};
+use crate::integrators::IntegratorChoice;
+use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
+use crate::relabel::Relabel;
+use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker};
+use file::{Num, SceneFile};
+use nalgebra::{DVector, Matrix3, Vector3};
+use std::collections::BTreeMap;
+
+/// The built-in scenes: `(name, TOML text)`.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("simplest", include_str!("../../scenes/simplest.toml")),
+    ("compass", include_str!("../../scenes/compass.toml")),
+    ("kneed2d", include_str!("../../scenes/kneed2d.toml")),
+];
+
+/// Why a scene could not be loaded or built. Each variant names what was wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// No such scene.
+    #[error("unknown scene `{name}` (available: {available})")]
+    UnknownScene {
+        /// Asked for.
+        name: String,
+        /// Known names.
+        available: String,
+    },
+    /// The file could not be read or parsed.
+    #[error("scene file `{path}`: {message}")]
+    File {
+        /// Path or scene name.
+        path: String,
+        /// Parser message.
+        message: String,
+    },
+    /// `--set` named a parameter the scene does not have.
+    #[error("scene `{scene}` has no parameter `{name}` (parameters: {available})")]
+    UnknownParameter {
+        /// Scene.
+        scene: String,
+        /// Asked for.
+        name: String,
+        /// Known names.
+        available: String,
+    },
+    /// A parameter value that is not a finite number.
+    #[error("parameter `{name}`: `{value}` is not a finite number")]
+    NotANumber {
+        /// Parameter.
+        name: String,
+        /// Given text.
+        value: String,
+    },
+    /// A parameter outside its physical range.
+    #[error("parameter `{name}` = {value} {unit} is outside its allowed range [{min}, {max}]")]
+    OutOfRange {
+        /// Parameter.
+        name: String,
+        /// Value.
+        value: f64,
+        /// Unit.
+        unit: String,
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// An expression failed.
+    #[error("{0}")]
+    Expr(#[from] expr::ExprError),
+    /// An expression gave NaN or infinity.
+    #[error("`{what}` evaluates to {value}, not a finite number")]
+    NonFinite {
+        /// Where.
+        what: String,
+        /// The value.
+        value: f64,
+    },
+    /// The model is not physical or inconsistent.
+    #[error("model: {0}")]
+    Model(#[from] ModelError),
+    /// A reference to something undefined, or a bad keyword.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// A scene file with its parameter values.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The parsed file.
+    pub file: SceneFile,
+    /// Current parameter values.
+    pub values: BTreeMap<String, f64>,
+}
+
+impl Scene {
+    /// Loads a built-in scene by name, or a scene file by path.
+    pub fn load(name_or_path: &str) -> Result<Self, SceneError> {
+        if let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
+            return Self::parse(name_or_path, text);
+        }
+        if name_or_path.ends_with(".toml") {
+            let text = std::fs::read_to_string(name_or_path).map_err(|e| SceneError::File {
+                path: name_or_path.to_string(),
+                message: e.to_string(),
+            })?;
+            return Self::parse(name_or_path, &text);
+        }
+        Err(SceneError::UnknownScene {
+            name: name_or_path.to_string(),
+            available: BUILTIN.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// Parses scene text; `origin` names it in errors.
+    pub fn parse(origin: &str, text: &str) -> Result<Self, SceneError> {
+        let file: SceneFile = toml::from_str(text)
+            .map_err(|e| SceneError::File { path: origin.to_string(), message: e.to_string() })?;
+        let values = file.parameters.iter().map(|(k, p)| (k.clone(), p.default)).collect();
+        let scene = Self { file, values };
+        for (k, p) in &scene.file.parameters {
+            scene.check_range(k, p.default)?;
+        }
+        Ok(scene)
+    }
+
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        &self.file.scene.name
+    }
+
+    fn canonical(&self, key: &str) -> Option<String> {
+        if self.file.parameters.contains_key(key) {
+            return Some(key.to_string());
+        }
+        self.file
+            .parameters
+            .iter()
+            .find(|(_, p)| p.aliases.iter().any(|a| a == key))
+            .map(|(k, _)| k.clone())
+    }
+
+    fn check_range(&self, name: &str, value: f64) -> Result<(), SceneError> {
+        let p = &self.file.parameters[name];
+        let (min, max) = (p.min.unwrap_or(f64::NEG_INFINITY), p.max.unwrap_or(f64::INFINITY));
+        if !value.is_finite() {
+            return Err(SceneError::NotANumber { name: name.into(), value: value.to_string() });
+        }
+        if value < min || value > max {
+            return Err(SceneError::OutOfRange {
+                name: name.into(),
+                value,
+                unit: p.unit.clone(),
+                min,
+                max,
+            });
+        }
+        Ok(())
+    }
+
+    /// Sets a parameter (by name or alias) to a value, checking its range.
+    pub fn set(&mut self, key: &str, value: f64) -> Result<(), SceneError> {
+        let name = self.canonical(key).ok_or_else(|| SceneError::UnknownParameter {
+            scene: self.name().to_string(),
+            name: key.to_string(),
+            available: self.file.parameters.keys().cloned().collect::<Vec<_>>().join(", "),
+        })?;
+        self.check_range(&name, value)?;
+        self.values.insert(name, value);
+        Ok(())
+    }
+
+    /// Sets a parameter from `key=value` text.
+    pub fn set_text(&mut self, assignment: &str) -> Result<(), SceneError> {
+        let (k, v) = assignment.split_once('=').ok_or_else(|| {
+            SceneError::Invalid(format!("`--set {assignment}`: expected key=value"))
+        })?;
+        let (k, v) = (k.trim(), v.trim());
+        // Name first, so an unknown key is reported as such even with a bad value.
+        let name = self.canonical(k).ok_or_else(|| SceneError::UnknownParameter {
+            scene: self.name().to_string(),
+            name: k.to_string(),
+            available: self.file.parameters.keys().cloned().collect::<Vec<_>>().join(", "),
+        })?;
+        let value: f64 = v
+            .parse()
+            .map_err(|_| SceneError::NotANumber { name: name.clone(), value: v.to_string() })?;
+        self.set(&name, value)
+    }
+
+    /// Evaluates a number or expression with the current parameter values.
+    pub fn num(&self, n: &Num, what: &str) -> Result<f64, SceneError> {
+        let v = match n {
+            Num::Value(v) => *v,
+            Num::Expr(e) => expr::eval(e, &self.values)?,
+        };
+        if !v.is_finite() {
+            return Err(SceneError::NonFinite { what: what.to_string(), value: v });
+        }
+        Ok(v)
+    }
+
+    fn vec3(&self, v: &Option<[Num; 3]>, what: &str) -> Result<Vector3<f64>, SceneError> {
+        match v {
+            None => Ok(Vector3::zeros()),
+            Some([a, b, c]) => Ok(Vector3::new(
+                self.num(a, what)?,
+                self.num(b, what)?,
+                self.num(c, what)?,
+            )),
+        }
+    }
+
+    fn opt(&self, n: &Option<Num>, what: &str) -> Result<f64, SceneError> {
+        n.as_ref().map_or(Ok(0.0), |n| self.num(n, what))
+    }
+
+    /// Builds the walker.
+    pub fn build(&self) -> Result<Walker, SceneError> {
+        let f = &self.file;
+        let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
+        let slope = self.num(&f.world.slope_rad, "world.slope_rad")?;
+        let mut model = Model::new(Model::gravity_on_slope(g, slope));
+        for l in &f.links {
+            let what = |field: &str| format!("link `{}`.{field}", l.name);
+            let axis = self.vec3(&l.axis, &what("axis"))?;
+            let joint = match l.joint.as_str() {
+                "revolute" => JointKind::Revolute { axis_parent: axis },
+                "prismatic" => JointKind::Prismatic { axis_parent: axis },
+                "weld" => JointKind::Weld,
+                other => {
+                    return Err(SceneError::Invalid(format!(
+                        "link `{}`: joint `{other}` is not revolute, prismatic or weld",
+                        l.name
+                    )))
+                }
+            };
+            let d = self.vec3(&l.inertia_diag_kg_m2, &what("inertia_diag_kg_m2"))?;
+            let body = BodyInertia {
+                mass_kg: self.opt(&l.mass_kg, &what("mass_kg"))?,
+                p_link_com_m: self.vec3(&l.com_m, &what("com_m"))?,
+                inertia_com_kg_m2: Matrix3::from_diagonal(&d),
+                infinitesimal: l.infinitesimal,
+            };
+            let force = JointForce {
+                stiffness: self.opt(&l.stiffness, &what("stiffness"))?,
+                rest_position: self.opt(&l.rest, &what("rest"))?,
+                damping: self.opt(&l.damping, &what("damping"))?,
+            };
+            if force.stiffness < 0.0 || force.damping < 0.0 {
+                return Err(SceneError::Invalid(format!(
+                    "link `{}`: stiffness and damping must not be negative",
+                    l.name
+                )));
+            }
+            let parent = if l.parent == "ground" { None } else { Some(l.parent.as_str()) };
+            model.add_link(&l.name, parent, self.vec3(&l.origin_m, &what("origin_m"))?, joint, force, body)?;
+        }
+        for p in &f.points {
+            model.add_point(&p.name, &p.link, self.vec3(&Some(p.position_m.clone()), &p.name)?)?;
+        }
+        let point = |name: &str| {
+            model.point_index(name).ok_or_else(|| SceneError::Invalid(format!("unknown point `{name}`")))
+        };
+        let link = |name: &str| {
+            model.link_index(name).ok_or_else(|| SceneError::Invalid(format!("unknown link `{name}`")))
+        };
+        let coord = |name: &str| {
+            model
+                .coord_index(name)
+                .ok_or_else(|| SceneError::Invalid(format!("unknown coordinate `{name}`")))
+        };
+        let hs = &f.heel_strike;
+        let swing_foot = point(&hs.swing_foot)?;
+        let constraints = hs
+            .constraints
+            .iter()
+            .map(|c| match c.as_str() {
+                "x" => Ok(ContactConstraint::X),
+                "y" => Ok(ContactConstraint::Y),
+                "z" => Ok(ContactConstraint::Z),
+                "yaw" => Ok(ContactConstraint::Yaw),
+                o => Err(SceneError::Invalid(format!("heel_strike.constraints: unknown `{o}`"))),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let release = hs
+            .release
+            .iter()
+            .map(|r| {
+                let axis = match &r[1..] {
+                    "x" => Vector3::x(),
+                    "y" => Vector3::y(),
+                    "z" => Vector3::z(),
+                    _ => Vector3::zeros(),
+                };
+                match (r.as_bytes().first(), axis.norm() > 0.0 && r.len() == 2) {
+                    (Some(b't'), true) => Ok(JointKind::Prismatic { axis_parent: axis }),
+                    (Some(b'r'), true) => Ok(JointKind::Revolute { axis_parent: axis }),
+                    _ => Err(SceneError::Invalid(format!("heel_strike.release: unknown `{r}`"))),
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let heel_strike = HeelStrikeRule {
+            swing_foot,
+            swing_foot_link: model.points[swing_foot.0].link,
+            min_ahead_m: self.opt(&hs.min_ahead_m, "heel_strike.min_ahead_m")?,
+            ignore_scuffing: hs.ignore_scuffing,
+            constraints,
+            restitution: self.opt(&hs.restitution, "heel_strike.restitution")?,
+            release: release.clone(),
+            stance_contact: point(&hs.stance_contact)?,
+        };
+        let knees = f
+            .knees
+            .iter()
+            .map(|k| {
+                Ok(KneeLock {
+                    coordinate: coord(&k.coordinate)?,
+                    stop_rad: self.num(&k.stop_rad, "knee.stop_rad")?,
+                    closing: direction(&k.closing)?,
+                })
+            })
+            .collect::<Result<Vec<_>, SceneError>>()?;
+        let fall = FallRule {
+            hip: point(&f.fall.hip)?,
+            min_hip_height_m: self.num(&f.fall.min_hip_height_m, "fall.min_hip_height_m")?,
+        };
+        let relabel = Relabel {
+            pairs: f
+                .relabel
+                .pairs
+                .iter()
+                .map(|[a, b]| Ok((link(a)?, link(b)?)))
+                .collect::<Result<Vec<_>, SceneError>>()?,
+            point_pairs: f
+                .relabel
+                .point_pairs
+                .iter()
+                .map(|[a, b]| Ok((point(a)?, point(b)?)))
+                .collect::<Result<Vec<_>, SceneError>>()?,
+            mirror: f.relabel.mirror,
+            cyclic: f.relabel.cyclic.iter().map(|c| coord(c)).collect::<Result<Vec<_>, _>>()?,
+            tolerance: 1e-13,
+            max_iterations: 50,
+        };
+        for c in &relabel.cyclic {
+            let l = &model.links[model.coordinates[c.0].link.0];
+            if l.parent.is_some() || slope != 0.0 {
+                return Err(SceneError::Invalid(format!(
+                    "cyclic coordinate `{}` must be a root joint on level ground",
+                    model.coordinates[c.0].name
+                )));
+            }
+        }
+        let it = &f.integrator;
+        let integrator = match it.kind.as_str() {
+            "meijaard" => IntegratorChoice::Meijaard { h_s: it.h_s.unwrap_or(1e-3), check_every: 0 },
+            "rk4" => IntegratorChoice::Rk4 { h_s: it.h_s.unwrap_or(1e-3) },
+            "dopri5" => IntegratorChoice::Dopri5 {
+                rtol: it.rtol.unwrap_or(1e-12),
+                atol: it.atol.unwrap_or(1e-12),
+                h_max_s: it.h_max_s.unwrap_or(0.05),
+            },
+            o => return Err(SceneError::Invalid(format!("integrator.kind: unknown `{o}`"))),
+        };
+        let max_stride_time_s = match &it.max_stride_time_s {
+            Some(n) => self.num(n, "integrator.max_stride_time_s")?,
+            None => 10.0,
+        };
+        let mut guess_q = DVector::zeros(model.dof());
+        let mut guess_qd = DVector::zeros(model.dof());
+        for (k, v) in &f.guess.q {
+            guess_q[coord(k)?.0] = self.num(v, "guess.q")?;
+        }
+        for (k, v) in &f.guess.qd {
+            guess_qd[coord(k)?.0] = self.num(v, "guess.qd")?;
+        }
+        let impact_model = model.with_released_root(&release);
+        Ok(Walker {
+            name: self.name().to_string(),
+            model,
+            impact_model,
+            heel_strike,
+            knees,
+            fall,
+            relabel,
+            integrator,
+            event_tolerance: EventTolerance::default(),
+            max_stride_time_s,
+            guess_q,
+            guess_qd,
+        })
+    }
+
+    /// Outputs in the publication's convention for a state (empty if the scene has none).
+    pub fn convention_outputs(
+        &self,
+        walker: &Walker,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<Vec<(String, f64)>, SceneError> {
+        let Some(conv) = &self.file.convention else { return Ok(Vec::new()) };
+        let ts = self.num(&conv.time_scale_s, "convention.time_scale_s")?;
+        let mut out = Vec::new();
+        for o in &conv.outputs {
+            let mut v = self.opt(&o.offset, &o.name)?;
+            let mut vd = 0.0;
+            for (name, c) in &o.coefficients {
+                let i: CoordIndex = walker.model.coord_index(name).ok_or_else(|| {
+                    SceneError::Invalid(format!("convention output `{}`: unknown `{name}`", o.name))
+                })?;
+                v += c * q[i.0];
+                vd += c * qd[i.0];
+            }
+            out.push((o.name.clone(), v));
+            out.push((format!("{}_dot", o.name), vd * ts));
+        }
+        Ok(out)
+    }
+}
+
+fn direction(s: &str) -> Result<Direction, SceneError> {
+    match s {
+        "rising" => Ok(Direction::Rising),
+        "falling" => Ok(Direction::Falling),
+        o => Err(SceneError::Invalid(format!("direction `{o}` is not rising or falling"))),
+    }
+}

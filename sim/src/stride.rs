@@ -1,0 +1,505 @@
+//! One stride: integrate single stance from just after one heel strike to just after the next,
+//! with knee locks on the way, then relabel (the stride function of eq. 22).
+
+use crate::dynamics::{Dynamics, DynamicsError};
+use crate::events::{locate, Direction, EventError};
+use crate::impact::resolve;
+use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
+use crate::kinematics::Kinematics;
+use crate::model::{LinkIndex, Model};
+use crate::relabel::LinkStates;
+use crate::walker::{ContactConstraint, Walker};
+use nalgebra::{DMatrix, DVector, Vector3};
+use serde::Serialize;
+
+/// The kinds of failure a stride can end in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// The walker fell with its hip behind the stance contact.
+    FellBackward,
+    /// The walker fell with its hip ahead of the stance contact.
+    FellForward,
+    /// The swing foot hit the floor mid-swing (scene does not ignore scuffing).
+    Scuffed,
+    /// Heel strike came before the swing knee locked.
+    HeelStrikeBeforeKneeLock,
+    /// After heel strike the old stance foot did not move upward.
+    StanceFootDidNotLift,
+    /// No heel strike within the stride time budget.
+    NoImpactWithinTime,
+    /// The state became NaN or infinite, or the mass matrix singular.
+    NonFiniteState,
+    /// A fixed step exceeded the stability limit of eq. (12).
+    StepTooLarge,
+    /// An adaptive step fell below its floor.
+    StepUnderflow,
+    /// An event could not be located to its tolerance.
+    EventNotLocated,
+    /// The impact equations were singular.
+    ImpactSingular,
+    /// The relabelled state could not be matched to the model.
+    RelabelFailed,
+}
+
+/// A failed stride.
+#[derive(Clone, Debug, PartialEq, Serialize, thiserror::Error)]
+#[error("{kind:?} at t = {time_s:.6} s: {detail}")]
+pub struct StrideFailure {
+    /// What happened.
+    pub kind: FailureKind,
+    /// When, from the start of the stride [s].
+    pub time_s: f64,
+    /// Details.
+    pub detail: String,
+}
+
+impl StrideFailure {
+    fn new(kind: FailureKind, time_s: f64, detail: impl Into<String>) -> Self {
+        Self { kind, time_s, detail: detail.into() }
+    }
+
+    fn from_integration(e: IntegrationError, t: f64) -> Self {
+        let kind = match &e {
+            IntegrationError::Dynamics(_) => FailureKind::NonFiniteState,
+            IntegrationError::StepTooLarge { .. } => FailureKind::StepTooLarge,
+            IntegrationError::StepUnderflow { .. } => FailureKind::StepUnderflow,
+        };
+        Self::new(kind, t, e.to_string())
+    }
+
+    fn from_event(e: EventError, t: f64) -> Self {
+        match e {
+            EventError::Integration(i) => Self::from_integration(i, t),
+            other => Self::new(FailureKind::EventNotLocated, t, other.to_string()),
+        }
+    }
+}
+
+/// An event inside a stride.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StrideEvent {
+    /// `knee_lock:<coordinate>` or `heel_strike`.
+    pub name: String,
+    /// Time from the start of the stride [s].
+    pub time_s: f64,
+}
+
+/// A completed stride.
+#[derive(Clone, Debug)]
+pub struct StrideResult {
+    /// Coordinates at the start of the next stride (relabelled).
+    pub q_next: DVector<f64>,
+    /// Velocities at the start of the next stride (relabelled).
+    pub qd_next: DVector<f64>,
+    /// Stride duration [s].
+    pub duration_s: f64,
+    /// New contact point in the old stance frame [m].
+    pub step_m: Vector3<f64>,
+    /// Heading change of the relabelled cyclic coordinates [rad].
+    pub heading_change_rad: f64,
+    /// Events in order.
+    pub events: Vec<StrideEvent>,
+    /// State just before heel strike (in the stance labelling).
+    pub pre_impact: Sample,
+    /// Upward velocity of the old stance contact just after impact [m/s].
+    pub lift_velocity_m_s: f64,
+    /// Mechanical energy lost in all impacts of the stride [J].
+    pub impact_energy_loss_j: f64,
+    /// Right-hand-side evaluations.
+    pub evaluations: usize,
+    /// Accepted samples, when recording.
+    pub trajectory: Vec<Sample>,
+}
+
+/// The smooth dynamics of one phase (which coordinates are free).
+pub struct Phase<'a> {
+    model: &'a Model,
+    dynamics: Dynamics,
+    /// Which coordinates are free to move.
+    pub active: Vec<bool>,
+}
+
+impl<'a> Phase<'a> {
+    /// All coordinates active.
+    pub fn new(model: &'a Model) -> Self {
+        Self { model, dynamics: Dynamics::new(model), active: vec![true; model.dof()] }
+    }
+}
+
+impl SecondOrderSystem for Phase<'_> {
+    fn accelerations(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        self.dynamics.accelerations(self.model, q, qd, &self.active, None)
+    }
+
+    fn stability_limit(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Option<StabilityLimit> {
+        linearised_limit(self.model, &mut self.dynamics, q, qd, &self.active)
+    }
+}
+
+/// `λ_max` and `β` of eq. (12) from the linearisation `M̄ δq̈ + C δq̇ + K δq = 0`, with
+/// `K = −∂f̄/∂q` and `C = −∂f̄/∂q̇` by central differences. `β` is estimated conservatively as
+/// `ρ(M̄⁻¹C) / (2 λ_max)`.
+pub fn linearised_limit(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    active: &[bool],
+) -> Option<StabilityLimit> {
+    let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
+    let n = idx.len();
+    if n == 0 || model.has_infinitesimal_bodies() {
+        return None;
+    }
+    dynamics.assemble(model, q, qd, None);
+    let m = dynamics.mass_matrix.select_rows(&idx).select_columns(&idx);
+    let mut k = DMatrix::zeros(n, n);
+    let mut c = DMatrix::zeros(n, n);
+    let d = 1e-6;
+    for (col, &i) in idx.iter().enumerate() {
+        for (target, is_q) in [(&mut k, true), (&mut c, false)] {
+            let (mut qp, mut qm, mut vp, mut vm) = (q.clone(), q.clone(), qd.clone(), qd.clone());
+            if is_q {
+                qp[i] += d;
+                qm[i] -= d;
+            } else {
+                vp[i] += d;
+                vm[i] -= d;
+            }
+            dynamics.assemble(model, &qp, &vp, None);
+            let fp = dynamics.force.select_rows(&idx);
+            dynamics.assemble(model, &qm, &vm, None);
+            let fm = dynamics.force.select_rows(&idx);
+            target.set_column(col, &((fm - fp) / (2.0 * d)));
+        }
+    }
+    let minv = m.try_inverse()?;
+    let mk = (&minv * k).complex_eigenvalues();
+    let lambda2 = mk.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
+    let damping = (&minv * c).complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
+    let lambda = lambda2.sqrt();
+    let beta = if lambda > 0.0 { (damping / (2.0 * lambda)).min(1.0) } else { 0.0 };
+    Some(StabilityLimit { lambda_max_rad_s: lambda, beta })
+}
+
+/// Witness values at a sample: what the stride loop watches.
+struct Witnesses<'a> {
+    walker: &'a Walker,
+    kin: Kinematics,
+}
+
+impl Witnesses<'_> {
+    fn update(&mut self, s: &Sample) {
+        self.kin.update(&self.walker.model, &s.q, &s.qd);
+    }
+    fn foot_height(&mut self, s: &Sample) -> f64 {
+        self.update(s);
+        self.kin.point_position(&self.walker.model, self.walker.heel_strike.swing_foot).y
+    }
+    fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
+        self.update(s);
+        let m = &self.walker.model;
+        let hs = &self.walker.heel_strike;
+        self.kin.point_position(m, hs.swing_foot).x - self.kin.point_position(m, hs.stance_contact).x
+    }
+    fn hip_height(&mut self, s: &Sample) -> f64 {
+        self.update(s);
+        self.kin.point_position(&self.walker.model, self.walker.fall.hip).y
+            - self.walker.fall.min_hip_height_m
+    }
+    fn hip_ahead_m(&mut self, s: &Sample) -> f64 {
+        self.update(s);
+        let m = &self.walker.model;
+        self.kin.point_position(m, self.walker.fall.hip).x
+            - self.kin.point_position(m, self.walker.heel_strike.stance_contact).x
+    }
+    fn hip_forward_velocity(&mut self, s: &Sample) -> f64 {
+        self.update(s);
+        let m = &self.walker.model;
+        let p = &m.points[self.walker.fall.hip.0];
+        let x = self.kin.position_of(p.link, &p.p_link_m);
+        self.kin.velocity_of(p.link, &x).x
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Watch {
+    Heel,
+    Knee(usize),
+    HipLow,
+    HipBack,
+}
+
+/// Options for [`Walker::stride`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StrideOptions {
+    /// Keep every accepted sample.
+    pub record: bool,
+}
+
+impl Walker {
+    /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling).
+    pub fn stride(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        options: StrideOptions,
+    ) -> Result<StrideResult, StrideFailure> {
+        let mut integrator = self.integrator.build();
+        integrator.reset();
+        let mut phase = Phase::new(&self.model);
+        let mut wit = Witnesses { walker: self, kin: Kinematics::new(&self.model) };
+        let mut cur = Sample { t_s: 0.0, q: q0.clone(), qd: qd0.clone() };
+        if cur.q.iter().chain(cur.qd.iter()).any(|v| !v.is_finite()) {
+            return Err(StrideFailure::new(FailureKind::NonFiniteState, 0.0, "initial state"));
+        }
+        let mut events = Vec::new();
+        let mut trajectory = Vec::new();
+        let mut energy_loss = 0.0;
+        if options.record {
+            trajectory.push(cur.clone());
+        }
+        loop {
+            if cur.t_s > self.max_stride_time_s {
+                return Err(StrideFailure::new(
+                    FailureKind::NoImpactWithinTime,
+                    cur.t_s,
+                    format!("no heel strike within {} s", self.max_stride_time_s),
+                ));
+            }
+            let next = integrator
+                .advance(&mut phase, &cur, f64::INFINITY)
+                .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+            if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
+                return Err(StrideFailure::new(FailureKind::NonFiniteState, next.t_s, "state"));
+            }
+            // Which witnesses changed sign in the right direction over this step?
+            let mut triggered: Vec<Watch> = Vec::new();
+            if Direction::Falling.triggered(wit.foot_height(&cur), wit.foot_height(&next)) {
+                triggered.push(Watch::Heel);
+            }
+            for (k, knee) in self.knees.iter().enumerate() {
+                let c = knee.coordinate.0;
+                if phase.active[c]
+                    && knee.closing.triggered(cur.q[c] - knee.stop_rad, next.q[c] - knee.stop_rad)
+                {
+                    triggered.push(Watch::Knee(k));
+                }
+            }
+            if Direction::Falling.triggered(wit.hip_height(&cur), wit.hip_height(&next)) {
+                triggered.push(Watch::HipLow);
+            }
+            if wit.hip_ahead_m(&next) < 0.0
+                && Direction::Falling
+                    .triggered(wit.hip_forward_velocity(&cur), wit.hip_forward_velocity(&next))
+            {
+                triggered.push(Watch::HipBack);
+            }
+            if triggered.is_empty() {
+                cur = next;
+                if options.record {
+                    trajectory.push(cur.clone());
+                }
+                continue;
+            }
+            // Locate each and take the earliest.
+            let mut first: Option<(Watch, Sample)> = None;
+            for w in triggered {
+                let mut g: Box<dyn FnMut(&Sample) -> f64> = match w {
+                    Watch::Heel => Box::new(|s: &Sample| wit.foot_height(s)),
+                    Watch::Knee(k) => {
+                        let c = self.knees[k].coordinate.0;
+                        let stop = self.knees[k].stop_rad;
+                        Box::new(move |s: &Sample| s.q[c] - stop)
+                    }
+                    Watch::HipLow => Box::new(|s: &Sample| wit.hip_height(s)),
+                    Watch::HipBack => Box::new(|s: &Sample| wit.hip_forward_velocity(s)),
+                };
+                let s = locate(
+                    integrator.as_mut(),
+                    &mut phase,
+                    &cur,
+                    &next,
+                    g.as_mut(),
+                    &self.event_tolerance,
+                )
+                .map_err(|e| StrideFailure::from_event(e, cur.t_s))?;
+                drop(g);
+                if first.as_ref().map_or(true, |(_, f)| s.t_s < f.t_s) {
+                    first = Some((w, s));
+                }
+            }
+            let Some((watch, at)) = first else { continue };
+            match watch {
+                Watch::HipLow => {
+                    let kind = if wit.hip_ahead_m(&at) >= 0.0 {
+                        FailureKind::FellForward
+                    } else {
+                        FailureKind::FellBackward
+                    };
+                    return Err(StrideFailure::new(kind, at.t_s, "hip below its minimum height"));
+                }
+                Watch::HipBack => {
+                    return Err(StrideFailure::new(
+                        FailureKind::FellBackward,
+                        at.t_s,
+                        "hip moved back behind the stance contact",
+                    ));
+                }
+                Watch::Knee(k) => {
+                    let c = self.knees[k].coordinate.0;
+                    let mut g = DMatrix::zeros(1, self.model.dof());
+                    g[(0, c)] = 1.0;
+                    let mut dynamics = Dynamics::new(&self.model);
+                    let before = energy(&mut dynamics, &self.model, &at);
+                    let imp =
+                        resolve(&mut dynamics, &self.model, &at.q, &at.qd, &phase.active, &g, 0.0)
+                            .map_err(|e| {
+                                StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
+                            })?;
+                    phase.active[c] = false;
+                    let mut qd = imp.qd_plus;
+                    qd[c] = 0.0;
+                    let mut q = at.q.clone();
+                    q[c] = self.knees[k].stop_rad;
+                    cur = Sample { t_s: at.t_s, q, qd };
+                    energy_loss += before - energy(&mut dynamics, &self.model, &cur);
+                    events.push(StrideEvent {
+                        name: format!("knee_lock:{}", self.model.coordinates[c].name),
+                        time_s: at.t_s,
+                    });
+                    integrator.reset();
+                    if options.record {
+                        trajectory.push(cur.clone());
+                    }
+                }
+                Watch::Heel => {
+                    let ahead = wit.foot_ahead_m(&at);
+                    if ahead < self.heel_strike.min_ahead_m {
+                        if self.heel_strike.ignore_scuffing {
+                            cur = next;
+                            if options.record {
+                                trajectory.push(cur.clone());
+                            }
+                            continue;
+                        }
+                        return Err(StrideFailure::new(
+                            FailureKind::Scuffed,
+                            at.t_s,
+                            format!("swing foot touched the floor {ahead:.4} m ahead of the stance contact"),
+                        ));
+                    }
+                    if let Some(knee) = self.knees.iter().find(|k| phase.active[k.coordinate.0]) {
+                        return Err(StrideFailure::new(
+                            FailureKind::HeelStrikeBeforeKneeLock,
+                            at.t_s,
+                            format!(
+                                "knee `{}` still free at heel strike",
+                                self.model.coordinates[knee.coordinate.0].name
+                            ),
+                        ));
+                    }
+                    events.push(StrideEvent { name: "heel_strike".into(), time_s: at.t_s });
+                    if options.record {
+                        trajectory.push(at.clone());
+                    }
+                    return self.finish_stride(at, &phase.active, events, energy_loss, integrator.as_ref(), trajectory);
+                }
+            }
+        }
+    }
+
+    /// Heel-strike impact with the stance contact released, lift check, relabelling.
+    fn finish_stride(
+        &self,
+        at: Sample,
+        active: &[bool],
+        events: Vec<StrideEvent>,
+        mut energy_loss: f64,
+        integrator: &dyn Integrator,
+        trajectory: Vec<Sample>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let t = at.t_s;
+        let hs = &self.heel_strike;
+        let nr = hs.release.len();
+        let m = &self.impact_model;
+        let n = m.dof();
+        let mut q = DVector::zeros(n);
+        let mut qd = DVector::zeros(n);
+        q.rows_mut(nr, n - nr).copy_from(&at.q);
+        qd.rows_mut(nr, n - nr).copy_from(&at.qd);
+        let mut act = vec![true; nr];
+        act.extend_from_slice(active);
+        let mut kin = Kinematics::new(m);
+        kin.update(m, &q, &qd);
+        let foot = &m.points[hs.swing_foot.0];
+        let p_foot = kin.position_of(foot.link, &foot.p_link_m);
+        let jv = kin.point_jacobian(m, foot.link, &p_foot);
+        let jw = kin.angular_jacobian(m, LinkIndex(hs.swing_foot_link.0 + nr));
+        let mut g = DMatrix::zeros(hs.constraints.len(), n);
+        for (r, c) in hs.constraints.iter().enumerate() {
+            let row = match c {
+                ContactConstraint::X => jv.row(0),
+                ContactConstraint::Y => jv.row(1),
+                ContactConstraint::Z => jv.row(2),
+                ContactConstraint::Yaw => jw.row(1),
+            };
+            g.row_mut(r).copy_from(&row);
+        }
+        let mut dynamics = Dynamics::new(m);
+        let before = energy(&mut dynamics, m, &Sample { t_s: t, q: q.clone(), qd: qd.clone() });
+        let imp = resolve(&mut dynamics, m, &q, &qd, &act, &g, hs.restitution)
+            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, t, e.to_string()))?;
+        let after = energy(&mut dynamics, m, &Sample { t_s: t, q: q.clone(), qd: imp.qd_plus.clone() });
+        energy_loss += before - after;
+        kin.update(m, &q, &imp.qd_plus);
+        let sc = &m.points[hs.stance_contact.0];
+        let p_sc = kin.position_of(sc.link, &sc.p_link_m);
+        let lift = kin.velocity_of(sc.link, &p_sc).y;
+        if lift <= 0.0 {
+            return Err(StrideFailure::new(
+                FailureKind::StanceFootDidNotLift,
+                t,
+                format!("old stance contact moves {lift:.3e} m/s upward after impact"),
+            ));
+        }
+        let mut states = LinkStates::from_kinematics(&kin, nr, &p_foot);
+        if self.relabel.mirror {
+            states = states.mirrored();
+        }
+        let solved = self
+            .relabel
+            .solve(&self.model, &states, &self.guess_q)
+            .or_else(|_| self.relabel.solve(&self.model, &states, &at.q))
+            .map_err(|e| StrideFailure::new(FailureKind::RelabelFailed, t, e.to_string()))?;
+        Ok(StrideResult {
+            q_next: solved.q,
+            qd_next: solved.qd,
+            duration_s: t,
+            step_m: p_foot,
+            heading_change_rad: solved.cyclic_values.first().copied().unwrap_or(0.0),
+            events,
+            pre_impact: at,
+            lift_velocity_m_s: lift,
+            impact_energy_loss_j: energy_loss,
+            evaluations: integrator.evaluations(),
+            trajectory,
+        })
+    }
+}
+
+fn energy(dynamics: &mut Dynamics, model: &Model, s: &Sample) -> f64 {
+    dynamics.assemble(model, &s.q, &s.qd, None);
+    dynamics.energy_j(model, &s.q, &s.qd)
+}

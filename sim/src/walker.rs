@@ -1,0 +1,131 @@
+//! A hybrid walker: a model plus its contact, impact, event and relabelling rules.
+
+use crate::events::{Direction, EventTolerance};
+use crate::integrators::IntegratorChoice;
+use crate::model::{CoordIndex, JointKind, LinkIndex, Model, PointIndex};
+use crate::relabel::Relabel;
+use nalgebra::DVector;
+
+/// A direction of the swing-foot contact constrained at heel strike.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactConstraint {
+    /// Translation along floor x.
+    X,
+    /// Translation along the floor normal y.
+    Y,
+    /// Translation along floor z.
+    Z,
+    /// Rotation of the foot link about the floor normal (no spin).
+    Yaw,
+}
+
+/// What counts as heel strike, and what is ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeelStrikeRule {
+    /// The swing-foot point whose height above the floor is the witness (falling through 0).
+    pub swing_foot: PointIndex,
+    /// The link carrying the swing foot (for the yaw constraint).
+    pub swing_foot_link: LinkIndex,
+    /// A crossing counts only when the swing foot is at least this far ahead of the stance
+    /// contact along x [m]; crossings behind it are mid-swing scuffs.
+    pub min_ahead_m: f64,
+    /// Mid-swing scuffs are ignored (the foot passes through the floor, as in Garcia et al.'s
+    /// and McGeer's analyses) rather than ending the stride as a failure.
+    pub ignore_scuffing: bool,
+    /// Constrained directions at the new contact.
+    pub constraints: Vec<ContactConstraint>,
+    /// Coefficient of restitution `e` of eq. (20).
+    pub restitution: f64,
+    /// Joints that become free at the old stance contact during the impact (its release).
+    pub release: Vec<JointKind>,
+    /// The old stance contact point, which must move upward after the impact.
+    pub stance_contact: PointIndex,
+}
+
+/// A knee with a hyperextension stop that locks after its inelastic impact.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KneeLock {
+    /// The knee coordinate.
+    pub coordinate: CoordIndex,
+    /// Stop angle [rad].
+    pub stop_rad: f64,
+    /// Direction of `q − stop` that means reaching the stop.
+    pub closing: Direction,
+}
+
+/// When the walker has fallen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FallRule {
+    /// A point at the hip.
+    pub hip: PointIndex,
+    /// Fallen when the hip is lower than this above the floor [m].
+    pub min_hip_height_m: f64,
+}
+
+/// A complete hybrid walker.
+#[derive(Clone, Debug)]
+pub struct Walker {
+    /// The scene name.
+    pub name: String,
+    /// The single-stance model.
+    pub model: Model,
+    /// The same model with the stance contact released (for impacts).
+    pub impact_model: Model,
+    /// Heel strike.
+    pub heel_strike: HeelStrikeRule,
+    /// Knee locks (empty for straight legs).
+    pub knees: Vec<KneeLock>,
+    /// Falls.
+    pub fall: FallRule,
+    /// Relabelling after heel strike.
+    pub relabel: Relabel,
+    /// Integrator.
+    pub integrator: IntegratorChoice,
+    /// Event tolerances.
+    pub event_tolerance: EventTolerance,
+    /// A stride longer than this fails [s].
+    pub max_stride_time_s: f64,
+    /// A starting guess for the gait (just after heel strike).
+    pub guess_q: DVector<f64>,
+    /// A starting guess for the gait velocities.
+    pub guess_qd: DVector<f64>,
+}
+
+impl Walker {
+    /// The coordinates that enter the stride map (all but the cyclic ones).
+    pub fn map_coordinates(&self) -> Vec<CoordIndex> {
+        (0..self.model.dof())
+            .map(CoordIndex)
+            .filter(|c| !self.relabel.cyclic.contains(c))
+            .collect()
+    }
+
+    /// Packs `q`, `q̇` into a stride-map vector (positions then velocities, cyclic omitted).
+    pub fn pack(&self, q: &DVector<f64>, qd: &DVector<f64>) -> DVector<f64> {
+        let c = self.map_coordinates();
+        let n = c.len();
+        DVector::from_fn(2 * n, |i, _| if i < n { q[c[i].0] } else { qd[c[i - n].0] })
+    }
+
+    /// Unpacks a stride-map vector (cyclic coordinates and their rates are zero).
+    pub fn unpack(&self, x: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+        let c = self.map_coordinates();
+        let n = c.len();
+        let mut q = DVector::zeros(self.model.dof());
+        let mut qd = DVector::zeros(self.model.dof());
+        for (i, ci) in c.iter().enumerate() {
+            q[ci.0] = x[i];
+            qd[ci.0] = x[n + i];
+        }
+        (q, qd)
+    }
+
+    /// Names of the stride-map entries: `coord` then `coord_dot`.
+    pub fn map_names(&self) -> Vec<String> {
+        let c = self.map_coordinates();
+        let mut names: Vec<String> =
+            c.iter().map(|ci| self.model.coordinates[ci.0].name.clone()).collect();
+        names.extend(c.iter().map(|ci| format!("{}_dot", self.model.coordinates[ci.0].name)));
+        names
+    }
+}
