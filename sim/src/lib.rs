@@ -2,6 +2,7 @@
 //! (2001), section 3: TMT equations of motion, Meijaard's integrator, Hermite event location,
 //! impact equations, stride function, Newton-Raphson limit cycles and their stability.
 
+pub mod continuation;
 pub mod dynamics;
 pub mod events;
 pub mod impact;
@@ -10,8 +11,10 @@ pub mod kinematics;
 pub mod math;
 pub mod model;
 pub mod relabel;
+pub mod report;
 pub mod singular_limit;
 pub mod limit_cycle;
 pub mod scene;
 pub mod stride;
+pub mod walk;
 pub mod walker;

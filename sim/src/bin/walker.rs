@@ -1,1 +1,392 @@
-fn main(){}
+//! `walker`: find gaits, walk, sweep parameters, list scenes.
+//!
+//! Bad input (unknown scene, unknown or ill-typed parameter, non-physical value) exits with
+//! code 2 and a message naming the problem; a gait that cannot be found exits with code 1.
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use serde_json::{json, Value};
+use sim::continuation::sweep;
+use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::NewtonSettings;
+use sim::report::{gait_json, sweep_json, walk_json};
+use sim::scene::{Scene, SceneError, BUILTIN};
+use sim::walker::Walker;
+use std::io::Write;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "walker", version, about = "Passive dynamic walker simulator (Wisse, Schwab & van der Linde 2001)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Find the periodic gait of a scene and its stability.
+    Gait {
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
+    Walk {
+        #[command(flatten)]
+        common: Common,
+        /// Number of steps.
+        #[arg(long)]
+        steps: usize,
+        /// Perturb a start-state entry: `coord=delta` (coordinate or `coord_dot`).
+        #[arg(long = "perturb", value_name = "COORD=DELTA")]
+        perturb: Vec<String>,
+        /// Start from `gait` (the fixed point) or `guess` (the scene's guess, no search).
+        #[arg(long, default_value = "gait")]
+        start: String,
+        /// Write the trajectory (every integrator sample) as CSV.
+        #[arg(long, value_name = "FILE.csv")]
+        out: Option<std::path::PathBuf>,
+    },
+    /// Continuation: follow the gait while one parameter changes.
+    Sweep {
+        #[command(flatten)]
+        common: Common,
+        /// Parameter to vary.
+        #[arg(long)]
+        param: String,
+        /// First value.
+        #[arg(long, allow_negative_numbers = true)]
+        from: f64,
+        /// Last value.
+        #[arg(long, allow_negative_numbers = true)]
+        to: f64,
+        /// Number of points (≥ 2).
+        #[arg(long)]
+        points: usize,
+    },
+    /// List the scenes and their parameters.
+    Scenes {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Args)]
+struct Common {
+    /// Scene name (see `walker scenes`) or path to a scene .toml file.
+    #[arg(long)]
+    scene: String,
+    /// Set a parameter: `key=value` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Integrator: meijaard, rk4 or dopri5 (default: the scene's).
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Fixed step for meijaard/rk4 [s].
+    #[arg(long)]
+    step_s: Option<f64>,
+    /// Relative and absolute tolerance for dopri5.
+    #[arg(long)]
+    rtol: Option<f64>,
+    /// Newton tolerance on |Δv|.
+    #[arg(long, default_value_t = 1e-11)]
+    newton_tol: f64,
+    /// Newton iteration budget.
+    #[arg(long, default_value_t = 30)]
+    newton_max_iter: usize,
+    /// Perturbation step of the stride Jacobian.
+    #[arg(long, default_value_t = 1e-6)]
+    perturbation: f64,
+}
+
+/// Bad input: exit code 2.
+#[derive(Debug, thiserror::Error)]
+enum InputError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error("{0}")]
+    Other(String),
+}
+
+impl Common {
+    fn scene(&self) -> Result<Scene, InputError> {
+        let mut scene = Scene::load(&self.scene)?;
+        for s in &self.set {
+            scene.set_text(s)?;
+        }
+        Ok(scene)
+    }
+
+    fn walker(&self, scene: &Scene) -> Result<Walker, InputError> {
+        let mut w = scene.build()?;
+        let positive = |name: &str, v: Option<f64>| match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => {
+                Err(InputError::Other(format!("--{name} must be a positive number, got {x}")))
+            }
+            _ => Ok(()),
+        };
+        positive("step-s", self.step_s)?;
+        positive("rtol", self.rtol)?;
+        positive("newton-tol", Some(self.newton_tol))?;
+        positive("perturbation", Some(self.perturbation))?;
+        if let Some(kind) = &self.integrator {
+            w.integrator = match kind.as_str() {
+                "meijaard" => IntegratorChoice::Meijaard { h_s: self.step_s.unwrap_or(1e-3), check_every: 0 },
+                "rk4" => IntegratorChoice::Rk4 { h_s: self.step_s.unwrap_or(1e-3) },
+                "dopri5" => IntegratorChoice::Dopri5 {
+                    rtol: self.rtol.unwrap_or(1e-12),
+                    atol: self.rtol.unwrap_or(1e-12),
+                    h_max_s: 0.05,
+                },
+                other => {
+                    return Err(InputError::Other(format!(
+                        "--integrator `{other}`: expected meijaard, rk4 or dopri5"
+                    )))
+                }
+            };
+        } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) = (self.rtol, &w.integrator) {
+            w.integrator = IntegratorChoice::Dopri5 { rtol: r, atol: r, h_max_s: *h_max_s };
+        } else if let Some(h) = self.step_s {
+            w.integrator = match w.integrator {
+                IntegratorChoice::Meijaard { check_every, .. } => IntegratorChoice::Meijaard { h_s: h, check_every },
+                IntegratorChoice::Rk4 { .. } => IntegratorChoice::Rk4 { h_s: h },
+                other => other,
+            };
+        }
+        Ok(w)
+    }
+
+    fn newton(&self) -> NewtonSettings {
+        NewtonSettings {
+            tolerance: self.newton_tol,
+            max_iterations: self.newton_max_iter,
+            perturbation: self.perturbation,
+            central: true,
+        }
+    }
+}
+
+fn print_json(v: &Value) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    serde_json::to_writer_pretty(&mut out, v)?;
+    writeln!(out)?;
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Scenes { json } => scenes(json),
+        Command::Gait { common } => {
+            let scene = common.scene()?;
+            let walker = common.walker(&scene)?;
+            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+            let result = walker.find_gait(&v0, &common.newton());
+            let report = gait_json(&scene, &walker, &result);
+            if common.json {
+                print_json(&report)?;
+            } else {
+                print_gait_text(&report);
+            }
+            Ok(if result.is_ok() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+        }
+        Command::Walk { common, steps, perturb, start, out } => {
+            let scene = common.scene()?;
+            let walker = common.walker(&scene)?;
+            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+            let mut v = match start.as_str() {
+                "guess" => v0,
+                "gait" => match walker.find_gait(&v0, &common.newton()) {
+                    Ok(g) => g.fixed_point,
+                    Err(e) => {
+                        eprintln!("error: no gait to start from: {e} (use --start guess)");
+                        return Ok(ExitCode::from(1));
+                    }
+                },
+                other => {
+                    return Err(InputError::Other(format!("--start `{other}`: expected gait or guess")).into())
+                }
+            };
+            let names = walker.map_names();
+            for p in &perturb {
+                let (k, d) = p.split_once('=').ok_or_else(|| {
+                    InputError::Other(format!("--perturb `{p}`: expected coord=delta"))
+                })?;
+                let i = names.iter().position(|n| n == k.trim()).ok_or_else(|| {
+                    InputError::Other(format!(
+                        "--perturb: unknown coordinate `{}` (known: {})",
+                        k.trim(),
+                        names.join(", ")
+                    ))
+                })?;
+                let d: f64 = d.trim().parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| {
+                    InputError::Other(format!("--perturb `{p}`: `{}` is not a finite number", d.trim()))
+                })?;
+                v[i] += d;
+            }
+            let (q, qd) = walker.unpack(&v);
+            let walk = walker.walk(&q, &qd, steps, out.is_some());
+            if let Some(path) = out {
+                write_csv(&path, &walker, &walk)?;
+            }
+            let report = walk_json(&scene, &walk);
+            if common.json {
+                print_json(&report)?;
+            } else {
+                println!("scene {}: {} of {steps} steps", scene.name(), walk.steps.len());
+                println!("{:>5} {:>10} {:>10} {:>10} {:>12}", "step", "t_s", "period_s", "length_m", "deviation");
+                for s in &walk.steps {
+                    println!(
+                        "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
+                        s.step, s.start_time_s, s.duration_s, s.step_length_m, s.state_deviation
+                    );
+                }
+                match &walk.failure {
+                    None => println!("no failure"),
+                    Some(f) => println!("failure: {:?} in step {} at t = {:.4} s: {}", f.kind, f.step, f.time_s, f.detail),
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Sweep { common, param, from, to, points } => {
+            let scene = common.scene()?;
+            common.walker(&scene)?;
+            if !(from.is_finite() && to.is_finite()) {
+                return Err(InputError::Other("--from and --to must be finite".into()).into());
+            }
+            if points < 2 {
+                return Err(InputError::Other(format!("--points must be at least 2, got {points}")).into());
+            }
+            let (pts, bounds) = sweep(&scene, &param, from, to, points, &common.newton())
+                .map_err(|e| match e {
+                    sim::continuation::SweepError::Scene(s) => InputError::Scene(s),
+                    other => InputError::Other(other.to_string()),
+                })?;
+            let walker_for = |value: f64| {
+                let mut s = scene.clone();
+                s.set(&param, value).ok()?;
+                let w = s.build().ok()?;
+                Some((s, w))
+            };
+            let report = sweep_json(&scene, &walker_for, &param, &pts, &bounds);
+            if common.json {
+                print_json(&report)?;
+            } else {
+                println!("{:>14} {:>10} {:>8}", param, "max|λ|", "stable");
+                for p in &pts {
+                    match &p.gait {
+                        Ok(g) => println!("{:>14.6} {:>10.6} {:>8}", p.value, g.max_abs_eigenvalue(), g.stable()),
+                        Err(e) => println!("{:>14.6} {:>10} {:>8}  {e}", p.value, "-", "-"),
+                    }
+                }
+                for b in &bounds {
+                    println!("stability {} at {} ≈ {:.6}", b.change, param, b.value);
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn scenes(as_json: bool) -> Result<ExitCode> {
+    let mut list = Vec::new();
+    for (name, _) in BUILTIN {
+        let s = Scene::load(name)?;
+        let params: Vec<Value> = s
+            .file
+            .parameters
+            .iter()
+            .map(|(k, p)| {
+                json!({"name": k, "default": p.default, "unit": p.unit, "doc": p.doc,
+                       "min": p.min, "max": p.max, "aliases": p.aliases})
+            })
+            .collect();
+        list.push(json!({"name": name, "summary": s.file.scene.summary,
+                         "reference": s.file.scene.reference, "parameters": params}));
+    }
+    if as_json {
+        print_json(&json!({ "scenes": list }))?;
+    } else {
+        for s in &list {
+            println!("{} — {}", s["name"].as_str().unwrap_or(""), s["summary"].as_str().unwrap_or(""));
+            for p in s["parameters"].as_array().into_iter().flatten() {
+                println!(
+                    "    {:<24} default {:<10} [{}]  {}",
+                    p["name"].as_str().unwrap_or(""),
+                    p["default"],
+                    p["unit"].as_str().unwrap_or(""),
+                    p["doc"].as_str().unwrap_or("")
+                );
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_gait_text(r: &Value) {
+    println!("scene: {}", r["scene"].as_str().unwrap_or(""));
+    if r["converged"] != json!(true) {
+        println!("no gait found: {}", r["error"].as_str().unwrap_or(""));
+        return;
+    }
+    println!("fixed point (just after heel strike):");
+    if let Some(m) = r["fixed_point"].as_object() {
+        for (k, v) in m {
+            println!("    {k:<28} {:>20.12}", v.as_f64().unwrap_or(f64::NAN));
+        }
+    }
+    println!("eigenvalues of the stride Jacobian:");
+    for e in r["eigenvalues"].as_array().into_iter().flatten() {
+        let (re, im) = (e[0].as_f64().unwrap_or(f64::NAN), e[1].as_f64().unwrap_or(f64::NAN));
+        println!("    {re:>14.8} {im:>+14.8}i   |λ| = {:.8}", re.hypot(im));
+    }
+    println!(
+        "max |λ| = {:.8} ({}), period {:.6} s, step {:.6} m, speed {:.6} m/s, {} Newton iterations",
+        r["max_abs_eigenvalue"].as_f64().unwrap_or(f64::NAN),
+        if r["stable"] == json!(true) { "stable" } else { "unstable" },
+        r["step_period_s"].as_f64().unwrap_or(f64::NAN),
+        r["step_length_m"].as_f64().unwrap_or(f64::NAN),
+        r["speed_m_s"].as_f64().unwrap_or(f64::NAN),
+        r["newton_iterations"],
+    );
+}
+
+fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) -> Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let coords: Vec<&str> = walker.model.coordinates.iter().map(|c| c.name.as_str()).collect();
+    write!(f, "step,time_s")?;
+    for c in &coords {
+        write!(f, ",{c}")?;
+    }
+    for c in &coords {
+        write!(f, ",{c}_dot")?;
+    }
+    writeln!(f, ",hip_x_m,hip_y_m,hip_z_m")?;
+    for s in &walk.path {
+        write!(f, "{},{}", s.step, s.time_s)?;
+        for v in s.q.iter().chain(s.qd.iter()) {
+            write!(f, ",{v}")?;
+        }
+        writeln!(f, ",{},{},{}", s.hip_floor_m.x, s.hip_floor_m.y, s.hip_floor_m.z)?;
+    }
+    f.flush()?;
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e}");
+            if e.downcast_ref::<InputError>().is_some() || e.downcast_ref::<SceneError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+

@@ -1,0 +1,164 @@
+//! JSON reports of gaits, walks and sweeps: the output contract other tools read.
+
+use crate::continuation::{StabilityBoundary, SweepPoint};
+use crate::limit_cycle::{Gait, NewtonError};
+use crate::scene::Scene;
+use crate::walk::Walk;
+use crate::walker::Walker;
+use serde_json::{json, Map, Value};
+
+/// The fixed point as `name → value`: coordinates, their rates (`_dot`), and the scene's
+/// convention outputs.
+pub fn fixed_point_object(scene: &Scene, walker: &Walker, gait: &Gait) -> Value {
+    let mut m = Map::new();
+    for (name, v) in walker.map_names().iter().zip(gait.fixed_point.iter()) {
+        m.insert(name.clone(), json!(v));
+    }
+    let (q, qd) = walker.unpack(&gait.fixed_point);
+    if let Ok(extra) = scene.convention_outputs(walker, &q, &qd) {
+        for (k, v) in extra {
+            m.insert(k, json!(v));
+        }
+    }
+    Value::Object(m)
+}
+
+/// Gait summary numbers.
+pub struct GaitNumbers {
+    /// Step period [s].
+    pub step_period_s: f64,
+    /// Step length [m].
+    pub step_length_m: f64,
+    /// Speed [m/s].
+    pub speed_m_s: f64,
+}
+
+/// Period, step length and speed of a gait.
+pub fn gait_numbers(gait: &Gait) -> GaitNumbers {
+    let step_period_s = gait.stride.duration_s;
+    let step_length_m = gait.stride.step_m.norm();
+    GaitNumbers { step_period_s, step_length_m, speed_m_s: step_length_m / step_period_s }
+}
+
+/// The `walker gait --json` object.
+pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonError>) -> Value {
+    let mut map = Map::new();
+    let o = &mut map;
+    o.insert("scene".into(), json!(scene.name()));
+    o.insert("parameters".into(), json!(scene.values));
+    o.insert("integrator".into(), json!(walker.integrator));
+    match result {
+        Err(e) => {
+            o.insert("converged".into(), json!(false));
+            o.insert("error".into(), json!(e.to_string()));
+            for k in [
+                "fixed_point",
+                "eigenvalues",
+                "max_abs_eigenvalue",
+                "stable",
+                "step_period_s",
+                "step_length_m",
+                "speed_m_s",
+            ] {
+                o.insert(k.into(), Value::Null);
+            }
+            let iterations = match e {
+                NewtonError::NotConverged { iterations, .. } => json!(iterations),
+                NewtonError::StrideFailed { iteration, failure } => {
+                    o.insert("failure".into(), json!(failure));
+                    json!(iteration)
+                }
+                NewtonError::Singular { iteration } => json!(iteration),
+            };
+            o.insert("newton_iterations".into(), iterations);
+        }
+        Ok(g) => {
+            let n = gait_numbers(g);
+            let mass = walker.model.total_mass_kg();
+            let g_m_s2 = walker.model.gravity_floor_m_s2.norm();
+            o.insert("converged".into(), json!(true));
+            o.insert("fixed_point".into(), fixed_point_object(scene, walker, g));
+            o.insert(
+                "eigenvalues".into(),
+                json!(g.eigenvalues.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>()),
+            );
+            o.insert("max_abs_eigenvalue".into(), json!(g.max_abs_eigenvalue()));
+            o.insert("stable".into(), json!(g.stable()));
+            o.insert("step_period_s".into(), json!(n.step_period_s));
+            o.insert("step_length_m".into(), json!(n.step_length_m));
+            o.insert("speed_m_s".into(), json!(n.speed_m_s));
+            o.insert("newton_iterations".into(), json!(g.iterations));
+            o.insert("residual".into(), json!(g.residual));
+            o.insert("events".into(), json!(g.stride.events));
+            o.insert("impact_energy_loss_j".into(), json!(g.stride.impact_energy_loss_j));
+            if mass > 0.0 && n.step_length_m > 0.0 {
+                o.insert(
+                    "specific_cost_of_transport".into(),
+                    json!(g.stride.impact_energy_loss_j / (mass * g_m_s2 * n.step_length_m)),
+                );
+            }
+        }
+    }
+    Value::Object(map)
+}
+
+/// The `walker walk --json` object.
+pub fn walk_json(scene: &Scene, walk: &Walk) -> Value {
+    json!({
+        "scene": scene.name(),
+        "parameters": scene.values,
+        "steps_completed": walk.steps.len(),
+        "failure": walk.failure,
+        "steps": walk.steps,
+    })
+}
+
+/// The `walker sweep --json` object.
+pub fn sweep_json(
+    scene: &Scene,
+    walker_for: &dyn Fn(f64) -> Option<(Scene, Walker)>,
+    param: &str,
+    points: &[SweepPoint],
+    boundaries: &[StabilityBoundary],
+) -> Value {
+    let pts: Vec<Value> = points
+        .iter()
+        .map(|p| match &p.gait {
+            Ok(g) => {
+                let fp = walker_for(p.value)
+                    .map(|(s, w)| fixed_point_object(&s, &w, g))
+                    .unwrap_or(Value::Null);
+                json!({
+                    "parameter": param,
+                    "value": p.value,
+                    "converged": true,
+                    "max_abs_eigenvalue": g.max_abs_eigenvalue(),
+                    "stable": g.stable(),
+                    "eigenvalues": g.eigenvalues.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+                    "fixed_point": fp,
+                    "step_period_s": g.stride.duration_s,
+                    "step_length_m": g.stride.step_m.norm(),
+                })
+            }
+            Err(e) => json!({
+                "parameter": param,
+                "value": p.value,
+                "converged": false,
+                "max_abs_eigenvalue": null,
+                "stable": false,
+                "fixed_point": null,
+                "error": e.to_string(),
+            }),
+        })
+        .collect();
+    json!({
+        "scene": scene.name(),
+        "param": param,
+        "points": pts,
+        "stability_boundaries": boundaries
+            .iter()
+            .map(|b| json!({"value": b.value, "change": b.change}))
+            .collect::<Vec<_>>(),
+    })
+}
+

@@ -1,0 +1,180 @@
+//! Walking many strides from a state, tracking the path on the floor.
+//!
+//! Every stride is computed in its own stance frame (origin at the stance contact, and for 3D
+//! walkers reflected at every step). [`FloorFrame`] composes those frames so that paths are
+//! reported in one fixed floor frame.
+
+use crate::integrators::Sample;
+use crate::kinematics::Kinematics;
+use crate::math::{rotation_about, sagittal_reflection};
+use crate::stride::{FailureKind, StrideEvent, StrideOptions};
+use crate::walker::Walker;
+use nalgebra::{DVector, Matrix3, Vector3};
+use serde::Serialize;
+
+/// The pose of the current stance frame in the fixed floor frame (rotation may be improper).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloorFrame {
+    /// Stance frame → floor frame (det = ±1).
+    pub r: Matrix3<f64>,
+    /// Stance-frame origin in the floor frame [m].
+    pub p_m: Vector3<f64>,
+}
+
+impl Default for FloorFrame {
+    fn default() -> Self {
+        Self { r: Matrix3::identity(), p_m: Vector3::zeros() }
+    }
+}
+
+impl FloorFrame {
+    /// Maps a stance-frame point to the floor frame.
+    pub fn apply(&self, p_stance_m: &Vector3<f64>) -> Vector3<f64> {
+        self.p_m + self.r * p_stance_m
+    }
+
+    /// The frame of the next stride: origin at the new contact, turned by the heading
+    /// change, reflected if the walker mirrors.
+    pub fn next(&self, step_m: &Vector3<f64>, heading_rad: f64, mirror: bool) -> Self {
+        let mut r = self.r * rotation_about(&Vector3::y(), heading_rad);
+        if mirror {
+            r *= sagittal_reflection();
+        }
+        Self { r, p_m: self.apply(step_m) }
+    }
+}
+
+/// Summary of one completed step.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepSummary {
+    /// 0-based step number.
+    pub step: usize,
+    /// Time at the start of the step [s].
+    pub start_time_s: f64,
+    /// Duration [s].
+    pub duration_s: f64,
+    /// Distance between the contacts [m].
+    pub step_length_m: f64,
+    /// Heading change [rad].
+    pub heading_change_rad: f64,
+    /// Hip position in the floor frame at the end of the step [m].
+    pub hip_floor_m: [f64; 3],
+    /// Largest deviation of the state from the start state of the walk (∞-norm).
+    pub state_deviation: f64,
+    /// Impact energy loss [J].
+    pub impact_energy_loss_j: f64,
+    /// Events.
+    pub events: Vec<StrideEvent>,
+    /// Stride-map state at the end of the step, by name.
+    pub state: Vec<(String, f64)>,
+}
+
+/// The first failure of a walk.
+#[derive(Clone, Debug, Serialize)]
+pub struct WalkFailure {
+    /// Failure kind.
+    pub kind: FailureKind,
+    /// 0-based step in which it happened.
+    pub step: usize,
+    /// Time from the start of the walk [s].
+    pub time_s: f64,
+    /// Details.
+    pub detail: String,
+}
+
+/// A sample along the walk, in the floor frame.
+#[derive(Clone, Debug)]
+pub struct PathSample {
+    /// Step number.
+    pub step: usize,
+    /// Time from the start of the walk [s].
+    pub time_s: f64,
+    /// Coordinates (stance labelling of that step).
+    pub q: DVector<f64>,
+    /// Velocities.
+    pub qd: DVector<f64>,
+    /// Hip in the floor frame [m].
+    pub hip_floor_m: Vector3<f64>,
+}
+
+/// The outcome of a walk.
+#[derive(Clone, Debug)]
+pub struct Walk {
+    /// Steps completed.
+    pub steps: Vec<StepSummary>,
+    /// The first failure, if any.
+    pub failure: Option<WalkFailure>,
+    /// Samples, when recording.
+    pub path: Vec<PathSample>,
+}
+
+impl Walker {
+    /// Walks up to `steps` strides from `q0`, `qd0`; records the path when `record`.
+    pub fn walk(&self, q0: &DVector<f64>, qd0: &DVector<f64>, steps: usize, record: bool) -> Walk {
+        let mut frame = FloorFrame::default();
+        let (mut q, mut qd) = (q0.clone(), qd0.clone());
+        let v0 = self.pack(q0, qd0);
+        let names = self.map_names();
+        let mut kin = Kinematics::new(&self.model);
+        let mut out = Walk { steps: Vec::new(), failure: None, path: Vec::new() };
+        let mut t0 = 0.0;
+        let hip = &self.model.points[self.fall.hip.0];
+        for step in 0..steps {
+            match self.stride(&q, &qd, StrideOptions { record }) {
+                Err(f) => {
+                    out.failure = Some(WalkFailure {
+                        kind: f.kind,
+                        step,
+                        time_s: t0 + f.time_s,
+                        detail: f.detail,
+                    });
+                    break;
+                }
+                Ok(r) => {
+                    for s in &r.trajectory {
+                        out.path.push(self.path_sample(&mut kin, &frame, step, t0, s));
+                    }
+                    kin.update(&self.model, &r.pre_impact.q, &r.pre_impact.qd);
+                    let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
+                    let v = self.pack(&r.q_next, &r.qd_next);
+                    out.steps.push(StepSummary {
+                        step,
+                        start_time_s: t0,
+                        duration_s: r.duration_s,
+                        step_length_m: r.step_m.norm(),
+                        heading_change_rad: r.heading_change_rad,
+                        hip_floor_m: [p_hip.x, p_hip.y, p_hip.z],
+                        state_deviation: (&v - &v0).amax(),
+                        impact_energy_loss_j: r.impact_energy_loss_j,
+                        events: r.events.clone(),
+                        state: names.iter().cloned().zip(v.iter().copied()).collect(),
+                    });
+                    frame = frame.next(&r.step_m, r.heading_change_rad, self.relabel.mirror);
+                    t0 += r.duration_s;
+                    q = r.q_next;
+                    qd = r.qd_next;
+                }
+            }
+        }
+        out
+    }
+
+    fn path_sample(
+        &self,
+        kin: &mut Kinematics,
+        frame: &FloorFrame,
+        step: usize,
+        t0: f64,
+        s: &Sample,
+    ) -> PathSample {
+        kin.update(&self.model, &s.q, &s.qd);
+        let hip = &self.model.points[self.fall.hip.0];
+        PathSample {
+            step,
+            time_s: t0 + s.t_s,
+            q: s.q.clone(),
+            qd: s.qd.clone(),
+            hip_floor_m: frame.apply(&kin.position_of(hip.link, &hip.p_link_m)),
+        }
+    }
+}
