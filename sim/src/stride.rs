@@ -256,6 +256,21 @@ impl Walker {
         qd0: &DVector<f64>,
         options: StrideOptions,
     ) -> Result<StrideResult, StrideFailure> {
+        let mut trajectory = Vec::new();
+        let mut r = self.stride_recording(q0, qd0, options, &mut trajectory)?;
+        r.trajectory = trajectory;
+        Ok(r)
+    }
+
+    /// As [`Self::stride`], appending accepted samples to `trajectory` when
+    /// `options.record`, so that a failed stride keeps its samples up to the failure.
+    pub fn stride_recording(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        options: StrideOptions,
+        trajectory: &mut Vec<Sample>,
+    ) -> Result<StrideResult, StrideFailure> {
         let mut integrator = self.integrator.build();
         integrator.reset();
         let mut phase = Phase::new(&self.model);
@@ -265,7 +280,6 @@ impl Walker {
             return Err(StrideFailure::new(FailureKind::NonFiniteState, 0.0, "initial state"));
         }
         let mut events = Vec::new();
-        let mut trajectory = Vec::new();
         let mut energy_loss = 0.0;
         if options.record {
             trajectory.push(cur.clone());
@@ -414,7 +428,13 @@ impl Walker {
                     if options.record {
                         trajectory.push(at.clone());
                     }
-                    return self.finish_stride(at, &phase.active, events, energy_loss, integrator.as_ref(), trajectory);
+                    return self.finish_stride(
+                        at,
+                        &phase.active,
+                        events,
+                        energy_loss,
+                        integrator.as_ref(),
+                    );
                 }
             }
         }
@@ -428,7 +448,6 @@ impl Walker {
         events: Vec<StrideEvent>,
         mut energy_loss: f64,
         integrator: &dyn Integrator,
-        trajectory: Vec<Sample>,
     ) -> Result<StrideResult, StrideFailure> {
         let t = at.t_s;
         let hs = &self.heel_strike;
@@ -494,7 +513,7 @@ impl Walker {
             lift_velocity_m_s: lift,
             impact_energy_loss_j: energy_loss,
             evaluations: integrator.evaluations(),
-            trajectory,
+            trajectory: Vec::new(),
         })
     }
 }

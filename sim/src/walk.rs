@@ -119,8 +119,14 @@ impl Walker {
         let mut out = Walk { steps: Vec::new(), failure: None, path: Vec::new() };
         let mut t0 = 0.0;
         let hip = &self.model.points[self.fall.hip.0];
+        let mut samples = Vec::new();
         for step in 0..steps {
-            match self.stride(&q, &qd, StrideOptions { record }) {
+            samples.clear();
+            let result = self.stride_recording(&q, &qd, StrideOptions { record }, &mut samples);
+            for s in &samples {
+                out.path.push(self.path_sample(&mut kin, &frame, step, t0, s));
+            }
+            match result {
                 Err(f) => {
                     out.failure = Some(WalkFailure {
                         kind: f.kind,
@@ -131,9 +137,6 @@ impl Walker {
                     break;
                 }
                 Ok(r) => {
-                    for s in &r.trajectory {
-                        out.path.push(self.path_sample(&mut kin, &frame, step, t0, s));
-                    }
                     kin.update(&self.model, &r.pre_impact.q, &r.pre_impact.qd);
                     let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
                     let v = self.pack(&r.q_next, &r.qd_next);
