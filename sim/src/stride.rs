@@ -3,7 +3,7 @@
 
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::events::{locate, Direction, EventError};
-use crate::impact::resolve;
+use crate::impact::{resolve, ImpactError};
 use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
 use crate::kinematics::Kinematics;
 use crate::model::{LinkIndex, Model};
@@ -241,6 +241,23 @@ enum Watch {
     HipBack,
 }
 
+/// The heel-strike impact on the impact model (coordinates: released root first).
+#[derive(Clone, Debug)]
+pub struct HeelStrikeImpact {
+    /// Coordinates of the impact model.
+    pub q: DVector<f64>,
+    /// Velocities before.
+    pub qd_minus: DVector<f64>,
+    /// Velocities after.
+    pub qd_plus: DVector<f64>,
+    /// Contact impulse per constraint row.
+    pub impulse: DVector<f64>,
+    /// The new contact point in the stance frame [m].
+    pub p_contact_m: Vector3<f64>,
+    /// Mechanical energy lost [J].
+    pub energy_loss_j: f64,
+}
+
 /// Options for [`Walker::stride`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StrideOptions {
@@ -440,16 +457,13 @@ impl Walker {
         }
     }
 
-    /// Heel-strike impact with the stance contact released, lift check, relabelling.
-    fn finish_stride(
+    /// The heel-strike impact at `at` (stance labelling) with the stance contact released:
+    /// eq. (21) on the impact model. Does not check the lift or relabel.
+    pub fn heel_strike_impact(
         &self,
-        at: Sample,
+        at: &Sample,
         active: &[bool],
-        events: Vec<StrideEvent>,
-        mut energy_loss: f64,
-        integrator: &dyn Integrator,
-    ) -> Result<StrideResult, StrideFailure> {
-        let t = at.t_s;
+    ) -> Result<HeelStrikeImpact, ImpactError> {
         let hs = &self.heel_strike;
         let nr = hs.release.len();
         let m = &self.impact_model;
@@ -477,12 +491,39 @@ impl Walker {
             g.row_mut(r).copy_from(&row);
         }
         let mut dynamics = Dynamics::new(m);
-        let before = energy(&mut dynamics, m, &Sample { t_s: t, q: q.clone(), qd: qd.clone() });
-        let imp = resolve(&mut dynamics, m, &q, &qd, &act, &g, hs.restitution)
+        let before = energy(&mut dynamics, m, &Sample { t_s: at.t_s, q: q.clone(), qd: qd.clone() });
+        let imp = resolve(&mut dynamics, m, &q, &qd, &act, &g, hs.restitution)?;
+        let after =
+            energy(&mut dynamics, m, &Sample { t_s: at.t_s, q: q.clone(), qd: imp.qd_plus.clone() });
+        Ok(HeelStrikeImpact {
+            q,
+            qd_minus: qd,
+            qd_plus: imp.qd_plus,
+            impulse: imp.impulse,
+            p_contact_m: p_foot,
+            energy_loss_j: before - after,
+        })
+    }
+
+    /// Heel-strike impact, lift check, relabelling.
+    fn finish_stride(
+        &self,
+        at: Sample,
+        active: &[bool],
+        events: Vec<StrideEvent>,
+        mut energy_loss: f64,
+        integrator: &dyn Integrator,
+    ) -> Result<StrideResult, StrideFailure> {
+        let t = at.t_s;
+        let hs = &self.heel_strike;
+        let nr = hs.release.len();
+        let m = &self.impact_model;
+        let HeelStrikeImpact { q, qd_plus, p_contact_m: p_foot, energy_loss_j, .. } = self
+            .heel_strike_impact(&at, active)
             .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, t, e.to_string()))?;
-        let after = energy(&mut dynamics, m, &Sample { t_s: t, q: q.clone(), qd: imp.qd_plus.clone() });
-        energy_loss += before - after;
-        kin.update(m, &q, &imp.qd_plus);
+        energy_loss += energy_loss_j;
+        let mut kin = Kinematics::new(m);
+        kin.update(m, &q, &qd_plus);
         let sc = &m.points[hs.stance_contact.0];
         let p_sc = kin.position_of(sc.link, &sc.p_link_m);
         let lift = kin.velocity_of(sc.link, &p_sc).y;
