@@ -1,0 +1,125 @@
+//! Every typed failure outcome is reached, by a physical cause where there is one.
+#![allow(missing_docs)]
+
+mod common;
+
+use nalgebra::DVector;
+use sim::events::EventTolerance;
+use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::{NewtonError, NewtonSettings};
+use sim::stride::{FailureKind, StrideOptions};
+use sim::walker::{ContactConstraint, Walker};
+
+/// The failure of one stride from the gait's start with `name += delta`.
+fn perturbed(w: &Walker, name: &str, delta: f64) -> FailureKind {
+    let g = common::gait(w);
+    let i = w.map_names().iter().position(|n| n == name).unwrap();
+    let mut v = g.fixed_point.clone();
+    v[i] += delta;
+    w.stride_map(&v).expect_err("stride must fail").kind
+}
+
+#[test]
+fn too_slow_falls_backward() {
+    let (_, w) = common::walker("compass");
+    assert_eq!(perturbed(&w, "stance_leg_dot", 0.6), FailureKind::FellBackward);
+}
+
+#[test]
+fn too_fast_falls_forward() {
+    let (_, w) = common::walker("compass");
+    assert_eq!(perturbed(&w, "stance_leg", -0.5), FailureKind::FellForward);
+}
+
+#[test]
+fn a_bent_knee_scuffs_the_floor() {
+    let (_, w) = common::walker("kneed2d");
+    assert_eq!(perturbed(&w, "swing_knee", -1.0), FailureKind::Scuffed);
+}
+
+#[test]
+fn a_short_step_strikes_before_the_knee_locks() {
+    let (_, w) = common::walker("kneed2d");
+    assert_eq!(perturbed(&w, "stance_leg", -0.5), FailureKind::HeelStrikeBeforeKneeLock);
+}
+
+#[test]
+fn a_swing_leg_thrown_forward_keeps_the_old_stance_foot_down() {
+    let (_, w) = common::walker("compass");
+    assert_eq!(perturbed(&w, "swing_leg_dot", 3.0), FailureKind::StanceFootDidNotLift);
+}
+
+#[test]
+fn no_heel_strike_within_the_time_budget() {
+    let (_, mut w) = common::walker("compass");
+    w.max_stride_time_s = 0.1;
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::NoImpactWithinTime);
+}
+
+#[test]
+fn a_non_finite_state_is_caught() {
+    let (_, w) = common::walker("compass");
+    let mut q = w.guess_q.clone();
+    q[0] = f64::NAN;
+    let e = w.stride(&q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::NonFiniteState);
+}
+
+#[test]
+fn a_meijaard_step_beyond_the_stability_limit_is_reported() {
+    let (_, mut w) = common::walker("compass");
+    w.integrator = IntegratorChoice::Meijaard { h_s: 1.0, check_every: 1 };
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
+    // The same step without the check produces a stride anyway (garbage or failure) - the
+    // check is what turns it into a typed error; a small step passes the check.
+    w.integrator = IntegratorChoice::Meijaard { h_s: 1e-3, check_every: 1 };
+    w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap();
+}
+
+#[test]
+fn an_unreachable_tolerance_underflows_the_adaptive_step() {
+    let (_, mut w) = common::walker("compass");
+    w.integrator = IntegratorChoice::Dopri5 { rtol: 1e-30, atol: 1e-30, h_max_s: 0.05 };
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::StepUnderflow);
+}
+
+#[test]
+fn an_event_without_refinement_budget_is_not_located() {
+    let (_, mut w) = common::walker("compass");
+    w.event_tolerance = EventTolerance { max_iterations: 0, ..Default::default() };
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::EventNotLocated);
+}
+
+#[test]
+fn redundant_contact_constraints_make_the_impact_singular() {
+    let (_, mut w) = common::walker("compass");
+    w.heel_strike.constraints = vec![ContactConstraint::X, ContactConstraint::Y, ContactConstraint::X];
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::ImpactSingular);
+}
+
+#[test]
+fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
+    let (_, mut w) = common::walker("compass");
+    let (a, b) = (w.relabel.pairs[0].0, w.relabel.pairs[1].0);
+    w.relabel.pairs = vec![(a, a), (b, b)];
+    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::RelabelFailed);
+}
+
+#[test]
+fn newton_reports_its_spent_budget_and_failed_strides() {
+    let (_, w) = common::walker("compass");
+    let v0 = w.pack(&w.guess_q, &w.guess_qd);
+    let tight = NewtonSettings { max_iterations: 1, ..Default::default() };
+    assert!(matches!(w.find_gait(&v0, &tight), Err(NewtonError::NotConverged { iterations: 1, .. })));
+    let bad = DVector::from_vec(vec![0.27, -0.54, -3.0, 0.7]);
+    assert!(matches!(
+        w.find_gait(&bad, &NewtonSettings::default()),
+        Err(NewtonError::StrideFailed { iteration: 0, .. })
+    ));
+}
