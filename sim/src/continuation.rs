@@ -78,7 +78,12 @@ pub fn sweep(
     let mut boundaries = Vec::new();
     let converged: Vec<(f64, f64)> = out
         .iter()
-        .filter_map(|p| p.gait.as_ref().ok().map(|g| (p.value, g.max_abs_eigenvalue())))
+        .filter_map(|p| {
+            p.gait
+                .as_ref()
+                .ok()
+                .map(|g| (p.value, g.max_abs_eigenvalue()))
+        })
         .collect();
     for w in converged.windows(2) {
         let ((p0, m0), (p1, m1)) = (w[0], w[1]);

@@ -75,10 +75,14 @@ impl Dynamics {
             }
             let li = LinkIndex(i);
             let p_com = self.kin.position_of(li, &b.p_link_com_m);
-            self.kin.point_jacobian_into(model, li, &p_com, &mut self.jv);
+            self.kin
+                .point_jacobian_into(model, li, &p_com, &mut self.jv);
             let a_bias = self.kin.bias_acceleration_of(li, &p_com);
             let (mm, ff) = if b.infinitesimal {
-                (&mut self.mass_matrix_infinitesimal, &mut self.force_infinitesimal)
+                (
+                    &mut self.mass_matrix_infinitesimal,
+                    &mut self.force_infinitesimal,
+                )
             } else {
                 (&mut self.mass_matrix, &mut self.force)
             };
@@ -128,7 +132,10 @@ impl Dynamics {
         let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
         let f0 = self.force.select_rows(&idx);
         let x = if self.has_infinitesimal {
-            let m1 = self.mass_matrix_infinitesimal.select_rows(&idx).select_columns(&idx);
+            let m1 = self
+                .mass_matrix_infinitesimal
+                .select_rows(&idx)
+                .select_columns(&idx);
             let f1 = self.force_infinitesimal.select_rows(&idx);
             solve_limit(&m0, &m1, &f0, &f1, 1e-12)?
         } else {

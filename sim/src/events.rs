@@ -38,7 +38,11 @@ pub struct EventTolerance {
 
 impl Default for EventTolerance {
     fn default() -> Self {
-        Self { time_s: 1e-13, witness: 1e-14, max_iterations: 60 }
+        Self {
+            time_s: 1e-13,
+            witness: 1e-14,
+            max_iterations: 60,
+        }
     }
 }
 
@@ -139,7 +143,11 @@ pub fn locate(
             }
             side = 1;
         }
-        t = if g1 != g0 { t0 - g0 * (t1 - t0) / (g1 - g0) } else { 0.5 * (t0 + t1) };
+        t = if g1 != g0 {
+            t0 - g0 * (t1 - t0) / (g1 - g0)
+        } else {
+            0.5 * (t0 + t1)
+        };
         if !(t > t0.min(t1) && t < t0.max(t1)) {
             t = 0.5 * (t0 + t1);
         }
@@ -150,7 +158,10 @@ pub fn locate(
     if (t1 - t0).abs() <= 1e3 * tol.time_s {
         return Ok(best);
     }
-    Err(EventError::NotLocated { iterations: tol.max_iterations, bracket_s: (t1 - t0).abs() })
+    Err(EventError::NotLocated {
+        iterations: tol.max_iterations,
+        bracket_s: (t1 - t0).abs(),
+    })
 }
 
 #[cfg(test)]

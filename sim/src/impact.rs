@@ -39,7 +39,10 @@ pub fn resolve(
     let n = idx.len();
     let k = g_rows.nrows();
     let m0 = dynamics.mass_matrix.select_rows(&idx).select_columns(&idx);
-    let m1 = dynamics.mass_matrix_infinitesimal.select_rows(&idx).select_columns(&idx);
+    let m1 = dynamics
+        .mass_matrix_infinitesimal
+        .select_rows(&idx)
+        .select_columns(&idx);
     let g = g_rows.select_columns(&idx);
     let v = qd_minus.select_rows(&idx);
     let mut a0 = DMatrix::zeros(n + k, n + k);
@@ -58,5 +61,8 @@ pub fn resolve(
     for (j, &i) in idx.iter().enumerate() {
         qd_plus[i] = x[j];
     }
-    Ok(ImpactResult { qd_plus, impulse: x.rows(n, k).into_owned() })
+    Ok(ImpactResult {
+        qd_plus,
+        impulse: x.rows(n, k).into_owned(),
+    })
 }

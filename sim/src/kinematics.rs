@@ -182,7 +182,8 @@ impl Kinematics {
         while let Some(l) = cur {
             let lk = &model.links[l.0];
             if let (Some(c), JointKind::Revolute { .. }) = (lk.coordinate, &lk.joint) {
-                j.fixed_view_mut::<3, 1>(0, c.0).copy_from(&self.axis_floor[l.0]);
+                j.fixed_view_mut::<3, 1>(0, c.0)
+                    .copy_from(&self.axis_floor[l.0]);
             }
             cur = lk.parent;
         }

@@ -21,7 +21,12 @@ pub struct NewtonSettings {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { tolerance: 1e-11, max_iterations: 30, perturbation: 1e-6, central: true }
+        Self {
+            tolerance: 1e-11,
+            max_iterations: 30,
+            perturbation: 1e-6,
+            central: true,
+        }
     }
 }
 
@@ -72,7 +77,10 @@ pub struct Gait {
 impl Gait {
     /// Largest eigenvalue modulus.
     pub fn max_abs_eigenvalue(&self) -> f64 {
-        self.eigenvalues.iter().map(|z| z.norm()).fold(0.0, f64::max)
+        self.eigenvalues
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max)
     }
     /// All eigenvalues strictly inside the unit circle.
     pub fn stable(&self) -> bool {
@@ -82,7 +90,10 @@ impl Gait {
 
 impl Walker {
     /// The stride function `S(v)` on packed stride-map vectors.
-    pub fn stride_map(&self, v: &DVector<f64>) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+    pub fn stride_map(
+        &self,
+        v: &DVector<f64>,
+    ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
         let (q, qd) = self.unpack(v);
         let r = self.stride(&q, &qd, StrideOptions::default())?;
         Ok((self.pack(&r.q_next, &r.qd_next), r))
@@ -116,12 +127,19 @@ impl Walker {
     }
 
     /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
-    pub fn find_gait(&self, v0: &DVector<f64>, settings: &NewtonSettings) -> Result<Gait, NewtonError> {
+    pub fn find_gait(
+        &self,
+        v0: &DVector<f64>,
+        settings: &NewtonSettings,
+    ) -> Result<Gait, NewtonError> {
         let mut v = v0.clone();
         let n = v.len();
         let mut last_step = f64::INFINITY;
         for it in 0..=settings.max_iterations {
-            let fail = |failure| NewtonError::StrideFailed { iteration: it, failure };
+            let fail = |failure| NewtonError::StrideFailed {
+                iteration: it,
+                failure,
+            };
             let (s, stride) = self.stride_map(&v).map_err(fail)?;
             let r = &s - &v;
             let j = self.stride_jacobian(&v, &s, settings).map_err(fail)?;
@@ -140,10 +158,16 @@ impl Walker {
                 break;
             }
             let a = DMatrix::identity(n, n) - &j;
-            let dv = a.lu().solve(&r).ok_or(NewtonError::Singular { iteration: it })?;
+            let dv = a
+                .lu()
+                .solve(&r)
+                .ok_or(NewtonError::Singular { iteration: it })?;
             last_step = dv.amax();
             v += dv;
         }
-        Err(NewtonError::NotConverged { iterations: settings.max_iterations, last_step })
+        Err(NewtonError::NotConverged {
+            iterations: settings.max_iterations,
+            last_step,
+        })
     }
 }

@@ -163,7 +163,12 @@ pub enum ModelError {
 impl Model {
     /// An empty model with the given gravity vector.
     pub fn new(gravity_floor_m_s2: Vector3<f64>) -> Self {
-        Self { links: Vec::new(), coordinates: Vec::new(), points: Vec::new(), gravity_floor_m_s2 }
+        Self {
+            links: Vec::new(),
+            coordinates: Vec::new(),
+            points: Vec::new(),
+            gravity_floor_m_s2,
+        }
     }
 
     /// Gravity for magnitude `g_m_s2` on a floor sloping down by `slope_rad` in +x.
@@ -192,10 +197,13 @@ impl Model {
         }
         let parent = match parent {
             None => None,
-            Some(p) => Some(self.link_index(p).ok_or_else(|| ModelError::UnknownParent {
-                child: name.to_string(),
-                parent: p.to_string(),
-            })?),
+            Some(p) => Some(
+                self.link_index(p)
+                    .ok_or_else(|| ModelError::UnknownParent {
+                        child: name.to_string(),
+                        parent: p.to_string(),
+                    })?,
+            ),
         };
         let joint = match joint {
             JointKind::Revolute { axis_parent } | JointKind::Prismatic { axis_parent }
@@ -203,12 +211,12 @@ impl Model {
             {
                 return Err(ModelError::ZeroAxis(name.to_string()));
             }
-            JointKind::Revolute { axis_parent } => {
-                JointKind::Revolute { axis_parent: axis_parent.normalize() }
-            }
-            JointKind::Prismatic { axis_parent } => {
-                JointKind::Prismatic { axis_parent: axis_parent.normalize() }
-            }
+            JointKind::Revolute { axis_parent } => JointKind::Revolute {
+                axis_parent: axis_parent.normalize(),
+            },
+            JointKind::Prismatic { axis_parent } => JointKind::Prismatic {
+                axis_parent: axis_parent.normalize(),
+            },
             JointKind::Weld => JointKind::Weld,
         };
         check_body(name, &body)?;
@@ -217,7 +225,10 @@ impl Model {
             JointKind::Weld => None,
             _ => {
                 let c = CoordIndex(self.coordinates.len());
-                self.coordinates.push(Coordinate { name: name.to_string(), link: index });
+                self.coordinates.push(Coordinate {
+                    name: name.to_string(),
+                    link: index,
+                });
                 Some(c)
             }
         };
@@ -243,37 +254,58 @@ impl Model {
         if self.point_index(name).is_some() {
             return Err(ModelError::DuplicateName(name.to_string()));
         }
-        let l = self.link_index(link).ok_or_else(|| ModelError::UnknownLink {
-            point: name.to_string(),
-            link: link.to_string(),
-        })?;
-        self.points.push(Point { name: name.to_string(), link: l, p_link_m });
+        let l = self
+            .link_index(link)
+            .ok_or_else(|| ModelError::UnknownLink {
+                point: name.to_string(),
+                link: link.to_string(),
+            })?;
+        self.points.push(Point {
+            name: name.to_string(),
+            link: l,
+            p_link_m,
+        });
         Ok(PointIndex(self.points.len() - 1))
     }
 
     /// Looks a link up by name.
     pub fn link_index(&self, name: &str) -> Option<LinkIndex> {
-        self.links.iter().position(|l| l.name == name).map(LinkIndex)
+        self.links
+            .iter()
+            .position(|l| l.name == name)
+            .map(LinkIndex)
     }
 
     /// Looks a coordinate up by name.
     pub fn coord_index(&self, name: &str) -> Option<CoordIndex> {
-        self.coordinates.iter().position(|c| c.name == name).map(CoordIndex)
+        self.coordinates
+            .iter()
+            .position(|c| c.name == name)
+            .map(CoordIndex)
     }
 
     /// Looks a point up by name.
     pub fn point_index(&self, name: &str) -> Option<PointIndex> {
-        self.points.iter().position(|p| p.name == name).map(PointIndex)
+        self.points
+            .iter()
+            .position(|p| p.name == name)
+            .map(PointIndex)
     }
 
     /// Total mass [kg] (infinitesimal bodies count as zero).
     pub fn total_mass_kg(&self) -> f64 {
-        self.links.iter().filter(|l| !l.body.infinitesimal).map(|l| l.body.mass_kg).sum()
+        self.links
+            .iter()
+            .filter(|l| !l.body.infinitesimal)
+            .map(|l| l.body.mass_kg)
+            .sum()
     }
 
     /// Whether any body is infinitesimal (the equations are a singular limit).
     pub fn has_infinitesimal_bodies(&self) -> bool {
-        self.links.iter().any(|l| l.body.infinitesimal && l.body.mass_kg > 0.0)
+        self.links
+            .iter()
+            .any(|l| l.body.infinitesimal && l.body.mass_kg > 0.0)
     }
 
     /// The chain of links from `link` up to the root, `link` first.
@@ -310,8 +342,10 @@ impl Model {
         for link in &self.links {
             let index = LinkIndex(m.links.len());
             let coordinate = link.coordinate.map(|c| {
-                m.coordinates
-                    .push(Coordinate { name: self.coordinates[c.0].name.clone(), link: index });
+                m.coordinates.push(Coordinate {
+                    name: self.coordinates[c.0].name.clone(),
+                    link: index,
+                });
                 CoordIndex(m.coordinates.len() - 1)
             });
             let parent = match link.parent {
@@ -319,19 +353,34 @@ impl Model {
                 None if offset > 0 => Some(LinkIndex(offset - 1)),
                 None => None,
             };
-            m.links.push(Link { parent, coordinate, ..link.clone() });
+            m.links.push(Link {
+                parent,
+                coordinate,
+                ..link.clone()
+            });
         }
         for p in &self.points {
-            m.points.push(Point { link: LinkIndex(p.link.0 + offset), ..p.clone() });
+            m.points.push(Point {
+                link: LinkIndex(p.link.0 + offset),
+                ..p.clone()
+            });
         }
         m
     }
 }
 
 fn check_body(name: &str, b: &BodyInertia) -> Result<(), ModelError> {
-    let bad = |what: String| Err(ModelError::NonPhysical { link: name.to_string(), what });
+    let bad = |what: String| {
+        Err(ModelError::NonPhysical {
+            link: name.to_string(),
+            what,
+        })
+    };
     if !b.mass_kg.is_finite() || b.mass_kg < 0.0 {
-        return bad(format!("mass {} kg is not a finite non-negative number", b.mass_kg));
+        return bad(format!(
+            "mass {} kg is not a finite non-negative number",
+            b.mass_kg
+        ));
     }
     if b.p_link_com_m.iter().any(|v| !v.is_finite()) {
         return bad("centre of mass is not finite".into());
@@ -343,7 +392,9 @@ fn check_body(name: &str, b: &BodyInertia) -> Result<(), ModelError> {
     let eig = i.symmetric_eigenvalues();
     let (a, bb, c) = (eig[0], eig[1], eig[2]);
     if a < -1e-12 || bb < -1e-12 || c < -1e-12 {
-        return bad(format!("inertia tensor has a negative principal moment ({a}, {bb}, {c})"));
+        return bad(format!(
+            "inertia tensor has a negative principal moment ({a}, {bb}, {c})"
+        ));
     }
     // Triangle inequality of principal moments, with a tolerance for rounding.
     let tol = 1e-9 * (a + bb + c).max(1e-300);

@@ -68,7 +68,10 @@ impl LinkStates {
     pub fn from_kinematics(kin: &Kinematics, skip: usize, origin: &Vector3<f64>) -> Self {
         Self {
             r: kin.r_floor_link[skip..].to_vec(),
-            p: kin.p_floor_link_m[skip..].iter().map(|p| p - origin).collect(),
+            p: kin.p_floor_link_m[skip..]
+                .iter()
+                .map(|p| p - origin)
+                .collect(),
             w: kin.omega_floor_rad_s[skip..].to_vec(),
             v: kin.v_floor_link_m_s[skip..].to_vec(),
         }
@@ -131,14 +134,18 @@ impl Relabel {
         loop {
             kin.update(model, &q, &zero);
             for (k, &(new, old_l)) in self.pairs.iter().enumerate() {
-                res.fixed_rows_mut::<3>(3 * k)
-                    .copy_from(&orientation_error(&old.r[old_l.0], &kin.r_floor_link[new.0]));
-                jac.view_mut((3 * k, 0), (3, n)).copy_from(&kin.angular_jacobian(model, new));
+                res.fixed_rows_mut::<3>(3 * k).copy_from(&orientation_error(
+                    &old.r[old_l.0],
+                    &kin.r_floor_link[new.0],
+                ));
+                jac.view_mut((3 * k, 0), (3, n))
+                    .copy_from(&kin.angular_jacobian(model, new));
             }
             for (k, &(np_, _)) in self.point_pairs.iter().enumerate() {
                 let pt = &model.points[np_.0];
                 let p = kin.position_of(pt.link, &pt.p_link_m);
-                res.fixed_rows_mut::<3>(3 * (np + k)).copy_from(&(old_points[k].0 - p));
+                res.fixed_rows_mut::<3>(3 * (np + k))
+                    .copy_from(&(old_points[k].0 - p));
                 jac.view_mut((3 * (np + k), 0), (3, n))
                     .copy_from(&kin.point_jacobian(model, pt.link, &p));
             }
@@ -147,7 +154,10 @@ impl Relabel {
                 break;
             }
             if iterations >= self.max_iterations || !r.is_finite() {
-                return Err(RelabelError::PoseMismatch { residual: r, iterations });
+                return Err(RelabelError::PoseMismatch {
+                    residual: r,
+                    iterations,
+                });
             }
             let dq = least_squares(&jac, &res);
             q += dq;
@@ -158,8 +168,8 @@ impl Relabel {
         for (k, &(_, old_l)) in self.pairs.iter().enumerate() {
             target.fixed_rows_mut::<3>(3 * k).copy_from(&old.w[old_l.0]);
         }
-        for k in 0..self.point_pairs.len() {
-            target.fixed_rows_mut::<3>(3 * (np + k)).copy_from(&old_points[k].1);
+        for (k, (_, v)) in old_points.iter().enumerate() {
+            target.fixed_rows_mut::<3>(3 * (np + k)).copy_from(v);
         }
         let qd = least_squares(&jac, &target);
         let vres = (&jac * &qd - &target).norm();
@@ -171,12 +181,18 @@ impl Relabel {
             cyclic_values.push(q[c.0]);
             q[c.0] = 0.0;
         }
-        Ok(Relabelled { q, qd, cyclic_values, iterations })
+        Ok(Relabelled {
+            q,
+            qd,
+            cyclic_values,
+            iterations,
+        })
     }
 }
 
 fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     let svd = a.clone().svd(true, true);
     let tol = 1e-12 * svd.singular_values.max().max(1e-300);
-    svd.solve(b, tol).unwrap_or_else(|_| DVector::zeros(a.ncols()))
+    svd.solve(b, tol)
+        .unwrap_or_else(|_| DVector::zeros(a.ncols()))
 }

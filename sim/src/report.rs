@@ -37,7 +37,11 @@ pub struct GaitNumbers {
 pub fn gait_numbers(gait: &Gait) -> GaitNumbers {
     let step_period_s = gait.stride.duration_s;
     let step_length_m = gait.stride.step_m.norm();
-    GaitNumbers { step_period_s, step_length_m, speed_m_s: step_length_m / step_period_s }
+    GaitNumbers {
+        step_period_s,
+        step_length_m,
+        speed_m_s: step_length_m / step_period_s,
+    }
 }
 
 /// The `walker gait --json` object.
@@ -80,7 +84,11 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             o.insert("fixed_point".into(), fixed_point_object(scene, walker, g));
             o.insert(
                 "eigenvalues".into(),
-                json!(g.eigenvalues.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>()),
+                json!(g
+                    .eigenvalues
+                    .iter()
+                    .map(|z| [z.re, z.im])
+                    .collect::<Vec<_>>()),
             );
             o.insert("max_abs_eigenvalue".into(), json!(g.max_abs_eigenvalue()));
             o.insert("stable".into(), json!(g.stable()));
@@ -90,7 +98,10 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             o.insert("newton_iterations".into(), json!(g.iterations));
             o.insert("residual".into(), json!(g.residual));
             o.insert("events".into(), json!(g.stride.events));
-            o.insert("impact_energy_loss_j".into(), json!(g.stride.impact_energy_loss_j));
+            o.insert(
+                "impact_energy_loss_j".into(),
+                json!(g.stride.impact_energy_loss_j),
+            );
             if mass > 0.0 && n.step_length_m > 0.0 {
                 o.insert(
                     "specific_cost_of_transport".into(),
@@ -161,4 +172,3 @@ pub fn sweep_json(
             .collect::<Vec<_>>(),
     })
 }
-

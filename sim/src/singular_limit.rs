@@ -28,7 +28,10 @@ pub enum LimitSolveError {
 
 /// Solves `A x = b` for a symmetric `A` (LU with partial pivoting, any definiteness).
 pub fn solve_regular(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>, LimitSolveError> {
-    a.clone().lu().solve(b).ok_or(LimitSolveError::Degenerate { nullity: 1 })
+    a.clone()
+        .lu()
+        .solve(b)
+        .ok_or(LimitSolveError::Degenerate { nullity: 1 })
 }
 
 /// Solves the limit `ε → 0` of `(A0 + ε A1) x = b0 + ε b1` for symmetric `A0`.
@@ -43,7 +46,9 @@ pub fn solve_limit(
     let n = a0.nrows();
     let eig = a0.clone().symmetric_eigen();
     let scale = eig.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let null: Vec<usize> = (0..n).filter(|&i| eig.eigenvalues[i].abs() <= rel_tol * scale).collect();
+    let null: Vec<usize> = (0..n)
+        .filter(|&i| eig.eigenvalues[i].abs() <= rel_tol * scale)
+        .collect();
     if null.is_empty() {
         return solve_regular(a0, b0);
     }
@@ -69,7 +74,10 @@ pub fn solve_limit(
     }
     let lhs = nmat.transpose() * a1 * &nmat;
     let rhs = nmat.transpose() * (b1 - a1 * &x_r);
-    let y = lhs.lu().solve(&rhs).ok_or(LimitSolveError::Degenerate { nullity: k })?;
+    let y = lhs
+        .lu()
+        .solve(&rhs)
+        .ok_or(LimitSolveError::Degenerate { nullity: k })?;
     Ok(x_r + nmat * y)
 }
 

@@ -56,7 +56,11 @@ pub struct StrideFailure {
 
 impl StrideFailure {
     fn new(kind: FailureKind, time_s: f64, detail: impl Into<String>) -> Self {
-        Self { kind, time_s, detail: detail.into() }
+        Self {
+            kind,
+            time_s,
+            detail: detail.into(),
+        }
     }
 
     fn from_integration(e: IntegrationError, t: f64) -> Self {
@@ -123,7 +127,11 @@ pub struct Phase<'a> {
 impl<'a> Phase<'a> {
     /// All coordinates active.
     pub fn new(model: &'a Model) -> Self {
-        Self { model, dynamics: Dynamics::new(model), active: vec![true; model.dof()] }
+        Self {
+            model,
+            dynamics: Dynamics::new(model),
+            active: vec![true; model.dof()],
+        }
     }
 }
 
@@ -134,7 +142,8 @@ impl SecondOrderSystem for Phase<'_> {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
-        self.dynamics.accelerations(self.model, q, qd, &self.active, None)
+        self.dynamics
+            .accelerations(self.model, q, qd, &self.active, None)
     }
 
     fn stability_limit(
@@ -187,10 +196,21 @@ pub fn linearised_limit(
     let minv = m.try_inverse()?;
     let mk = (&minv * k).complex_eigenvalues();
     let lambda2 = mk.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
-    let damping = (&minv * c).complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
+    let damping = (&minv * c)
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max);
     let lambda = lambda2.sqrt();
-    let beta = if lambda > 0.0 { (damping / (2.0 * lambda)).min(1.0) } else { 0.0 };
-    Some(StabilityLimit { lambda_max_rad_s: lambda, beta })
+    let beta = if lambda > 0.0 {
+        (damping / (2.0 * lambda)).min(1.0)
+    } else {
+        0.0
+    };
+    Some(StabilityLimit {
+        lambda_max_rad_s: lambda,
+        beta,
+    })
 }
 
 /// Witness values at a sample: what the stride loop watches.
@@ -205,24 +225,32 @@ impl Witnesses<'_> {
     }
     fn foot_height(&mut self, s: &Sample) -> f64 {
         self.update(s);
-        self.kin.point_position(&self.walker.model, self.walker.heel_strike.swing_foot).y
+        self.kin
+            .point_position(&self.walker.model, self.walker.heel_strike.swing_foot)
+            .y
     }
     fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
         self.update(s);
         let m = &self.walker.model;
         let hs = &self.walker.heel_strike;
-        self.kin.point_position(m, hs.swing_foot).x - self.kin.point_position(m, hs.stance_contact).x
+        self.kin.point_position(m, hs.swing_foot).x
+            - self.kin.point_position(m, hs.stance_contact).x
     }
     fn hip_height(&mut self, s: &Sample) -> f64 {
         self.update(s);
-        self.kin.point_position(&self.walker.model, self.walker.fall.hip).y
+        self.kin
+            .point_position(&self.walker.model, self.walker.fall.hip)
+            .y
             - self.walker.fall.min_hip_height_m
     }
     fn hip_ahead_m(&mut self, s: &Sample) -> f64 {
         self.update(s);
         let m = &self.walker.model;
         self.kin.point_position(m, self.walker.fall.hip).x
-            - self.kin.point_position(m, self.walker.heel_strike.stance_contact).x
+            - self
+                .kin
+                .point_position(m, self.walker.heel_strike.stance_contact)
+                .x
     }
     fn hip_forward_velocity(&mut self, s: &Sample) -> f64 {
         self.update(s);
@@ -291,10 +319,21 @@ impl Walker {
         let mut integrator = self.integrator.build();
         integrator.reset();
         let mut phase = Phase::new(&self.model);
-        let mut wit = Witnesses { walker: self, kin: Kinematics::new(&self.model) };
-        let mut cur = Sample { t_s: 0.0, q: q0.clone(), qd: qd0.clone() };
+        let mut wit = Witnesses {
+            walker: self,
+            kin: Kinematics::new(&self.model),
+        };
+        let mut cur = Sample {
+            t_s: 0.0,
+            q: q0.clone(),
+            qd: qd0.clone(),
+        };
         if cur.q.iter().chain(cur.qd.iter()).any(|v| !v.is_finite()) {
-            return Err(StrideFailure::new(FailureKind::NonFiniteState, 0.0, "initial state"));
+            return Err(StrideFailure::new(
+                FailureKind::NonFiniteState,
+                0.0,
+                "initial state",
+            ));
         }
         let mut events = Vec::new();
         let mut energy_loss = 0.0;
@@ -313,7 +352,11 @@ impl Walker {
                 .advance(&mut phase, &cur, f64::INFINITY)
                 .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
             if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
-                return Err(StrideFailure::new(FailureKind::NonFiniteState, next.t_s, "state"));
+                return Err(StrideFailure::new(
+                    FailureKind::NonFiniteState,
+                    next.t_s,
+                    "state",
+                ));
             }
             // Which witnesses changed sign in the right direction over this step?
             let mut triggered: Vec<Watch> = Vec::new();
@@ -323,7 +366,9 @@ impl Walker {
             for (k, knee) in self.knees.iter().enumerate() {
                 let c = knee.coordinate.0;
                 if phase.active[c]
-                    && knee.closing.triggered(cur.q[c] - knee.stop_rad, next.q[c] - knee.stop_rad)
+                    && knee
+                        .closing
+                        .triggered(cur.q[c] - knee.stop_rad, next.q[c] - knee.stop_rad)
                 {
                     triggered.push(Watch::Knee(k));
                 }
@@ -332,8 +377,10 @@ impl Walker {
                 triggered.push(Watch::HipLow);
             }
             if wit.hip_ahead_m(&next) < 0.0
-                && Direction::Falling
-                    .triggered(wit.hip_forward_velocity(&cur), wit.hip_forward_velocity(&next))
+                && Direction::Falling.triggered(
+                    wit.hip_forward_velocity(&cur),
+                    wit.hip_forward_velocity(&next),
+                )
             {
                 triggered.push(Watch::HipBack);
             }
@@ -367,7 +414,7 @@ impl Walker {
                 )
                 .map_err(|e| StrideFailure::from_event(e, cur.t_s))?;
                 drop(g);
-                if first.as_ref().map_or(true, |(_, f)| s.t_s < f.t_s) {
+                if first.as_ref().is_none_or(|(_, f)| s.t_s < f.t_s) {
                     first = Some((w, s));
                 }
             }
@@ -379,7 +426,11 @@ impl Walker {
                     } else {
                         FailureKind::FellBackward
                     };
-                    return Err(StrideFailure::new(kind, at.t_s, "hip below its minimum height"));
+                    return Err(StrideFailure::new(
+                        kind,
+                        at.t_s,
+                        "hip below its minimum height",
+                    ));
                 }
                 Watch::HipBack => {
                     return Err(StrideFailure::new(
@@ -394,11 +445,18 @@ impl Walker {
                     g[(0, c)] = 1.0;
                     let mut dynamics = Dynamics::new(&self.model);
                     let before = energy(&mut dynamics, &self.model, &at);
-                    let imp =
-                        resolve(&mut dynamics, &self.model, &at.q, &at.qd, &phase.active, &g, 0.0)
-                            .map_err(|e| {
-                                StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
-                            })?;
+                    let imp = resolve(
+                        &mut dynamics,
+                        &self.model,
+                        &at.q,
+                        &at.qd,
+                        &phase.active,
+                        &g,
+                        0.0,
+                    )
+                    .map_err(|e| {
+                        StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
+                    })?;
                     phase.active[c] = false;
                     let mut qd = imp.qd_plus;
                     qd[c] = 0.0;
@@ -441,7 +499,10 @@ impl Walker {
                             ),
                         ));
                     }
-                    events.push(StrideEvent { name: "heel_strike".into(), time_s: at.t_s });
+                    events.push(StrideEvent {
+                        name: "heel_strike".into(),
+                        time_s: at.t_s,
+                    });
                     if options.record {
                         trajectory.push(at.clone());
                     }
@@ -491,10 +552,25 @@ impl Walker {
             g.row_mut(r).copy_from(&row);
         }
         let mut dynamics = Dynamics::new(m);
-        let before = energy(&mut dynamics, m, &Sample { t_s: at.t_s, q: q.clone(), qd: qd.clone() });
+        let before = energy(
+            &mut dynamics,
+            m,
+            &Sample {
+                t_s: at.t_s,
+                q: q.clone(),
+                qd: qd.clone(),
+            },
+        );
         let imp = resolve(&mut dynamics, m, &q, &qd, &act, &g, hs.restitution)?;
-        let after =
-            energy(&mut dynamics, m, &Sample { t_s: at.t_s, q: q.clone(), qd: imp.qd_plus.clone() });
+        let after = energy(
+            &mut dynamics,
+            m,
+            &Sample {
+                t_s: at.t_s,
+                q: q.clone(),
+                qd: imp.qd_plus.clone(),
+            },
+        );
         Ok(HeelStrikeImpact {
             q,
             qd_minus: qd,
@@ -518,7 +594,13 @@ impl Walker {
         let hs = &self.heel_strike;
         let nr = hs.release.len();
         let m = &self.impact_model;
-        let HeelStrikeImpact { q, qd_plus, p_contact_m: p_foot, energy_loss_j, .. } = self
+        let HeelStrikeImpact {
+            q,
+            qd_plus,
+            p_contact_m: p_foot,
+            energy_loss_j,
+            ..
+        } = self
             .heel_strike_impact(&at, active)
             .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, t, e.to_string()))?;
         energy_loss += energy_loss_j;

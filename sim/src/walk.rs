@@ -23,7 +23,10 @@ pub struct FloorFrame {
 
 impl Default for FloorFrame {
     fn default() -> Self {
-        Self { r: Matrix3::identity(), p_m: Vector3::zeros() }
+        Self {
+            r: Matrix3::identity(),
+            p_m: Vector3::zeros(),
+        }
     }
 }
 
@@ -40,7 +43,10 @@ impl FloorFrame {
         if mirror {
             r *= sagittal_reflection();
         }
-        Self { r, p_m: self.apply(step_m) }
+        Self {
+            r,
+            p_m: self.apply(step_m),
+        }
     }
 }
 
@@ -116,7 +122,11 @@ impl Walker {
         let v0 = self.pack(q0, qd0);
         let names = self.map_names();
         let mut kin = Kinematics::new(&self.model);
-        let mut out = Walk { steps: Vec::new(), failure: None, path: Vec::new() };
+        let mut out = Walk {
+            steps: Vec::new(),
+            failure: None,
+            path: Vec::new(),
+        };
         let mut t0 = 0.0;
         let hip = &self.model.points[self.fall.hip.0];
         let mut samples = Vec::new();
@@ -124,7 +134,8 @@ impl Walker {
             samples.clear();
             let result = self.stride_recording(&q, &qd, StrideOptions { record }, &mut samples);
             for s in &samples {
-                out.path.push(self.path_sample(&mut kin, &frame, step, t0, s));
+                out.path
+                    .push(self.path_sample(&mut kin, &frame, step, t0, s));
             }
             match result {
                 Err(f) => {

@@ -123,9 +123,14 @@ impl Walker {
     /// Names of the stride-map entries: `coord` then `coord_dot`.
     pub fn map_names(&self) -> Vec<String> {
         let c = self.map_coordinates();
-        let mut names: Vec<String> =
-            c.iter().map(|ci| self.model.coordinates[ci.0].name.clone()).collect();
-        names.extend(c.iter().map(|ci| format!("{}_dot", self.model.coordinates[ci.0].name)));
+        let mut names: Vec<String> = c
+            .iter()
+            .map(|ci| self.model.coordinates[ci.0].name.clone())
+            .collect();
+        names.extend(
+            c.iter()
+                .map(|ci| format!("{}_dot", self.model.coordinates[ci.0].name)),
+        );
         names
     }
 }

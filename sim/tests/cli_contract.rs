@@ -1,15 +1,22 @@
 //! The `walker` command line: output contract and bad-input handling.
-#![allow(missing_docs)]
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use serde_json::Value;
 use std::process::{Command, Output};
 
 fn walker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_walker")).args(args).output().expect("walker runs")
+    Command::new(env!("CARGO_BIN_EXE_walker"))
+        .args(args)
+        .output()
+        .expect("walker runs")
 }
 
 fn json(out: &Output) -> Value {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("valid json")
 }
 
@@ -17,14 +24,49 @@ fn json(out: &Output) -> Value {
 fn bad_input_is_named_and_exits_2() {
     let cases: &[(&[&str], &str)] = &[
         (&["gait", "--scene", "nosuch"], "nosuch"),
-        (&["gait", "--scene", "compass", "--set", "leg_mass=1"], "leg_mass"),
-        (&["gait", "--scene", "compass", "--set", "leg_mass_kg=heavy"], "heavy"),
-        (&["gait", "--scene", "compass", "--set", "leg_mass_kg=-2"], "leg_mass_kg"),
-        (&["gait", "--scene", "compass", "--set", "hip_mass_kg=NaN"], "hip_mass_kg"),
-        (&["gait", "--scene", "compass", "--set", "slope_rad"], "slope_rad"),
-        (&["walk", "--scene", "compass", "--steps", "2", "--perturb", "knee=1"], "knee"),
-        (&["sweep", "--scene", "compass", "--param", "nope", "--from", "0", "--to", "1", "--points", "3"], "nope"),
-        (&["gait", "--scene", "compass", "--integrator", "euler"], "euler"),
+        (
+            &["gait", "--scene", "compass", "--set", "leg_mass=1"],
+            "leg_mass",
+        ),
+        (
+            &["gait", "--scene", "compass", "--set", "leg_mass_kg=heavy"],
+            "heavy",
+        ),
+        (
+            &["gait", "--scene", "compass", "--set", "leg_mass_kg=-2"],
+            "leg_mass_kg",
+        ),
+        (
+            &["gait", "--scene", "compass", "--set", "hip_mass_kg=NaN"],
+            "hip_mass_kg",
+        ),
+        (
+            &["gait", "--scene", "compass", "--set", "slope_rad"],
+            "slope_rad",
+        ),
+        (
+            &[
+                "walk",
+                "--scene",
+                "compass",
+                "--steps",
+                "2",
+                "--perturb",
+                "knee=1",
+            ],
+            "knee",
+        ),
+        (
+            &[
+                "sweep", "--scene", "compass", "--param", "nope", "--from", "0", "--to", "1",
+                "--points", "3",
+            ],
+            "nope",
+        ),
+        (
+            &["gait", "--scene", "compass", "--integrator", "euler"],
+            "euler",
+        ),
         (&["walk", "--scene", "compass", "--steps", "many"], "many"),
     ];
     for (args, needle) in cases {
@@ -37,7 +79,9 @@ fn bad_input_is_named_and_exits_2() {
 
 #[test]
 fn walk_json_reports_steps_and_the_first_failure() {
-    let ok = json(&walker(&["walk", "--scene", "compass", "--steps", "4", "--json"]));
+    let ok = json(&walker(&[
+        "walk", "--scene", "compass", "--steps", "4", "--json",
+    ]));
     assert_eq!(ok["steps_completed"], 4);
     assert!(ok["failure"].is_null());
     assert_eq!(ok["steps"].as_array().unwrap().len(), 4);
@@ -46,7 +90,14 @@ fn walk_json_reports_steps_and_the_first_failure() {
         assert!(s["state_deviation"].as_f64().unwrap() < 1e-8);
     }
     let bad = json(&walker(&[
-        "walk", "--scene", "compass", "--steps", "10", "--perturb", "stance_leg_dot=0.6", "--json",
+        "walk",
+        "--scene",
+        "compass",
+        "--steps",
+        "10",
+        "--perturb",
+        "stance_leg_dot=0.6",
+        "--json",
     ]));
     assert_eq!(bad["steps_completed"], 0);
     assert_eq!(bad["failure"]["kind"], "fell_backward");
@@ -59,7 +110,15 @@ fn walk_writes_its_trajectory_as_csv() {
     let dir = std::env::temp_dir().join(format!("walker-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("walk.csv");
-    let out = walker(&["walk", "--scene", "compass", "--steps", "2", "--out", path.to_str().unwrap()]);
+    let out = walker(&[
+        "walk",
+        "--scene",
+        "compass",
+        "--steps",
+        "2",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
     assert!(out.status.success());
     let text = std::fs::read_to_string(&path).unwrap();
     let mut lines = text.lines();
@@ -67,7 +126,9 @@ fn walk_writes_its_trajectory_as_csv() {
         lines.next().unwrap(),
         "step,time_s,stance_leg,swing_leg,stance_leg_dot,swing_leg_dot,hip_x_m,hip_y_m,hip_z_m"
     );
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
     assert!(rows.len() > 20);
     // The hip advances down the slope over two steps.
     assert!(rows.last().unwrap()[6] > rows[0][6] + 0.8);
@@ -77,8 +138,8 @@ fn walk_writes_its_trajectory_as_csv() {
 #[test]
 fn sweep_json_reports_points_and_stability_boundaries() {
     let v = json(&walker(&[
-        "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.012", "--to", "0.0165", "--points", "10",
-        "--json",
+        "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.012", "--to", "0.0165",
+        "--points", "10", "--json",
     ]));
     let points = v["points"].as_array().unwrap();
     assert_eq!(points.len(), 10);
@@ -96,12 +157,22 @@ fn sweep_json_reports_points_and_stability_boundaries() {
 #[test]
 fn scenes_lists_parameters_with_units_and_defaults() {
     let v = json(&walker(&["scenes", "--json"]));
-    let names: Vec<&str> = v["scenes"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> = v["scenes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
     for n in ["simplest", "compass", "kneed2d"] {
         assert!(names.contains(&n));
     }
     let simplest = &v["scenes"][0];
-    let slope = simplest["parameters"].as_array().unwrap().iter().find(|p| p["name"] == "slope_rad").unwrap();
+    let slope = simplest["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "slope_rad")
+        .unwrap();
     assert_eq!(slope["default"], 0.009);
     assert_eq!(slope["unit"], "rad");
     assert_eq!(slope["aliases"][0], "slope");

@@ -1,5 +1,5 @@
 //! Every typed failure outcome is reached, by a physical cause where there is one.
-#![allow(missing_docs)]
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
 
@@ -22,7 +22,10 @@ fn perturbed(w: &Walker, name: &str, delta: f64) -> FailureKind {
 #[test]
 fn too_slow_falls_backward() {
     let (_, w) = common::walker("compass");
-    assert_eq!(perturbed(&w, "stance_leg_dot", 0.6), FailureKind::FellBackward);
+    assert_eq!(
+        perturbed(&w, "stance_leg_dot", 0.6),
+        FailureKind::FellBackward
+    );
 }
 
 #[test]
@@ -40,20 +43,28 @@ fn a_bent_knee_scuffs_the_floor() {
 #[test]
 fn a_short_step_strikes_before_the_knee_locks() {
     let (_, w) = common::walker("kneed2d");
-    assert_eq!(perturbed(&w, "stance_leg", -0.5), FailureKind::HeelStrikeBeforeKneeLock);
+    assert_eq!(
+        perturbed(&w, "stance_leg", -0.5),
+        FailureKind::HeelStrikeBeforeKneeLock
+    );
 }
 
 #[test]
 fn a_swing_leg_thrown_forward_keeps_the_old_stance_foot_down() {
     let (_, w) = common::walker("compass");
-    assert_eq!(perturbed(&w, "swing_leg_dot", 3.0), FailureKind::StanceFootDidNotLift);
+    assert_eq!(
+        perturbed(&w, "swing_leg_dot", 3.0),
+        FailureKind::StanceFootDidNotLift
+    );
 }
 
 #[test]
 fn no_heel_strike_within_the_time_budget() {
     let (_, mut w) = common::walker("compass");
     w.max_stride_time_s = 0.1;
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::NoImpactWithinTime);
 }
 
@@ -62,43 +73,71 @@ fn a_non_finite_state_is_caught() {
     let (_, w) = common::walker("compass");
     let mut q = w.guess_q.clone();
     q[0] = f64::NAN;
-    let e = w.stride(&q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    let e = w
+        .stride(&q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
 
 #[test]
 fn a_meijaard_step_beyond_the_stability_limit_is_reported() {
     let (_, mut w) = common::walker("compass");
-    w.integrator = IntegratorChoice::Meijaard { h_s: 1.0, check_every: 1 };
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    w.integrator = IntegratorChoice::Meijaard {
+        h_s: 1.0,
+        check_every: 1,
+    };
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
     // The same step without the check produces a stride anyway (garbage or failure) - the
     // check is what turns it into a typed error; a small step passes the check.
-    w.integrator = IntegratorChoice::Meijaard { h_s: 1e-3, check_every: 1 };
-    w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap();
+    w.integrator = IntegratorChoice::Meijaard {
+        h_s: 1e-3,
+        check_every: 1,
+    };
+    w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap();
 }
 
 #[test]
 fn an_unreachable_tolerance_underflows_the_adaptive_step() {
     let (_, mut w) = common::walker("compass");
-    w.integrator = IntegratorChoice::Dopri5 { rtol: 1e-30, atol: 1e-30, h_max_s: 0.05 };
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    w.integrator = IntegratorChoice::Dopri5 {
+        rtol: 1e-30,
+        atol: 1e-30,
+        h_max_s: 0.05,
+    };
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::StepUnderflow);
 }
 
 #[test]
 fn an_event_without_refinement_budget_is_not_located() {
     let (_, mut w) = common::walker("compass");
-    w.event_tolerance = EventTolerance { max_iterations: 0, ..Default::default() };
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    w.event_tolerance = EventTolerance {
+        max_iterations: 0,
+        ..Default::default()
+    };
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::EventNotLocated);
 }
 
 #[test]
 fn redundant_contact_constraints_make_the_impact_singular() {
     let (_, mut w) = common::walker("compass");
-    w.heel_strike.constraints = vec![ContactConstraint::X, ContactConstraint::Y, ContactConstraint::X];
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    w.heel_strike.constraints = vec![
+        ContactConstraint::X,
+        ContactConstraint::Y,
+        ContactConstraint::X,
+    ];
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::ImpactSingular);
 }
 
@@ -107,7 +146,9 @@ fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
     let (_, mut w) = common::walker("compass");
     let (a, b) = (w.relabel.pairs[0].0, w.relabel.pairs[1].0);
     w.relabel.pairs = vec![(a, a), (b, b)];
-    let e = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default()).unwrap_err();
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
     assert_eq!(e.kind, FailureKind::RelabelFailed);
 }
 
@@ -115,8 +156,14 @@ fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
 fn newton_reports_its_spent_budget_and_failed_strides() {
     let (_, w) = common::walker("compass");
     let v0 = w.pack(&w.guess_q, &w.guess_qd);
-    let tight = NewtonSettings { max_iterations: 1, ..Default::default() };
-    assert!(matches!(w.find_gait(&v0, &tight), Err(NewtonError::NotConverged { iterations: 1, .. })));
+    let tight = NewtonSettings {
+        max_iterations: 1,
+        ..Default::default()
+    };
+    assert!(matches!(
+        w.find_gait(&v0, &tight),
+        Err(NewtonError::NotConverged { iterations: 1, .. })
+    ));
     let bad = DVector::from_vec(vec![0.27, -0.54, -3.0, 0.7]);
     assert!(matches!(
         w.find_gait(&bad, &NewtonSettings::default()),

@@ -1,6 +1,6 @@
 //! Physics checked against physics: energy in passive phases and integrator orders, angular
 //! momentum across heel strike, the mass matrix, mirroring.
-#![allow(missing_docs)]
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
 
@@ -14,7 +14,13 @@ use sim::stride::Phase;
 use sim::walker::Walker;
 
 /// Integrates `sys` over `[0, t_end]` in `n` equal steps.
-fn integrate(ch: &IntegratorChoice, sys: &mut dyn SecondOrderSystem, s0: &Sample, t_end: f64, n: usize) -> Sample {
+fn integrate(
+    ch: &IntegratorChoice,
+    sys: &mut dyn SecondOrderSystem,
+    s0: &Sample,
+    t_end: f64,
+    n: usize,
+) -> Sample {
     let mut integ = ch.build();
     let h = t_end / n as f64;
     let mut s = s0.clone();
@@ -25,7 +31,12 @@ fn integrate(ch: &IntegratorChoice, sys: &mut dyn SecondOrderSystem, s0: &Sample
 }
 
 fn reference(sys: &mut dyn SecondOrderSystem, s0: &Sample, t_end: f64) -> Sample {
-    let mut integ = IntegratorChoice::Dopri5 { rtol: 1e-14, atol: 1e-14, h_max_s: 0.01 }.build();
+    let mut integ = IntegratorChoice::Dopri5 {
+        rtol: 1e-14,
+        atol: 1e-14,
+        h_max_s: 0.01,
+    }
+    .build();
     let mut s = s0.clone();
     while s.t_s < t_end - 1e-15 {
         s = integ.advance(sys, &s, t_end - s.t_s).unwrap();
@@ -46,7 +57,11 @@ fn energy(model: &Model, s: &Sample) -> f64 {
 
 fn compass_swing() -> (Walker, Sample) {
     let (_, w) = common::walker("compass");
-    let s0 = Sample { t_s: 0.0, q: w.guess_q.clone(), qd: w.guess_qd.clone() };
+    let s0 = Sample {
+        t_s: 0.0,
+        q: w.guess_q.clone(),
+        qd: w.guess_qd.clone(),
+    };
     (w, s0)
 }
 
@@ -62,7 +77,13 @@ fn energy_is_conserved_in_passive_swing_with_error_shrinking_at_each_order() {
     let steps = [50, 100, 200, 400];
     let rk4: Vec<f64> = steps
         .iter()
-        .map(|&n| (energy(&w.model, &integrate(&IntegratorChoice::Rk4 { h_s: 0.0 }, &mut sys, &s0, t_end, n)) - e0).abs())
+        .map(|&n| {
+            (energy(
+                &w.model,
+                &integrate(&IntegratorChoice::Rk4 { h_s: 0.0 }, &mut sys, &s0, t_end, n),
+            ) - e0)
+                .abs()
+        })
         .collect();
     for p in orders(&rk4[..3]) {
         assert!((3.7..4.4).contains(&p), "rk4 energy order {p} ({rk4:?})");
@@ -72,17 +93,28 @@ fn energy_is_conserved_in_passive_swing_with_error_shrinking_at_each_order() {
     let mj: Vec<f64> = steps
         .iter()
         .map(|&n| {
-            let ch = IntegratorChoice::Meijaard { h_s: 0.0, check_every: 0 };
+            let ch = IntegratorChoice::Meijaard {
+                h_s: 0.0,
+                check_every: 0,
+            };
             (energy(&w.model, &integrate(&ch, &mut sys, &s0, t_end, n)) - e0).abs()
         })
         .collect();
     for p in orders(&mj) {
-        assert!((0.9..1.4).contains(&p), "meijaard energy order {p} ({mj:?})");
+        assert!(
+            (0.9..1.4).contains(&p),
+            "meijaard energy order {p} ({mj:?})"
+        );
     }
     // Dopri5's error shrinks with its tolerance.
     let mut last = f64::INFINITY;
     for rtol in [1e-6, 1e-8, 1e-10] {
-        let mut integ = IntegratorChoice::Dopri5 { rtol, atol: rtol, h_max_s: 0.05 }.build();
+        let mut integ = IntegratorChoice::Dopri5 {
+            rtol,
+            atol: rtol,
+            h_max_s: 0.05,
+        }
+        .build();
         let mut s = s0.clone();
         while s.t_s < t_end - 1e-15 {
             s = integ.advance(&mut sys, &s, t_end - s.t_s).unwrap();
@@ -100,9 +132,18 @@ fn pendulum(damping: f64) -> Model {
         "arm",
         None,
         Vector3::zeros(),
-        JointKind::Revolute { axis_parent: Vector3::z() },
-        JointForce { damping, ..Default::default() },
-        BodyInertia { mass_kg: 1.0, p_link_com_m: Vector3::new(0.0, -1.0, 0.0), ..BodyInertia::massless() },
+        JointKind::Revolute {
+            axis_parent: Vector3::z(),
+        },
+        JointForce {
+            damping,
+            ..Default::default()
+        },
+        BodyInertia {
+            mass_kg: 1.0,
+            p_link_com_m: Vector3::new(0.0, -1.0, 0.0),
+            ..BodyInertia::massless()
+        },
     )
     .unwrap();
     m
@@ -122,8 +163,15 @@ fn state_errors(model: &Model, ch: &IntegratorChoice, s0: &Sample, t_end: f64) -
 
 #[test]
 fn meijaard_is_second_order_without_velocity_dependence_and_first_order_with_strong_damping() {
-    let s0 = Sample { t_s: 0.0, q: DVector::from_element(1, 0.5), qd: DVector::from_element(1, 0.0) };
-    let ch = IntegratorChoice::Meijaard { h_s: 0.0, check_every: 0 };
+    let s0 = Sample {
+        t_s: 0.0,
+        q: DVector::from_element(1, 0.5),
+        qd: DVector::from_element(1, 0.0),
+    };
+    let ch = IntegratorChoice::Meijaard {
+        h_s: 0.0,
+        check_every: 0,
+    };
     let undamped = state_errors(&pendulum(0.0), &ch, &s0, 2.0);
     for p in orders(&undamped) {
         assert!((1.8..2.3).contains(&p), "undamped order {p} ({undamped:?})");
@@ -132,7 +180,12 @@ fn meijaard_is_second_order_without_velocity_dependence_and_first_order_with_str
     for p in orders(&damped) {
         assert!((0.8..1.3).contains(&p), "damped order {p} ({damped:?})");
     }
-    let rk4 = state_errors(&pendulum(4.0), &IntegratorChoice::Rk4 { h_s: 0.0 }, &s0, 2.0);
+    let rk4 = state_errors(
+        &pendulum(4.0),
+        &IntegratorChoice::Rk4 { h_s: 0.0 },
+        &s0,
+        2.0,
+    );
     for p in orders(&rk4) {
         assert!((3.7..4.4).contains(&p), "rk4 order {p} ({rk4:?})");
     }
@@ -143,14 +196,19 @@ fn angular_momentum_about_the_new_contact_is_conserved_across_heel_strike() {
     for name in ["compass", "kneed2d"] {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
-        let active: Vec<bool> = (0..w.model.dof()).map(|i| !w.knees.iter().any(|k| k.coordinate.0 == i)).collect();
+        let active: Vec<bool> = (0..w.model.dof())
+            .map(|i| !w.knees.iter().any(|k| k.coordinate.0 == i))
+            .collect();
         let imp = w.heel_strike_impact(&g.stride.pre_impact, &active).unwrap();
         let mut d = Dynamics::new(&w.impact_model);
         d.assemble(&w.impact_model, &imp.q, &imp.qd_minus, None);
         let before = d.angular_momentum_about(&w.impact_model, &imp.p_contact_m);
         d.assemble(&w.impact_model, &imp.q, &imp.qd_plus, None);
         let after = d.angular_momentum_about(&w.impact_model, &imp.p_contact_m);
-        assert!((before - after).norm() < 1e-12 * (1.0 + before.norm()), "{name}: {before} vs {after}");
+        assert!(
+            (before - after).norm() < 1e-12 * (1.0 + before.norm()),
+            "{name}: {before} vs {after}"
+        );
         // And the impact is dissipative and the new contact is at rest.
         assert!(imp.energy_loss_j > 0.0);
         // Angular momentum about the old contact is NOT conserved (the check could fail).
@@ -163,7 +221,12 @@ fn angular_momentum_about_the_new_contact_is_conserved_across_heel_strike() {
 }
 
 /// A random spatial chain: 2-6 links with random axes, offsets and inertias.
-fn random_chain(axes: &[[f64; 3]], offsets: &[[f64; 3]], masses: &[f64], inertias: &[[f64; 3]]) -> Model {
+fn random_chain(
+    axes: &[[f64; 3]],
+    offsets: &[[f64; 3]],
+    masses: &[f64],
+    inertias: &[[f64; 3]],
+) -> Model {
     let mut m = Model::new(Vector3::new(0.0, -9.81, 0.0));
     let mut parent: Option<String> = None;
     for i in 0..axes.len() {
@@ -175,7 +238,9 @@ fn random_chain(axes: &[[f64; 3]], offsets: &[[f64; 3]], masses: &[f64], inertia
             &name,
             parent.as_deref(),
             Vector3::from(offsets[i]),
-            JointKind::Revolute { axis_parent: Vector3::from(axes[i]) },
+            JointKind::Revolute {
+                axis_parent: Vector3::from(axes[i]),
+            },
             JointForce::default(),
             BodyInertia {
                 mass_kg: masses[i],
@@ -191,7 +256,8 @@ fn random_chain(axes: &[[f64; 3]], offsets: &[[f64; 3]], masses: &[f64], inertia
 }
 
 fn axis() -> impl Strategy<Value = [f64; 3]> {
-    prop::array::uniform3(-1.0..1.0f64).prop_filter("non-zero", |a| a.iter().map(|x| x * x).sum::<f64>() > 0.01)
+    prop::array::uniform3(-1.0..1.0f64)
+        .prop_filter("non-zero", |a| a.iter().map(|x| x * x).sum::<f64>() > 0.01)
 }
 
 proptest! {
@@ -279,7 +345,10 @@ fn relabelling_twice_returns_the_configuration() {
             w.relabel.solve(&w.model, &states, q).unwrap().q
         };
         let once = relabel_once(&q0);
-        assert!((&once - &q0).amax() > 1e-3, "{name}: relabelling must change the labels");
+        assert!(
+            (&once - &q0).amax() > 1e-3,
+            "{name}: relabelling must change the labels"
+        );
         let twice = relabel_once(&once);
         assert!((&twice - &q0).amax() < 1e-10, "{name}: {twice} vs {q0}");
     }
@@ -292,15 +361,26 @@ fn stride_jacobian_eigenvalues_converge_as_the_perturbation_shrinks() {
         let g = common::gait(&w);
         let s = w.stride_map(&g.fixed_point).unwrap().0;
         let spectral = |d: f64| {
-            let set = sim::limit_cycle::NewtonSettings { perturbation: d, ..Default::default() };
+            let set = sim::limit_cycle::NewtonSettings {
+                perturbation: d,
+                ..Default::default()
+            };
             let j = w.stride_jacobian(&g.fixed_point, &s, &set).unwrap();
-            j.complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max)
+            j.complex_eigenvalues()
+                .iter()
+                .map(|z| z.norm())
+                .fold(0.0, f64::max)
         };
         let reference = spectral(1e-6);
-        let errors: Vec<f64> =
-            [4e-3, 1e-3, 2.5e-4].iter().map(|&d| (spectral(d) - reference).abs()).collect();
+        let errors: Vec<f64> = [4e-3, 1e-3, 2.5e-4]
+            .iter()
+            .map(|&d| (spectral(d) - reference).abs())
+            .collect();
         // Central differences: the error falls like d², a factor ~16 per quartering of the step.
-        assert!(errors[0] > 8.0 * errors[1] && errors[1] > 8.0 * errors[2], "{name}: {errors:?}");
+        assert!(
+            errors[0] > 8.0 * errors[1] && errors[1] > 8.0 * errors[2],
+            "{name}: {errors:?}"
+        );
         assert!(errors[2] < 1e-3, "{name}: {errors:?}");
     }
 }

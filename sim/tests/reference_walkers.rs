@@ -1,5 +1,5 @@
 //! The general engine against published numbers and hand-derived reference models.
-#![allow(missing_docs)]
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
 
@@ -17,7 +17,11 @@ fn walker_gait_json_reproduces_garcia_fixed_point_to_1e_8() {
         .args(["gait", "--scene", "simplest", "--json"])
         .output()
         .expect("walker runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(v["scene"], "simplest");
     assert_eq!(v["converged"], true);
@@ -27,7 +31,10 @@ fn walker_gait_json_reproduces_garcia_fixed_point_to_1e_8() {
     let phi = fp["phi"].as_f64().unwrap();
     let phi_dot = fp["phi_dot"].as_f64().unwrap();
     assert!((theta - GARCIA_THETA).abs() < 1e-8, "theta {theta}");
-    assert!((theta_dot - GARCIA_THETA_DOT).abs() < 1e-8, "theta_dot {theta_dot}");
+    assert!(
+        (theta_dot - GARCIA_THETA_DOT).abs() < 1e-8,
+        "theta_dot {theta_dot}"
+    );
     // At heel strike phi = 2 theta, and the collision law gives phi_dot = (1 - cos 2θ) θ_dot.
     assert!((phi - 2.0 * GARCIA_THETA).abs() < 1e-8, "phi {phi}");
     let phi_dot_ref = (1.0 - (2.0 * GARCIA_THETA).cos()) * GARCIA_THETA_DOT;
@@ -52,10 +59,22 @@ fn garcia_stride(theta: f64, theta_dot: f64, slope: f64) -> Vector2<f64> {
     let f = |y: [f64; 4]| {
         let [th, thd, ph, phd] = y;
         let thdd = (th - slope).sin();
-        [thd, thdd, phd, thdd + (thd * thd - (th - slope).cos()) * ph.sin()]
+        [
+            thd,
+            thdd,
+            phd,
+            thdd + (thd * thd - (th - slope).cos()) * ph.sin(),
+        ]
     };
     let rk4 = |y: [f64; 4], h: f64| {
-        let add = |a: [f64; 4], b: [f64; 4], s: f64| [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2], a[3] + s * b[3]];
+        let add = |a: [f64; 4], b: [f64; 4], s: f64| {
+            [
+                a[0] + s * b[0],
+                a[1] + s * b[1],
+                a[2] + s * b[2],
+                a[3] + s * b[3],
+            ]
+        };
         let k1 = f(y);
         let k2 = f(add(y, k1, h / 2.0));
         let k3 = f(add(y, k2, h / 2.0));
@@ -67,7 +86,12 @@ fn garcia_stride(theta: f64, theta_dot: f64, slope: f64) -> Vector2<f64> {
         o
     };
     let g = |y: [f64; 4]| y[2] - 2.0 * y[0];
-    let mut y = [theta, theta_dot, 2.0 * theta, (1.0 - (2.0 * theta).cos()) * theta_dot];
+    let mut y = [
+        theta,
+        theta_dot,
+        2.0 * theta,
+        (1.0 - (2.0 * theta).cos()) * theta_dot,
+    ];
     let h = 1e-3;
     let mut t = 0.0;
     loop {
@@ -96,7 +120,10 @@ fn simplest_eigenvalues_match_a_hand_written_model_of_garcias_equations() {
     let g = common::gait(&w);
     let v = Vector2::new(g.fixed_point[0], g.fixed_point[2]);
     let s = garcia_stride(v[0], v[1], 0.009);
-    assert!((s - v).amax() < 1e-9, "independent model maps the fixed point to {s:?}");
+    assert!(
+        (s - v).amax() < 1e-9,
+        "independent model maps the fixed point to {s:?}"
+    );
     let d = 1e-6;
     let mut j = DMatrix::zeros(2, 2);
     for k in 0..2 {
@@ -104,14 +131,25 @@ fn simplest_eigenvalues_match_a_hand_written_model_of_garcias_equations() {
         a[k] += d;
         let mut b = v;
         b[k] -= d;
-        j.set_column(k, &((garcia_stride(a[0], a[1], 0.009) - garcia_stride(b[0], b[1], 0.009)) / (2.0 * d)));
+        j.set_column(
+            k,
+            &((garcia_stride(a[0], a[1], 0.009) - garcia_stride(b[0], b[1], 0.009)) / (2.0 * d)),
+        );
     }
     let reference = j.complex_eigenvalues();
     let max_ref = reference.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    assert!((g.max_abs_eigenvalue() - max_ref).abs() < 1e-6, "{} vs {max_ref}", g.max_abs_eigenvalue());
+    assert!(
+        (g.max_abs_eigenvalue() - max_ref).abs() < 1e-6,
+        "{} vs {max_ref}",
+        g.max_abs_eigenvalue()
+    );
     // The two nonzero eigenvalues of the 4x4 Jacobian are those of the 2x2 section map.
     for z in reference.iter() {
-        assert!(g.eigenvalues.iter().any(|e| (e - z).norm() < 1e-6), "{z} not among {:?}", g.eigenvalues);
+        assert!(
+            g.eigenvalues.iter().any(|e| (e - z).norm() < 1e-6),
+            "{z} not among {:?}",
+            g.eigenvalues
+        );
     }
 }
 
@@ -119,22 +157,23 @@ fn simplest_eigenvalues_match_a_hand_written_model_of_garcias_equations() {
 fn simplest_loses_stability_by_period_doubling_near_slope_0_0151() {
     // Garcia et al. (1998): the period-one gait becomes unstable at γ ≈ 0.0151.
     let (scene, _) = common::walker("simplest");
-    let (points, bounds) = sim::continuation::sweep(
-        &scene,
-        "slope",
-        0.009,
-        0.0165,
-        16,
-        &Default::default(),
-    )
-    .unwrap();
+    let (points, bounds) =
+        sim::continuation::sweep(&scene, "slope", 0.009, 0.0165, 16, &Default::default()).unwrap();
     assert!(points.iter().all(|p| p.gait.is_ok()));
     assert_eq!(bounds.len(), 1, "{bounds:?}");
     assert_eq!(bounds[0].change, "lost");
-    assert!((bounds[0].value - 0.0151).abs() < 2e-4, "{}", bounds[0].value);
+    assert!(
+        (bounds[0].value - 0.0151).abs() < 2e-4,
+        "{}",
+        bounds[0].value
+    );
     // Lost through −1: the critical eigenvalue is real and negative.
     let last = points.last().unwrap().gait.as_ref().unwrap();
-    let critical = last.eigenvalues.iter().max_by(|a, b| a.norm().total_cmp(&b.norm())).unwrap();
+    let critical = last
+        .eigenvalues
+        .iter()
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .unwrap();
     assert!(critical.re < -1.0 && critical.im.abs() < 1e-9, "{critical}");
 }
 
@@ -145,8 +184,11 @@ fn compass_gait_is_stable_with_goswami_leg_angles() {
     let (scene, w) = common::walker("compass");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    let out: std::collections::BTreeMap<_, _> =
-        scene.convention_outputs(&w, &q, &qd).unwrap().into_iter().collect();
+    let out: std::collections::BTreeMap<_, _> = scene
+        .convention_outputs(&w, &q, &qd)
+        .unwrap()
+        .into_iter()
+        .collect();
     assert!((out["stance"] + 0.2188).abs() < 1e-3, "{out:?}");
     assert!((out["swing"] - 0.3238).abs() < 1e-3, "{out:?}");
     assert!(g.stable());

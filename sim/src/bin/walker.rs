@@ -16,7 +16,11 @@ use std::io::Write;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "walker", version, about = "Passive dynamic walker simulator (Wisse, Schwab & van der Linde 2001)")]
+#[command(
+    name = "walker",
+    version,
+    about = "Passive dynamic walker simulator (Wisse, Schwab & van der Linde 2001)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -123,9 +127,9 @@ impl Common {
     fn walker(&self, scene: &Scene) -> Result<Walker, InputError> {
         let mut w = scene.build()?;
         let positive = |name: &str, v: Option<f64>| match v {
-            Some(x) if !(x.is_finite() && x > 0.0) => {
-                Err(InputError::Other(format!("--{name} must be a positive number, got {x}")))
-            }
+            Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
+                "--{name} must be a positive number, got {x}"
+            ))),
             _ => Ok(()),
         };
         positive("step-s", self.step_s)?;
@@ -134,8 +138,13 @@ impl Common {
         positive("perturbation", Some(self.perturbation))?;
         if let Some(kind) = &self.integrator {
             w.integrator = match kind.as_str() {
-                "meijaard" => IntegratorChoice::Meijaard { h_s: self.step_s.unwrap_or(1e-3), check_every: 0 },
-                "rk4" => IntegratorChoice::Rk4 { h_s: self.step_s.unwrap_or(1e-3) },
+                "meijaard" => IntegratorChoice::Meijaard {
+                    h_s: self.step_s.unwrap_or(1e-3),
+                    check_every: 0,
+                },
+                "rk4" => IntegratorChoice::Rk4 {
+                    h_s: self.step_s.unwrap_or(1e-3),
+                },
                 "dopri5" => IntegratorChoice::Dopri5 {
                     rtol: self.rtol.unwrap_or(1e-12),
                     atol: self.rtol.unwrap_or(1e-12),
@@ -147,11 +156,20 @@ impl Common {
                     )))
                 }
             };
-        } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) = (self.rtol, &w.integrator) {
-            w.integrator = IntegratorChoice::Dopri5 { rtol: r, atol: r, h_max_s: *h_max_s };
+        } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) =
+            (self.rtol, &w.integrator)
+        {
+            w.integrator = IntegratorChoice::Dopri5 {
+                rtol: r,
+                atol: r,
+                h_max_s: *h_max_s,
+            };
         } else if let Some(h) = self.step_s {
             w.integrator = match w.integrator {
-                IntegratorChoice::Meijaard { check_every, .. } => IntegratorChoice::Meijaard { h_s: h, check_every },
+                IntegratorChoice::Meijaard { check_every, .. } => IntegratorChoice::Meijaard {
+                    h_s: h,
+                    check_every,
+                },
                 IntegratorChoice::Rk4 { .. } => IntegratorChoice::Rk4 { h_s: h },
                 other => other,
             };
@@ -190,9 +208,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
             } else {
                 print_gait_text(&report);
             }
-            Ok(if result.is_ok() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+            Ok(if result.is_ok() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            })
         }
-        Command::Walk { common, steps, perturb, start, out } => {
+        Command::Walk {
+            common,
+            steps,
+            perturb,
+            start,
+            out,
+        } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
@@ -206,7 +234,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     }
                 },
                 other => {
-                    return Err(InputError::Other(format!("--start `{other}`: expected gait or guess")).into())
+                    return Err(InputError::Other(format!(
+                        "--start `{other}`: expected gait or guess"
+                    ))
+                    .into())
                 }
             };
             let names = walker.map_names();
@@ -221,9 +252,17 @@ fn run(cli: Cli) -> Result<ExitCode> {
                         names.join(", ")
                     ))
                 })?;
-                let d: f64 = d.trim().parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| {
-                    InputError::Other(format!("--perturb `{p}`: `{}` is not a finite number", d.trim()))
-                })?;
+                let d: f64 = d
+                    .trim()
+                    .parse()
+                    .ok()
+                    .filter(|x: &f64| x.is_finite())
+                    .ok_or_else(|| {
+                        InputError::Other(format!(
+                            "--perturb `{p}`: `{}` is not a finite number",
+                            d.trim()
+                        ))
+                    })?;
                 v[i] += d;
             }
             let (q, qd) = walker.unpack(&v);
@@ -235,8 +274,15 @@ fn run(cli: Cli) -> Result<ExitCode> {
             if common.json {
                 print_json(&report)?;
             } else {
-                println!("scene {}: {} of {steps} steps", scene.name(), walk.steps.len());
-                println!("{:>5} {:>10} {:>10} {:>10} {:>12}", "step", "t_s", "period_s", "length_m", "deviation");
+                println!(
+                    "scene {}: {} of {steps} steps",
+                    scene.name(),
+                    walk.steps.len()
+                );
+                println!(
+                    "{:>5} {:>10} {:>10} {:>10} {:>12}",
+                    "step", "t_s", "period_s", "length_m", "deviation"
+                );
                 for s in &walk.steps {
                     println!(
                         "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
@@ -245,22 +291,34 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 }
                 match &walk.failure {
                     None => println!("no failure"),
-                    Some(f) => println!("failure: {:?} in step {} at t = {:.4} s: {}", f.kind, f.step, f.time_s, f.detail),
+                    Some(f) => println!(
+                        "failure: {:?} in step {} at t = {:.4} s: {}",
+                        f.kind, f.step, f.time_s, f.detail
+                    ),
                 }
             }
             Ok(ExitCode::SUCCESS)
         }
-        Command::Sweep { common, param, from, to, points } => {
+        Command::Sweep {
+            common,
+            param,
+            from,
+            to,
+            points,
+        } => {
             let scene = common.scene()?;
             common.walker(&scene)?;
             if !(from.is_finite() && to.is_finite()) {
                 return Err(InputError::Other("--from and --to must be finite".into()).into());
             }
             if points < 2 {
-                return Err(InputError::Other(format!("--points must be at least 2, got {points}")).into());
+                return Err(InputError::Other(format!(
+                    "--points must be at least 2, got {points}"
+                ))
+                .into());
             }
-            let (pts, bounds) = sweep(&scene, &param, from, to, points, &common.newton())
-                .map_err(|e| match e {
+            let (pts, bounds) =
+                sweep(&scene, &param, from, to, points, &common.newton()).map_err(|e| match e {
                     sim::continuation::SweepError::Scene(s) => InputError::Scene(s),
                     other => InputError::Other(other.to_string()),
                 })?;
@@ -277,7 +335,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 println!("{:>14} {:>10} {:>8}", param, "max|λ|", "stable");
                 for p in &pts {
                     match &p.gait {
-                        Ok(g) => println!("{:>14.6} {:>10.6} {:>8}", p.value, g.max_abs_eigenvalue(), g.stable()),
+                        Ok(g) => println!(
+                            "{:>14.6} {:>10.6} {:>8}",
+                            p.value,
+                            g.max_abs_eigenvalue(),
+                            g.stable()
+                        ),
                         Err(e) => println!("{:>14.6} {:>10} {:>8}  {e}", p.value, "-", "-"),
                     }
                 }
@@ -310,7 +373,11 @@ fn scenes(as_json: bool) -> Result<ExitCode> {
         print_json(&json!({ "scenes": list }))?;
     } else {
         for s in &list {
-            println!("{} — {}", s["name"].as_str().unwrap_or(""), s["summary"].as_str().unwrap_or(""));
+            println!(
+                "{} — {}",
+                s["name"].as_str().unwrap_or(""),
+                s["summary"].as_str().unwrap_or("")
+            );
             for p in s["parameters"].as_array().into_iter().flatten() {
                 println!(
                     "    {:<24} default {:<10} [{}]  {}",
@@ -339,13 +406,20 @@ fn print_gait_text(r: &Value) {
     }
     println!("eigenvalues of the stride Jacobian:");
     for e in r["eigenvalues"].as_array().into_iter().flatten() {
-        let (re, im) = (e[0].as_f64().unwrap_or(f64::NAN), e[1].as_f64().unwrap_or(f64::NAN));
+        let (re, im) = (
+            e[0].as_f64().unwrap_or(f64::NAN),
+            e[1].as_f64().unwrap_or(f64::NAN),
+        );
         println!("    {re:>14.8} {im:>+14.8}i   |λ| = {:.8}", re.hypot(im));
     }
     println!(
         "max |λ| = {:.8} ({}), period {:.6} s, step {:.6} m, speed {:.6} m/s, {} Newton iterations",
         r["max_abs_eigenvalue"].as_f64().unwrap_or(f64::NAN),
-        if r["stable"] == json!(true) { "stable" } else { "unstable" },
+        if r["stable"] == json!(true) {
+            "stable"
+        } else {
+            "unstable"
+        },
         r["step_period_s"].as_f64().unwrap_or(f64::NAN),
         r["step_length_m"].as_f64().unwrap_or(f64::NAN),
         r["speed_m_s"].as_f64().unwrap_or(f64::NAN),
@@ -355,7 +429,12 @@ fn print_gait_text(r: &Value) {
 
 fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) -> Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let coords: Vec<&str> = walker.model.coordinates.iter().map(|c| c.name.as_str()).collect();
+    let coords: Vec<&str> = walker
+        .model
+        .coordinates
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
     write!(f, "step,time_s")?;
     for c in &coords {
         write!(f, ",{c}")?;
@@ -369,7 +448,11 @@ fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) ->
         for v in s.q.iter().chain(s.qd.iter()) {
             write!(f, ",{v}")?;
         }
-        writeln!(f, ",{},{},{}", s.hip_floor_m.x, s.hip_floor_m.y, s.hip_floor_m.z)?;
+        writeln!(
+            f,
+            ",{},{},{}",
+            s.hip_floor_m.x, s.hip_floor_m.y, s.hip_floor_m.z
+        )?;
     }
     f.flush()?;
     Ok(())
@@ -381,7 +464,8 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
-            if e.downcast_ref::<InputError>().is_some() || e.downcast_ref::<SceneError>().is_some() {
+            if e.downcast_ref::<InputError>().is_some() || e.downcast_ref::<SceneError>().is_some()
+            {
                 ExitCode::from(2)
             } else {
                 ExitCode::from(1)
@@ -389,4 +473,3 @@ fn main() -> ExitCode {
         }
     }
 }
-

@@ -9,9 +9,30 @@ const A: [[f64; 6]; 7] = [
     [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
     [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
-    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
 ];
 /// Fifth-order weights minus fourth-order weights.
 const E: [f64; 7] = [
@@ -39,7 +60,14 @@ pub struct Dopri5 {
 impl Dopri5 {
     /// Tolerances on the local error, and the largest step [s].
     pub fn new(rtol: f64, atol: f64, h_max_s: f64) -> Self {
-        Self { rtol, atol, h_max_s, h_next_s: 0.0, evaluations: 0, h_min_s: 1e-14 }
+        Self {
+            rtol,
+            atol,
+            h_max_s,
+            h_next_s: 0.0,
+            evaluations: 0,
+            h_min_s: 1e-14,
+        }
     }
 
     /// One Dormand-Prince step of size `h`; returns the new sample and the scaled error norm.
@@ -91,7 +119,14 @@ impl Dopri5 {
             err2 += (h * eq / sq).powi(2) + (h * ev / sv).powi(2);
         }
         let err = (err2 / (2 * n).max(1) as f64).sqrt();
-        Ok((Sample { t_s: s.t_s + h, q: q_new, qd: v_new }, err))
+        Ok((
+            Sample {
+                t_s: s.t_s + h,
+                q: q_new,
+                qd: v_new,
+            },
+            err,
+        ))
     }
 }
 
@@ -120,14 +155,25 @@ impl Integrator for Dopri5 {
         let mut h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
         loop {
             let (next, err) = self.try_step(sys, from, h)?;
-            let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+            let factor = if err == 0.0 {
+                5.0
+            } else {
+                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+            };
             if err <= 1.0 && err.is_finite() {
                 self.h_next_s = (h * factor).min(self.h_max_s);
                 return Ok(next);
             }
-            h *= if err.is_finite() { factor.min(0.9) } else { 0.2 };
+            h *= if err.is_finite() {
+                factor.min(0.9)
+            } else {
+                0.2
+            };
             if h < self.h_min_s {
-                return Err(IntegrationError::StepUnderflow { h_s: h, t_s: from.t_s });
+                return Err(IntegrationError::StepUnderflow {
+                    h_s: h,
+                    t_s: from.t_s,
+                });
             }
         }
     }

@@ -36,7 +36,12 @@ pub struct Meijaard {
 impl Meijaard {
     /// Fixed step `h_s` [s]; eq. (12) is checked every `check_every` steps (0: never).
     pub fn new(h_s: f64, check_every: usize) -> Self {
-        Self { h_s, check_every, steps: 0, evaluations: 0 }
+        Self {
+            h_s,
+            check_every,
+            steps: 0,
+            evaluations: 0,
+        }
     }
 }
 
@@ -57,7 +62,7 @@ impl Integrator for Meijaard {
         from: &Sample,
         h_limit_s: f64,
     ) -> Result<Sample, IntegrationError> {
-        if self.check_every > 0 && self.steps % self.check_every == 0 {
+        if self.check_every > 0 && self.steps.is_multiple_of(self.check_every) {
             if let Some(lim) = sys.stability_limit(from.t_s, &from.q, &from.qd) {
                 if self.h_s > lim.h_max_s() {
                     return Err(IntegrationError::StepTooLarge {

@@ -111,9 +111,11 @@ impl IntegratorChoice {
                 Box::new(Meijaard::new(h_s, check_every))
             }
             IntegratorChoice::Rk4 { h_s } => Box::new(Rk4::new(h_s)),
-            IntegratorChoice::Dopri5 { rtol, atol, h_max_s } => {
-                Box::new(Dopri5::new(rtol, atol, h_max_s))
-            }
+            IntegratorChoice::Dopri5 {
+                rtol,
+                atol,
+                h_max_s,
+            } => Box::new(Dopri5::new(rtol, atol, h_max_s)),
         }
     }
 

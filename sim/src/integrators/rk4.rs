@@ -12,7 +12,10 @@ pub struct Rk4 {
 impl Rk4 {
     /// Fixed step `h_s` [s].
     pub fn new(h_s: f64) -> Self {
-        Self { h_s, evaluations: 0 }
+        Self {
+            h_s,
+            evaluations: 0,
+        }
     }
 }
 

@@ -28,7 +28,12 @@ pub enum ExprError {
 
 /// Evaluates `expr` with `vars` bound.
 pub fn eval(expr: &str, vars: &BTreeMap<String, f64>) -> Result<f64, ExprError> {
-    let mut p = Parser { s: expr.as_bytes(), i: 0, expr, vars };
+    let mut p = Parser {
+        s: expr.as_bytes(),
+        i: 0,
+        expr,
+        vars,
+    };
     let v = p.sum()?;
     p.ws();
     if p.i != p.s.len() {
@@ -46,7 +51,11 @@ struct Parser<'a> {
 
 impl Parser<'_> {
     fn err(&self, what: &str) -> ExprError {
-        ExprError::Syntax { expr: self.expr.to_string(), what: what.to_string(), column: self.i + 1 }
+        ExprError::Syntax {
+            expr: self.expr.to_string(),
+            what: what.to_string(),
+            column: self.i + 1,
+        }
     }
     fn ws(&mut self) {
         while self.i < self.s.len() && self.s[self.i].is_ascii_whitespace() {
@@ -159,10 +168,13 @@ impl Parser<'_> {
                 if name == "pi" {
                     return Ok(std::f64::consts::PI);
                 }
-                self.vars.get(name).copied().ok_or_else(|| ExprError::UnknownName {
-                    expr: self.expr.to_string(),
-                    name: name.to_string(),
-                })
+                self.vars
+                    .get(name)
+                    .copied()
+                    .ok_or_else(|| ExprError::UnknownName {
+                        expr: self.expr.to_string(),
+                        name: name.to_string(),
+                    })
             }
             _ => Err(self.err("expected a number, a name or `(`")),
         }
@@ -186,7 +198,9 @@ mod tests {
     #[test]
     fn errors_name_the_problem() {
         let v = BTreeMap::new();
-        assert!(matches!(eval("x + 1", &v), Err(ExprError::UnknownName { name, .. }) if name == "x"));
+        assert!(
+            matches!(eval("x + 1", &v), Err(ExprError::UnknownName { name, .. }) if name == "x")
+        );
         assert!(matches!(eval("1 +", &v), Err(ExprError::Syntax { .. })));
         assert!(matches!(eval("(1", &v), Err(ExprError::Syntax { .. })));
     }

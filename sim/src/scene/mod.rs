@@ -116,15 +116,25 @@ impl Scene {
         }
         Err(SceneError::UnknownScene {
             name: name_or_path.to_string(),
-            available: BUILTIN.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+            available: BUILTIN
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", "),
         })
     }
 
     /// Parses scene text; `origin` names it in errors.
     pub fn parse(origin: &str, text: &str) -> Result<Self, SceneError> {
-        let file: SceneFile = toml::from_str(text)
-            .map_err(|e| SceneError::File { path: origin.to_string(), message: e.to_string() })?;
-        let values = file.parameters.iter().map(|(k, p)| (k.clone(), p.default)).collect();
+        let file: SceneFile = toml::from_str(text).map_err(|e| SceneError::File {
+            path: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        let values = file
+            .parameters
+            .iter()
+            .map(|(k, p)| (k.clone(), p.default))
+            .collect();
         let scene = Self { file, values };
         for (k, p) in &scene.file.parameters {
             scene.check_range(k, p.default)?;
@@ -150,9 +160,15 @@ impl Scene {
 
     fn check_range(&self, name: &str, value: f64) -> Result<(), SceneError> {
         let p = &self.file.parameters[name];
-        let (min, max) = (p.min.unwrap_or(f64::NEG_INFINITY), p.max.unwrap_or(f64::INFINITY));
+        let (min, max) = (
+            p.min.unwrap_or(f64::NEG_INFINITY),
+            p.max.unwrap_or(f64::INFINITY),
+        );
         if !value.is_finite() {
-            return Err(SceneError::NotANumber { name: name.into(), value: value.to_string() });
+            return Err(SceneError::NotANumber {
+                name: name.into(),
+                value: value.to_string(),
+            });
         }
         if value < min || value > max {
             return Err(SceneError::OutOfRange {
@@ -168,11 +184,19 @@ impl Scene {
 
     /// Sets a parameter (by name or alias) to a value, checking its range.
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), SceneError> {
-        let name = self.canonical(key).ok_or_else(|| SceneError::UnknownParameter {
-            scene: self.name().to_string(),
-            name: key.to_string(),
-            available: self.file.parameters.keys().cloned().collect::<Vec<_>>().join(", "),
-        })?;
+        let name = self
+            .canonical(key)
+            .ok_or_else(|| SceneError::UnknownParameter {
+                scene: self.name().to_string(),
+                name: key.to_string(),
+                available: self
+                    .file
+                    .parameters
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
         self.check_range(&name, value)?;
         self.values.insert(name, value);
         Ok(())
@@ -185,14 +209,23 @@ impl Scene {
         })?;
         let (k, v) = (k.trim(), v.trim());
         // Name first, so an unknown key is reported as such even with a bad value.
-        let name = self.canonical(k).ok_or_else(|| SceneError::UnknownParameter {
-            scene: self.name().to_string(),
-            name: k.to_string(),
-            available: self.file.parameters.keys().cloned().collect::<Vec<_>>().join(", "),
+        let name = self
+            .canonical(k)
+            .ok_or_else(|| SceneError::UnknownParameter {
+                scene: self.name().to_string(),
+                name: k.to_string(),
+                available: self
+                    .file
+                    .parameters
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        let value: f64 = v.parse().map_err(|_| SceneError::NotANumber {
+            name: name.clone(),
+            value: v.to_string(),
         })?;
-        let value: f64 = v
-            .parse()
-            .map_err(|_| SceneError::NotANumber { name: name.clone(), value: v.to_string() })?;
         self.set(&name, value)
     }
 
@@ -203,7 +236,10 @@ impl Scene {
             Num::Expr(e) => expr::eval(e, &self.values)?,
         };
         if !v.is_finite() {
-            return Err(SceneError::NonFinite { what: what.to_string(), value: v });
+            return Err(SceneError::NonFinite {
+                what: what.to_string(),
+                value: v,
+            });
         }
         Ok(v)
     }
@@ -261,17 +297,36 @@ impl Scene {
                     l.name
                 )));
             }
-            let parent = if l.parent == "ground" { None } else { Some(l.parent.as_str()) };
-            model.add_link(&l.name, parent, self.vec3(&l.origin_m, &what("origin_m"))?, joint, force, body)?;
+            let parent = if l.parent == "ground" {
+                None
+            } else {
+                Some(l.parent.as_str())
+            };
+            model.add_link(
+                &l.name,
+                parent,
+                self.vec3(&l.origin_m, &what("origin_m"))?,
+                joint,
+                force,
+                body,
+            )?;
         }
         for p in &f.points {
-            model.add_point(&p.name, &p.link, self.vec3(&Some(p.position_m.clone()), &p.name)?)?;
+            model.add_point(
+                &p.name,
+                &p.link,
+                self.vec3(&Some(p.position_m.clone()), &p.name)?,
+            )?;
         }
         let point = |name: &str| {
-            model.point_index(name).ok_or_else(|| SceneError::Invalid(format!("unknown point `{name}`")))
+            model
+                .point_index(name)
+                .ok_or_else(|| SceneError::Invalid(format!("unknown point `{name}`")))
         };
         let link = |name: &str| {
-            model.link_index(name).ok_or_else(|| SceneError::Invalid(format!("unknown link `{name}`")))
+            model
+                .link_index(name)
+                .ok_or_else(|| SceneError::Invalid(format!("unknown link `{name}`")))
         };
         let coord = |name: &str| {
             model
@@ -288,7 +343,9 @@ impl Scene {
                 "y" => Ok(ContactConstraint::Y),
                 "z" => Ok(ContactConstraint::Z),
                 "yaw" => Ok(ContactConstraint::Yaw),
-                o => Err(SceneError::Invalid(format!("heel_strike.constraints: unknown `{o}`"))),
+                o => Err(SceneError::Invalid(format!(
+                    "heel_strike.constraints: unknown `{o}`"
+                ))),
             })
             .collect::<Result<Vec<_>, _>>()?;
         let release = hs
@@ -304,7 +361,9 @@ impl Scene {
                 match (r.as_bytes().first(), axis.norm() > 0.0 && r.len() == 2) {
                     (Some(b't'), true) => Ok(JointKind::Prismatic { axis_parent: axis }),
                     (Some(b'r'), true) => Ok(JointKind::Revolute { axis_parent: axis }),
-                    _ => Err(SceneError::Invalid(format!("heel_strike.release: unknown `{r}`"))),
+                    _ => Err(SceneError::Invalid(format!(
+                        "heel_strike.release: unknown `{r}`"
+                    ))),
                 }
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -347,7 +406,12 @@ impl Scene {
                 .map(|[a, b]| Ok((point(a)?, point(b)?)))
                 .collect::<Result<Vec<_>, SceneError>>()?,
             mirror: f.relabel.mirror,
-            cyclic: f.relabel.cyclic.iter().map(|c| coord(c)).collect::<Result<Vec<_>, _>>()?,
+            cyclic: f
+                .relabel
+                .cyclic
+                .iter()
+                .map(|c| coord(c))
+                .collect::<Result<Vec<_>, _>>()?,
             tolerance: 1e-13,
             max_iterations: 50,
         };
@@ -362,14 +426,23 @@ impl Scene {
         }
         let it = &f.integrator;
         let integrator = match it.kind.as_str() {
-            "meijaard" => IntegratorChoice::Meijaard { h_s: it.h_s.unwrap_or(1e-3), check_every: 0 },
-            "rk4" => IntegratorChoice::Rk4 { h_s: it.h_s.unwrap_or(1e-3) },
+            "meijaard" => IntegratorChoice::Meijaard {
+                h_s: it.h_s.unwrap_or(1e-3),
+                check_every: 0,
+            },
+            "rk4" => IntegratorChoice::Rk4 {
+                h_s: it.h_s.unwrap_or(1e-3),
+            },
             "dopri5" => IntegratorChoice::Dopri5 {
                 rtol: it.rtol.unwrap_or(1e-12),
                 atol: it.atol.unwrap_or(1e-12),
                 h_max_s: it.h_max_s.unwrap_or(0.05),
             },
-            o => return Err(SceneError::Invalid(format!("integrator.kind: unknown `{o}`"))),
+            o => {
+                return Err(SceneError::Invalid(format!(
+                    "integrator.kind: unknown `{o}`"
+                )))
+            }
         };
         let max_stride_time_s = match &it.max_stride_time_s {
             Some(n) => self.num(n, "integrator.max_stride_time_s")?,
@@ -407,7 +480,9 @@ impl Scene {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<Vec<(String, f64)>, SceneError> {
-        let Some(conv) = &self.file.convention else { return Ok(Vec::new()) };
+        let Some(conv) = &self.file.convention else {
+            return Ok(Vec::new());
+        };
         let ts = self.num(&conv.time_scale_s, "convention.time_scale_s")?;
         let mut out = Vec::new();
         for o in &conv.outputs {
@@ -431,6 +506,8 @@ fn direction(s: &str) -> Result<Direction, SceneError> {
     match s {
         "rising" => Ok(Direction::Rising),
         "falling" => Ok(Direction::Falling),
-        o => Err(SceneError::Invalid(format!("direction `{o}` is not rising or falling"))),
+        o => Err(SceneError::Invalid(format!(
+            "direction `{o}` is not rising or falling"
+        ))),
     }
 }
