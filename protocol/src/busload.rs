@@ -113,7 +113,11 @@ mod tests {
     #[test]
     fn nominal_load_is_well_below_half_the_bus() {
         let l = nominal_load(crate::BITRATE_BPS);
-        assert!(l.fraction() > 0.05 && l.fraction() < 0.5, "{}", l.fraction());
+        assert!(
+            l.fraction() > 0.05 && l.fraction() < 0.5,
+            "{}",
+            l.fraction()
+        );
         assert!(l.unstuffed_bits_per_s < l.bits_per_s);
     }
 }

@@ -27,7 +27,11 @@ fn receivers(sender: &str) -> String {
 }
 
 fn write_dbc(out: &mut String) -> core::fmt::Result {
-    writeln!(out, "VERSION \"walker-protocol-{}\"", crate::PROTOCOL_VERSION)?;
+    writeln!(
+        out,
+        "VERSION \"walker-protocol-{}\"",
+        crate::PROTOCOL_VERSION
+    )?;
     writeln!(out)?;
     writeln!(out, "NS_ :")?;
     writeln!(out)?;
@@ -106,8 +110,10 @@ mod tests {
         let bo: alloc::vec::Vec<&str> = d.lines().filter(|l| l.starts_with("BO_ ")).collect();
         let expected: usize = MESSAGES.iter().map(|m| m.node_fields().count()).sum();
         assert_eq!(bo.len(), expected);
-        let mut ids: alloc::vec::Vec<&str> =
-            bo.iter().filter_map(|l| l.split_whitespace().nth(1)).collect();
+        let mut ids: alloc::vec::Vec<&str> = bo
+            .iter()
+            .filter_map(|l| l.split_whitespace().nth(1))
+            .collect();
         ids.sort_unstable();
         ids.dedup();
         assert_eq!(ids.len(), expected);

@@ -26,7 +26,7 @@ pub mod vectors;
 pub use error::{DecodeError, EncodeError, RangeError};
 pub use id::{CanId, MessageClass, NodeId, Target};
 pub use messages::{
-    spec, AnkleState, Command, CommandKind, FaultEvent, HeelStrike, Heartbeat, Message, ParamAck,
+    spec, AnkleState, Command, CommandKind, FaultEvent, Heartbeat, HeelStrike, Message, ParamAck,
     RawFrame, Version, BITRATE_BPS, MESSAGES, PROTOCOL_VERSION,
 };
 pub use values::{

@@ -66,12 +66,8 @@ pub mod layout {
     pub mod emergency_stop {
         use super::*;
         /// Always `EmergencyStop`.
-        pub const OPCODE: SignalSpec = enum_sig(
-            "opcode",
-            0,
-            Opcode::CHOICES,
-            "always EmergencyStop (3)",
-        );
+        pub const OPCODE: SignalSpec =
+            enum_sig("opcode", 0, Opcode::CHOICES, "always EmergencyStop (3)");
         /// Signals in byte order.
         pub const SIGNALS: &[SignalSpec] = &[OPCODE];
     }
@@ -117,7 +113,7 @@ pub mod layout {
         pub const DETAIL: SignalSpec = sig(
             "detail",
             2,
-Kind::I16,
+            Kind::I16,
             1.0,
             "",
             "offending raw value (encoder counts, rate in mrad/s, ...), 0 if none",
@@ -241,8 +237,12 @@ Kind::I16,
             "ankle angle the string is being held at (last setpoint when released)",
         );
         /// Reflex phase.
-        pub const PHASE: SignalSpec =
-            enum_sig("reflex_phase", 6, ReflexPhase::CHOICES, "stretch-reflex phase");
+        pub const PHASE: SignalSpec = enum_sig(
+            "reflex_phase",
+            6,
+            ReflexPhase::CHOICES,
+            "stretch-reflex phase",
+        );
         /// Signals in byte order.
         pub const SIGNALS: &[SignalSpec] = &[ANGLE, RATE, ACTUATOR_POSITION, PHASE];
     }
@@ -673,9 +673,7 @@ impl Message {
                     emergency_stop::OPCODE.put(&mut b, Opcode::EmergencyStop.raw() as i64);
                 }
                 CommandKind::Enable => command::OPCODE.put(&mut b, Opcode::Enable.raw() as i64),
-                CommandKind::Disable => {
-                    command::OPCODE.put(&mut b, Opcode::Disable.raw() as i64)
-                }
+                CommandKind::Disable => command::OPCODE.put(&mut b, Opcode::Disable.raw() as i64),
                 CommandKind::SetParam { param, value } => {
                     command::OPCODE.put(&mut b, Opcode::SetParam.raw() as i64);
                     command::PARAM_ID.put(&mut b, param.raw() as i64);
@@ -718,13 +716,9 @@ impl Message {
     pub fn decode(raw_id: u16, data: &[u8]) -> Result<Message, DecodeError> {
         use layout::*;
         let id = CanId::from_raw(raw_id)?;
-        let spec = spec(id.class).ok_or(DecodeError::UnknownId {
-            raw: raw_id as u32,
-        })?;
+        let spec = spec(id.class).ok_or(DecodeError::UnknownId { raw: raw_id as u32 })?;
         if !spec.has_node_field(id.node_raw) {
-            return Err(DecodeError::UnknownId {
-                raw: raw_id as u32,
-            });
+            return Err(DecodeError::UnknownId { raw: raw_id as u32 });
         }
         if data.len() != spec.dlc as usize {
             return Err(DecodeError::WrongLength {
@@ -889,7 +883,12 @@ mod tests {
                     used |= 1 << byte;
                 }
             }
-            assert_eq!(used.count_ones(), m.dlc as u32, "{}: payload fully used", m.name);
+            assert_eq!(
+                used.count_ones(),
+                m.dlc as u32,
+                "{}: payload fully used",
+                m.name
+            );
         }
     }
 
@@ -959,9 +958,6 @@ mod tests {
             target: Target::Node(NodeId::Host),
             kind: CommandKind::Enable,
         });
-        assert!(matches!(
-            cmd.encode(),
-            Err(EncodeError::InvalidNode { .. })
-        ));
+        assert!(matches!(cmd.encode(), Err(EncodeError::InvalidNode { .. })));
     }
 }

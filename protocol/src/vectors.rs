@@ -11,7 +11,7 @@ use core::fmt::Write as _;
 
 use crate::id::{NodeId, Target};
 use crate::messages::{
-    spec, AnkleState, Command, CommandKind, FaultEvent, HeelStrike, Heartbeat, Message, ParamAck,
+    spec, AnkleState, Command, CommandKind, FaultEvent, Heartbeat, HeelStrike, Message, ParamAck,
     Version,
 };
 use crate::values::{

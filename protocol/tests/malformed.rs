@@ -1,5 +1,7 @@
 //! Every kind of malformed frame gives its typed error.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
 use embedded_can::{ExtendedId, Frame, Id, StandardId};
 use protocol::*;
 
@@ -161,7 +163,10 @@ fn every_undefined_identifier_is_rejected() {
         let r = Message::decode(raw, &[0u8; 8][..]);
         if known {
             defined += 1;
-            assert!(!matches!(r, Err(DecodeError::UnknownId { .. })), "0x{raw:03X}");
+            assert!(
+                !matches!(r, Err(DecodeError::UnknownId { .. })),
+                "0x{raw:03X}"
+            );
         } else {
             assert_eq!(r, Err(DecodeError::UnknownId { raw: raw as u32 }));
         }

@@ -1,6 +1,8 @@
 //! Property: every message decodes back to itself, bit for bit, and its frame has the
 //! message's fixed length and identifier layout.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
 use proptest::prelude::*;
 use protocol::*;
 
@@ -11,10 +13,7 @@ fn ankle() -> impl Strategy<Value = NodeId> {
     prop::sample::select(NodeId::ANKLES.to_vec())
 }
 fn target() -> impl Strategy<Value = Target> {
-    prop_oneof![
-        ankle().prop_map(Target::Node),
-        Just(Target::Broadcast)
-    ]
+    prop_oneof![ankle().prop_map(Target::Node), Just(Target::Broadcast)]
 }
 fn pick<T: Copy + core::fmt::Debug + 'static>(all: &'static [T]) -> impl Strategy<Value = T> {
     prop::sample::select(all.to_vec())
@@ -49,13 +48,15 @@ fn message() -> impl Strategy<Value = Message> {
             0..=FaultFlags::defined_bits(),
             any::<u32>()
         )
-            .prop_map(|(node, state, bits, uptime_ms)| Message::Heartbeat(Heartbeat {
-                node,
-                state,
-                faults: FaultFlags::from_bits(bits & FaultFlags::defined_bits())
-                    .unwrap_or_default(),
-                uptime_ms,
-            })),
+            .prop_map(
+                |(node, state, bits, uptime_ms)| Message::Heartbeat(Heartbeat {
+                    node,
+                    state,
+                    faults: FaultFlags::from_bits(bits & FaultFlags::defined_bits())
+                        .unwrap_or_default(),
+                    uptime_ms,
+                })
+            ),
         (
             target(),
             prop_oneof![

@@ -1,0 +1,445 @@
+//! The ankle node: one deterministic `tick(now, inputs) -> outputs` step that handles
+//! commands, checks sensors, raises and clears faults, runs the reflex and schedules the
+//! node's CAN messages. No hardware here; drivers feed it ([`crate::runner`]) and so can a
+//! simulator.
+
+use heapless::Vec;
+use protocol::{
+    Angle, AngularRate, AnkleState, Command, CommandKind, FaultCode, FaultEvent, FaultFlags,
+    FaultTransition, Heartbeat, HeelStrike, Message, NodeId, NodeState, ParamAck, ParamStatus,
+    ReflexPhase, Version, PROTOCOL_VERSION,
+};
+
+use crate::estimator::{AngleEstimator, EstimatorGains};
+use crate::fmt::{log_info, log_warn};
+use crate::params::ReflexParams;
+use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
+use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
+use crate::time::Instant;
+
+/// Messages the node reads per tick at most (bounded work); callers keep the rest queued.
+pub const MAX_RX_PER_TICK: usize = 8;
+/// Capacity of the per-tick transmit list: heel strike, every fault code changing at once,
+/// one acknowledgement per received message, state, heartbeat and version.
+pub const MAX_TX_PER_TICK: usize = 1 + 8 + MAX_RX_PER_TICK + 3;
+
+/// Firmware version sent in the [`Version`] message.
+pub const FIRMWARE_VERSION: (u8, u8, u8) = (0, 1, 0);
+
+/// Configuration fixed at start-up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeConfig {
+    /// Which ankle this is.
+    pub node: NodeId,
+    /// Period of [`AnkleState`] telemetry [µs] (nominal 5 000: 200 Hz).
+    pub state_period_us: u64,
+    /// Period of the heartbeat [µs] (nominal 50 000: 20 Hz).
+    pub heartbeat_period_us: u64,
+    /// Period of the version message [µs] (nominal 5 000 000; also sent at start).
+    pub version_period_us: u64,
+    /// Build identifier sent in the version message.
+    pub build_id: u32,
+    /// Estimator gains.
+    pub estimator: EstimatorGains,
+}
+
+impl NodeConfig {
+    /// Nominal configuration for `node` (rates as in `docs/protocol.md`).
+    pub fn nominal(node: NodeId) -> Self {
+        NodeConfig {
+            node,
+            state_period_us: 5_000,
+            heartbeat_period_us: 50_000,
+            version_period_us: 5_000_000,
+            build_id: 0,
+            estimator: EstimatorGains::default(),
+        }
+    }
+}
+
+/// Why a node could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// Only the two ankles run this firmware.
+    NotAnAnkle(NodeId),
+    /// A period of zero would send every tick without bound.
+    ZeroPeriod,
+}
+
+/// Health of the drivers, as seen after the previous tick's outputs were applied.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct DriverHealth {
+    /// The actuator driver failed to apply the last command.
+    pub actuator_error: bool,
+    /// The CAN controller reported an error, or a frame could not be queued.
+    pub can_error: bool,
+}
+
+/// Inputs of one tick.
+#[derive(Clone, Copy, Debug)]
+pub struct TickInputs<'a> {
+    /// The encoder read of this tick.
+    pub angle: Result<AngleSample, EncoderError>,
+    /// Debounced contact switch: true when the foot is on the floor.
+    pub contact_closed: bool,
+    /// Messages received since the last tick (only the first [`MAX_RX_PER_TICK`] are read).
+    pub received: &'a [Message],
+    /// Driver health.
+    pub drivers: DriverHealth,
+}
+
+/// Outputs of one tick.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TickOutputs {
+    /// What the actuator must do.
+    pub actuator: ActuatorCommand,
+    /// Messages to send, highest priority first.
+    pub transmit: Vec<Message, MAX_TX_PER_TICK>,
+    /// Node state after the tick.
+    pub state: NodeState,
+    /// Reflex phase after the tick.
+    pub phase: ReflexPhase,
+}
+
+/// The ankle node.
+#[derive(Clone, Debug)]
+pub struct AnkleNode {
+    config: NodeConfig,
+    peer: NodeId,
+    params: ReflexParams,
+    state: NodeState,
+    reflex: Reflex,
+    faults: FaultFlags,
+    plausibility: Plausibility,
+    estimator: AngleEstimator,
+    last_sample_at: Option<Instant>,
+    contact: Option<bool>,
+    step_count: u16,
+    started_at: Option<Instant>,
+    last_peer_heartbeat: Option<Instant>,
+    next_state_at: Instant,
+    next_heartbeat_at: Instant,
+    next_version_at: Instant,
+    dropped_tx: u32,
+}
+
+/// Accumulates one tick's transmissions, counting what does not fit.
+struct Outbox<'a> {
+    list: Vec<Message, MAX_TX_PER_TICK>,
+    dropped: &'a mut u32,
+}
+
+impl Outbox<'_> {
+    fn push(&mut self, m: Message) {
+        if self.list.push(m).is_err() {
+            *self.dropped = self.dropped.saturating_add(1);
+        }
+    }
+}
+
+impl AnkleNode {
+    /// A disabled node with default parameters.
+    ///
+    /// # Errors
+    /// [`ConfigError::NotAnAnkle`] for the host id, [`ConfigError::ZeroPeriod`] for a zero
+    /// message period.
+    pub fn new(config: NodeConfig) -> Result<Self, ConfigError> {
+        let peer = config
+            .node
+            .peer()
+            .ok_or(ConfigError::NotAnAnkle(config.node))?;
+        if config.state_period_us == 0
+            || config.heartbeat_period_us == 0
+            || config.version_period_us == 0
+        {
+            return Err(ConfigError::ZeroPeriod);
+        }
+        Ok(AnkleNode {
+            config,
+            peer,
+            params: ReflexParams::default(),
+            state: NodeState::Disabled,
+            reflex: Reflex::default(),
+            faults: FaultFlags::NONE,
+            plausibility: Plausibility::default(),
+            estimator: AngleEstimator::new(config.estimator),
+            last_sample_at: None,
+            contact: None,
+            step_count: 0,
+            started_at: None,
+            last_peer_heartbeat: None,
+            next_state_at: Instant(0),
+            next_heartbeat_at: Instant(0),
+            next_version_at: Instant(0),
+            dropped_tx: 0,
+        })
+    }
+
+    /// This node's id.
+    pub fn id(&self) -> NodeId {
+        self.config.node
+    }
+    /// Node state.
+    pub fn state(&self) -> NodeState {
+        self.state
+    }
+    /// Reflex phase.
+    pub fn phase(&self) -> ReflexPhase {
+        self.reflex.phase()
+    }
+    /// Active faults.
+    pub fn faults(&self) -> FaultFlags {
+        self.faults
+    }
+    /// Parameters in force.
+    pub fn params(&self) -> &ReflexParams {
+        &self.params
+    }
+    /// Messages that did not fit a tick's transmit list (should stay 0).
+    pub fn dropped_tx(&self) -> u32 {
+        self.dropped_tx
+    }
+    /// Estimated ankle angle [rad] and rate [rad/s], `None` before a good sample.
+    pub fn estimate(&self) -> Option<(f32, f32)> {
+        self.estimator
+            .angle_rad()
+            .zip(self.estimator.rate_rad_per_s())
+    }
+
+    fn set_fault(&mut self, out: &mut Outbox, now: Instant, code: FaultCode, detail: Option<i16>) {
+        let present = detail.is_some();
+        if present == self.faults.contains(code) {
+            return;
+        }
+        let transition = if present {
+            self.faults.insert(code);
+            log_warn!("fault raised: {}", code);
+            FaultTransition::Raised
+        } else {
+            self.faults.remove(code);
+            log_info!("fault cleared: {}", code);
+            FaultTransition::Cleared
+        };
+        out.push(Message::Fault(FaultEvent {
+            node: self.config.node,
+            code,
+            transition,
+            detail: detail.unwrap_or(0),
+            uptime_ms: now.uptime_ms(),
+        }));
+    }
+
+    fn enter(&mut self, state: NodeState, contact_closed: bool) {
+        if state == self.state {
+            return;
+        }
+        log_info!("node state {} -> {}", self.state, state);
+        self.state = state;
+        if state == NodeState::Enabled {
+            self.reflex.start(contact_closed);
+        } else {
+            self.reflex.stop();
+        }
+    }
+
+    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, contact_closed: bool) {
+        if !cmd.target.addresses(self.config.node) {
+            return;
+        }
+        match cmd.kind {
+            CommandKind::EmergencyStop => self.enter(NodeState::EmergencyStop, contact_closed),
+            CommandKind::Disable => self.enter(NodeState::Disabled, contact_closed),
+            CommandKind::Enable => {
+                // From Disabled or Safe only, and only without a safety-relevant fault;
+                // emergency stop needs a Disable first.
+                let allowed = matches!(self.state, NodeState::Disabled | NodeState::Safe);
+                if allowed && !self.faults.any_safety_relevant() {
+                    self.enter(NodeState::Enabled, contact_closed);
+                }
+            }
+            CommandKind::SetParam { param, value } => {
+                let status = if self.state == NodeState::Enabled {
+                    ParamStatus::NotWhileEnabled
+                } else {
+                    match self.params.set(param, value) {
+                        Ok(()) => ParamStatus::Accepted,
+                        Err(s) => s,
+                    }
+                };
+                out.push(Message::ParamAck(ParamAck {
+                    node: self.config.node,
+                    param,
+                    status,
+                    value: self.params.wire_value(param),
+                }));
+            }
+        }
+    }
+
+    /// One control tick: constant work plus at most [`MAX_RX_PER_TICK`] messages.
+    pub fn tick(&mut self, now: Instant, inputs: &TickInputs) -> TickOutputs {
+        let mut dropped = self.dropped_tx;
+        let mut out = Outbox {
+            list: Vec::new(),
+            dropped: &mut dropped,
+        };
+        let started = *self.started_at.get_or_insert(now);
+        let contact = inputs.contact_closed;
+
+        // 1. Messages: commands to this node, the peer's heartbeat and heel strike.
+        let mut peer_heel_strike = false;
+        for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
+            match m {
+                Message::Command(c) => self.handle_command(&mut out, c, contact),
+                Message::Heartbeat(h) if h.node == self.peer => {
+                    self.last_peer_heartbeat = Some(now);
+                }
+                Message::HeelStrike(h) if h.node == self.peer => peer_heel_strike = true,
+                _ => {}
+            }
+        }
+
+        // 2. Sensors: plausibility, then the estimator on good samples.
+        let driving = self.reflex.phase() == ReflexPhase::Push;
+        let found: SensorFindings =
+            self.plausibility
+                .check(now, &inputs.angle, driving, &self.params);
+        self.set_fault(&mut out, now, FaultCode::EncoderComms, found.comms);
+        self.set_fault(&mut out, now, FaultCode::EncoderRange, found.range);
+        self.set_fault(&mut out, now, FaultCode::EncoderRate, found.rate);
+        self.set_fault(&mut out, now, FaultCode::EncoderStuck, found.stuck);
+        match inputs.angle {
+            Ok(s) if found.range.is_none() && found.rate.is_none() => {
+                let dt = self
+                    .last_sample_at
+                    .map(|t| now.secs_since(t))
+                    .unwrap_or(0.0);
+                self.estimator.update(s.angle_rad, dt);
+                self.last_sample_at = Some(now);
+            }
+            _ => {
+                self.estimator.reset();
+                self.last_sample_at = None;
+            }
+        }
+
+        // 3. Peer liveness (counted from start-up until the first heartbeat) and drivers.
+        let peer_seen = self.last_peer_heartbeat.unwrap_or(started);
+        let silent_s = now.secs_since(peer_seen);
+        let lost = silent_s > self.params.peer_heartbeat_timeout_s();
+        let silent_ms = (silent_s * 1000.0) as i16;
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::PeerHeartbeatLost,
+            lost.then_some(silent_ms),
+        );
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::Actuator,
+            inputs.drivers.actuator_error.then_some(0),
+        );
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::CanBus,
+            inputs.drivers.can_error.then_some(0),
+        );
+
+        // 4. Contact edges; the own heel strike is announced in every state.
+        let previous_contact = self.contact.replace(contact);
+        let heel_strike = previous_contact == Some(false) && contact;
+        let lift_off = previous_contact == Some(true) && !contact;
+        if heel_strike {
+            self.step_count = self.step_count.wrapping_add(1);
+            out.push(Message::HeelStrike(HeelStrike {
+                node: self.config.node,
+                step_count: self.step_count,
+                time_us: now.uptime_us(),
+            }));
+        }
+
+        // 5. Safe state on any safety-relevant fault.
+        if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
+            self.enter(NodeState::Safe, contact);
+        }
+
+        // 6. The reflex.
+        let angle_rad = self.estimator.angle_rad().unwrap_or(0.0);
+        let (actuator, event) = self.reflex.step(
+            &ReflexInputs {
+                now,
+                angle_rad,
+                heel_strike,
+                lift_off,
+                peer_heel_strike,
+            },
+            &self.params,
+        );
+        match event {
+            Some(ReflexEvent::Released(ReleaseCause::OwnLiftOff)) => {
+                self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, Some(0));
+            }
+            Some(ReflexEvent::Released(ReleaseCause::PeerHeelStrike)) => {
+                self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+            }
+            _ => {}
+        }
+        if self.state != NodeState::Enabled {
+            self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+        }
+
+        // 7. Periodic messages.
+        if now >= self.next_state_at {
+            let (a, r) = self.estimate().unwrap_or((0.0, 0.0));
+            out.push(Message::AnkleState(AnkleState {
+                node: self.config.node,
+                angle: Angle::saturating_from_si(a),
+                rate: AngularRate::saturating_from_si(r),
+                actuator_position: Angle::saturating_from_si(self.reflex.last_setpoint_rad()),
+                phase: self.reflex.phase(),
+            }));
+            self.next_state_at = Instant(now.0.saturating_add(self.config.state_period_us));
+        }
+        if now >= self.next_heartbeat_at {
+            out.push(Message::Heartbeat(Heartbeat {
+                node: self.config.node,
+                state: self.state,
+                faults: self.faults,
+                uptime_ms: now.uptime_ms(),
+            }));
+            self.next_heartbeat_at = Instant(now.0.saturating_add(self.config.heartbeat_period_us));
+        }
+        if now >= self.next_version_at {
+            let (major, minor, patch) = FIRMWARE_VERSION;
+            out.push(Message::Version(Version {
+                node: self.config.node,
+                protocol: PROTOCOL_VERSION,
+                major,
+                minor,
+                patch,
+                build: self.config.build_id,
+            }));
+            self.next_version_at = Instant(now.0.saturating_add(self.config.version_period_us));
+        }
+
+        // Priority order, stable (insertion sort: at most MAX_TX_PER_TICK entries).
+        let mut transmit = out.list;
+        for i in 1..transmit.len() {
+            let mut j = i;
+            while j > 0 && transmit[j - 1].id().raw() > transmit[j].id().raw() {
+                transmit.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        self.dropped_tx = dropped;
+        TickOutputs {
+            actuator,
+            transmit,
+            state: self.state,
+            phase: self.reflex.phase(),
+        }
+    }
+}

@@ -1,0 +1,272 @@
+//! Sensor samples as the node sees them, and their plausibility checks (range, rate, stuck).
+
+use crate::params::{ReflexParams, ANKLE_ANGLE_LIMIT_RAD};
+use crate::time::Instant;
+
+/// Counts per revolution of the 14-bit magnetic encoder.
+pub const ENCODER_COUNTS_PER_REV: u16 = 1 << 14;
+
+/// One good encoder reading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AngleSample {
+    /// Raw encoder counts (0..16383).
+    pub counts: u16,
+    /// Ankle angle after calibration [rad], negative when the hip is ahead of the ankle.
+    pub angle_rad: f32,
+}
+
+/// Why the encoder gave no reading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum EncoderError {
+    /// The SPI transfer failed.
+    Bus(embedded_hal::spi::ErrorKind),
+    /// The answer's even-parity bit is wrong.
+    Parity {
+        /// The 16-bit word received.
+        word: u16,
+    },
+    /// The sensor set its error flag (e.g. magnet too weak, framing error of the command).
+    ErrorFlag {
+        /// The 16-bit word received.
+        word: u16,
+    },
+}
+
+impl EncoderError {
+    /// A small code for the fault event's `detail` field: 1 bus, 2 parity, 3 error flag.
+    pub fn detail(&self) -> i16 {
+        match self {
+            EncoderError::Bus(_) => 1,
+            EncoderError::Parity { .. } => 2,
+            EncoderError::ErrorFlag { .. } => 3,
+        }
+    }
+}
+
+/// Encoder zero and direction: maps counts to the ankle angle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AngleCalibration {
+    /// Counts read when the ankle angle is zero.
+    pub zero_counts: u16,
+    /// True when the ankle angle grows as the counts fall.
+    pub reversed: bool,
+}
+
+impl AngleCalibration {
+    /// Ankle angle for a reading [rad], wrapped to (−π, π].
+    pub fn angle_rad(&self, counts: u16) -> f32 {
+        let n = ENCODER_COUNTS_PER_REV as i32;
+        let mut d = (counts as i32 - self.zero_counts as i32).rem_euclid(n);
+        if d > n / 2 {
+            d -= n;
+        }
+        if self.reversed {
+            d = -d;
+        }
+        d as f32 * (core::f32::consts::TAU / ENCODER_COUNTS_PER_REV as f32)
+    }
+
+    /// The reading that gives `angle_rad` (inverse of [`Self::angle_rad`], rounded to a count);
+    /// used by simulated encoders to quantise like the real sensor.
+    pub fn counts(&self, angle_rad: f32) -> u16 {
+        let per_rad = ENCODER_COUNTS_PER_REV as f32 / core::f32::consts::TAU;
+        let mut d = libm::roundf(angle_rad * per_rad) as i32;
+        if self.reversed {
+            d = -d;
+        }
+        (self.zero_counts as i32 + d).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
+    }
+}
+
+/// What the plausibility checks found in one sample; `Some(detail)` when a check fails,
+/// with the offending raw value for the fault event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct SensorFindings {
+    /// The read failed (detail: [`EncoderError::detail`]).
+    pub comms: Option<i16>,
+    /// Angle outside ±[`ANKLE_ANGLE_LIMIT_RAD`] (detail: angle in 0.1 mrad, saturated).
+    pub range: Option<i16>,
+    /// Rate above the limit (detail: rate in 10 mrad/s, saturated).
+    pub rate: Option<i16>,
+    /// No change while the actuator drives (detail: the stuck counts, as i16).
+    pub stuck: Option<i16>,
+}
+
+/// Range, rate and stuck-value checks across samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Plausibility {
+    last_good: Option<(Instant, AngleSample)>,
+    last_change: Option<(Instant, u16)>,
+    stuck_at: Option<u16>,
+}
+
+fn saturate_i16(x: f32) -> i16 {
+    // Float-to-int `as` saturates and maps NaN to 0.
+    x as i16
+}
+
+impl Plausibility {
+    /// Check one read. `driving` is true while the actuator is moving the ankle (push phase),
+    /// when a frozen reading means a stuck sensor.
+    pub fn check(
+        &mut self,
+        now: Instant,
+        read: &Result<AngleSample, EncoderError>,
+        driving: bool,
+        params: &ReflexParams,
+    ) -> SensorFindings {
+        let mut f = SensorFindings::default();
+        let s = match read {
+            Err(e) => {
+                f.comms = Some(e.detail());
+                return f;
+            }
+            Ok(s) => *s,
+        };
+        if s.angle_rad.is_nan() || s.angle_rad.abs() > ANKLE_ANGLE_LIMIT_RAD {
+            f.range = Some(saturate_i16(s.angle_rad * 1.0e4));
+        }
+        if let Some((t, prev)) = self.last_good {
+            let dt = now.secs_since(t);
+            if dt > 0.0 {
+                let rate = (s.angle_rad - prev.angle_rad) / dt;
+                if rate.abs() > params.max_angular_rate_rad_per_s() {
+                    f.rate = Some(saturate_i16(rate * 100.0));
+                }
+            }
+        }
+        // The stuck timer runs only while driving, from the start of driving or the last
+        // change of the reading, whichever is later.
+        match self.last_change {
+            _ if !driving => self.last_change = None,
+            Some((_, c)) if c == s.counts => {}
+            _ => self.last_change = Some((now, s.counts)),
+        }
+        if let Some((since, c)) = self.last_change {
+            if driving && now.secs_since(since) > params.stuck_timeout_s() {
+                self.stuck_at = Some(c);
+            }
+        }
+        // A stuck reading stays a fault, driving or not, until the reading changes.
+        match self.stuck_at {
+            Some(c) if c == s.counts => f.stuck = Some(c as i16),
+            _ => self.stuck_at = None,
+        }
+        self.last_good = Some((now, s));
+        f
+    }
+}
+
+/// Integrating debouncer for a contact switch: the state flips after `threshold` consecutive
+/// samples that disagree with it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Debouncer {
+    state: bool,
+    count: u8,
+    threshold: u8,
+}
+
+impl Debouncer {
+    /// Start in `initial`, flip after `threshold` (at least 1) disagreeing samples.
+    pub fn new(initial: bool, threshold: u8) -> Self {
+        Debouncer {
+            state: initial,
+            count: 0,
+            threshold: threshold.max(1),
+        }
+    }
+    /// Feed one raw sample, get the debounced state.
+    pub fn update(&mut self, raw: bool) -> bool {
+        if raw == self.state {
+            self.count = 0;
+        } else {
+            self.count = self.count.saturating_add(1);
+            if self.count >= self.threshold {
+                self.state = raw;
+                self.count = 0;
+            }
+        }
+        self.state
+    }
+    /// The debounced state.
+    pub fn state(&self) -> bool {
+        self.state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(counts: u16) -> Result<AngleSample, EncoderError> {
+        let cal = AngleCalibration {
+            zero_counts: 8000,
+            reversed: false,
+        };
+        Ok(AngleSample {
+            counts,
+            angle_rad: cal.angle_rad(counts),
+        })
+    }
+
+    #[test]
+    fn calibration_wraps_and_inverts() {
+        let cal = AngleCalibration {
+            zero_counts: 100,
+            reversed: true,
+        };
+        assert_eq!(cal.angle_rad(100), 0.0);
+        let a = cal.angle_rad(50);
+        assert!((a - 50.0 * core::f32::consts::TAU / 16384.0).abs() < 1e-7);
+        for x in [-0.9f32, -0.08, 0.0, 0.2, 0.9] {
+            let c = cal.counts(x);
+            assert!((cal.angle_rad(c) - x).abs() <= 0.5 * core::f32::consts::TAU / 16384.0 + 1e-7);
+        }
+        assert_eq!(cal.counts(cal.angle_rad(16383)), 16383);
+    }
+
+    #[test]
+    fn comms_range_rate_and_stuck() {
+        let p = ReflexParams::default();
+        let mut pl = Plausibility::default();
+        let t = |ms| Instant::from_millis(ms);
+        assert_eq!(
+            pl.check(t(0), &sample(8000), false, &p),
+            SensorFindings::default()
+        );
+        let f = pl.check(t(1), &Err(EncoderError::Parity { word: 1 }), false, &p);
+        assert_eq!(f.comms, Some(2));
+        // 1.2 rad: out of range and, 2 ms after the last good sample, too fast.
+        let far = 8000 + (1.2 * 16384.0 / core::f32::consts::TAU) as u16;
+        let f = pl.check(t(2), &sample(far), false, &p);
+        assert!(f.range.is_some() && f.rate.is_some());
+        // Stuck only counts while driving.
+        let mut pl = Plausibility::default();
+        for ms in 0..100 {
+            assert_eq!(pl.check(t(ms), &sample(8000), false, &p).stuck, None);
+        }
+        let mut stuck_at = None;
+        for ms in 100..200 {
+            if pl.check(t(ms), &sample(8000), true, &p).stuck.is_some() {
+                stuck_at = Some(ms);
+                break;
+            }
+        }
+        assert_eq!(stuck_at, Some(151), "50 ms stuck timeout");
+    }
+
+    #[test]
+    fn debouncer_needs_consecutive_samples() {
+        let mut d = Debouncer::new(false, 3);
+        assert!(!d.update(true));
+        assert!(!d.update(true));
+        assert!(!d.update(false), "bounce resets the count");
+        assert!(!d.update(true));
+        assert!(!d.update(true));
+        assert!(d.update(true));
+        assert!(d.state());
+        assert_eq!(Debouncer::new(true, 0).threshold, 1);
+    }
+}

@@ -1,0 +1,575 @@
+//! Every node-state transition, every fault (raised and cleared) and the reflex through the
+//! node, driven tick by tick.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use firmware::node::{AnkleNode, DriverHealth, NodeConfig, TickInputs, TickOutputs};
+use firmware::scenarios::CALIBRATION;
+use firmware::sensors::{AngleSample, EncoderError};
+use firmware::{ActuatorCommand, Instant};
+use protocol::*;
+
+const ME: NodeId = NodeId::LeftAnkle;
+const PEER: NodeId = NodeId::RightAnkle;
+
+struct Bench {
+    node: AnkleNode,
+    ms: u64,
+    angle: f32,
+    contact: bool,
+    encoder_error: Option<EncoderError>,
+    frozen: Option<u16>,
+    drivers: DriverHealth,
+    heartbeats: bool,
+}
+
+fn cmd(kind: CommandKind) -> Message {
+    Message::Command(Command {
+        target: Target::Node(ME),
+        kind,
+    })
+}
+
+impl Bench {
+    fn new() -> Self {
+        Bench {
+            node: AnkleNode::new(NodeConfig::nominal(ME)).unwrap(),
+            ms: 0,
+            angle: 0.1,
+            contact: false,
+            encoder_error: None,
+            frozen: None,
+            drivers: DriverHealth::default(),
+            heartbeats: true,
+        }
+    }
+
+    fn tick_with(&mut self, extra: &[Message]) -> TickOutputs {
+        let mut rx: Vec<Message> = extra.to_vec();
+        if self.heartbeats && self.ms.is_multiple_of(50) {
+            rx.push(Message::Heartbeat(Heartbeat {
+                node: PEER,
+                state: NodeState::Enabled,
+                faults: FaultFlags::NONE,
+                uptime_ms: self.ms as u32,
+            }));
+        }
+        let angle = match self.encoder_error {
+            Some(e) => Err(e),
+            None => {
+                let counts = self
+                    .frozen
+                    .unwrap_or_else(|| CALIBRATION.counts(self.angle));
+                Ok(AngleSample {
+                    counts,
+                    angle_rad: CALIBRATION.angle_rad(counts),
+                })
+            }
+        };
+        let out = self.node.tick(
+            Instant::from_millis(self.ms),
+            &TickInputs {
+                angle,
+                contact_closed: self.contact,
+                received: &rx,
+                drivers: self.drivers,
+            },
+        );
+        self.ms += 1;
+        // The plant: a taut string holds the ankle at or above the setpoint.
+        if let ActuatorCommand::Position { ankle_angle_rad } = out.actuator {
+            if ankle_angle_rad > self.angle {
+                self.angle = ankle_angle_rad;
+            }
+        }
+        out
+    }
+
+    fn tick(&mut self) -> TickOutputs {
+        self.tick_with(&[])
+    }
+
+    fn run(&mut self, n: u32) -> Vec<Message> {
+        (0..n)
+            .flat_map(|_| self.tick().transmit.into_iter())
+            .collect()
+    }
+
+    fn enabled() -> Self {
+        let mut b = Bench::new();
+        b.tick();
+        let o = b.tick_with(&[cmd(CommandKind::Enable)]);
+        assert_eq!(o.state, NodeState::Enabled);
+        assert_eq!(o.phase, ReflexPhase::Swing);
+        b
+    }
+
+    /// Move the ankle at 10 rad/s (below the rate limit) to `target`.
+    fn move_to(&mut self, target: f32) {
+        // Bounded: the plant may hold the angle above the target once the string pulls.
+        for _ in 0..1000 {
+            if (self.angle - target).abs() <= 1e-6 {
+                break;
+            }
+            self.angle += (target - self.angle).clamp(-0.01, 0.01);
+            self.tick();
+        }
+    }
+
+    /// Heel strike and ride the angle down to the taut angle: ends in Push.
+    fn drive_to_push(&mut self) {
+        self.contact = true;
+        for _ in 0..3 {
+            self.tick();
+        }
+        assert_eq!(self.node.phase(), ReflexPhase::Free);
+        while self.node.phase() == ReflexPhase::Free {
+            self.angle -= 0.001;
+            self.tick();
+            assert!(self.angle > -0.2);
+        }
+        assert_eq!(self.node.phase(), ReflexPhase::Push);
+    }
+}
+
+fn fault_events(msgs: &[Message], code: FaultCode) -> Vec<FaultTransition> {
+    msgs.iter()
+        .filter_map(|m| match m {
+            Message::Fault(f) if f.code == code => Some(f.transition),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn not_an_ankle_is_refused() {
+    assert!(AnkleNode::new(NodeConfig::nominal(NodeId::Host)).is_err());
+    let mut c = NodeConfig::nominal(ME);
+    c.state_period_us = 0;
+    assert!(AnkleNode::new(c).is_err());
+}
+
+#[test]
+fn starts_disabled_and_sends_version_heartbeat_and_state() {
+    let mut b = Bench::new();
+    let o = b.tick();
+    assert_eq!(o.state, NodeState::Disabled);
+    assert_eq!(o.phase, ReflexPhase::Inactive);
+    assert_eq!(o.actuator, ActuatorCommand::Released);
+    let classes: Vec<_> = o.transmit.iter().map(|m| m.class()).collect();
+    assert_eq!(
+        classes,
+        [
+            MessageClass::Heartbeat,
+            MessageClass::AnkleState,
+            MessageClass::Version
+        ]
+    );
+    // Over one second: 200 states, 20 heartbeats, one version.
+    let msgs = b.run(1000);
+    let count = |c| msgs.iter().filter(|m| m.class() == c).count();
+    assert_eq!(count(MessageClass::AnkleState), 200);
+    assert_eq!(count(MessageClass::Heartbeat), 20);
+    assert_eq!(count(MessageClass::Version), 0);
+    assert_eq!(b.node.dropped_tx(), 0);
+}
+
+#[test]
+fn enable_disable_and_addressing() {
+    let mut b = Bench::new();
+    b.tick();
+    // To the other ankle: ignored; broadcast: taken.
+    let other = Message::Command(Command {
+        target: Target::Node(PEER),
+        kind: CommandKind::Enable,
+    });
+    assert_eq!(b.tick_with(&[other]).state, NodeState::Disabled);
+    let all = Message::Command(Command {
+        target: Target::Broadcast,
+        kind: CommandKind::Enable,
+    });
+    assert_eq!(b.tick_with(&[all]).state, NodeState::Enabled);
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Disable)]).state,
+        NodeState::Disabled
+    );
+    // Enable with the foot on the floor starts in Free.
+    b.contact = true;
+    let o = b.tick_with(&[cmd(CommandKind::Enable)]);
+    assert_eq!((o.state, o.phase), (NodeState::Enabled, ReflexPhase::Free));
+}
+
+#[test]
+fn full_reflex_cycle_through_the_node() {
+    let mut b = Bench::enabled();
+    b.contact = true;
+    let o = b.tick();
+    let hs: Vec<_> = o
+        .transmit
+        .iter()
+        .filter(|m| matches!(m, Message::HeelStrike(h) if h.node == ME && h.step_count == 1))
+        .collect();
+    assert_eq!(hs.len(), 1, "own heel strike announced");
+    // Debounce is the driver's job: the node reacts on the first closed tick.
+    assert_eq!(o.phase, ReflexPhase::Free);
+    assert_eq!(o.actuator, ActuatorCommand::Released);
+    b.drive_to_push();
+    let mut last = -1.0;
+    for _ in 0..200 {
+        let o = b.tick();
+        if let ActuatorCommand::Position { ankle_angle_rad } = o.actuator {
+            assert!(ankle_angle_rad >= last - 1e-6);
+            last = ankle_angle_rad;
+        }
+    }
+    assert_eq!(b.node.phase(), ReflexPhase::Hold);
+    assert_eq!(last, 0.2);
+    let peer_hs = Message::HeelStrike(HeelStrike {
+        node: PEER,
+        step_count: 9,
+        time_us: 0,
+    });
+    let o = b.tick_with(&[peer_hs]);
+    assert_eq!(
+        (o.phase, o.actuator),
+        (ReflexPhase::Swing, ActuatorCommand::Released)
+    );
+    assert!(fault_events(&o.transmit, FaultCode::PeerHeelStrikeLate).is_empty());
+    // Our own heel strike echoed back (or the host's) does not release.
+    b.contact = false;
+    b.tick();
+    b.drive_to_push();
+    let own = Message::HeelStrike(HeelStrike {
+        node: ME,
+        step_count: 1,
+        time_us: 0,
+    });
+    assert_eq!(b.tick_with(&[own]).phase, ReflexPhase::Push);
+}
+
+#[test]
+fn late_peer_message_falls_back_to_lift_off_and_clears_next_stride() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.contact = false;
+    let o = b.tick();
+    assert_eq!(
+        (o.phase, o.actuator),
+        (ReflexPhase::Swing, ActuatorCommand::Released)
+    );
+    assert_eq!(
+        fault_events(&o.transmit, FaultCode::PeerHeelStrikeLate),
+        [FaultTransition::Raised]
+    );
+    assert_eq!(o.state, NodeState::Enabled, "not safety-relevant");
+    b.move_to(0.1);
+    b.drive_to_push();
+    let peer_hs = Message::HeelStrike(HeelStrike {
+        node: PEER,
+        step_count: 1,
+        time_us: 0,
+    });
+    let o = b.tick_with(&[peer_hs]);
+    assert_eq!(
+        fault_events(&o.transmit, FaultCode::PeerHeelStrikeLate),
+        [FaultTransition::Cleared]
+    );
+}
+
+#[test]
+fn emergency_stop_from_every_state_latches_until_disable() {
+    // From Disabled, Enabled (in push) and Safe.
+    for start in 0..3 {
+        let mut b = Bench::enabled();
+        match start {
+            0 => {
+                b.tick_with(&[cmd(CommandKind::Disable)]);
+            }
+            1 => b.drive_to_push(),
+            _ => {
+                b.drivers.actuator_error = true;
+                assert_eq!(b.tick().state, NodeState::Safe);
+                b.drivers.actuator_error = false;
+            }
+        }
+        let estop = Message::Command(Command {
+            target: Target::Broadcast,
+            kind: CommandKind::EmergencyStop,
+        });
+        let o = b.tick_with(&[estop]);
+        assert_eq!(o.state, NodeState::EmergencyStop);
+        assert_eq!(o.actuator, ActuatorCommand::Released);
+        assert_eq!(o.phase, ReflexPhase::Inactive);
+        assert_eq!(
+            b.tick_with(&[cmd(CommandKind::Enable)]).state,
+            NodeState::EmergencyStop
+        );
+        assert_eq!(
+            b.tick_with(&[cmd(CommandKind::Disable)]).state,
+            NodeState::Disabled
+        );
+        assert_eq!(
+            b.tick_with(&[cmd(CommandKind::Enable)]).state,
+            NodeState::Enabled
+        );
+    }
+}
+
+/// Raise a fault while pushing: safe state, released, fault event; clear it: cleared event,
+/// still safe until Enable; Enable then works; Disable from Safe works too.
+fn check_safety_fault(
+    code: FaultCode,
+    raise: impl Fn(&mut Bench),
+    clear: impl Fn(&mut Bench),
+    ticks_to_raise: u32,
+) {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    raise(&mut b);
+    let mut msgs = Vec::new();
+    let mut last = None;
+    for _ in 0..ticks_to_raise {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        last = Some(o);
+    }
+    let o = last.unwrap();
+    assert_eq!(o.state, NodeState::Safe, "{code:?}");
+    assert_eq!(o.actuator, ActuatorCommand::Released, "{code:?}");
+    assert_eq!(
+        fault_events(&msgs, code),
+        [FaultTransition::Raised],
+        "{code:?}"
+    );
+    assert!(b.node.faults().contains(code));
+    // Enable is refused while the fault is present (commands are read before the sensors,
+    // so a one-sample fault is still set here).
+    let o = b.tick_with(&[cmd(CommandKind::Enable)]);
+    assert_eq!(o.state, NodeState::Safe);
+    let mut msgs: Vec<Message> = o.transmit.iter().copied().collect();
+    clear(&mut b);
+    msgs.extend(b.run(60));
+    assert_eq!(
+        fault_events(&msgs, code),
+        [FaultTransition::Cleared],
+        "{code:?}"
+    );
+    assert_eq!(b.node.state(), NodeState::Safe, "latched until Enable");
+    assert!(b.node.faults().is_empty(), "{:?}", b.node.faults());
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Enable)]).state,
+        NodeState::Enabled
+    );
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Disable)]).state,
+        NodeState::Disabled
+    );
+}
+
+#[test]
+fn encoder_comms_fault() {
+    check_safety_fault(
+        FaultCode::EncoderComms,
+        |b| b.encoder_error = Some(EncoderError::Parity { word: 1 }),
+        |b| b.encoder_error = None,
+        1,
+    );
+}
+
+#[test]
+fn encoder_range_fault() {
+    check_safety_fault(
+        FaultCode::EncoderRange,
+        |b| {
+            // Creep out of range slowly (no rate fault).
+            b.angle = 0.99;
+            b.frozen = Some(CALIBRATION.counts(1.05));
+        },
+        |b| {
+            b.frozen = None;
+            b.angle = 0.99;
+        },
+        1,
+    );
+}
+
+#[test]
+fn encoder_rate_fault() {
+    check_safety_fault(
+        FaultCode::EncoderRate,
+        |b| b.angle += 0.2, // 0.2 rad in 1 ms: 200 rad/s
+        |_| {},
+        1,
+    );
+}
+
+#[test]
+fn encoder_stuck_fault() {
+    check_safety_fault(
+        FaultCode::EncoderStuck,
+        |b| b.frozen = Some(CALIBRATION.counts(b.angle)),
+        |b| {
+            b.frozen = None;
+            b.angle += 0.005;
+        },
+        60,
+    );
+}
+
+#[test]
+fn peer_heartbeat_lost_fault() {
+    check_safety_fault(
+        FaultCode::PeerHeartbeatLost,
+        |b| b.heartbeats = false,
+        |b| b.heartbeats = true,
+        352,
+    );
+}
+
+#[test]
+fn actuator_fault() {
+    check_safety_fault(
+        FaultCode::Actuator,
+        |b| b.drivers.actuator_error = true,
+        |b| b.drivers.actuator_error = false,
+        1,
+    );
+}
+
+#[test]
+fn can_bus_fault() {
+    check_safety_fault(
+        FaultCode::CanBus,
+        |b| b.drivers.can_error = true,
+        |b| b.drivers.can_error = false,
+        1,
+    );
+}
+
+#[test]
+fn faults_while_disabled_are_reported_and_block_enable() {
+    let mut b = Bench::new();
+    b.tick();
+    b.encoder_error = Some(EncoderError::ErrorFlag { word: 0x4000 });
+    let o = b.tick();
+    assert_eq!(o.state, NodeState::Disabled);
+    assert_eq!(
+        fault_events(&o.transmit, FaultCode::EncoderComms),
+        [FaultTransition::Raised]
+    );
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Enable)]).state,
+        NodeState::Disabled
+    );
+    let hb = b.run(60).into_iter().find_map(|m| match m {
+        Message::Heartbeat(h) => Some(h),
+        _ => None,
+    });
+    assert!(hb.unwrap().faults.contains(FaultCode::EncoderComms));
+}
+
+#[test]
+fn peer_lost_counts_from_start_up() {
+    let mut b = Bench::new();
+    b.heartbeats = false;
+    let msgs = b.run(300);
+    assert!(fault_events(&msgs, FaultCode::PeerHeartbeatLost).is_empty());
+    let msgs = b.run(2);
+    assert_eq!(
+        fault_events(&msgs, FaultCode::PeerHeartbeatLost),
+        [FaultTransition::Raised]
+    );
+}
+
+#[test]
+fn parameters_are_range_checked_and_acknowledged() {
+    let mut b = Bench::new();
+    b.tick();
+    let set = |p: ParamId, raw: i32| {
+        cmd(CommandKind::SetParam {
+            param: p,
+            value: ParamValue(raw),
+        })
+    };
+    let ack = |o: TickOutputs| {
+        o.transmit
+            .iter()
+            .find_map(|m| match m {
+                Message::ParamAck(a) => Some(*a),
+                _ => None,
+            })
+            .unwrap()
+    };
+    let a = ack(b.tick_with(&[set(ParamId::TautAngle, -100_000)]));
+    assert_eq!(
+        (a.status, a.value),
+        (ParamStatus::Accepted, ParamValue(-100_000))
+    );
+    assert_eq!(b.node.params().taut_angle_rad(), -0.1);
+    let a = ack(b.tick_with(&[set(ParamId::TautAngle, 100_000)]));
+    assert_eq!(
+        (a.status, a.value),
+        (ParamStatus::OutOfRange, ParamValue(-100_000))
+    );
+    let a = ack(b.tick_with(&[set(ParamId::ExtendedAngle, -80_000)]));
+    assert_eq!(a.status, ParamStatus::OutOfRange);
+    let a = ack(b.tick_with(&[set(ParamId::ExtendedAngle, 0)]));
+    assert_eq!(a.status, ParamStatus::Accepted);
+    let a = ack(b.tick_with(&[set(ParamId::TautAngle, -30_000)]));
+    assert_eq!(
+        (a.status, a.value),
+        (ParamStatus::Inconsistent, ParamValue(-100_000))
+    );
+    let a = ack(b.tick_with(&[set(ParamId::ExtendedAngle, 200_000)]));
+    assert_eq!(a.status, ParamStatus::Accepted);
+    b.tick_with(&[cmd(CommandKind::Enable)]);
+    let a = ack(b.tick_with(&[set(ParamId::PushDuration, 200_000)]));
+    assert_eq!(a.status, ParamStatus::NotWhileEnabled);
+    // The new taut angle is the one that engages.
+    b.contact = true;
+    b.tick();
+    b.move_to(-0.09);
+    assert_eq!(b.node.phase(), ReflexPhase::Free);
+    // Quantisation (0.38 mrad) and the filter: go a little past the threshold.
+    b.move_to(-0.102);
+    assert!(matches!(
+        b.node.phase(),
+        ReflexPhase::Push | ReflexPhase::Hold
+    ));
+}
+
+#[test]
+fn receive_work_is_bounded() {
+    let mut b = Bench::new();
+    b.tick();
+    let set = cmd(CommandKind::SetParam {
+        param: ParamId::StuckTimeout,
+        value: ParamValue(100_000),
+    });
+    let many = vec![set; 50];
+    let o = b.tick_with(&many);
+    let acks = o
+        .transmit
+        .iter()
+        .filter(|m| matches!(m, Message::ParamAck(_)))
+        .count();
+    assert_eq!(acks, firmware::node::MAX_RX_PER_TICK);
+    assert_eq!(b.node.dropped_tx(), 0);
+}
+
+#[test]
+fn estimator_reports_angle_and_rate_in_telemetry() {
+    let mut b = Bench::new();
+    let mut state = None;
+    for k in 0..500 {
+        b.angle = 0.1 - 0.5e-3 * k as f32; // −0.5 rad/s
+        for m in b.tick().transmit {
+            if let Message::AnkleState(s) = m {
+                state = Some(s);
+            }
+        }
+    }
+    let s = state.unwrap();
+    assert!((s.rate.to_si() + 0.5).abs() < 0.02, "{:?}", s.rate);
+    assert!((s.angle.to_si() - (0.1 - 0.5e-3 * 495.0)).abs() < 0.01);
+}
