@@ -114,23 +114,29 @@ impl Dynamics {
         }
     }
 
-    /// Accelerations `q̈` at `q`, `q̇` with the coordinates where `active` is false held fixed
-    /// (their `q̈` is zero). Assembles first.
+    /// Accelerations `q̈` at `q`, `q̇`. Coordinates where `active` is false are not free: their
+    /// accelerations are given by `qdd_prescribed` (zero if `None`: locked joints), and the
+    /// free ones answer `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p`. Assembles first.
     pub fn accelerations(
         &mut self,
         model: &Model,
         q: &DVector<f64>,
         qd: &DVector<f64>,
         active: &[bool],
-        tau_extra: Option<&DVector<f64>>,
+        qdd_prescribed: Option<&DVector<f64>>,
     ) -> Result<DVector<f64>, DynamicsError> {
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
-        self.assemble(model, q, qd, tau_extra);
+        self.assemble(model, q, qd, None);
         let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
         let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
-        let f0 = self.force.select_rows(&idx);
+        let mut f0 = self.force.select_rows(&idx);
+        if let Some(qdd_p) = qdd_prescribed {
+            let fixed: Vec<usize> = (0..q.len()).filter(|&i| !active[i]).collect();
+            let m_ap = self.mass_matrix.select_rows(&idx).select_columns(&fixed);
+            f0 -= m_ap * qdd_p.select_rows(&fixed);
+        }
         let x = if self.has_infinitesimal {
             let m1 = self
                 .mass_matrix_infinitesimal
@@ -144,7 +150,10 @@ impl Dynamics {
                 None => return Err(LimitSolveError::Degenerate { nullity: 1 }.into()),
             }
         };
-        let mut qdd = DVector::zeros(q.len());
+        let mut qdd = match qdd_prescribed {
+            Some(p) => p.clone(),
+            None => DVector::zeros(q.len()),
+        };
         for (k, &i) in idx.iter().enumerate() {
             qdd[i] = x[k];
         }

@@ -24,7 +24,7 @@ pub struct ImpactResult {
 }
 
 /// Solves eq. (21) at `q` with pre-impact velocities `qd_minus`, over the coordinates where
-/// `active` is true, for constraint rows `g_rows` (k × n) and restitution `e`.
+/// `active` is true (the others keep their rates: locked or actuator-driven joints), for constraint rows `g_rows` (k × n) and restitution `e`.
 pub fn resolve(
     dynamics: &mut Dynamics,
     model: &Model,
@@ -53,7 +53,14 @@ pub fn resolve(
     a1.view_mut((0, 0), (n, n)).copy_from(&m1);
     let mut b0 = DVector::zeros(n + k);
     b0.rows_mut(0, n).copy_from(&(&m0 * &v));
-    b0.rows_mut(n, k).copy_from(&(&g * &v * (-restitution)));
+    // Newton's law on the whole contact velocity, G q̇⁺ = −e G q̇⁻, with the coordinates that
+    // are not free (locked, or driven by an actuator) keeping their rates through the impact.
+    let mut v_fixed = qd_minus.clone();
+    for &i in &idx {
+        v_fixed[i] = 0.0;
+    }
+    let rhs = g_rows * qd_minus * (-restitution) - g_rows * &v_fixed;
+    b0.rows_mut(n, k).copy_from(&rhs);
     let mut b1 = DVector::zeros(n + k);
     b1.rows_mut(0, n).copy_from(&(&m1 * &v));
     let x = solve_limit(&a0, &a1, &b0, &b1, 1e-12)?;

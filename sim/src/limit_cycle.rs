@@ -17,6 +17,9 @@ pub struct NewtonSettings {
     pub perturbation: f64,
     /// Central (true) or forward (false) differences.
     pub central: bool,
+    /// Step halvings allowed when a full Newton step lands where the stride fails or the
+    /// residual grows (0: the plain iteration of eq. 26).
+    pub max_halvings: usize,
 }
 
 impl Default for NewtonSettings {
@@ -26,6 +29,7 @@ impl Default for NewtonSettings {
             max_iterations: 30,
             perturbation: 1e-6,
             central: true,
+            max_halvings: 8,
         }
     }
 }
@@ -158,12 +162,20 @@ impl Walker {
                 break;
             }
             let a = DMatrix::identity(n, n) - &j;
-            let dv = a
-                .lu()
-                .solve(&r)
-                .ok_or(NewtonError::Singular { iteration: it })?;
-            last_step = dv.amax();
-            v += dv;
+            let dv = a.lu().solve(&r).ok_or(NewtonError::Singular { iteration: it })?;
+            // Damped step: halve while the stride from the new point fails or its residual
+            // grows; keep the last trial if the budget runs out (the next iteration reports).
+            let r_norm = r.amax();
+            let mut lambda = 1.0;
+            for _ in 0..settings.max_halvings {
+                let trial = &v + &dv * lambda;
+                match self.stride_map(&trial) {
+                    Ok((st, _)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => break,
+                    _ => lambda *= 0.5,
+                }
+            }
+            last_step = dv.amax() * lambda;
+            v += dv * lambda;
         }
         Err(NewtonError::NotConverged {
             iterations: settings.max_iterations,

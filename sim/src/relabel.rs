@@ -24,6 +24,8 @@ pub struct Relabel {
     pub mirror: bool,
     /// Root coordinates that are cyclic (heading): reported and then set to zero.
     pub cyclic: Vec<CoordIndex>,
+    /// Coordinates held at zero (locked at the start of a stride), not solved for.
+    pub fixed: Vec<CoordIndex>,
     /// Gauss-Newton tolerance on the pose residual [m or rad].
     pub tolerance: f64,
     /// Gauss-Newton iteration budget.
@@ -103,8 +105,8 @@ pub struct Relabelled {
 }
 
 impl Relabel {
-    /// Finds `q`, `q̇` of `model` whose paired links match `old` (already translated and, if
-    /// wanted, mirrored), starting the search at `q_guess`.
+    /// Finds `q`, `q̇` of `model` whose paired links and points match `old` (translated to the
+    /// new contact, not yet mirrored: the mirroring is done here), starting at `q_guess`.
     pub fn solve(
         &self,
         model: &Model,
@@ -117,10 +119,15 @@ impl Relabel {
         let mut kin = Kinematics::new(model);
         let zero = DVector::zeros(n);
         let mut q = q_guess.clone();
+        for c in &self.fixed {
+            q[c.0] = 0.0;
+        }
         let mut jac = DMatrix::zeros(rows, n);
         let mut res = DVector::zeros(rows);
         let mut iterations = 0;
-        // Old point positions and velocities, from the old link states.
+        // Old point positions and velocities, from the old link states before any mirroring
+        // (a point's offset in its link frame is not mirrored by reflecting the frame).
+        let s = sagittal_reflection();
         let old_points: Vec<(Vector3<f64>, Vector3<f64>)> = self
             .point_pairs
             .iter()
@@ -128,9 +135,21 @@ impl Relabel {
                 let pt = &model.points[op.0];
                 let l = pt.link.0;
                 let p = old.p[l] + old.r[l] * pt.p_link_m;
-                (p, old.v[l] + old.w[l].cross(&(p - old.p[l])))
+                let v = old.v[l] + old.w[l].cross(&(p - old.p[l]));
+                if self.mirror {
+                    (s * p, s * v)
+                } else {
+                    (p, v)
+                }
             })
             .collect();
+        let mirrored;
+        let old = if self.mirror {
+            mirrored = old.mirrored();
+            &mirrored
+        } else {
+            old
+        };
         loop {
             kin.update(model, &q, &zero);
             for (k, &(new, old_l)) in self.pairs.iter().enumerate() {
@@ -149,11 +168,17 @@ impl Relabel {
                 jac.view_mut((3 * (np + k), 0), (3, n))
                     .copy_from(&kin.point_jacobian(model, pt.link, &p));
             }
+            for c in &self.fixed {
+                jac.column_mut(c.0).fill(0.0);
+            }
             let r = res.norm();
             if r <= self.tolerance {
                 break;
             }
             if iterations >= self.max_iterations || !r.is_finite() {
+                if std::env::var_os("WALKER_DEBUG_RELABEL").is_some() {
+                    eprintln!("relabel residual {:?}\nq {:?}", res.as_slice(), q.as_slice());
+                }
                 return Err(RelabelError::PoseMismatch {
                     residual: r,
                     iterations,
@@ -174,6 +199,9 @@ impl Relabel {
         let qd = least_squares(&jac, &target);
         let vres = (&jac * &qd - &target).norm();
         if vres > 1e-8 * (1.0 + target.norm()) {
+            if std::env::var_os("WALKER_DEBUG_RELABEL").is_some() {
+                eprintln!("relabel velocity residual {:?}", (&jac * &qd - &target).as_slice());
+            }
             return Err(RelabelError::VelocityMismatch { residual: vres });
         }
         let mut cyclic_values = Vec::with_capacity(self.cyclic.len());

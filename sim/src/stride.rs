@@ -6,7 +6,8 @@ use crate::events::{locate, Direction, EventError};
 use crate::impact::{resolve, ImpactError};
 use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
 use crate::kinematics::Kinematics;
-use crate::model::{LinkIndex, Model};
+use crate::actuator::AnkleProfile;
+use crate::model::{CoordIndex, LinkIndex, Model};
 use crate::relabel::LinkStates;
 use crate::walker::{ContactConstraint, Walker};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -34,6 +35,10 @@ pub enum FailureKind {
     StepTooLarge,
     /// An adaptive step fell below its floor.
     StepUnderflow,
+    /// At string engagement the heel would be pressed into the floor instead of lifting.
+    HeelDidNotLift,
+    /// During push-off the heel came back down to the floor.
+    HeelReturnedToFloor,
     /// An event could not be located to its tolerance.
     EventNotLocated,
     /// The impact equations were singular.
@@ -114,6 +119,57 @@ pub struct StrideResult {
     pub evaluations: usize,
     /// Accepted samples, when recording.
     pub trajectory: Vec<Sample>,
+    /// Work done by the ankle actuator (trapezoidal quadrature on accepted steps) [J].
+    pub actuator_work_j: f64,
+    /// Energy dissipated by joint dampers (trapezoidal quadrature) [J].
+    pub damping_dissipation_j: f64,
+}
+
+/// Running actuator work and damper dissipation over accepted steps.
+#[derive(Default)]
+struct Power {
+    work_j: f64,
+    dissipation_j: f64,
+    /// Actuator power at the start of the current step, if known.
+    last_w: Option<f64>,
+    /// Velocities jumped (impact) since the last sample: restart the quadrature.
+    jumped: bool,
+}
+
+impl Power {
+    fn actuator_power(phase: &mut Phase, s: &Sample) -> Result<f64, DynamicsError> {
+        let (tau, rate) = phase.actuator_torque(s)?;
+        Ok(tau * rate)
+    }
+
+    fn restart(&mut self, phase: &mut Phase, s: &Sample) -> Result<(), DynamicsError> {
+        self.last_w = Some(Self::actuator_power(phase, s)?);
+        self.jumped = false;
+        Ok(())
+    }
+
+    fn accumulate(
+        &mut self,
+        phase: &mut Phase,
+        damping: &[(usize, f64)],
+        from: &Sample,
+        to: &Sample,
+    ) -> Result<(), DynamicsError> {
+        let h = to.t_s - from.t_s;
+        let diss = |s: &Sample| damping.iter().map(|&(i, c)| c * s.qd[i] * s.qd[i]).sum::<f64>();
+        self.dissipation_j += 0.5 * h * (diss(from) + diss(to));
+        if phase.prescribed.is_some() {
+            let w0 = match (self.last_w, self.jumped) {
+                (Some(w), false) => w,
+                _ => Self::actuator_power(phase, from)?,
+            };
+            let w1 = Self::actuator_power(phase, to)?;
+            self.work_j += 0.5 * h * (w0 + w1);
+            self.last_w = Some(w1);
+        }
+        self.jumped = false;
+        Ok(())
+    }
 }
 
 /// The smooth dynamics of one phase (which coordinates are free).
@@ -122,6 +178,8 @@ pub struct Phase<'a> {
     dynamics: Dynamics,
     /// Which coordinates are free to move.
     pub active: Vec<bool>,
+    /// A coordinate driven along a profile (not free, not locked).
+    pub prescribed: Option<(CoordIndex, AnkleProfile)>,
 }
 
 impl<'a> Phase<'a> {
@@ -131,19 +189,49 @@ impl<'a> Phase<'a> {
             model,
             dynamics: Dynamics::new(model),
             active: vec![true; model.dof()],
+            prescribed: None,
         }
+    }
+
+    /// Puts the prescribed coordinate of `s` exactly on its profile.
+    pub fn snap(&self, s: &mut Sample) {
+        if let Some((c, p)) = &self.prescribed {
+            let (a, ad, _) = p.eval(s.t_s);
+            s.q[c.0] = a;
+            s.qd[c.0] = ad;
+        }
+    }
+
+    /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
+    /// coordinate's rate: their product is the actuator power.
+    pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
+        let Some((c, _)) = self.prescribed else { return Ok((0.0, 0.0)) };
+        let qdd = self.accelerations(s.t_s, &s.q, &s.qd)?;
+        let m = &self.dynamics.mass_matrix;
+        let tau = (m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0];
+        Ok((tau, s.qd[c.0]))
     }
 }
 
 impl SecondOrderSystem for Phase<'_> {
     fn accelerations(
         &mut self,
-        _t: f64,
+        t: f64,
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
-        self.dynamics
-            .accelerations(self.model, q, qd, &self.active, None)
+        match &self.prescribed {
+            None => self.dynamics.accelerations(self.model, q, qd, &self.active, None),
+            Some((c, p)) => {
+                let (a, ad, add) = p.eval(t);
+                let (mut q, mut qd) = (q.clone(), qd.clone());
+                q[c.0] = a;
+                qd[c.0] = ad;
+                let mut qdd_p = DVector::zeros(q.len());
+                qdd_p[c.0] = add;
+                self.dynamics.accelerations(self.model, &q, &qd, &self.active, Some(&qdd_p))
+            }
+        }
     }
 
     fn stability_limit(
@@ -229,35 +317,44 @@ impl Witnesses<'_> {
             .point_position(&self.walker.model, self.walker.heel_strike.swing_foot)
             .y
     }
-    fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
+    /// The walking direction: the stance contact link's forward axis, level with the floor.
+    fn heading(&self) -> Vector3<f64> {
+        let m = &self.walker.model;
+        let link = m.points[self.walker.heel_strike.stance_contact.0].link;
+        let mut d = self.kin.r_floor_link[link.0] * Vector3::x();
+        d.y = 0.0;
+        let n = d.norm();
+        if n > 1e-9 {
+            d / n
+        } else {
+            Vector3::x()
+        }
+    }
+    /// How far ahead of the stance contact, along the walking direction, a point is [m].
+    fn ahead_of_stance_m(&mut self, s: &Sample, point: crate::model::PointIndex) -> f64 {
         self.update(s);
         let m = &self.walker.model;
-        let hs = &self.walker.heel_strike;
-        self.kin.point_position(m, hs.swing_foot).x
-            - self.kin.point_position(m, hs.stance_contact).x
+        let d = self.kin.point_position(m, point)
+            - self.kin.point_position(m, self.walker.heel_strike.stance_contact);
+        d.dot(&self.heading())
+    }
+    fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
+        self.ahead_of_stance_m(s, self.walker.heel_strike.swing_foot)
     }
     fn hip_height(&mut self, s: &Sample) -> f64 {
         self.update(s);
-        self.kin
-            .point_position(&self.walker.model, self.walker.fall.hip)
-            .y
+        self.kin.point_position(&self.walker.model, self.walker.fall.hip).y
             - self.walker.fall.min_hip_height_m
     }
     fn hip_ahead_m(&mut self, s: &Sample) -> f64 {
-        self.update(s);
-        let m = &self.walker.model;
-        self.kin.point_position(m, self.walker.fall.hip).x
-            - self
-                .kin
-                .point_position(m, self.walker.heel_strike.stance_contact)
-                .x
+        self.ahead_of_stance_m(s, self.walker.fall.hip)
     }
     fn hip_forward_velocity(&mut self, s: &Sample) -> f64 {
         self.update(s);
         let m = &self.walker.model;
         let p = &m.points[self.walker.fall.hip.0];
         let x = self.kin.position_of(p.link, &p.p_link_m);
-        self.kin.velocity_of(p.link, &x).x
+        self.kin.velocity_of(p.link, &x).dot(&self.heading())
     }
 }
 
@@ -267,6 +364,8 @@ enum Watch {
     Knee(usize),
     HipLow,
     HipBack,
+    Engage,
+    HeelDrop,
 }
 
 /// The heel-strike impact on the impact model (coordinates: released root first).
@@ -319,6 +418,17 @@ impl Walker {
         let mut integrator = self.integrator.build();
         integrator.reset();
         let mut phase = Phase::new(&self.model);
+        for c in &self.initially_locked {
+            phase.active[c.0] = false;
+        }
+        let damping: Vec<(usize, f64)> = self
+            .model
+            .links
+            .iter()
+            .filter_map(|l| l.coordinate.map(|c| (c.0, l.joint_force.damping)))
+            .filter(|(_, d)| *d != 0.0)
+            .collect();
+        let mut power = Power::default();
         let mut wit = Witnesses {
             walker: self,
             kin: Kinematics::new(&self.model),
@@ -348,9 +458,10 @@ impl Walker {
                     format!("no heel strike within {} s", self.max_stride_time_s),
                 ));
             }
-            let next = integrator
+            let mut next = integrator
                 .advance(&mut phase, &cur, f64::INFINITY)
                 .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+            phase.snap(&mut next);
             if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
                 return Err(StrideFailure::new(
                     FailureKind::NonFiniteState,
@@ -384,7 +495,19 @@ impl Walker {
             {
                 triggered.push(Watch::HipBack);
             }
+            if let Some(r) = &self.ankle {
+                let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+                let flat = !phase.active[toe] && phase.prescribed.is_none();
+                if flat && Direction::Falling.triggered(cur.q[a] - r.engage_rad, next.q[a] - r.engage_rad) {
+                    triggered.push(Watch::Engage);
+                }
+                if phase.active[toe] && Direction::Rising.triggered(cur.q[toe], next.q[toe]) {
+                    triggered.push(Watch::HeelDrop);
+                }
+            }
             if triggered.is_empty() {
+                power.accumulate(&mut phase, &damping, &cur, &next)
+                    .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string()))?;
                 cur = next;
                 if options.record {
                     trajectory.push(cur.clone());
@@ -403,6 +526,14 @@ impl Walker {
                     }
                     Watch::HipLow => Box::new(|s: &Sample| wit.hip_height(s)),
                     Watch::HipBack => Box::new(|s: &Sample| wit.hip_forward_velocity(s)),
+                    Watch::Engage => {
+                        let (a, e) = self.ankle.as_ref().map_or((0, 0.0), |r| (r.ankle.0, r.engage_rad));
+                        Box::new(move |s: &Sample| s.q[a] - e)
+                    }
+                    Watch::HeelDrop => {
+                        let toe = self.ankle.as_ref().map_or(0, |r| r.toe_pitch.0);
+                        Box::new(move |s: &Sample| s.q[toe])
+                    }
                 };
                 let s = locate(
                     integrator.as_mut(),
@@ -418,7 +549,10 @@ impl Walker {
                     first = Some((w, s));
                 }
             }
-            let Some((watch, at)) = first else { continue };
+            let Some((watch, mut at)) = first else { continue };
+            phase.snap(&mut at);
+            power.accumulate(&mut phase, &damping, &cur, &at)
+                .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string()))?;
             match watch {
                 Watch::HipLow => {
                     let kind = if wit.hip_ahead_m(&at) >= 0.0 {
@@ -438,6 +572,58 @@ impl Walker {
                         at.t_s,
                         "hip moved back behind the stance contact",
                     ));
+                }
+                Watch::HeelDrop => {
+                    return Err(StrideFailure::new(
+                        FailureKind::HeelReturnedToFloor,
+                        at.t_s,
+                        "the stance heel came back down during push-off",
+                    ));
+                }
+                Watch::Engage => {
+                    let Some(r) = &self.ankle else { continue };
+                    let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+                    // The string becomes taut: an inelastic impact stops the ankle while the
+                    // foot becomes free to pivot about its toe.
+                    let mut act = phase.active.clone();
+                    act[toe] = true;
+                    let mut g = DMatrix::zeros(1, self.model.dof());
+                    g[(0, a)] = 1.0;
+                    let mut dynamics = Dynamics::new(&self.model);
+                    let before = energy(&mut dynamics, &self.model, &at);
+                    let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, 0.0)
+                        .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+                    let mut q = at.q.clone();
+                    q[a] = r.engage_rad;
+                    let mut qd = imp.qd_plus;
+                    qd[a] = 0.0;
+                    if qd[toe] > 0.0 {
+                        return Err(StrideFailure::new(
+                            FailureKind::HeelDidNotLift,
+                            at.t_s,
+                            format!("at string engagement the heel moves down ({:.3e} rad/s)", qd[toe]),
+                        ));
+                    }
+                    cur = Sample { t_s: at.t_s, q, qd };
+                    energy_loss += before - energy(&mut dynamics, &self.model, &cur);
+                    act[a] = false;
+                    phase.active = act;
+                    phase.prescribed = Some((
+                        r.ankle,
+                        AnkleProfile {
+                            start_s: at.t_s,
+                            duration_s: r.duration_s,
+                            from_rad: r.engage_rad,
+                            to_rad: r.final_rad,
+                        },
+                    ));
+                    power.restart(&mut phase, &cur)
+                        .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string()))?;
+                    events.push(StrideEvent { name: "string_engaged".into(), time_s: at.t_s });
+                    integrator.reset();
+                    if options.record {
+                        trajectory.push(cur.clone());
+                    }
                 }
                 Watch::Knee(k) => {
                     let c = self.knees[k].coordinate.0;
@@ -459,6 +645,7 @@ impl Walker {
                     })?;
                     phase.active[c] = false;
                     let mut qd = imp.qd_plus;
+                    power.jumped = true;
                     qd[c] = 0.0;
                     let mut q = at.q.clone();
                     q[c] = self.knees[k].stop_rad;
@@ -506,13 +693,16 @@ impl Walker {
                     if options.record {
                         trajectory.push(at.clone());
                     }
-                    return self.finish_stride(
+                    let mut r = self.finish_stride(
                         at,
                         &phase.active,
                         events,
                         energy_loss,
                         integrator.as_ref(),
-                    );
+                    )?;
+                    r.actuator_work_j = power.work_j;
+                    r.damping_dissipation_j = power.dissipation_j;
+                    return Ok(r);
                 }
             }
         }
@@ -541,15 +731,22 @@ impl Walker {
         let p_foot = kin.position_of(foot.link, &foot.p_link_m);
         let jv = kin.point_jacobian(m, foot.link, &p_foot);
         let jw = kin.angular_jacobian(m, LinkIndex(hs.swing_foot_link.0 + nr));
-        let mut g = DMatrix::zeros(hs.constraints.len(), n);
-        for (r, c) in hs.constraints.iter().enumerate() {
-            let row = match c {
+        // A constraint on a direction that no coordinate can move (e.g. yaw in a 2D variant)
+        // holds trivially: its row is zero and is dropped.
+        let rows: Vec<_> = hs
+            .constraints
+            .iter()
+            .map(|c| match c {
                 ContactConstraint::X => jv.row(0),
                 ContactConstraint::Y => jv.row(1),
                 ContactConstraint::Z => jv.row(2),
                 ContactConstraint::Yaw => jw.row(1),
-            };
-            g.row_mut(r).copy_from(&row);
+            })
+            .filter(|r| r.amax() > 1e-12)
+            .collect();
+        let mut g = DMatrix::zeros(rows.len(), n);
+        for (r, row) in rows.iter().enumerate() {
+            g.row_mut(r).copy_from(row);
         }
         let mut dynamics = Dynamics::new(m);
         let before = energy(
@@ -616,10 +813,7 @@ impl Walker {
                 format!("old stance contact moves {lift:.3e} m/s upward after impact"),
             ));
         }
-        let mut states = LinkStates::from_kinematics(&kin, nr, &p_foot);
-        if self.relabel.mirror {
-            states = states.mirrored();
-        }
+        let states = LinkStates::from_kinematics(&kin, nr, &p_foot);
         let solved = self
             .relabel
             .solve(&self.model, &states, &self.guess_q)
@@ -637,6 +831,8 @@ impl Walker {
             impact_energy_loss_j: energy_loss,
             evaluations: integrator.evaluations(),
             trajectory: Vec::new(),
+            actuator_work_j: 0.0,
+            damping_dissipation_j: 0.0,
         })
     }
 }

@@ -85,6 +85,11 @@ pub struct Walker {
     pub event_tolerance: EventTolerance,
     /// A stride longer than this fails [s].
     pub max_stride_time_s: f64,
+    /// The stance ankle's stretch reflex, if the walker has one.
+    pub ankle: Option<crate::actuator::AnkleReflex>,
+    /// Coordinates locked (at zero) at the start of every stride, e.g. the toe pitch of a flat
+    /// stance foot. They are left out of the stride map.
+    pub initially_locked: Vec<CoordIndex>,
     /// A starting guess for the gait (just after heel strike).
     pub guess_q: DVector<f64>,
     /// A starting guess for the gait velocities.
@@ -96,7 +101,7 @@ impl Walker {
     pub fn map_coordinates(&self) -> Vec<CoordIndex> {
         (0..self.model.dof())
             .map(CoordIndex)
-            .filter(|c| !self.relabel.cyclic.contains(c))
+            .filter(|c| !self.relabel.cyclic.contains(c) && !self.initially_locked.contains(c))
             .collect()
     }
 

@@ -183,6 +183,7 @@ impl Common {
             max_iterations: self.newton_max_iter,
             perturbation: self.perturbation,
             central: true,
+            max_halvings: 8,
         }
     }
 }

@@ -76,19 +76,20 @@ impl Parser<'_> {
         Ok(v)
     }
     fn product(&mut self) -> Result<f64, ExprError> {
-        let mut v = self.power()?;
+        let mut v = self.unary()?;
         while let Some(c @ (b'*' | b'/')) = self.peek() {
             self.i += 1;
-            let r = self.power()?;
+            let r = self.unary()?;
             v = if c == b'*' { v * r } else { v / r };
         }
         Ok(v)
     }
+    /// `atom ^ unary`: right-associative, binding tighter than a leading sign (−x^2 = −(x^2)).
     fn power(&mut self) -> Result<f64, ExprError> {
-        let base = self.unary()?;
+        let base = self.atom()?;
         if self.peek() == Some(b'^') {
             self.i += 1;
-            let e = self.power()?;
+            let e = self.unary()?;
             return Ok(base.powf(e));
         }
         Ok(base)
@@ -103,7 +104,7 @@ impl Parser<'_> {
                 self.i += 1;
                 self.unary()
             }
-            _ => self.atom(),
+            _ => self.power(),
         }
     }
     fn atom(&mut self) -> Result<f64, ExprError> {

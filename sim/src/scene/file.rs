@@ -44,6 +44,12 @@ pub struct SceneFile {
     pub integrator: IntegratorDef,
     /// Starting guess for the gait.
     pub guess: GuessDef,
+    /// The stance ankle's stretch reflex with an ideal actuator.
+    #[serde(default)]
+    pub ankle_reflex: Option<AnkleReflexDef>,
+    /// Freedoms of the 3D model (reported in eigenvalue modes).
+    #[serde(default)]
+    pub three_d_freedoms: Vec<String>,
     /// Derived outputs in a publication's own convention.
     #[serde(default)]
     pub convention: Option<ConventionDef>,
@@ -279,4 +285,22 @@ pub struct OutputDef {
     /// Constant offset (an expression: it may depend on parameters).
     #[serde(default)]
     pub offset: Option<Num>,
+}
+
+/// The ankle stretch reflex.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnkleReflexDef {
+    /// Ankle coordinate.
+    pub ankle: String,
+    /// Toe-pitch coordinate (locked while the foot is flat).
+    pub toe_pitch: String,
+    /// Toe point.
+    pub toe: String,
+    /// Engagement angle [rad].
+    pub engage_rad: Num,
+    /// Final angle [rad].
+    pub final_rad: Num,
+    /// Extension duration [s].
+    pub duration_s: Num,
 }

@@ -5,7 +5,9 @@
 
 pub mod expr;
 pub mod file;
+pub mod variant;
 
+use crate::actuator::AnkleReflex;
 use crate::events::{Direction, EventTolerance};
 use crate::integrators::IntegratorChoice;
 use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
@@ -20,6 +22,9 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("simplest", include_str!("../../scenes/simplest.toml")),
     ("compass", include_str!("../../scenes/compass.toml")),
     ("kneed2d", include_str!("../../scenes/kneed2d.toml")),
+    ("wisse3d", include_str!("../../scenes/wisse3d.toml")),
+    ("wisse2d", include_str!("../../scenes/wisse2d.toml")),
+    ("wisse3d-uncompensated", include_str!("../../scenes/wisse3d-uncompensated.toml")),
 ];
 
 /// Why a scene could not be loaded or built. Each variant names what was wrong.
@@ -126,7 +131,8 @@ impl Scene {
 
     /// Parses scene text; `origin` names it in errors.
     pub fn parse(origin: &str, text: &str) -> Result<Self, SceneError> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| SceneError::File {
+        let table = Self::resolve(origin, text, 0)?;
+        let file: SceneFile = table.try_into().map_err(|e: toml::de::Error| SceneError::File {
             path: origin.to_string(),
             message: e.to_string(),
         })?;
@@ -140,6 +146,26 @@ impl Scene {
             scene.check_range(k, p.default)?;
         }
         Ok(scene)
+    }
+
+    /// Parses text to a TOML table, resolving `[variant] base = ...` (at most 4 deep).
+    fn resolve(origin: &str, text: &str, depth: usize) -> Result<toml::Table, SceneError> {
+        let file_err = |message: String| SceneError::File { path: origin.to_string(), message };
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| file_err(e.to_string()))?;
+        let Some(base) = table.get("variant").and_then(|v| v.get("base")).and_then(|b| b.as_str())
+        else {
+            return Ok(table);
+        };
+        if depth > 4 {
+            return Err(file_err("variant chain too deep".into()));
+        }
+        let base_text = BUILTIN
+            .iter()
+            .find(|(n, _)| *n == base)
+            .map(|(_, t)| *t)
+            .ok_or_else(|| file_err(format!("variant base `{base}` is not a built-in scene")))?;
+        let base_table = Self::resolve(base, base_text, depth + 1)?;
+        variant::apply(base_table, table)
     }
 
     /// The scene's name.
@@ -412,6 +438,7 @@ impl Scene {
                 .iter()
                 .map(|c| coord(c))
                 .collect::<Result<Vec<_>, _>>()?,
+            fixed: Vec::new(),
             tolerance: 1e-13,
             max_iterations: 50,
         };
@@ -456,6 +483,28 @@ impl Scene {
         for (k, v) in &f.guess.qd {
             guess_qd[coord(k)?.0] = self.num(v, "guess.qd")?;
         }
+        let ankle = match &f.ankle_reflex {
+            None => None,
+            Some(a) => {
+                let duration_s = self.num(&a.duration_s, "ankle_reflex.duration_s")?;
+                if duration_s <= 0.0 {
+                    return Err(SceneError::Invalid(format!(
+                        "ankle_reflex.duration_s must be positive, got {duration_s}"
+                    )));
+                }
+                Some(AnkleReflex {
+                    ankle: coord(&a.ankle)?,
+                    toe_pitch: coord(&a.toe_pitch)?,
+                    toe: point(&a.toe)?,
+                    engage_rad: self.num(&a.engage_rad, "ankle_reflex.engage_rad")?,
+                    final_rad: self.num(&a.final_rad, "ankle_reflex.final_rad")?,
+                    duration_s,
+                })
+            }
+        };
+        let initially_locked: Vec<CoordIndex> = ankle.iter().map(|a| a.toe_pitch).collect();
+        let mut relabel = relabel;
+        relabel.fixed = initially_locked.clone();
         let impact_model = model.with_released_root(&release);
         Ok(Walker {
             name: self.name().to_string(),
@@ -470,6 +519,8 @@ impl Scene {
             max_stride_time_s,
             guess_q,
             guess_qd,
+            ankle,
+            initially_locked,
         })
     }
 

@@ -1,0 +1,83 @@
+//! The ankle stretch reflex with an ideal actuator (paper Fig. 8, `MODEL.md`).
+//!
+//! While the string is slack the ankle is free and the foot flat. When the ankle angle falls to
+//! the engagement angle the string is taut: an inelastic impact stops the ankle, the foot starts
+//! to pivot about its toe, and the actuator drives the ankle angle along a smooth profile to its
+//! final angle, then holds it. The actuator releases at the other foot's heel strike, when this
+//! leg becomes the swing leg (whose massless foot is not modelled).
+
+use crate::model::{CoordIndex, PointIndex};
+use serde::Serialize;
+
+/// The reflex of the stance ankle, as a scene describes it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AnkleReflex {
+    /// The ankle coordinate (leg pitch relative to the foot; negative with the hip ahead).
+    #[serde(skip)]
+    pub ankle: CoordIndex,
+    /// The foot's pitch about its toe (0 while flat, negative with the heel up).
+    #[serde(skip)]
+    pub toe_pitch: CoordIndex,
+    /// The toe point (the contact during push-off).
+    #[serde(skip)]
+    pub toe: PointIndex,
+    /// Ankle angle at which the string becomes taut [rad].
+    pub engage_rad: f64,
+    /// Ankle angle the actuator extends to [rad].
+    pub final_rad: f64,
+    /// Duration of the extension [s].
+    pub duration_s: f64,
+}
+
+/// A prescribed ankle angle: a quintic smooth step (zero rate and acceleration at both ends)
+/// from `from_rad` at `start_s` to `to_rad` at `start_s + duration_s`, held after.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnkleProfile {
+    /// Start time [s].
+    pub start_s: f64,
+    /// Duration [s].
+    pub duration_s: f64,
+    /// Start angle [rad].
+    pub from_rad: f64,
+    /// Final angle [rad].
+    pub to_rad: f64,
+}
+
+impl AnkleProfile {
+    /// Angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s`.
+    pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
+        let span = self.to_rad - self.from_rad;
+        let d = self.duration_s;
+        let x = ((t_s - self.start_s) / d).clamp(0.0, 1.0);
+        if x <= 0.0 || x >= 1.0 {
+            return (if x >= 1.0 { self.to_rad } else { self.from_rad }, 0.0, 0.0);
+        }
+        let (x2, x3) = (x * x, x * x * x);
+        let s = x3 * (10.0 - 15.0 * x + 6.0 * x2);
+        let ds = 30.0 * x2 * (1.0 - x) * (1.0 - x);
+        let dds = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x);
+        (self.from_rad + span * s, span * ds / d, span * dds / (d * d))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn profile_is_smooth_and_reaches_its_end() {
+        let p = AnkleProfile { start_s: 1.0, duration_s: 0.2, from_rad: -0.08, to_rad: 0.2 };
+        assert_eq!(p.eval(0.5), (-0.08, 0.0, 0.0));
+        assert_eq!(p.eval(1.3), (0.2, 0.0, 0.0));
+        // Rate is the derivative of the angle, acceleration of the rate.
+        let h = 1e-6;
+        for t in [1.03, 1.1, 1.17] {
+            let (a0, v0, acc0) = p.eval(t);
+            let (ap, vp, _) = p.eval(t + h);
+            let (am, vm, _) = p.eval(t - h);
+            assert!(((ap - am) / (2.0 * h) - v0).abs() < 1e-6);
+            assert!(((vp - vm) / (2.0 * h) - acc0).abs() < 1e-4);
+            assert!(a0 > -0.08 && a0 < 0.2);
+        }
+    }
+}
