@@ -1,2 +1,1 @@
 //! hil-tests crate (being built, see README.md).
-

@@ -19,6 +19,9 @@ enum Cmd {
     Vectors,
     /// Print the bus-load table (Markdown) for the nominal message rates.
     BusLoad,
+    /// Run the firmware's scripted scenarios on the host and print the per-tick trace (the
+    /// QEMU binary prints the same lines; `#` lines differ and are not compared).
+    Scenarios,
     /// Rewrite every generated file in the repository (DBC, test vectors, docs table).
     Gen {
         /// Only check; exit non-zero when a file is stale.
@@ -33,6 +36,22 @@ fn main() -> Result<()> {
         Cmd::Dbc => print!("{}", protocol::dbc::render()),
         Cmd::Vectors => print!("{}", protocol::vectors::render_json()),
         Cmd::BusLoad => print!("{}", walker_tools::busload_markdown()),
+        Cmd::Scenarios => {
+            let mut out = String::new();
+            let mut ok = true;
+            for sc in firmware::scenarios::SCENARIOS {
+                let summary =
+                    firmware::scenarios::run(sc, &mut out, &mut firmware::scenarios::NoHook)
+                        .map_err(|e| anyhow::anyhow!("{}: {e:?}", sc.name))?;
+                let verdict = sc.verdict(&summary);
+                ok &= verdict.is_ok();
+                out.push_str(&format!("# {}: verdict {verdict:?}\n", sc.name));
+            }
+            print!("{out}");
+            if !ok {
+                bail!("a scenario failed its expectations");
+            }
+        }
         Cmd::Gen { check } => {
             let root = repo_root();
             let mut stale = Vec::new();
