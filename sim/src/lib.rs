@@ -3,6 +3,7 @@
 //! impact equations, stride function, Newton-Raphson limit cycles and their stability.
 
 pub mod actuator;
+pub mod contact;
 pub mod continuation;
 pub mod dynamics;
 pub mod events;
@@ -16,6 +17,7 @@ pub mod relabel;
 pub mod report;
 pub mod scene;
 pub mod singular_limit;
+pub mod stability;
 pub mod stride;
 pub mod walk;
 pub mod walker;

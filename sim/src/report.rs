@@ -3,6 +3,8 @@
 use crate::continuation::{StabilityBoundary, SweepPoint};
 use crate::limit_cycle::{Gait, NewtonError};
 use crate::scene::Scene;
+use crate::stability::modes;
+use crate::stride::StrideOptions;
 use crate::walk::Walk;
 use crate::walker::Walker;
 use serde_json::{json, Map, Value};
@@ -107,6 +109,34 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
                     "specific_cost_of_transport".into(),
                     json!(g.stride.impact_energy_loss_j / (mass * g_m_s2 * n.step_length_m)),
                 );
+            }
+            o.insert("heading_change_rad_per_step".into(), json!(g.stride.heading_change_rad));
+            o.insert("total_mass_kg".into(), json!(mass));
+            let names = walker.map_names();
+            o.insert(
+                "eigenvalue_modes".into(),
+                json!(modes(&g.jacobian, &g.eigenvalues, &names, &walker.three_d_freedoms)),
+            );
+            if walker.ankle.is_some() {
+                let s = &g.stride;
+                o.insert("actuator_work_j_per_step".into(), json!(s.actuator_work_j));
+                o.insert("damping_dissipation_j_per_step".into(), json!(s.damping_dissipation_j));
+                o.insert(
+                    "cost_of_transport_J_per_kg_m".into(),
+                    json!(s.actuator_work_j / (mass * n.step_length_m)),
+                );
+                // Over a periodic stride on level ground the actuator's work is what the impacts
+                // and dampers take: the difference checks the quadrature.
+                o.insert(
+                    "energy_balance_residual_j".into(),
+                    json!(s.actuator_work_j - s.impact_energy_loss_j - s.damping_dissipation_j),
+                );
+            }
+            let (q, qd) = walker.unpack(&g.fixed_point);
+            if let Ok(c) = walker.stride(&q, &qd, StrideOptions { record: false, contact: true }) {
+                o.insert("max_lateral_cop_m".into(), json!(c.contact.max_lateral_cop_m));
+                o.insert("min_normal_force_n".into(), json!(c.contact.min_normal_force_n));
+                o.insert("mid_swing_clearance_m".into(), json!(c.contact.mid_swing_clearance_m));
             }
         }
     }

@@ -123,6 +123,8 @@ pub struct StrideResult {
     pub actuator_work_j: f64,
     /// Energy dissipated by joint dampers (trapezoidal quadrature) [J].
     pub damping_dissipation_j: f64,
+    /// Contact figures (with [`StrideOptions::contact`]).
+    pub contact: ContactSummary,
 }
 
 /// Running actuator work and damper dissipation over accepted steps.
@@ -390,6 +392,45 @@ pub struct HeelStrikeImpact {
 pub struct StrideOptions {
     /// Keep every accepted sample.
     pub record: bool,
+    /// Compute the contact load, lateral centre of pressure and swing clearance at every
+    /// accepted sample (for reports; costs one more evaluation per step).
+    pub contact: bool,
+}
+
+/// Contact and clearance figures of a stride (with [`StrideOptions::contact`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ContactSummary {
+    /// Largest |lateral centre of pressure| under the stance foot [m].
+    pub max_lateral_cop_m: f64,
+    /// Smallest normal force on the stance foot [N] (negative: the foot would have to pull).
+    pub min_normal_force_n: f64,
+    /// Smallest swing-ankle height while it passes within 0.1 m of the stance contact [m].
+    pub mid_swing_clearance_m: Option<f64>,
+    /// Lateral centre of pressure at each accepted sample `(t_s, cop_m)`.
+    pub lateral_cop_trace: Vec<(f64, f64)>,
+}
+
+impl ContactSummary {
+    fn add(&mut self, walker: &Walker, phase: &mut Phase, wit: &mut Witnesses, s: &Sample) -> Result<(), DynamicsError> {
+        let qdd = phase.accelerations(s.t_s, &s.q, &s.qd)?;
+        let mut s2 = s.clone();
+        phase.snap(&mut s2);
+        wit.update(&s2);
+        let load = crate::contact::ContactLoad::from_motion(&walker.model, &wit.kin, &qdd);
+        let cop = load.lateral_cop_m(&wit.heading());
+        if self.lateral_cop_trace.is_empty() {
+            self.min_normal_force_n = f64::INFINITY;
+        }
+        self.lateral_cop_trace.push((s.t_s, cop));
+        self.max_lateral_cop_m = self.max_lateral_cop_m.max(cop.abs());
+        self.min_normal_force_n = self.min_normal_force_n.min(load.force_n.y);
+        let ahead = wit.foot_ahead_m(&s2);
+        if ahead.abs() < 0.1 {
+            let h = wit.foot_height(&s2);
+            self.mid_swing_clearance_m = Some(self.mid_swing_clearance_m.map_or(h, |m| m.min(h)));
+        }
+        Ok(())
+    }
 }
 
 impl Walker {
@@ -429,6 +470,7 @@ impl Walker {
             .filter(|(_, d)| *d != 0.0)
             .collect();
         let mut power = Power::default();
+        let mut contact = ContactSummary::default();
         let mut wit = Witnesses {
             walker: self,
             kin: Kinematics::new(&self.model),
@@ -508,6 +550,11 @@ impl Walker {
             if triggered.is_empty() {
                 power.accumulate(&mut phase, &damping, &cur, &next)
                     .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string()))?;
+                if options.contact {
+                    contact.add(self, &mut phase, &mut wit, &next).map_err(|e| {
+                        StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
+                    })?;
+                }
                 cur = next;
                 if options.record {
                     trajectory.push(cur.clone());
@@ -701,6 +748,7 @@ impl Walker {
                         integrator.as_ref(),
                     )?;
                     r.actuator_work_j = power.work_j;
+                    r.contact = contact;
                     r.damping_dissipation_j = power.dissipation_j;
                     return Ok(r);
                 }
@@ -833,6 +881,7 @@ impl Walker {
             trajectory: Vec::new(),
             actuator_work_j: 0.0,
             damping_dissipation_j: 0.0,
+            contact: ContactSummary::default(),
         })
     }
 }

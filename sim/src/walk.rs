@@ -132,7 +132,7 @@ impl Walker {
         let mut samples = Vec::new();
         for step in 0..steps {
             samples.clear();
-            let result = self.stride_recording(&q, &qd, StrideOptions { record }, &mut samples);
+            let result = self.stride_recording(&q, &qd, StrideOptions { record, contact: false }, &mut samples);
             for s in &samples {
                 out.path
                     .push(self.path_sample(&mut kin, &frame, step, t0, s));

@@ -90,6 +90,8 @@ pub struct Walker {
     /// Coordinates locked (at zero) at the start of every stride, e.g. the toe pitch of a flat
     /// stance foot. They are left out of the stride map.
     pub initially_locked: Vec<CoordIndex>,
+    /// Coordinates only the 3D model has (for eigenvalue reports).
+    pub three_d_freedoms: Vec<String>,
     /// A starting guess for the gait (just after heel strike).
     pub guess_q: DVector<f64>,
     /// A starting guess for the gait velocities.

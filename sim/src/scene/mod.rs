@@ -521,6 +521,7 @@ impl Scene {
             guess_qd,
             ankle,
             initially_locked,
+            three_d_freedoms: f.three_d_freedoms.clone(),
         })
     }
 
