@@ -19,5 +19,6 @@ pub mod scene;
 pub mod singular_limit;
 pub mod stability;
 pub mod stride;
+pub mod tune;
 pub mod walk;
 pub mod walker;

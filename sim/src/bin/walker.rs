@@ -5,12 +5,14 @@
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+use nalgebra::DVector;
 use serde_json::{json, Value};
 use sim::continuation::sweep;
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::NewtonSettings;
 use sim::report::{gait_json, sweep_json, walk_json};
 use sim::scene::{Scene, SceneError, BUILTIN};
+use sim::tune::{tune, TunedParameter};
 use sim::walker::Walker;
 use std::io::Write;
 use std::process::ExitCode;
@@ -46,6 +48,11 @@ enum Command {
         /// Start from `gait` (the fixed point) or `guess` (the scene's guess, no search).
         #[arg(long, default_value = "gait")]
         start: String,
+        /// Start from the gait of another scene instead, coordinate by coordinate (those this
+        /// scene lacks are dropped, those it adds start at 0), e.g. the compensated walker's
+        /// leg state for the uncompensated one.
+        #[arg(long, value_name = "SCENE")]
+        start_from_scene: Option<String>,
         /// Write the trajectory (every integrator sample) as CSV.
         #[arg(long, value_name = "FILE.csv")]
         out: Option<std::path::PathBuf>,
@@ -66,6 +73,17 @@ enum Command {
         /// Number of points (≥ 2).
         #[arg(long)]
         points: usize,
+    },
+    /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
+    Tune {
+        #[command(flatten)]
+        common: Common,
+        /// A parameter the search may change: `name=min:max` (repeatable).
+        #[arg(long = "vary", value_name = "NAME=MIN:MAX", required = true)]
+        vary: Vec<String>,
+        /// Gait searches allowed.
+        #[arg(long, default_value_t = 60)]
+        evaluations: usize,
     },
     /// List the scenes and their parameters.
     Scenes {
@@ -215,26 +233,24 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 ExitCode::from(1)
             })
         }
-        Command::Walk {
-            common,
-            steps,
-            perturb,
-            start,
-            out,
-        } => {
+        Command::Walk { common, steps, perturb, start, start_from_scene, out } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-            let mut v = match start.as_str() {
-                "guess" => v0,
-                "gait" => match walker.find_gait(&v0, &common.newton()) {
+            let mut v = match (start_from_scene, start.as_str()) {
+                (Some(other), _) => match start_from_other(&other, &scene, &walker, &common)? {
+                    Some(v) => v,
+                    None => return Ok(ExitCode::from(1)),
+                },
+                (None, "guess") => v0,
+                (None, "gait") => match walker.find_gait(&v0, &common.newton()) {
                     Ok(g) => g.fixed_point,
                     Err(e) => {
                         eprintln!("error: no gait to start from: {e} (use --start guess)");
                         return Ok(ExitCode::from(1));
                     }
                 },
-                other => {
+                (None, other) => {
                     return Err(InputError::Other(format!(
                         "--start `{other}`: expected gait or guess"
                     ))
@@ -300,6 +316,36 @@ fn run(cli: Cli) -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Command::Tune { common, vary, evaluations } => {
+            let scene = common.scene()?;
+            common.walker(&scene)?;
+            let mut params = Vec::new();
+            for v in &vary {
+                let bad = || InputError::Other(format!("--vary `{v}`: expected name=min:max"));
+                let (name, range) = v.split_once('=').ok_or_else(bad)?;
+                let (lo, hi) = range.split_once(':').ok_or_else(bad)?;
+                let (min, max): (f64, f64) =
+                    (lo.trim().parse().map_err(|_| bad())?, hi.trim().parse().map_err(|_| bad())?);
+                if !(min.is_finite() && max.is_finite() && min < max) {
+                    return Err(bad().into());
+                }
+                params.push(TunedParameter { name: name.trim().to_string(), min, max });
+            }
+            let result = tune(&scene, &params, evaluations, &common.newton())?;
+            if common.json {
+                print_json(&json!(result))?;
+            } else {
+                println!("{} evaluations", result.history.len());
+                for (p, v) in result.parameters.iter().zip(&result.best.values) {
+                    println!("    {:<36} {:>12.6}   (bounds {} .. {})", p.name, v, p.min, p.max);
+                }
+                match result.best.max_abs_eigenvalue {
+                    Some(m) => println!("best max |λ| = {m:.6}"),
+                    None => println!("no gait found"),
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Sweep {
             common,
             param,
@@ -352,6 +398,39 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// The gait of scene `other` (with this scene's shared parameter values), mapped onto this
+/// walker's stride-map entries by name. `None` (after a message) if it has no gait.
+fn start_from_other(
+    other: &str,
+    scene: &Scene,
+    walker: &Walker,
+    common: &Common,
+) -> Result<Option<DVector<f64>>> {
+    let mut other_scene = Scene::load(other)?;
+    for (k, val) in &scene.values {
+        if other_scene.file.parameters.contains_key(k) {
+            other_scene.set(k, *val)?;
+        }
+    }
+    let ow = other_scene.build()?;
+    let og = match ow.find_gait(&ow.pack(&ow.guess_q, &ow.guess_qd), &common.newton()) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("error: scene `{other}` has no gait to start from: {e}");
+            return Ok(None);
+        }
+    };
+    let names = walker.map_names();
+    let onames = ow.map_names();
+    let mut v = DVector::zeros(names.len());
+    for (i, n) in names.iter().enumerate() {
+        if let Some(j) = onames.iter().position(|m| m == n) {
+            v[i] = og.fixed_point[j];
+        }
+    }
+    Ok(Some(v))
 }
 
 fn scenes(as_json: bool) -> Result<ExitCode> {
