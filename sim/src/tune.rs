@@ -52,15 +52,15 @@ pub fn tune(
 ) -> Result<TuneResult, SceneError> {
     let mut scene = scene.clone();
     let n = params.len();
+    let start: Vec<f64> = params
+        .iter()
+        .map(|p| scene_value(&scene, &p.name).clamp(p.min, p.max))
+        .collect();
     for p in params {
         // Validates names and bounds against the scene's own ranges.
         scene.set(&p.name, p.min)?;
         scene.set(&p.name, p.max)?;
     }
-    let start: Vec<f64> = params
-        .iter()
-        .map(|p| scene_value(&scene, &p.name).clamp(p.min, p.max))
-        .collect();
     let mut warm: Option<DVector<f64>> = None;
     let mut history: Vec<TunePoint> = Vec::new();
     let mut eval = |x: &[f64], history: &mut Vec<TunePoint>| -> Result<f64, SceneError> {

@@ -36,17 +36,13 @@ impl FloorFrame {
         self.p_m + self.r * p_stance_m
     }
 
-    /// The frame of the next stride: origin at the new contact, turned by the heading
-    /// change, reflected if the walker mirrors.
+    /// The frame of the next stride. The relabelling maps old stance-frame points `p` to
+    /// `R_y(−ψ) S (p − c)` (translate to the new contact `c`, reflect if mirroring, then zero the
+    /// heading `ψ`), so a new-frame point `p'` is the old-frame point `c + S R_y(ψ) p'`.
     pub fn next(&self, step_m: &Vector3<f64>, heading_rad: f64, mirror: bool) -> Self {
-        let mut r = self.r * rotation_about(&Vector3::y(), heading_rad);
-        if mirror {
-            r *= sagittal_reflection();
-        }
-        Self {
-            r,
-            p_m: self.apply(step_m),
-        }
+        let turn = rotation_about(&Vector3::y(), heading_rad);
+        let r = if mirror { self.r * sagittal_reflection() * turn } else { self.r * turn };
+        Self { r, p_m: self.apply(step_m) }
     }
 }
 

@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use nalgebra::DVector;
 use serde_json::{json, Value};
 use sim::continuation::sweep;
+use sim::figures;
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::NewtonSettings;
 use sim::report::{gait_json, sweep_json, walk_json};
@@ -34,6 +35,9 @@ enum Command {
     Gait {
         #[command(flatten)]
         common: Common,
+        /// Write SVG figures (eigenvalues, joint angles over a stride) into this folder.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<std::path::PathBuf>,
     },
     /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
     Walk {
@@ -56,6 +60,13 @@ enum Command {
         /// Write the trajectory (every integrator sample) as CSV.
         #[arg(long, value_name = "FILE.csv")]
         out: Option<std::path::PathBuf>,
+        /// Write the floor path of the hip-axle centre as SVG into this folder.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<std::path::PathBuf>,
+        /// Also walk this scene from its own gait, the same number of steps, and draw its path
+        /// in the same figure (e.g. the compensated walker beside the uncompensated one).
+        #[arg(long, value_name = "SCENE")]
+        plot_with: Option<String>,
     },
     /// Continuation: follow the gait while one parameter changes.
     Sweep {
@@ -216,12 +227,20 @@ fn print_json(v: &Value) -> Result<()> {
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Scenes { json } => scenes(json),
-        Command::Gait { common } => {
+        Command::Gait { common, plot } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
             let result = walker.find_gait(&v0, &common.newton());
             let report = gait_json(&scene, &walker, &result);
+            if let (Some(dir), Ok(g)) = (&plot, &result) {
+                std::fs::create_dir_all(dir)?;
+                let name = scene.name();
+                let eig = figures::eigenvalues(&walker, g, &format!("{name}: eigenvalues of the stride Jacobian"));
+                std::fs::write(dir.join("eigenvalues.svg"), eig.to_svg(640.0, 600.0))?;
+                let ang = figures::joint_angles(&walker, g, &format!("{name}: joint angles over one step"));
+                std::fs::write(dir.join("joint_angles.svg"), ang.to_svg(820.0, 480.0))?;
+            }
             if common.json {
                 print_json(&report)?;
             } else {
@@ -233,7 +252,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 ExitCode::from(1)
             })
         }
-        Command::Walk { common, steps, perturb, start, start_from_scene, out } => {
+        Command::Walk { common, steps, perturb, start, start_from_scene, out, plot, plot_with } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
@@ -283,7 +302,27 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 v[i] += d;
             }
             let (q, qd) = walker.unpack(&v);
-            let walk = walker.walk(&q, &qd, steps, out.is_some());
+            let walk = walker.walk(&q, &qd, steps, out.is_some() || plot.is_some());
+            if let Some(dir) = &plot {
+                std::fs::create_dir_all(dir)?;
+                let mut walks = vec![(scene.name().to_string(), walk.clone())];
+                if let Some(other) = &plot_with {
+                    let mut os = Scene::load(other)?;
+                    for (k, val) in &scene.values {
+                        if os.file.parameters.contains_key(k) {
+                            os.set(k, *val)?;
+                        }
+                    }
+                    let ow = os.build()?;
+                    let v0 = ow.pack(&ow.guess_q, &ow.guess_qd);
+                    let start = ow.find_gait(&v0, &common.newton()).map(|g| g.fixed_point).unwrap_or(v0);
+                    let (oq, oqd) = ow.unpack(&start);
+                    walks.push((os.name().to_string(), ow.walk(&oq, &oqd, steps, true)));
+                }
+                let refs: Vec<(&str, &sim::walk::Walk)> = walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
+                let fig = figures::floor_paths(&refs, "path of the hip-axle centre on the floor");
+                std::fs::write(dir.join("floor_path.svg"), fig.to_svg(820.0, 420.0))?;
+            }
             if let Some(path) = out {
                 write_csv(&path, &walker, &walk)?;
             }

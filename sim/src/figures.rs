@@ -1,0 +1,94 @@
+//! The figures of the paper, from our results: eigenvalues in the complex plane (Figs. 11,
+//! 13), the floor path of the hip-axle centre (Fig. 12), and joint angles over a stride.
+
+use crate::limit_cycle::Gait;
+use crate::plot::{Plot, Series, Style, PALETTE};
+use crate::stability::modes;
+use crate::walk::Walk;
+use crate::walker::Walker;
+use crate::stride::StrideOptions;
+
+/// Eigenvalues of the stride Jacobian with the unit circle; those whose eigenvector is
+/// dominated by a freedom only the 3D model has are drawn as stars.
+pub fn eigenvalues(walker: &Walker, gait: &Gait, title: &str) -> Plot {
+    let m = modes(&gait.jacobian, &gait.eigenvalues, &walker.map_names(), &walker.three_d_freedoms);
+    let (three_d, plain): (Vec<_>, Vec<_>) = m.iter().partition(|e| e.three_d);
+    let mut series = vec![Series {
+        label: "eigenvalue".into(),
+        points: plain.iter().map(|e| (e.eigenvalue[0], e.eigenvalue[1])).collect(),
+        style: Style::Circle,
+        color: PALETTE[0],
+    }];
+    if !three_d.is_empty() {
+        series.push(Series {
+            label: "* 3D mode (yaw, roll)".into(),
+            points: three_d.iter().map(|e| (e.eigenvalue[0], e.eigenvalue[1])).collect(),
+            style: Style::Star,
+            color: PALETTE[1],
+        });
+    }
+    Plot {
+        title: title.into(),
+        x_label: "Re λ [-]".into(),
+        y_label: "Im λ [-]".into(),
+        series,
+        equal_aspect: true,
+        unit_circle: true,
+    }
+}
+
+/// The path of the hip-axle centre on the floor for one or more walks.
+pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
+    let series = walks
+        .iter()
+        .enumerate()
+        .map(|(i, (label, w))| Series {
+            label: match &w.failure {
+                Some(f) => format!("{label} (fails in step {}: {:?})", f.step + 1, f.kind),
+                None => format!("{label} ({} steps)", w.steps.len()),
+            },
+            points: w.path.iter().map(|s| (s.hip_floor_m.x, s.hip_floor_m.z)).collect(),
+            style: if i == 0 { Style::Line } else { Style::Dashed },
+            color: PALETTE[i % PALETTE.len()],
+        })
+        .collect();
+    Plot {
+        title: title.into(),
+        x_label: "forward x [m]".into(),
+        y_label: "lateral z [m] (to the right)".into(),
+        series,
+        equal_aspect: false,
+        unit_circle: false,
+    }
+}
+
+/// Every joint coordinate over one stride from the gait's fixed point.
+pub fn joint_angles(walker: &Walker, gait: &Gait, title: &str) -> Plot {
+    let (q, qd) = walker.unpack(&gait.fixed_point);
+    let samples = walker
+        .stride(&q, &qd, StrideOptions { record: true, contact: false })
+        .map(|r| r.trajectory)
+        .unwrap_or_default();
+    let series = walker
+        .model
+        .coordinates
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| samples.iter().any(|s| s.q[*i].abs() > 1e-12))
+        .enumerate()
+        .map(|(k, (i, c))| Series {
+            label: c.name.clone(),
+            points: samples.iter().map(|s| (s.t_s, s.q[i])).collect(),
+            style: Style::Line,
+            color: PALETTE[k % PALETTE.len()],
+        })
+        .collect();
+    Plot {
+        title: title.into(),
+        x_label: "time from heel strike [s]".into(),
+        y_label: "joint angle [rad]".into(),
+        series,
+        equal_aspect: false,
+        unit_circle: false,
+    }
+}
