@@ -425,21 +425,31 @@ impl AnkleNode {
             self.next_version_at = Instant(now.0.saturating_add(self.config.version_period_us));
         }
 
-        // Priority order, stable (insertion sort: at most MAX_TX_PER_TICK entries).
-        let mut transmit = out.list;
+        // Priority order, stable (insertion sort over at most MAX_TX_PER_TICK entries). Every
+        // message of this node carries the same node field, so the class orders the
+        // identifiers. Pairs are taken with `get_mut` and a slice pattern: no indexing, no
+        // bounds-check panic path.
+        let transmit = &mut out.list;
         for i in 1..transmit.len() {
             let mut j = i;
-            while j > 0 && transmit[j - 1].id().raw() > transmit[j].id().raw() {
-                transmit.swap(j - 1, j);
+            while j > 0 {
+                let Some([a, b]) = transmit.get_mut(j - 1..=j) else {
+                    break;
+                };
+                if a.class() <= b.class() {
+                    break;
+                }
+                core::mem::swap(a, b);
                 j -= 1;
             }
         }
-        self.dropped_tx = dropped;
-        TickOutputs {
+        let outputs = TickOutputs {
             actuator,
-            transmit,
+            transmit: out.list,
             state: self.state,
             phase: self.reflex.phase(),
-        }
+        };
+        self.dropped_tx = dropped;
+        outputs
     }
 }

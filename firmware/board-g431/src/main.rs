@@ -156,9 +156,9 @@ async fn main(_spawner: Spawner) {
         rx: buffered.reader(),
     };
 
-    // Encoder on SPI1 (mode 1, 1 MHz).
+    // Encoder on SPI1 (mode 1, 10 MHz: the AS5047P maximum).
     let mut spi_cfg = spi::Config::default();
-    spi_cfg.frequency = mhz(1);
+    spi_cfg.frequency = mhz(10);
     spi_cfg.mode = spi::MODE_1;
     let spi_bus = Spi::new_blocking(p.SPI1, p.PB3, p.PB5, p.PB4, spi_cfg);
     let cs = Output::new(p.PA15, Level::High, Speed::VeryHigh);
