@@ -256,6 +256,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+            let start_from_scene = match (start_from_scene, start.as_str()) {
+                (None, "gait") => match &scene.file.walk_start_scene {
+                    Some(other) if walker.find_gait(&v0, &common.newton()).is_err() => {
+                        eprintln!(
+                            "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
+                            scene.name()
+                        );
+                        Some(other.clone())
+                    }
+                    _ => None,
+                },
+                (s, _) => s,
+            };
             let mut v = match (start_from_scene, start.as_str()) {
                 (Some(other), _) => match start_from_other(&other, &scene, &walker, &common)? {
                     Some(v) => v,

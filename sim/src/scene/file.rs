@@ -50,6 +50,10 @@ pub struct SceneFile {
     /// Freedoms of the 3D model (reported in eigenvalue modes).
     #[serde(default)]
     pub three_d_freedoms: Vec<String>,
+    /// Scene whose gait starts `walker walk` when this scene has no gait of its own (its
+    /// coordinates are matched by name).
+    #[serde(default)]
+    pub walk_start_scene: Option<String>,
     /// Derived outputs in a publication's own convention.
     #[serde(default)]
     pub convention: Option<ConventionDef>,

@@ -25,6 +25,8 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("wisse3d", include_str!("../../scenes/wisse3d.toml")),
     ("wisse2d", include_str!("../../scenes/wisse2d.toml")),
     ("wisse3d-uncompensated", include_str!("../../scenes/wisse3d-uncompensated.toml")),
+    ("wisse3d-table1", include_str!("../../scenes/wisse3d-table1.toml")),
+    ("wisse2d-uncompensated", include_str!("../../scenes/wisse2d-uncompensated.toml")),
 ];
 
 /// Why a scene could not be loaded or built. Each variant names what was wrong.
