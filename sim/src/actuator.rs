@@ -56,7 +56,11 @@ impl AnkleProfile {
         let s = x3 * (10.0 - 15.0 * x + 6.0 * x2);
         let ds = 30.0 * x2 * (1.0 - x) * (1.0 - x);
         let dds = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x);
-        (self.from_rad + span * s, span * ds / d, span * dds / (d * d))
+        (
+            self.from_rad + span * s,
+            span * ds / d,
+            span * dds / (d * d),
+        )
     }
 }
 
@@ -66,7 +70,12 @@ mod tests {
 
     #[test]
     fn profile_is_smooth_and_reaches_its_end() {
-        let p = AnkleProfile { start_s: 1.0, duration_s: 0.2, from_rad: -0.08, to_rad: 0.2 };
+        let p = AnkleProfile {
+            start_s: 1.0,
+            duration_s: 0.2,
+            from_rad: -0.08,
+            to_rad: 0.2,
+        };
         assert_eq!(p.eval(0.5), (-0.08, 0.0, 0.0));
         assert_eq!(p.eval(1.3), (0.2, 0.0, 0.0));
         // Rate is the derivative of the angle, acceleration of the rate.

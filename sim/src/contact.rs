@@ -39,7 +39,10 @@ impl ContactLoad {
             force_n += f;
             moment_n_m += r.cross(&f) + inertia * alpha + w.cross(&(inertia * w));
         }
-        Self { force_n, moment_n_m }
+        Self {
+            force_n,
+            moment_n_m,
+        }
     }
 
     /// Lateral offset of the centre of pressure from the origin [m], to the right of the

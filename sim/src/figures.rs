@@ -4,25 +4,36 @@
 use crate::limit_cycle::Gait;
 use crate::plot::{Plot, Series, Style, PALETTE};
 use crate::stability::modes;
+use crate::stride::StrideOptions;
 use crate::walk::Walk;
 use crate::walker::Walker;
-use crate::stride::StrideOptions;
 
 /// Eigenvalues of the stride Jacobian with the unit circle; those whose eigenvector is
 /// dominated by a freedom only the 3D model has are drawn as stars.
 pub fn eigenvalues(walker: &Walker, gait: &Gait, title: &str) -> Plot {
-    let m = modes(&gait.jacobian, &gait.eigenvalues, &walker.map_names(), &walker.three_d_freedoms);
+    let m = modes(
+        &gait.jacobian,
+        &gait.eigenvalues,
+        &walker.map_names(),
+        &walker.three_d_freedoms,
+    );
     let (three_d, plain): (Vec<_>, Vec<_>) = m.iter().partition(|e| e.three_d);
     let mut series = vec![Series {
         label: "eigenvalue".into(),
-        points: plain.iter().map(|e| (e.eigenvalue[0], e.eigenvalue[1])).collect(),
+        points: plain
+            .iter()
+            .map(|e| (e.eigenvalue[0], e.eigenvalue[1]))
+            .collect(),
         style: Style::Circle,
         color: PALETTE[0],
     }];
     if !three_d.is_empty() {
         series.push(Series {
             label: "* 3D mode (yaw, roll)".into(),
-            points: three_d.iter().map(|e| (e.eigenvalue[0], e.eigenvalue[1])).collect(),
+            points: three_d
+                .iter()
+                .map(|e| (e.eigenvalue[0], e.eigenvalue[1]))
+                .collect(),
             style: Style::Star,
             color: PALETTE[1],
         });
@@ -47,7 +58,11 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
                 Some(f) => format!("{label} (fails in step {}: {:?})", f.step + 1, f.kind),
                 None => format!("{label} ({} steps)", w.steps.len()),
             },
-            points: w.path.iter().map(|s| (s.hip_floor_m.x, s.hip_floor_m.z)).collect(),
+            points: w
+                .path
+                .iter()
+                .map(|s| (s.hip_floor_m.x, s.hip_floor_m.z))
+                .collect(),
             style: if i == 0 { Style::Line } else { Style::Dashed },
             color: PALETTE[i % PALETTE.len()],
         })
@@ -66,7 +81,14 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
 pub fn joint_angles(walker: &Walker, gait: &Gait, title: &str) -> Plot {
     let (q, qd) = walker.unpack(&gait.fixed_point);
     let samples = walker
-        .stride(&q, &qd, StrideOptions { record: true, contact: false })
+        .stride(
+            &q,
+            &qd,
+            StrideOptions {
+                record: true,
+                contact: false,
+            },
+        )
         .map(|r| r.trajectory)
         .unwrap_or_default();
     let series = walker

@@ -162,7 +162,10 @@ impl Walker {
                 break;
             }
             let a = DMatrix::identity(n, n) - &j;
-            let dv = a.lu().solve(&r).ok_or(NewtonError::Singular { iteration: it })?;
+            let dv = a
+                .lu()
+                .solve(&r)
+                .ok_or(NewtonError::Singular { iteration: it })?;
             // Damped step: halve while the stride from the new point fails or its residual
             // grows; keep the last trial if the budget runs out (the next iteration reports).
             let r_norm = r.amax();

@@ -46,8 +46,9 @@ pub struct Plot {
 }
 
 /// Colours for successive series.
-pub const PALETTE: [&str; 8] =
-    ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
+pub const PALETTE: [&str; 8] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+];
 
 fn nice_step(span: f64, target: usize) -> f64 {
     let raw = span / target as f64;
@@ -76,7 +77,9 @@ fn fmt_tick(v: f64, step: f64) -> String {
 }
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 impl Plot {
@@ -142,10 +145,9 @@ impl Plot {
         let mut t = (x0 / xstep).ceil() * xstep;
         while t <= x1 + 1e-12 {
             let x = px(t);
-            let _ = write!(
+            let _ = writeln!(
                 o,
-                r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="#e4e4e4"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>
-"##,
+                r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="#e4e4e4"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
                 mt + ph,
                 mt + ph + 18.0,
                 fmt_tick(t, xstep)
@@ -155,10 +157,9 @@ impl Plot {
         let mut t = (y0 / ystep).ceil() * ystep;
         while t <= y1 + 1e-12 {
             let y = py(t);
-            let _ = write!(
+            let _ = writeln!(
                 o,
-                r##"<line x1="{ml}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e4e4e4"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>
-"##,
+                r##"<line x1="{ml}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e4e4e4"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
                 ml + pw,
                 ml - 6.0,
                 y + 4.0,
@@ -190,13 +191,23 @@ impl Plot {
             );
         }
         for s in &self.series {
-            let pts: Vec<(f64, f64)> =
-                s.points.iter().filter(|p| p.0.is_finite() && p.1.is_finite()).copied().collect();
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .copied()
+                .collect();
             match s.style {
                 Style::Line | Style::Dashed => {
-                    let d: Vec<String> =
-                        pts.iter().map(|&(x, y)| format!("{:.2},{:.2}", px(x), py(y))).collect();
-                    let dash = if s.style == Style::Dashed { r#" stroke-dasharray="6,4""# } else { "" };
+                    let d: Vec<String> = pts
+                        .iter()
+                        .map(|&(x, y)| format!("{:.2},{:.2}", px(x), py(y)))
+                        .collect();
+                    let dash = if s.style == Style::Dashed {
+                        r#" stroke-dasharray="6,4""#
+                    } else {
+                        ""
+                    };
                     let _ = writeln!(
                         o,
                         r#"<polyline fill="none" stroke="{}" stroke-width="1.8"{dash} points="{}"/>"#,
@@ -230,7 +241,15 @@ impl Plot {
         }
         let _ = writeln!(o, "</g>");
         // Legend, top right inside the plot area.
-        let lw = 12.0 + 7.5 * self.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0) as f64 + 34.0;
+        let lw = 12.0
+            + 7.5
+                * self
+                    .series
+                    .iter()
+                    .map(|s| s.label.chars().count())
+                    .max()
+                    .unwrap_or(0) as f64
+            + 34.0;
         let lx = ml + pw - lw - 8.0;
         let ly = mt + 8.0;
         let _ = writeln!(
@@ -241,12 +260,42 @@ impl Plot {
         for (i, s) in self.series.iter().enumerate() {
             let y = ly + 16.0 + 18.0 * i as f64;
             let mark = match s.style {
-                Style::Line => format!(r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"/>"#, lx + 6.0, y - 4.0, lx + 28.0, y - 4.0, s.color),
-                Style::Dashed => format!(r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2" stroke-dasharray="6,4"/>"#, lx + 6.0, y - 4.0, lx + 28.0, y - 4.0, s.color),
-                Style::Circle => format!(r#"<circle cx="{:.1}" cy="{:.1}" r="4.5" fill="none" stroke="{}" stroke-width="1.8"/>"#, lx + 17.0, y - 4.0, s.color),
-                Style::Star => format!(r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="20" fill="{}">*</text>"#, lx + 17.0, y + 4.0, s.color),
+                Style::Line => format!(
+                    r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"/>"#,
+                    lx + 6.0,
+                    y - 4.0,
+                    lx + 28.0,
+                    y - 4.0,
+                    s.color
+                ),
+                Style::Dashed => format!(
+                    r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2" stroke-dasharray="6,4"/>"#,
+                    lx + 6.0,
+                    y - 4.0,
+                    lx + 28.0,
+                    y - 4.0,
+                    s.color
+                ),
+                Style::Circle => format!(
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="4.5" fill="none" stroke="{}" stroke-width="1.8"/>"#,
+                    lx + 17.0,
+                    y - 4.0,
+                    s.color
+                ),
+                Style::Star => format!(
+                    r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="20" fill="{}">*</text>"#,
+                    lx + 17.0,
+                    y + 4.0,
+                    s.color
+                ),
             };
-            let _ = writeln!(o, r#"{mark}<text x="{:.1}" y="{:.1}">{}</text>"#, lx + 34.0, y, escape(&s.label));
+            let _ = writeln!(
+                o,
+                r#"{mark}<text x="{:.1}" y="{:.1}">{}</text>"#,
+                lx + 34.0,
+                y,
+                escape(&s.label)
+            );
         }
         o.push_str("</svg>\n");
         o
@@ -264,8 +313,18 @@ mod tests {
             x_label: "time [s]".into(),
             y_label: "angle [rad]".into(),
             series: vec![
-                Series { label: "a".into(), points: vec![(0.0, 0.0), (1.0, 2.0)], style: Style::Line, color: PALETTE[0] },
-                Series { label: "b".into(), points: vec![(0.5, 1.0)], style: Style::Star, color: PALETTE[1] },
+                Series {
+                    label: "a".into(),
+                    points: vec![(0.0, 0.0), (1.0, 2.0)],
+                    style: Style::Line,
+                    color: PALETTE[0],
+                },
+                Series {
+                    label: "b".into(),
+                    points: vec![(0.5, 1.0)],
+                    style: Style::Star,
+                    color: PALETTE[1],
+                },
             ],
             equal_aspect: false,
             unit_circle: true,

@@ -177,7 +177,11 @@ impl Relabel {
             }
             if iterations >= self.max_iterations || !r.is_finite() {
                 if std::env::var_os("WALKER_DEBUG_RELABEL").is_some() {
-                    eprintln!("relabel residual {:?}\nq {:?}", res.as_slice(), q.as_slice());
+                    eprintln!(
+                        "relabel residual {:?}\nq {:?}",
+                        res.as_slice(),
+                        q.as_slice()
+                    );
                 }
                 return Err(RelabelError::PoseMismatch {
                     residual: r,
@@ -200,7 +204,10 @@ impl Relabel {
         let vres = (&jac * &qd - &target).norm();
         if vres > 1e-8 * (1.0 + target.norm()) {
             if std::env::var_os("WALKER_DEBUG_RELABEL").is_some() {
-                eprintln!("relabel velocity residual {:?}", (&jac * &qd - &target).as_slice());
+                eprintln!(
+                    "relabel velocity residual {:?}",
+                    (&jac * &qd - &target).as_slice()
+                );
             }
             return Err(RelabelError::VelocityMismatch { residual: vres });
         }

@@ -110,17 +110,28 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
                     json!(g.stride.impact_energy_loss_j / (mass * g_m_s2 * n.step_length_m)),
                 );
             }
-            o.insert("heading_change_rad_per_step".into(), json!(g.stride.heading_change_rad));
+            o.insert(
+                "heading_change_rad_per_step".into(),
+                json!(g.stride.heading_change_rad),
+            );
             o.insert("total_mass_kg".into(), json!(mass));
             let names = walker.map_names();
             o.insert(
                 "eigenvalue_modes".into(),
-                json!(modes(&g.jacobian, &g.eigenvalues, &names, &walker.three_d_freedoms)),
+                json!(modes(
+                    &g.jacobian,
+                    &g.eigenvalues,
+                    &names,
+                    &walker.three_d_freedoms
+                )),
             );
             if walker.ankle.is_some() {
                 let s = &g.stride;
                 o.insert("actuator_work_j_per_step".into(), json!(s.actuator_work_j));
-                o.insert("damping_dissipation_j_per_step".into(), json!(s.damping_dissipation_j));
+                o.insert(
+                    "damping_dissipation_j_per_step".into(),
+                    json!(s.damping_dissipation_j),
+                );
                 o.insert(
                     "cost_of_transport_J_per_kg_m".into(),
                     json!(s.actuator_work_j / (mass * n.step_length_m)),
@@ -133,10 +144,26 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
                 );
             }
             let (q, qd) = walker.unpack(&g.fixed_point);
-            if let Ok(c) = walker.stride(&q, &qd, StrideOptions { record: false, contact: true }) {
-                o.insert("max_lateral_cop_m".into(), json!(c.contact.max_lateral_cop_m));
-                o.insert("min_normal_force_n".into(), json!(c.contact.min_normal_force_n));
-                o.insert("mid_swing_clearance_m".into(), json!(c.contact.mid_swing_clearance_m));
+            if let Ok(c) = walker.stride(
+                &q,
+                &qd,
+                StrideOptions {
+                    record: false,
+                    contact: true,
+                },
+            ) {
+                o.insert(
+                    "max_lateral_cop_m".into(),
+                    json!(c.contact.max_lateral_cop_m),
+                );
+                o.insert(
+                    "min_normal_force_n".into(),
+                    json!(c.contact.min_normal_force_n),
+                );
+                o.insert(
+                    "mid_swing_clearance_m".into(),
+                    json!(c.contact.mid_swing_clearance_m),
+                );
             }
         }
     }

@@ -22,7 +22,12 @@ pub fn eigenvector(j: &DMatrix<f64>, lambda: Complex<f64>) -> Option<DVector<Com
     let n = j.nrows();
     let shift = lambda + Complex::new(1e-10 * (1.0 + lambda.norm()), 1e-10);
     let a = DMatrix::from_fn(n, n, |r, c| {
-        Complex::new(j[(r, c)], 0.0) - if r == c { shift } else { Complex::new(0.0, 0.0) }
+        Complex::new(j[(r, c)], 0.0)
+            - if r == c {
+                shift
+            } else {
+                Complex::new(0.0, 0.0)
+            }
     });
     let lu = a.lu();
     let mut v = DVector::from_fn(n, |i, _| Complex::new(1.0 + 0.1 * i as f64, 0.3));
@@ -55,10 +60,19 @@ pub fn modes(
                     .map(|i| (names[i].clone(), v[i].norm_sqr() + v[i + half].norm_sqr()))
                     .collect();
                 shares.sort_by(|a, b| b.1.total_cmp(&a.1));
-                dominant = shares.into_iter().filter(|(_, s)| *s >= 0.1).take(3).collect();
+                dominant = shares
+                    .into_iter()
+                    .filter(|(_, s)| *s >= 0.1)
+                    .take(3)
+                    .collect();
             }
             let three_d = dominant.first().is_some_and(|(n, _)| three_d.contains(n));
-            EigenMode { eigenvalue: [lambda.re, lambda.im], abs: lambda.norm(), dominant, three_d }
+            EigenMode {
+                eigenvalue: [lambda.re, lambda.im],
+                abs: lambda.norm(),
+                dominant,
+                three_d,
+            }
         })
         .collect()
 }
@@ -69,14 +83,26 @@ mod tests {
 
     #[test]
     fn eigenvector_of_a_block_matrix_lives_in_its_block() {
-        let j = DMatrix::from_row_slice(4, 4, &[
-            0.5, 0.0, 0.0, 0.0, //
-            0.0, 0.1, 0.0, 0.2, //
-            0.0, 0.0, -0.3, 0.0, //
-            0.0, 0.0, 0.0, 0.1,
-        ]);
-        let names: Vec<String> = ["a", "b", "a_dot", "b_dot"].iter().map(|s| s.to_string()).collect();
-        let m = modes(&j, &[Complex::new(0.5, 0.0), Complex::new(-0.3, 0.0)], &names, &["b".into()]);
+        let j = DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                0.5, 0.0, 0.0, 0.0, //
+                0.0, 0.1, 0.0, 0.2, //
+                0.0, 0.0, -0.3, 0.0, //
+                0.0, 0.0, 0.0, 0.1,
+            ],
+        );
+        let names: Vec<String> = ["a", "b", "a_dot", "b_dot"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let m = modes(
+            &j,
+            &[Complex::new(0.5, 0.0), Complex::new(-0.3, 0.0)],
+            &names,
+            &["b".into()],
+        );
         assert_eq!(m[0].dominant[0].0, "a");
         assert!(m[0].dominant[0].1 > 0.999);
         assert_eq!(m[1].dominant[0].0, "a");

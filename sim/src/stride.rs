@@ -1,12 +1,12 @@
 //! One stride: integrate single stance from just after one heel strike to just after the next,
 //! with knee locks on the way, then relabel (the stride function of eq. 22).
 
+use crate::actuator::AnkleProfile;
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::events::{locate, Direction, EventError};
 use crate::impact::{resolve, ImpactError};
 use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
 use crate::kinematics::Kinematics;
-use crate::actuator::AnkleProfile;
 use crate::model::{CoordIndex, LinkIndex, Model};
 use crate::relabel::LinkStates;
 use crate::walker::{ContactConstraint, Walker};
@@ -158,7 +158,12 @@ impl Power {
         to: &Sample,
     ) -> Result<(), DynamicsError> {
         let h = to.t_s - from.t_s;
-        let diss = |s: &Sample| damping.iter().map(|&(i, c)| c * s.qd[i] * s.qd[i]).sum::<f64>();
+        let diss = |s: &Sample| {
+            damping
+                .iter()
+                .map(|&(i, c)| c * s.qd[i] * s.qd[i])
+                .sum::<f64>()
+        };
         self.dissipation_j += 0.5 * h * (diss(from) + diss(to));
         if phase.prescribed.is_some() {
             let w0 = match (self.last_w, self.jumped) {
@@ -207,7 +212,9 @@ impl<'a> Phase<'a> {
     /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
     /// coordinate's rate: their product is the actuator power.
     pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
-        let Some((c, _)) = self.prescribed else { return Ok((0.0, 0.0)) };
+        let Some((c, _)) = self.prescribed else {
+            return Ok((0.0, 0.0));
+        };
         let qdd = self.accelerations(s.t_s, &s.q, &s.qd)?;
         let m = &self.dynamics.mass_matrix;
         let tau = (m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0];
@@ -223,7 +230,9 @@ impl SecondOrderSystem for Phase<'_> {
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
         match &self.prescribed {
-            None => self.dynamics.accelerations(self.model, q, qd, &self.active, None),
+            None => self
+                .dynamics
+                .accelerations(self.model, q, qd, &self.active, None),
             Some((c, p)) => {
                 let (a, ad, add) = p.eval(t);
                 let (mut q, mut qd) = (q.clone(), qd.clone());
@@ -231,7 +240,8 @@ impl SecondOrderSystem for Phase<'_> {
                 qd[c.0] = ad;
                 let mut qdd_p = DVector::zeros(q.len());
                 qdd_p[c.0] = add;
-                self.dynamics.accelerations(self.model, &q, &qd, &self.active, Some(&qdd_p))
+                self.dynamics
+                    .accelerations(self.model, &q, &qd, &self.active, Some(&qdd_p))
             }
         }
     }
@@ -337,7 +347,9 @@ impl Witnesses<'_> {
         self.update(s);
         let m = &self.walker.model;
         let d = self.kin.point_position(m, point)
-            - self.kin.point_position(m, self.walker.heel_strike.stance_contact);
+            - self
+                .kin
+                .point_position(m, self.walker.heel_strike.stance_contact);
         d.dot(&self.heading())
     }
     fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
@@ -345,7 +357,9 @@ impl Witnesses<'_> {
     }
     fn hip_height(&mut self, s: &Sample) -> f64 {
         self.update(s);
-        self.kin.point_position(&self.walker.model, self.walker.fall.hip).y
+        self.kin
+            .point_position(&self.walker.model, self.walker.fall.hip)
+            .y
             - self.walker.fall.min_hip_height_m
     }
     fn hip_ahead_m(&mut self, s: &Sample) -> f64 {
@@ -411,7 +425,13 @@ pub struct ContactSummary {
 }
 
 impl ContactSummary {
-    fn add(&mut self, walker: &Walker, phase: &mut Phase, wit: &mut Witnesses, s: &Sample) -> Result<(), DynamicsError> {
+    fn add(
+        &mut self,
+        walker: &Walker,
+        phase: &mut Phase,
+        wit: &mut Witnesses,
+        s: &Sample,
+    ) -> Result<(), DynamicsError> {
         let qdd = phase.accelerations(s.t_s, &s.q, &s.qd)?;
         let mut s2 = s.clone();
         phase.snap(&mut s2);
@@ -540,7 +560,10 @@ impl Walker {
             if let Some(r) = &self.ankle {
                 let (a, toe) = (r.ankle.0, r.toe_pitch.0);
                 let flat = !phase.active[toe] && phase.prescribed.is_none();
-                if flat && Direction::Falling.triggered(cur.q[a] - r.engage_rad, next.q[a] - r.engage_rad) {
+                if flat
+                    && Direction::Falling
+                        .triggered(cur.q[a] - r.engage_rad, next.q[a] - r.engage_rad)
+                {
                     triggered.push(Watch::Engage);
                 }
                 if phase.active[toe] && Direction::Rising.triggered(cur.q[toe], next.q[toe]) {
@@ -548,12 +571,17 @@ impl Walker {
                 }
             }
             if triggered.is_empty() {
-                power.accumulate(&mut phase, &damping, &cur, &next)
-                    .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string()))?;
-                if options.contact {
-                    contact.add(self, &mut phase, &mut wit, &next).map_err(|e| {
+                power
+                    .accumulate(&mut phase, &damping, &cur, &next)
+                    .map_err(|e| {
                         StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
                     })?;
+                if options.contact {
+                    contact
+                        .add(self, &mut phase, &mut wit, &next)
+                        .map_err(|e| {
+                            StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
+                        })?;
                 }
                 cur = next;
                 if options.record {
@@ -574,7 +602,10 @@ impl Walker {
                     Watch::HipLow => Box::new(|s: &Sample| wit.hip_height(s)),
                     Watch::HipBack => Box::new(|s: &Sample| wit.hip_forward_velocity(s)),
                     Watch::Engage => {
-                        let (a, e) = self.ankle.as_ref().map_or((0, 0.0), |r| (r.ankle.0, r.engage_rad));
+                        let (a, e) = self
+                            .ankle
+                            .as_ref()
+                            .map_or((0, 0.0), |r| (r.ankle.0, r.engage_rad));
                         Box::new(move |s: &Sample| s.q[a] - e)
                     }
                     Watch::HeelDrop => {
@@ -596,10 +627,15 @@ impl Walker {
                     first = Some((w, s));
                 }
             }
-            let Some((watch, mut at)) = first else { continue };
+            let Some((watch, mut at)) = first else {
+                continue;
+            };
             phase.snap(&mut at);
-            power.accumulate(&mut phase, &damping, &cur, &at)
-                .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string()))?;
+            power
+                .accumulate(&mut phase, &damping, &cur, &at)
+                .map_err(|e| {
+                    StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string())
+                })?;
             match watch {
                 Watch::HipLow => {
                     let kind = if wit.hip_ahead_m(&at) >= 0.0 {
@@ -639,7 +675,9 @@ impl Walker {
                     let mut dynamics = Dynamics::new(&self.model);
                     let before = energy(&mut dynamics, &self.model, &at);
                     let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, 0.0)
-                        .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+                        .map_err(|e| {
+                            StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
+                        })?;
                     let mut q = at.q.clone();
                     q[a] = r.engage_rad;
                     let mut qd = imp.qd_plus;
@@ -648,7 +686,10 @@ impl Walker {
                         return Err(StrideFailure::new(
                             FailureKind::HeelDidNotLift,
                             at.t_s,
-                            format!("at string engagement the heel moves down ({:.3e} rad/s)", qd[toe]),
+                            format!(
+                                "at string engagement the heel moves down ({:.3e} rad/s)",
+                                qd[toe]
+                            ),
                         ));
                     }
                     cur = Sample { t_s: at.t_s, q, qd };
@@ -664,9 +705,13 @@ impl Walker {
                             to_rad: r.final_rad,
                         },
                     ));
-                    power.restart(&mut phase, &cur)
-                        .map_err(|e| StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string()))?;
-                    events.push(StrideEvent { name: "string_engaged".into(), time_s: at.t_s });
+                    power.restart(&mut phase, &cur).map_err(|e| {
+                        StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string())
+                    })?;
+                    events.push(StrideEvent {
+                        name: "string_engaged".into(),
+                        time_s: at.t_s,
+                    });
                     integrator.reset();
                     if options.record {
                         trajectory.push(cur.clone());

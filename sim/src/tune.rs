@@ -64,12 +64,18 @@ pub fn tune(
     let mut warm: Option<DVector<f64>> = None;
     let mut history: Vec<TunePoint> = Vec::new();
     let mut eval = |x: &[f64], history: &mut Vec<TunePoint>| -> Result<f64, SceneError> {
-        let clamped: Vec<f64> = x.iter().zip(params).map(|(v, p)| v.clamp(p.min, p.max)).collect();
+        let clamped: Vec<f64> = x
+            .iter()
+            .zip(params)
+            .map(|(v, p)| v.clamp(p.min, p.max))
+            .collect();
         for (v, p) in clamped.iter().zip(params) {
             scene.set(&p.name, *v)?;
         }
         let walker = scene.build()?;
-        let guess = warm.clone().unwrap_or_else(|| walker.pack(&walker.guess_q, &walker.guess_qd));
+        let guess = warm
+            .clone()
+            .unwrap_or_else(|| walker.pack(&walker.guess_q, &walker.guess_qd));
         let gait = walker.find_gait(&guess, settings);
         let value = match &gait {
             Ok(g) => {
@@ -78,7 +84,10 @@ pub fn tune(
             }
             Err(_) => None,
         };
-        history.push(TunePoint { values: clamped, max_abs_eigenvalue: value });
+        history.push(TunePoint {
+            values: clamped,
+            max_abs_eigenvalue: value,
+        });
         Ok(value.unwrap_or(NO_GAIT))
     };
     // Nelder-Mead on the box, initial simplex 10% of each range.
@@ -88,14 +97,19 @@ pub fn tune(
     for (i, p) in params.iter().enumerate() {
         let mut x = start.clone();
         let d = 0.1 * (p.max - p.min);
-        x[i] = if x[i] + d <= p.max { x[i] + d } else { x[i] - d };
+        x[i] = if x[i] + d <= p.max {
+            x[i] + d
+        } else {
+            x[i] - d
+        };
         let f = eval(&x, &mut history)?;
         simplex.push((x, f));
     }
     while history.len() < evaluations {
         simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let centroid: Vec<f64> =
-            (0..n).map(|k| simplex[..n].iter().map(|(x, _)| x[k]).sum::<f64>() / n as f64).collect();
+        let centroid: Vec<f64> = (0..n)
+            .map(|k| simplex[..n].iter().map(|(x, _)| x[k]).sum::<f64>() / n as f64)
+            .collect();
         let worst = simplex[n].clone();
         let along = |t: f64| -> Vec<f64> {
             centroid
@@ -122,13 +136,20 @@ pub fn tune(
                 // Shrink towards the best.
                 let best = simplex[0].0.clone();
                 for s in simplex.iter_mut().skip(1) {
-                    let x: Vec<f64> = s.0.iter().zip(&best).map(|(v, b)| b + 0.5 * (v - b)).collect();
+                    let x: Vec<f64> =
+                        s.0.iter()
+                            .zip(&best)
+                            .map(|(v, b)| b + 0.5 * (v - b))
+                            .collect();
                     let f = eval(&x, &mut history)?;
                     *s = (x, f);
                 }
             }
         }
-        let spread = simplex.iter().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max)
+        let spread = simplex
+            .iter()
+            .map(|s| s.1)
+            .fold(f64::NEG_INFINITY, f64::max)
             - simplex.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
         if spread < 1e-6 {
             break;
@@ -137,10 +158,21 @@ pub fn tune(
     let best = history
         .iter()
         .filter(|p| p.max_abs_eigenvalue.is_some())
-        .min_by(|a, b| a.max_abs_eigenvalue.unwrap_or(NO_GAIT).total_cmp(&b.max_abs_eigenvalue.unwrap_or(NO_GAIT)))
+        .min_by(|a, b| {
+            a.max_abs_eigenvalue
+                .unwrap_or(NO_GAIT)
+                .total_cmp(&b.max_abs_eigenvalue.unwrap_or(NO_GAIT))
+        })
         .cloned()
-        .unwrap_or_else(|| TunePoint { values: start, max_abs_eigenvalue: None });
-    Ok(TuneResult { parameters: params.to_vec(), best, history })
+        .unwrap_or(TunePoint {
+            values: start,
+            max_abs_eigenvalue: None,
+        });
+    Ok(TuneResult {
+        parameters: params.to_vec(),
+        best,
+        history,
+    })
 }
 
 fn scene_value(scene: &Scene, name: &str) -> f64 {

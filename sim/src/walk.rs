@@ -41,8 +41,15 @@ impl FloorFrame {
     /// heading `ψ`), so a new-frame point `p'` is the old-frame point `c + S R_y(ψ) p'`.
     pub fn next(&self, step_m: &Vector3<f64>, heading_rad: f64, mirror: bool) -> Self {
         let turn = rotation_about(&Vector3::y(), heading_rad);
-        let r = if mirror { self.r * sagittal_reflection() * turn } else { self.r * turn };
-        Self { r, p_m: self.apply(step_m) }
+        let r = if mirror {
+            self.r * sagittal_reflection() * turn
+        } else {
+            self.r * turn
+        };
+        Self {
+            r,
+            p_m: self.apply(step_m),
+        }
     }
 }
 
@@ -128,7 +135,15 @@ impl Walker {
         let mut samples = Vec::new();
         for step in 0..steps {
             samples.clear();
-            let result = self.stride_recording(&q, &qd, StrideOptions { record, contact: false }, &mut samples);
+            let result = self.stride_recording(
+                &q,
+                &qd,
+                StrideOptions {
+                    record,
+                    contact: false,
+                },
+                &mut samples,
+            );
             for s in &samples {
                 out.path
                     .push(self.path_sample(&mut kin, &frame, step, t0, s));

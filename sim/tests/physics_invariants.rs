@@ -347,7 +347,10 @@ fn relabelling_twice_returns_the_configuration() {
             w.relabel.solve(&w.model, &states, q).unwrap().q
         };
         let once = relabel_once(&q0);
-        assert!((&once - &q0).amax() > 1e-3, "{name}: relabelling must change the labels");
+        assert!(
+            (&once - &q0).amax() > 1e-3,
+            "{name}: relabelling must change the labels"
+        );
         let twice = relabel_once(&once);
         for c in &w.relabel.cyclic {
             q0[c.0] = 0.0;

@@ -25,7 +25,12 @@ fn table_one_exactly_gives_a_gait_that_is_unstable_in_a_3d_mode() {
     let (_, w) = common::walker("wisse3d-table1");
     let g = common::gait(&w);
     assert!(!g.stable(), "max |λ| = {}", g.max_abs_eigenvalue());
-    let m = sim::stability::modes(&g.jacobian, &g.eigenvalues, &w.map_names(), &w.three_d_freedoms);
+    let m = sim::stability::modes(
+        &g.jacobian,
+        &g.eigenvalues,
+        &w.map_names(),
+        &w.three_d_freedoms,
+    );
     let worst = m.iter().max_by(|a, b| a.abs.total_cmp(&b.abs)).unwrap();
     assert!(worst.three_d, "{worst:?}");
 }
@@ -40,13 +45,26 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
     assert_eq!(walk.steps.len(), 200);
     // Straight: the hip positions at the ends of steps lie on a line (alternating sides by
     // less than a few centimetres), and the heading does not wander.
-    let pts: Vec<(f64, f64)> = walk.steps.iter().map(|s| (s.hip_floor_m[0], s.hip_floor_m[2])).collect();
+    let pts: Vec<(f64, f64)> = walk
+        .steps
+        .iter()
+        .map(|s| (s.hip_floor_m[0], s.hip_floor_m[2]))
+        .collect();
     let n = pts.len() as f64;
-    let (mx, mz) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let (mx, mz) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
     let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - mz)).sum::<f64>()
         / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    let worst = pts.iter().map(|p| (p.1 - mz - slope * (p.0 - mx)).abs()).fold(0.0, f64::max);
-    assert!(worst < 0.05, "largest deviation from the fitted line {worst} m");
+    let worst = pts
+        .iter()
+        .map(|p| (p.1 - mz - slope * (p.0 - mx)).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 0.05,
+        "largest deviation from the fitted line {worst} m"
+    );
     let distance = (pts[199].0 - pts[0].0).hypot(pts[199].1 - pts[0].1);
     assert!(distance > 150.0 * 0.3, "walked only {distance} m");
 }
@@ -64,18 +82,33 @@ fn the_uncompensated_walker_zigzags_with_growing_yaw_and_fails_within_30_steps()
     let names2 = w2.map_names();
     let v = nalgebra::DVector::from_iterator(
         names.len(),
-        names.iter().map(|n| names2.iter().position(|m| m == n).map_or(0.0, |j| g2.fixed_point[j])),
+        names.iter().map(|n| {
+            names2
+                .iter()
+                .position(|m| m == n)
+                .map_or(0.0, |j| g2.fixed_point[j])
+        }),
     );
     let (q, qd) = w.unpack(&v);
     let walk = w.walk(&q, &qd, 30, false);
     let failure = walk.failure.expect("must fail within 30 steps");
     assert!(
-        matches!(failure.kind, FailureKind::HeelStrikeBeforeKneeLock | FailureKind::FellBackward),
+        matches!(
+            failure.kind,
+            FailureKind::HeelStrikeBeforeKneeLock | FailureKind::FellBackward
+        ),
         "{failure:?}"
     );
     // The per-step yaw of the stance foot grows stride after stride (the paper's account).
-    let yaw: Vec<f64> = walk.steps.iter().map(|s| s.heading_change_rad.abs()).collect();
-    assert!(yaw.len() >= 2 && yaw.windows(2).all(|w| w[1] > w[0]), "{yaw:?}");
+    let yaw: Vec<f64> = walk
+        .steps
+        .iter()
+        .map(|s| s.heading_change_rad.abs())
+        .collect();
+    assert!(
+        yaw.len() >= 2 && yaw.windows(2).all(|w| w[1] > w[0]),
+        "{yaw:?}"
+    );
 }
 
 #[test]
@@ -92,7 +125,10 @@ fn speed_and_cost_of_transport_are_near_the_paper_and_energy_balances() {
         // Over a periodic stride on level ground the actuator's work is what impacts and the
         // foot damper take.
         let residual = s.actuator_work_j - s.impact_energy_loss_j - s.damping_dissipation_j;
-        assert!(residual.abs() < 1e-3 * s.actuator_work_j, "{name}: {residual}");
+        assert!(
+            residual.abs() < 1e-3 * s.actuator_work_j,
+            "{name}: {residual}"
+        );
     }
 }
 
@@ -102,7 +138,17 @@ fn roll_freedom_of_the_pelvis_shrinks_the_lateral_centre_of_pressure() {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
         let (q, qd) = common::start_state(&w, &g);
-        w.stride(&q, &qd, StrideOptions { record: false, contact: true }).unwrap().contact.max_lateral_cop_m
+        w.stride(
+            &q,
+            &qd,
+            StrideOptions {
+                record: false,
+                contact: true,
+            },
+        )
+        .unwrap()
+        .contact
+        .max_lateral_cop_m
     };
     let (c2, c3) = (cop("wisse2d"), cop("wisse3d"));
     assert!(c3 < c2, "3D {c3} vs 2D {c2}");
@@ -111,8 +157,12 @@ fn roll_freedom_of_the_pelvis_shrinks_the_lateral_centre_of_pressure() {
 fn gait_record(name: &str) -> Value {
     let (_, w) = common::walker(name);
     let g = common::gait(&w);
-    let fixed_point: serde_json::Map<String, Value> =
-        w.map_names().iter().zip(g.fixed_point.iter()).map(|(n, v)| (n.clone(), json!(v))).collect();
+    let fixed_point: serde_json::Map<String, Value> = w
+        .map_names()
+        .iter()
+        .zip(g.fixed_point.iter())
+        .map(|(n, v)| (n.clone(), json!(v)))
+        .collect();
     let mut moduli: Vec<f64> = g.eigenvalues.iter().map(|z| z.norm()).collect();
     moduli.sort_by(|a, b| b.total_cmp(a));
     json!({
@@ -124,9 +174,13 @@ fn gait_record(name: &str) -> Value {
 
 #[test]
 fn golden_fixed_points_and_eigenvalues() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/wisse_gaits.json");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/wisse_gaits.json");
     let names = ["wisse2d", "wisse3d", "wisse3d-table1"];
-    let current: serde_json::Map<String, Value> = names.iter().map(|n| (n.to_string(), gait_record(n))).collect();
+    let current: serde_json::Map<String, Value> = names
+        .iter()
+        .map(|n| (n.to_string(), gait_record(n)))
+        .collect();
     if std::env::var_os("UPDATE_GOLDEN").is_some() {
         let mut doc = current.clone();
         doc.insert(
@@ -142,10 +196,16 @@ fn golden_fixed_points_and_eigenvalues() {
             let d = (v.as_f64().unwrap() - c["fixed_point"][k].as_f64().unwrap()).abs();
             assert!(d < 1e-7, "{n}.{k}: {v} vs {}", c["fixed_point"][k]);
         }
-        let (ge, ce) = (g["eigenvalue_moduli"].as_array().unwrap(), c["eigenvalue_moduli"].as_array().unwrap());
+        let (ge, ce) = (
+            g["eigenvalue_moduli"].as_array().unwrap(),
+            c["eigenvalue_moduli"].as_array().unwrap(),
+        );
         assert_eq!(ge.len(), ce.len());
         for (a, b) in ge.iter().zip(ce) {
-            assert!((a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-5, "{n}: {a} vs {b}");
+            assert!(
+                (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-5,
+                "{n}: {a} vs {b}"
+            );
         }
     }
 }

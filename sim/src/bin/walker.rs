@@ -63,8 +63,9 @@ enum Command {
         /// Write the floor path of the hip-axle centre as SVG into this folder.
         #[arg(long, value_name = "DIR")]
         plot: Option<std::path::PathBuf>,
-        /// Also walk this scene from its own gait, the same number of steps, and draw its path
-        /// in the same figure (e.g. the compensated walker beside the uncompensated one).
+        /// Also walk this scene (with its own parameters) from its own gait, the same number of
+        /// steps, and draw its path in the same figure (e.g. the compensated walker beside the
+        /// uncompensated one).
         #[arg(long, value_name = "SCENE")]
         plot_with: Option<String>,
     },
@@ -236,9 +237,17 @@ fn run(cli: Cli) -> Result<ExitCode> {
             if let (Some(dir), Ok(g)) = (&plot, &result) {
                 std::fs::create_dir_all(dir)?;
                 let name = scene.name();
-                let eig = figures::eigenvalues(&walker, g, &format!("{name}: eigenvalues of the stride Jacobian"));
+                let eig = figures::eigenvalues(
+                    &walker,
+                    g,
+                    &format!("{name}: eigenvalues of the stride Jacobian"),
+                );
                 std::fs::write(dir.join("eigenvalues.svg"), eig.to_svg(640.0, 600.0))?;
-                let ang = figures::joint_angles(&walker, g, &format!("{name}: joint angles over one step"));
+                let ang = figures::joint_angles(
+                    &walker,
+                    g,
+                    &format!("{name}: joint angles over one step"),
+                );
                 std::fs::write(dir.join("joint_angles.svg"), ang.to_svg(820.0, 480.0))?;
             }
             if common.json {
@@ -252,7 +261,16 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 ExitCode::from(1)
             })
         }
-        Command::Walk { common, steps, perturb, start, start_from_scene, out, plot, plot_with } => {
+        Command::Walk {
+            common,
+            steps,
+            perturb,
+            start,
+            start_from_scene,
+            out,
+            plot,
+            plot_with,
+        } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
             let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
@@ -320,19 +338,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 std::fs::create_dir_all(dir)?;
                 let mut walks = vec![(scene.name().to_string(), walk.clone())];
                 if let Some(other) = &plot_with {
-                    let mut os = Scene::load(other)?;
-                    for (k, val) in &scene.values {
-                        if os.file.parameters.contains_key(k) {
-                            os.set(k, *val)?;
-                        }
-                    }
+                    // The other scene walks with its own defaults, from its own gait.
+                    let os = Scene::load(other)?;
                     let ow = os.build()?;
                     let v0 = ow.pack(&ow.guess_q, &ow.guess_qd);
-                    let start = ow.find_gait(&v0, &common.newton()).map(|g| g.fixed_point).unwrap_or(v0);
+                    let start = ow
+                        .find_gait(&v0, &common.newton())
+                        .map(|g| g.fixed_point)
+                        .unwrap_or(v0);
                     let (oq, oqd) = ow.unpack(&start);
                     walks.push((os.name().to_string(), ow.walk(&oq, &oqd, steps, true)));
                 }
-                let refs: Vec<(&str, &sim::walk::Walk)> = walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
+                let refs: Vec<(&str, &sim::walk::Walk)> =
+                    walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
                 let fig = figures::floor_paths(&refs, "path of the hip-axle centre on the floor");
                 std::fs::write(dir.join("floor_path.svg"), fig.to_svg(820.0, 420.0))?;
             }
@@ -368,7 +386,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Command::Tune { common, vary, evaluations } => {
+        Command::Tune {
+            common,
+            vary,
+            evaluations,
+        } => {
             let scene = common.scene()?;
             common.walker(&scene)?;
             let mut params = Vec::new();
@@ -376,12 +398,18 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 let bad = || InputError::Other(format!("--vary `{v}`: expected name=min:max"));
                 let (name, range) = v.split_once('=').ok_or_else(bad)?;
                 let (lo, hi) = range.split_once(':').ok_or_else(bad)?;
-                let (min, max): (f64, f64) =
-                    (lo.trim().parse().map_err(|_| bad())?, hi.trim().parse().map_err(|_| bad())?);
+                let (min, max): (f64, f64) = (
+                    lo.trim().parse().map_err(|_| bad())?,
+                    hi.trim().parse().map_err(|_| bad())?,
+                );
                 if !(min.is_finite() && max.is_finite() && min < max) {
                     return Err(bad().into());
                 }
-                params.push(TunedParameter { name: name.trim().to_string(), min, max });
+                params.push(TunedParameter {
+                    name: name.trim().to_string(),
+                    min,
+                    max,
+                });
             }
             let result = tune(&scene, &params, evaluations, &common.newton())?;
             if common.json {
@@ -389,7 +417,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
             } else {
                 println!("{} evaluations", result.history.len());
                 for (p, v) in result.parameters.iter().zip(&result.best.values) {
-                    println!("    {:<36} {:>12.6}   (bounds {} .. {})", p.name, v, p.min, p.max);
+                    println!(
+                        "    {:<36} {:>12.6}   (bounds {} .. {})",
+                        p.name, v, p.min, p.max
+                    );
                 }
                 match result.best.max_abs_eigenvalue {
                     Some(m) => println!("best max |λ| = {m:.6}"),

@@ -24,9 +24,18 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("kneed2d", include_str!("../../scenes/kneed2d.toml")),
     ("wisse3d", include_str!("../../scenes/wisse3d.toml")),
     ("wisse2d", include_str!("../../scenes/wisse2d.toml")),
-    ("wisse3d-uncompensated", include_str!("../../scenes/wisse3d-uncompensated.toml")),
-    ("wisse3d-table1", include_str!("../../scenes/wisse3d-table1.toml")),
-    ("wisse2d-uncompensated", include_str!("../../scenes/wisse2d-uncompensated.toml")),
+    (
+        "wisse3d-uncompensated",
+        include_str!("../../scenes/wisse3d-uncompensated.toml"),
+    ),
+    (
+        "wisse3d-table1",
+        include_str!("../../scenes/wisse3d-table1.toml"),
+    ),
+    (
+        "wisse2d-uncompensated",
+        include_str!("../../scenes/wisse2d-uncompensated.toml"),
+    ),
 ];
 
 /// Why a scene could not be loaded or built. Each variant names what was wrong.
@@ -134,10 +143,12 @@ impl Scene {
     /// Parses scene text; `origin` names it in errors.
     pub fn parse(origin: &str, text: &str) -> Result<Self, SceneError> {
         let table = Self::resolve(origin, text, 0)?;
-        let file: SceneFile = table.try_into().map_err(|e: toml::de::Error| SceneError::File {
-            path: origin.to_string(),
-            message: e.to_string(),
-        })?;
+        let file: SceneFile = table
+            .try_into()
+            .map_err(|e: toml::de::Error| SceneError::File {
+                path: origin.to_string(),
+                message: e.to_string(),
+            })?;
         let values = file
             .parameters
             .iter()
@@ -152,9 +163,17 @@ impl Scene {
 
     /// Parses text to a TOML table, resolving `[variant] base = ...` (at most 4 deep).
     fn resolve(origin: &str, text: &str, depth: usize) -> Result<toml::Table, SceneError> {
-        let file_err = |message: String| SceneError::File { path: origin.to_string(), message };
-        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| file_err(e.to_string()))?;
-        let Some(base) = table.get("variant").and_then(|v| v.get("base")).and_then(|b| b.as_str())
+        let file_err = |message: String| SceneError::File {
+            path: origin.to_string(),
+            message,
+        };
+        let table: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| file_err(e.to_string()))?;
+        let Some(base) = table
+            .get("variant")
+            .and_then(|v| v.get("base"))
+            .and_then(|b| b.as_str())
         else {
             return Ok(table);
         };

@@ -34,9 +34,15 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             None => Ok(Vec::new()),
             Some(Value::Array(a)) => a
                 .iter()
-                .map(|v| v.as_str().map(String::from).ok_or_else(|| invalid(format!("variant.{key}: expected strings"))))
+                .map(|v| {
+                    v.as_str()
+                        .map(String::from)
+                        .ok_or_else(|| invalid(format!("variant.{key}: expected strings")))
+                })
                 .collect(),
-            Some(_) => Err(invalid(format!("variant.{key}: expected an array of link names"))),
+            Some(_) => Err(invalid(format!(
+                "variant.{key}: expected an array of link names"
+            ))),
         }
     };
     let weld = names("weld")?;
@@ -45,7 +51,9 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
         match k.as_str() {
             "variant" => {}
             "parameters" => {
-                let merged = out.entry("parameters").or_insert_with(|| Value::Table(Table::new()));
+                let merged = out
+                    .entry("parameters")
+                    .or_insert_with(|| Value::Table(Table::new()));
                 if let (Some(m), Value::Table(add)) = (merged.as_table_mut(), v) {
                     for (pk, pv) in add {
                         m.insert(pk, pv);
@@ -57,8 +65,16 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             }
         }
     }
-    let links = out.get_mut("link").and_then(Value::as_array_mut).ok_or_else(|| invalid("base has no links".into()))?;
-    let link_name = |l: &Value| l.get("name").and_then(Value::as_str).unwrap_or("").to_string();
+    let links = out
+        .get_mut("link")
+        .and_then(Value::as_array_mut)
+        .ok_or_else(|| invalid("base has no links".into()))?;
+    let link_name = |l: &Value| {
+        l.get("name")
+            .and_then(Value::as_str)
+            .unwrap_or("")
+            .to_string()
+    };
     let known: BTreeSet<String> = links.iter().map(link_name).collect();
     for n in weld.iter().chain(remove.iter()) {
         if !known.contains(n) {
@@ -92,23 +108,35 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             let on = p.get("link").and_then(Value::as_str).unwrap_or("");
             let keep = !gone.contains(on);
             if !keep {
-                dead_points.insert(p.get("name").and_then(Value::as_str).unwrap_or("").to_string());
+                dead_points.insert(
+                    p.get("name")
+                        .and_then(Value::as_str)
+                        .unwrap_or("")
+                        .to_string(),
+                );
             }
             keep
         });
     }
-    let keep_str = |v: &Value, dead: &BTreeSet<String>| v.as_str().is_none_or(|s| !dead.contains(s));
+    let keep_str =
+        |v: &Value, dead: &BTreeSet<String>| v.as_str().is_none_or(|s| !dead.contains(s));
     if let Some(r) = out.get_mut("relabel").and_then(Value::as_table_mut) {
         for (key, dead) in [("pairs", &gone), ("point_pairs", &dead_points)] {
             if let Some(a) = r.get_mut(key).and_then(Value::as_array_mut) {
-                a.retain(|pair| pair.as_array().is_none_or(|p| p.iter().all(|x| keep_str(x, dead))));
+                a.retain(|pair| {
+                    pair.as_array()
+                        .is_none_or(|p| p.iter().all(|x| keep_str(x, dead)))
+                });
             }
         }
         if let Some(a) = r.get_mut("cyclic").and_then(Value::as_array_mut) {
             a.retain(|x| keep_str(x, &dead_coords));
         }
     }
-    if let Some(a) = out.get_mut("three_d_freedoms").and_then(Value::as_array_mut) {
+    if let Some(a) = out
+        .get_mut("three_d_freedoms")
+        .and_then(Value::as_array_mut)
+    {
         a.retain(|x| keep_str(x, &dead_coords));
     }
     if let Some(g) = out.get_mut("guess").and_then(Value::as_table_mut) {
@@ -119,7 +147,10 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
         }
     }
     if let Some(knees) = out.get_mut("knee").and_then(Value::as_array_mut) {
-        knees.retain(|k| k.get("coordinate").is_none_or(|x| keep_str(x, &dead_coords)));
+        knees.retain(|k| {
+            k.get("coordinate")
+                .is_none_or(|x| keep_str(x, &dead_coords))
+        });
     }
     Ok(out)
 }
