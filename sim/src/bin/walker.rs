@@ -167,25 +167,12 @@ impl Common {
         positive("newton-tol", Some(self.newton_tol))?;
         positive("perturbation", Some(self.perturbation))?;
         if let Some(kind) = &self.integrator {
-            w.integrator = match kind.as_str() {
-                "meijaard" => IntegratorChoice::Meijaard {
-                    h_s: self.step_s.unwrap_or(1e-3),
-                    check_every: 0,
-                },
-                "rk4" => IntegratorChoice::Rk4 {
-                    h_s: self.step_s.unwrap_or(1e-3),
-                },
-                "dopri5" => IntegratorChoice::Dopri5 {
-                    rtol: self.rtol.unwrap_or(1e-12),
-                    atol: self.rtol.unwrap_or(1e-12),
-                    h_max_s: 0.05,
-                },
-                other => {
-                    return Err(InputError::Other(format!(
-                        "--integrator `{other}`: expected meijaard, rk4 or dopri5"
-                    )))
-                }
-            };
+            w.integrator = IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None)
+                .ok_or_else(|| {
+                    InputError::Other(format!(
+                        "--integrator `{kind}`: expected meijaard, rk4 or dopri5"
+                    ))
+                })?;
         } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) =
             (self.rtol, &w.integrator)
         {

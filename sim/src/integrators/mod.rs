@@ -119,6 +119,32 @@ impl IntegratorChoice {
         }
     }
 
+    /// An integrator by kind name (`meijaard`, `rk4`, `dopri5`) with optional settings; the
+    /// defaults are a 1 ms step, tolerances 1e-12 and a 0.05 s largest step. `None` for an
+    /// unknown kind.
+    pub fn from_kind(
+        kind: &str,
+        h_s: Option<f64>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        h_max_s: Option<f64>,
+    ) -> Option<Self> {
+        let h_s = h_s.unwrap_or(1e-3);
+        match kind {
+            "meijaard" => Some(IntegratorChoice::Meijaard {
+                h_s,
+                check_every: 0,
+            }),
+            "rk4" => Some(IntegratorChoice::Rk4 { h_s }),
+            "dopri5" => Some(IntegratorChoice::Dopri5 {
+                rtol: rtol.unwrap_or(1e-12),
+                atol: atol.or(rtol).unwrap_or(1e-12),
+                h_max_s: h_max_s.unwrap_or(0.05),
+            }),
+            _ => None,
+        }
+    }
+
     /// A short label for tables.
     pub fn label(&self) -> String {
         match self {

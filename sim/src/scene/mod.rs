@@ -229,10 +229,9 @@ impl Scene {
         Ok(())
     }
 
-    /// Sets a parameter (by name or alias) to a value, checking its range.
-    pub fn set(&mut self, key: &str, value: f64) -> Result<(), SceneError> {
-        let name = self
-            .canonical(key)
+    /// The canonical name of a parameter given by name or alias.
+    pub fn parameter_name(&self, key: &str) -> Result<String, SceneError> {
+        self.canonical(key)
             .ok_or_else(|| SceneError::UnknownParameter {
                 scene: self.name().to_string(),
                 name: key.to_string(),
@@ -243,7 +242,12 @@ impl Scene {
                     .cloned()
                     .collect::<Vec<_>>()
                     .join(", "),
-            })?;
+            })
+    }
+
+    /// Sets a parameter (by name or alias) to a value, checking its range.
+    pub fn set(&mut self, key: &str, value: f64) -> Result<(), SceneError> {
+        let name = self.parameter_name(key)?;
         self.check_range(&name, value)?;
         self.values.insert(name, value);
         Ok(())
@@ -256,19 +260,7 @@ impl Scene {
         })?;
         let (k, v) = (k.trim(), v.trim());
         // Name first, so an unknown key is reported as such even with a bad value.
-        let name = self
-            .canonical(k)
-            .ok_or_else(|| SceneError::UnknownParameter {
-                scene: self.name().to_string(),
-                name: k.to_string(),
-                available: self
-                    .file
-                    .parameters
-                    .keys()
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })?;
+        let name = self.parameter_name(k)?;
         let value: f64 = v.parse().map_err(|_| SceneError::NotANumber {
             name: name.clone(),
             value: v.to_string(),
@@ -473,25 +465,11 @@ impl Scene {
             }
         }
         let it = &f.integrator;
-        let integrator = match it.kind.as_str() {
-            "meijaard" => IntegratorChoice::Meijaard {
-                h_s: it.h_s.unwrap_or(1e-3),
-                check_every: 0,
-            },
-            "rk4" => IntegratorChoice::Rk4 {
-                h_s: it.h_s.unwrap_or(1e-3),
-            },
-            "dopri5" => IntegratorChoice::Dopri5 {
-                rtol: it.rtol.unwrap_or(1e-12),
-                atol: it.atol.unwrap_or(1e-12),
-                h_max_s: it.h_max_s.unwrap_or(0.05),
-            },
-            o => {
-                return Err(SceneError::Invalid(format!(
-                    "integrator.kind: unknown `{o}`"
-                )))
-            }
-        };
+        let integrator =
+            IntegratorChoice::from_kind(&it.kind, it.h_s, it.rtol, it.atol, it.h_max_s)
+                .ok_or_else(|| {
+                    SceneError::Invalid(format!("integrator.kind: unknown `{}`", it.kind))
+                })?;
         let max_stride_time_s = match &it.max_stride_time_s {
             Some(n) => self.num(n, "integrator.max_stride_time_s")?,
             None => 10.0,
