@@ -114,3 +114,43 @@ pub fn joint_angles(walker: &Walker, gait: &Gait, title: &str) -> Plot {
         unit_circle: false,
     }
 }
+
+/// One log-log panel of a speed-against-error study: an error measure against CPU time per
+/// stride, one line per integrator.
+pub fn accuracy(
+    study: &crate::accuracy::AccuracyStudy,
+    error: fn(&crate::accuracy::AccuracyPoint) -> Option<f64>,
+    what: &str,
+) -> Plot {
+    let mut families: Vec<String> = Vec::new();
+    for p in &study.points {
+        if !families.contains(&p.integrator) {
+            families.push(p.integrator.clone());
+        }
+    }
+    let series = families
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Series {
+            label: f.clone(),
+            points: study
+                .points
+                .iter()
+                .filter(|p| &p.integrator == f)
+                .filter_map(|p| {
+                    error(p).filter(|e| *e > 0.0).map(|e| (p.cpu_us_per_stride.log10(), e.log10()))
+                })
+                .collect(),
+            style: Style::Line,
+            color: PALETTE[i % PALETTE.len()],
+        })
+        .collect();
+    Plot {
+        title: format!("{}: {what} against CPU time", study.scene),
+        x_label: "log10 CPU time per stride [µs]".into(),
+        y_label: format!("log10 {what}"),
+        series,
+        equal_aspect: false,
+        unit_circle: false,
+    }
+}

@@ -2,6 +2,7 @@
 //! (2001), section 3: TMT equations of motion, Meijaard's integrator, Hermite event location,
 //! impact equations, stride function, Newton-Raphson limit cycles and their stability.
 
+pub mod accuracy;
 pub mod actuator;
 pub mod contact;
 pub mod continuation;

@@ -7,6 +7,7 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use nalgebra::DVector;
 use serde_json::{json, Value};
+use sim::accuracy;
 use sim::continuation::sweep;
 use sim::figures;
 use sim::integrators::IntegratorChoice;
@@ -96,6 +97,15 @@ enum Command {
         /// Gait searches allowed.
         #[arg(long, default_value_t = 60)]
         evaluations: usize,
+    },
+    /// Speed against error: every integrator over a range of steps or tolerances, errors of
+    /// the fixed point, eigenvalues and heel-strike time against a tight reference.
+    Accuracy {
+        #[command(flatten)]
+        common: Common,
+        /// Write `accuracy.md` and log-log SVG plots into this folder.
+        #[arg(long, value_name = "DIR")]
+        out: Option<std::path::PathBuf>,
     },
     /// List the scenes and their parameters.
     Scenes {
@@ -373,6 +383,51 @@ fn run(cli: Cli) -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Command::Accuracy { common, out } => {
+            let scene = common.scene()?;
+            let walker = common.walker(&scene)?;
+            let reference = IntegratorChoice::Dopri5 { rtol: 1e-13, atol: 1e-13, h_max_s: 0.01 };
+            let period = {
+                let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+                match walker.find_gait(&v0, &common.newton()) {
+                    Ok(g) => g.stride.duration_s,
+                    Err(e) => {
+                        eprintln!("error: no gait: {e}");
+                        return Ok(ExitCode::from(1));
+                    }
+                }
+            };
+            let settings = accuracy::default_settings(period);
+            let study = match accuracy::study(&walker, reference, &settings, &common.newton()) {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!("error: no reference gait: {e}");
+                    return Ok(ExitCode::from(1));
+                }
+            };
+            let table = accuracy_table(&study);
+            if common.json {
+                print_json(&json!(study))?;
+            } else {
+                print!("{table}");
+            }
+            if let Some(dir) = out {
+                std::fs::create_dir_all(&dir)?;
+                std::fs::write(dir.join("accuracy.md"), &table)?;
+                let panels: [(&str, &str, fn(&accuracy::AccuracyPoint) -> Option<f64>); 3] = [
+                    ("fixed_point_error.svg", "fixed-point error [-]", |p| p.fixed_point_error),
+                    ("eigenvalue_error.svg", "eigenvalue error [-]", |p| p.eigenvalue_error),
+                    ("heel_strike_time_error.svg", "heel-strike time error [s]", |p| {
+                        p.heel_strike_time_error_s
+                    }),
+                ];
+                for (file, what, f) in panels {
+                    let plot = figures::accuracy(&study, f, what);
+                    std::fs::write(dir.join(file), plot.to_svg(720.0, 480.0))?;
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Tune {
             common,
             vary,
@@ -501,6 +556,30 @@ fn start_from_other(
         }
     }
     Ok(Some(v))
+}
+
+/// A markdown table of an accuracy study.
+fn accuracy_table(study: &accuracy::AccuracyStudy) -> String {
+    let fmt = |v: Option<f64>| v.map_or("—".to_string(), |x| format!("{x:.2e}"));
+    let mut t = format!(
+        "Scene `{}`, reference: dopri5 at rtol = atol = 1e-13, step period {:.6} s.\n\n\
+         | integrator | step [s] or rtol | CPU per stride [µs] | evaluations | fixed point | eigenvalues | heel-strike time [s] |\n\
+         | --- | --- | --- | --- | --- | --- | --- |\n",
+        study.scene, study.reference_step_period_s
+    );
+    for p in &study.points {
+        t.push_str(&format!(
+            "| {} | {:.3e} | {:.0} | {} | {} | {} | {} |\n",
+            p.integrator,
+            p.step_or_tolerance,
+            p.cpu_us_per_stride,
+            p.evaluations_per_stride,
+            p.failure.as_ref().map_or(fmt(p.fixed_point_error), |_| "no gait".into()),
+            fmt(p.eigenvalue_error),
+            fmt(p.heel_strike_time_error_s)
+        ));
+    }
+    t
 }
 
 fn scenes(as_json: bool) -> Result<ExitCode> {

@@ -1,0 +1,137 @@
+//! Speed against error: for each integrator over a range of steps or tolerances, the error of
+//! the fixed point, of the eigenvalues and of the heel-strike time against a tight reference,
+//! beside the CPU time of one stride.
+
+use crate::integrators::IntegratorChoice;
+use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
+use crate::stride::StrideOptions;
+use crate::walker::Walker;
+use nalgebra::Complex;
+use serde::Serialize;
+use std::time::Instant;
+
+/// One integrator setting and its errors.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyPoint {
+    /// Integrator family: `meijaard`, `rk4`, `dopri5`.
+    pub integrator: String,
+    /// The setting.
+    pub setting: IntegratorChoice,
+    /// Step [s] (fixed-step integrators) or relative tolerance (dopri5).
+    pub step_or_tolerance: f64,
+    /// CPU time of one stride from the reference fixed point [µs] (median of repeats).
+    pub cpu_us_per_stride: f64,
+    /// Right-hand-side evaluations per stride.
+    pub evaluations_per_stride: usize,
+    /// ∞-norm error of the fixed point, or `None` when no gait was found.
+    pub fixed_point_error: Option<f64>,
+    /// Largest error of an eigenvalue (each reference eigenvalue matched to the nearest).
+    pub eigenvalue_error: Option<f64>,
+    /// Error of the heel-strike time of the stride from the reference fixed point [s].
+    pub heel_strike_time_error_s: Option<f64>,
+    /// Why no gait was found, if none was.
+    pub failure: Option<String>,
+}
+
+/// The whole study for one scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyStudy {
+    /// Scene.
+    pub scene: String,
+    /// The reference integrator.
+    pub reference: IntegratorChoice,
+    /// Reference stride duration [s].
+    pub reference_step_period_s: f64,
+    /// Points.
+    pub points: Vec<AccuracyPoint>,
+}
+
+/// The settings studied: fixed steps for Meijaard and RK4 (halving), tolerances for DOPRI5.
+pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
+    let mut out = Vec::new();
+    for k in 0..6 {
+        let h = period_s / (100.0 * 2f64.powi(k));
+        out.push(("meijaard".into(), h, IntegratorChoice::Meijaard { h_s: h, check_every: 0 }));
+    }
+    for k in 0..5 {
+        let h = period_s / (25.0 * 2f64.powi(k));
+        out.push(("rk4".into(), h, IntegratorChoice::Rk4 { h_s: h }));
+    }
+    for k in [4, 6, 8, 10, 12] {
+        let tol = 10f64.powi(-k);
+        out.push((
+            "dopri5".into(),
+            tol,
+            IntegratorChoice::Dopri5 { rtol: tol, atol: tol, h_max_s: period_s / 10.0 },
+        ));
+    }
+    out
+}
+
+fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
+    reference
+        .iter()
+        .map(|r| other.iter().map(|o| (o - r).norm()).fold(f64::INFINITY, f64::min))
+        .fold(0.0, f64::max)
+}
+
+/// Runs the study: the reference gait with `reference`, then every setting, each gait search
+/// starting from the reference fixed point.
+pub fn study(
+    walker: &Walker,
+    reference: IntegratorChoice,
+    settings: &[(String, f64, IntegratorChoice)],
+    newton: &NewtonSettings,
+) -> Result<AccuracyStudy, NewtonError> {
+    let mut w = walker.clone();
+    w.integrator = reference.clone();
+    let v0 = w.pack(&w.guess_q, &w.guess_qd);
+    let reference_gait: Gait = w.find_gait(&v0, newton)?;
+    let x_ref = reference_gait.fixed_point.clone();
+    let t_ref = reference_gait.stride.duration_s;
+    let (q_ref, qd_ref) = w.unpack(&x_ref);
+    let mut points = Vec::new();
+    for (family, value, setting) in settings {
+        w.integrator = setting.clone();
+        // CPU time per stride: median of a few repeats of the stride from the reference point.
+        let mut times = Vec::new();
+        let mut evaluations = 0;
+        let mut t_hs = None;
+        for _ in 0..5 {
+            let start = Instant::now();
+            let r = w.stride(&q_ref, &qd_ref, StrideOptions::default());
+            times.push(start.elapsed().as_secs_f64() * 1e6);
+            if let Ok(r) = r {
+                evaluations = r.evaluations;
+                t_hs = Some(r.duration_s);
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        let gait = w.find_gait(&x_ref, newton);
+        let (fp, ev, failure) = match &gait {
+            Ok(g) => (
+                Some((&g.fixed_point - &x_ref).amax()),
+                Some(max_eigen_error(&reference_gait.eigenvalues, &g.eigenvalues)),
+                None,
+            ),
+            Err(e) => (None, None, Some(e.to_string())),
+        };
+        points.push(AccuracyPoint {
+            integrator: family.clone(),
+            setting: setting.clone(),
+            step_or_tolerance: *value,
+            cpu_us_per_stride: times[times.len() / 2],
+            evaluations_per_stride: evaluations,
+            fixed_point_error: fp,
+            eigenvalue_error: ev,
+            heel_strike_time_error_s: t_hs.map(|t| (t - t_ref).abs()),
+            failure,
+        });
+    }
+    Ok(AccuracyStudy {
+        scene: walker.name.clone(),
+        reference,
+        reference_step_period_s: t_ref,
+        points,
+    })
+}
