@@ -51,7 +51,14 @@ pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
     let mut out = Vec::new();
     for k in 0..6 {
         let h = period_s / (100.0 * 2f64.powi(k));
-        out.push(("meijaard".into(), h, IntegratorChoice::Meijaard { h_s: h, check_every: 0 }));
+        out.push((
+            "meijaard".into(),
+            h,
+            IntegratorChoice::Meijaard {
+                h_s: h,
+                check_every: 0,
+            },
+        ));
     }
     for k in 0..5 {
         let h = period_s / (25.0 * 2f64.powi(k));
@@ -62,7 +69,11 @@ pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
         out.push((
             "dopri5".into(),
             tol,
-            IntegratorChoice::Dopri5 { rtol: tol, atol: tol, h_max_s: period_s / 10.0 },
+            IntegratorChoice::Dopri5 {
+                rtol: tol,
+                atol: tol,
+                h_max_s: period_s / 10.0,
+            },
         ));
     }
     out
@@ -71,7 +82,12 @@ pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
 fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
     reference
         .iter()
-        .map(|r| other.iter().map(|o| (o - r).norm()).fold(f64::INFINITY, f64::min))
+        .map(|r| {
+            other
+                .iter()
+                .map(|o| (o - r).norm())
+                .fold(f64::INFINITY, f64::min)
+        })
         .fold(0.0, f64::max)
 }
 

@@ -34,6 +34,10 @@ pub struct EventTolerance {
     pub witness: f64,
     /// Refinement iterations allowed.
     pub max_iterations: usize,
+    /// Interior points of each step at which the swing-foot height is also checked on the
+    /// Hermite interpolant, so that a foot that dips below the floor and comes back up within
+    /// one step (a grazing contact) is not missed (0: endpoints only).
+    pub grazing_samples: usize,
 }
 
 impl Default for EventTolerance {
@@ -42,6 +46,7 @@ impl Default for EventTolerance {
             time_s: 1e-13,
             witness: 1e-14,
             max_iterations: 60,
+            grazing_samples: 4,
         }
     }
 }

@@ -138,7 +138,9 @@ pub fn accuracy(
                 .iter()
                 .filter(|p| &p.integrator == f)
                 .filter_map(|p| {
-                    error(p).filter(|e| *e > 0.0).map(|e| (p.cpu_us_per_stride.log10(), e.log10()))
+                    error(p)
+                        .filter(|e| *e > 0.0)
+                        .map(|e| (p.cpu_us_per_stride.log10(), e.log10()))
                 })
                 .collect(),
             style: Style::Line,

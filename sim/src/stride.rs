@@ -531,9 +531,30 @@ impl Walker {
                     "state",
                 ));
             }
+            // A grazing contact: the foot height is positive at both ends of the step but dips
+            // below the floor inside it. Check the Hermite interpolant at interior points; if the
+            // exact flow confirms a dip, shorten the step to end inside it.
+            let (g_cur, g_next) = (wit.foot_height(&cur), wit.foot_height(&next));
+            if g_cur > 0.0 && g_next > 0.0 {
+                let n = self.event_tolerance.grazing_samples;
+                for k in 1..=n {
+                    let t = cur.t_s + (next.t_s - cur.t_s) * k as f64 / (n + 1) as f64;
+                    let (q, qd) = crate::events::hermite(&cur, &next, t);
+                    if wit.foot_height(&Sample { t_s: t, q, qd }) <= 0.0 {
+                        let mut s = integrator
+                            .step_exact(&mut phase, &cur, t - cur.t_s)
+                            .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+                        phase.snap(&mut s);
+                        if wit.foot_height(&s) <= 0.0 {
+                            next = s;
+                        }
+                        break;
+                    }
+                }
+            }
             // Which witnesses changed sign in the right direction over this step?
             let mut triggered: Vec<Watch> = Vec::new();
-            if Direction::Falling.triggered(wit.foot_height(&cur), wit.foot_height(&next)) {
+            if Direction::Falling.triggered(g_cur, wit.foot_height(&next)) {
                 triggered.push(Watch::Heel);
             }
             for (k, knee) in self.knees.iter().enumerate() {

@@ -386,7 +386,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Accuracy { common, out } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
-            let reference = IntegratorChoice::Dopri5 { rtol: 1e-13, atol: 1e-13, h_max_s: 0.01 };
+            let reference = IntegratorChoice::Dopri5 {
+                rtol: 1e-13,
+                atol: 1e-13,
+                h_max_s: 0.01,
+            };
             let period = {
                 let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
                 match walker.find_gait(&v0, &common.newton()) {
@@ -414,12 +418,18 @@ fn run(cli: Cli) -> Result<ExitCode> {
             if let Some(dir) = out {
                 std::fs::create_dir_all(&dir)?;
                 std::fs::write(dir.join("accuracy.md"), &table)?;
-                let panels: [(&str, &str, fn(&accuracy::AccuracyPoint) -> Option<f64>); 3] = [
-                    ("fixed_point_error.svg", "fixed-point error [-]", |p| p.fixed_point_error),
-                    ("eigenvalue_error.svg", "eigenvalue error [-]", |p| p.eigenvalue_error),
-                    ("heel_strike_time_error.svg", "heel-strike time error [s]", |p| {
-                        p.heel_strike_time_error_s
+                let panels: [(&str, &str, ErrorOf); 3] = [
+                    ("fixed_point_error.svg", "fixed-point error [-]", |p| {
+                        p.fixed_point_error
                     }),
+                    ("eigenvalue_error.svg", "eigenvalue error [-]", |p| {
+                        p.eigenvalue_error
+                    }),
+                    (
+                        "heel_strike_time_error.svg",
+                        "heel-strike time error [s]",
+                        |p| p.heel_strike_time_error_s,
+                    ),
                 ];
                 for (file, what, f) in panels {
                     let plot = figures::accuracy(&study, f, what);
@@ -558,6 +568,9 @@ fn start_from_other(
     Ok(Some(v))
 }
 
+/// Picks one error measure from an accuracy point.
+type ErrorOf = fn(&accuracy::AccuracyPoint) -> Option<f64>;
+
 /// A markdown table of an accuracy study.
 fn accuracy_table(study: &accuracy::AccuracyStudy) -> String {
     let fmt = |v: Option<f64>| v.map_or("—".to_string(), |x| format!("{x:.2e}"));
@@ -574,7 +587,9 @@ fn accuracy_table(study: &accuracy::AccuracyStudy) -> String {
             p.step_or_tolerance,
             p.cpu_us_per_stride,
             p.evaluations_per_stride,
-            p.failure.as_ref().map_or(fmt(p.fixed_point_error), |_| "no gait".into()),
+            p.failure
+                .as_ref()
+                .map_or(fmt(p.fixed_point_error), |_| "no gait".into()),
             fmt(p.eigenvalue_error),
             fmt(p.heel_strike_time_error_s)
         ));

@@ -1,0 +1,193 @@
+//! Hard cases: each ends in a typed outcome or meets an error bound, and each could fail.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::NewtonSettings;
+use sim::stride::{FailureKind, StrideOptions};
+
+#[test]
+fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
+    // The compass gait's point foot passes 3.5 mm through the floor at mid-swing. Shorten the
+    // swing foot so that it dips only about 0.5 mm below the floor, for a few milliseconds, and
+    // count any touch behind the stance foot as a scuff.
+    let (_, mut w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let c0 = w
+        .stride(
+            &q,
+            &qd,
+            StrideOptions {
+                record: false,
+                contact: true,
+            },
+        )
+        .unwrap();
+    let clearance = c0.contact.mid_swing_clearance_m.unwrap();
+    assert!(clearance < -1e-3, "{clearance}");
+    w.model.points[w.heel_strike.swing_foot.0].p_link_m.y += -clearance - 5e-4;
+    w.heel_strike.ignore_scuffing = false;
+    w.heel_strike.min_ahead_m = 0.05;
+    let scuffs = |w: &sim::walker::Walker| matches!(w.stride(&q, &qd, StrideOptions::default()), Err(e) if e.kind == FailureKind::Scuffed);
+    assert!(scuffs(&w), "the accurate integrator must see the graze");
+    // Long fixed steps: the whole dip lies inside one step.
+    w.integrator = IntegratorChoice::Rk4 { h_s: 0.1 };
+    assert!(scuffs(&w), "the interior check must catch the graze");
+    w.event_tolerance.grazing_samples = 0;
+    assert!(
+        !scuffs(&w),
+        "without the interior check the graze is missed"
+    );
+}
+
+#[test]
+fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
+    let (mut scene, _) = common::walker("wisse3d");
+    scene
+        .set("pelvis_yaw_stiffness_n_m_per_rad", 1.0e7)
+        .unwrap();
+    let mut w = scene.build().unwrap();
+    w.integrator = IntegratorChoice::Meijaard {
+        h_s: 1e-3,
+        check_every: 1,
+    };
+    let e = w
+        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
+        .unwrap_err();
+    assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
+    // For a very stiff spring the fastest mode is the pelvis's yaw against the rest of the
+    // walker: λ² ≈ k (M̄⁻¹)_yaw,yaw, with the reduced mass matrix over the free coordinates.
+    assert!(e.detail.contains("h_max"), "{}", e.detail);
+    let lambda: f64 = e
+        .detail
+        .split("λ_max = ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut d = sim::dynamics::Dynamics::new(&w.model);
+    d.assemble(&w.model, &w.guess_q, &w.guess_qd, None);
+    let free: Vec<usize> = (0..w.model.dof())
+        .filter(|i| !w.initially_locked.iter().any(|c| c.0 == *i))
+        .collect();
+    let m = d.mass_matrix.select_rows(&free).select_columns(&free);
+    let yaw = free
+        .iter()
+        .position(|&i| i == w.model.coord_index("pelvis_yaw").unwrap().0)
+        .unwrap();
+    let expected = (1.0e7 * m.try_inverse().unwrap()[(yaw, yaw)]).sqrt();
+    assert!(
+        (lambda / expected - 1.0).abs() < 0.05,
+        "λ_max {lambda} vs {expected}"
+    );
+    assert!(lambda > 2.0 / 1e-3, "the step must really exceed the limit");
+    // A step inside the limit passes the check.
+    w.integrator = IntegratorChoice::Meijaard {
+        h_s: 1e-4,
+        check_every: 1,
+    };
+    let r = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default());
+    assert!(
+        !matches!(r, Err(ref e) if e.kind == FailureKind::StepTooLarge),
+        "{r:?}"
+    );
+}
+
+#[test]
+fn just_past_the_period_doubling_slope_the_walker_settles_into_two_alternating_steps() {
+    let (mut scene, _) = common::walker("simplest");
+    let (pts, _) = sim::continuation::sweep(
+        &scene,
+        "slope",
+        0.009,
+        0.0155,
+        14,
+        &NewtonSettings::default(),
+    )
+    .unwrap();
+    let last = pts.last().unwrap();
+    let g = last.gait.as_ref().unwrap();
+    assert!(!g.stable());
+    scene.set("slope", last.value).unwrap();
+    let w = scene.build().unwrap();
+    let mut v = g.fixed_point.clone();
+    v[0] += 1e-4;
+    let (q, qd) = w.unpack(&v);
+    let walk = w.walk(&q, &qd, 400, false);
+    assert!(walk.failure.is_none(), "{:?}", walk.failure);
+    let d: Vec<f64> = walk
+        .steps
+        .iter()
+        .rev()
+        .take(4)
+        .map(|s| s.duration_s)
+        .collect();
+    // Period two: alternate steps differ, every other step repeats.
+    assert!((d[0] - d[1]).abs() > 1e-3, "{d:?}");
+    assert!(
+        (d[0] - d[2]).abs() < 1e-8 && (d[1] - d[3]).abs() < 1e-8,
+        "{d:?}"
+    );
+}
+
+#[test]
+fn near_zero_slope_gaits_follow_garcias_cube_root_scaling() {
+    // Garcia et al. (1998): for small slopes the stance angle at heel strike scales as γ^(1/3).
+    let (scene, _) = common::walker("simplest");
+    let (pts, _) = sim::continuation::sweep(
+        &scene,
+        "slope",
+        0.009,
+        0.0001,
+        30,
+        &NewtonSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        pts.iter().all(|p| p.gait.is_ok()),
+        "a gait was lost on the way down"
+    );
+    let theta = |p: &sim::continuation::SweepPoint| p.gait.as_ref().unwrap().fixed_point[0];
+    let (a, b) = (&pts[pts.len() - 1], &pts[pts.len() - 8]);
+    let exponent = (theta(b) / theta(a)).ln() / (b.value / a.value).ln();
+    assert!((exponent - 1.0 / 3.0).abs() < 0.01, "exponent {exponent}");
+}
+
+#[test]
+fn ten_thousand_strides_from_the_fixed_point_do_not_drift() {
+    let (_, w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let walk = w.walk(&q, &qd, 10_000, false);
+    assert!(walk.failure.is_none());
+    let worst = walk
+        .steps
+        .iter()
+        .map(|s| s.state_deviation)
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-9,
+        "largest deviation from the fixed point {worst}"
+    );
+    let first = walk.steps[0].duration_s;
+    assert!(walk
+        .steps
+        .iter()
+        .all(|s| (s.duration_s - first).abs() < 1e-9));
+}
+
+#[test]
+fn a_non_finite_velocity_is_a_typed_failure() {
+    let (_, w) = common::walker("wisse3d");
+    let mut qd = w.guess_qd.clone();
+    qd[2] = f64::INFINITY;
+    let e = w
+        .stride(&w.guess_q, &qd, StrideOptions::default())
+        .unwrap_err();
+    assert_eq!(e.kind, FailureKind::NonFiniteState);
+}
