@@ -1,0 +1,446 @@
+//! candump log files (`candump -L` format), as python-can's `CanutilsLogReader` /
+//! `can.LogReader` reads and `CanutilsLogWriter` writes them.
+//!
+//! ```text
+//! (1700000000.123456) vcan0 123#DEADBEEF
+//! (1700000000.123789) vcan0 20000080#0000000000000000
+//! (1700000000.124000) vcan0 072#0102 R
+//! ```
+//!
+//! One record per line: timestamp in seconds with (usually six) decimals, channel, identifier
+//! (three hex digits: standard, eight: extended; `CAN_ERR_FLAG` 0x20000000 set: error frame),
+//! `#`, data as hex pairs (or `R[dlc]` for a remote frame), optionally ` R`/` T` (received or
+//! transmitted, written by python-can). [`read_log`] keeps every good line and reports each bad
+//! one with its line number.
+
+use std::io::{self, BufRead, Write};
+
+use thiserror::Error;
+
+use crate::bus::BusEvent;
+use crate::frame::Frame;
+
+/// Linux `CAN_ERR_FLAG`: the identifier is an error class, not a frame identifier.
+pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
+/// Linux `CAN_ERR_BUSERROR` (python-can needs it to recognise an error frame).
+pub const CAN_ERR_BUSERROR: u32 = 0x0000_0080;
+/// Linux `CAN_ERR_PROT` (protocol violation; details in data byte 2).
+pub const CAN_ERR_PROT: u32 = 0x0000_0008;
+/// Linux `CAN_ERR_BUSOFF`.
+pub const CAN_ERR_BUSOFF: u32 = 0x0000_0040;
+
+/// What a log line carries.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LogFrame {
+    /// A standard data frame.
+    Standard(Frame),
+    /// An extended (29-bit) data frame.
+    Extended {
+        /// Identifier.
+        id: u32,
+        /// Payload (0..=8 bytes).
+        data: Vec<u8>,
+    },
+    /// A remote frame.
+    Remote {
+        /// Identifier.
+        id: u32,
+        /// True for a 29-bit identifier.
+        extended: bool,
+        /// Requested length.
+        dlc: u8,
+    },
+    /// An error frame: the error class bits (without `CAN_ERR_FLAG`) and its 8 data bytes.
+    Error {
+        /// Error class bits.
+        class: u32,
+        /// Error details.
+        data: Vec<u8>,
+    },
+}
+
+/// Direction marker python-can appends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// ` R`.
+    Rx,
+    /// ` T`.
+    Tx,
+}
+
+/// One line of a log.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LogRecord {
+    /// Timestamp [ns since the Unix epoch, or since whatever origin the log uses].
+    pub timestamp_ns: u64,
+    /// Interface name.
+    pub channel: String,
+    /// The frame.
+    pub frame: LogFrame,
+    /// Direction, when the line has one.
+    pub direction: Option<Direction>,
+}
+
+/// Why a line is not a log record.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+#[error("line {line_no}: {reason}: `{line}`")]
+pub struct LineError {
+    /// 1-based line number.
+    pub line_no: usize,
+    /// The line as read.
+    pub line: String,
+    /// What is wrong.
+    pub reason: String,
+}
+
+/// Errors of [`read_log`] that stop reading altogether.
+#[derive(Debug, Error)]
+pub enum ReadError {
+    /// The reader failed.
+    #[error("reading the log: {0}")]
+    Io(#[from] io::Error),
+}
+
+fn parse_timestamp(s: &str) -> Result<u64, String> {
+    let inner = s
+        .strip_prefix('(')
+        .and_then(|t| t.strip_suffix(')'))
+        .ok_or_else(|| format!("timestamp `{s}` is not of the form (SECONDS.FRACTION)"))?;
+    let (secs, frac) = inner.split_once('.').unwrap_or((inner, ""));
+    let bad = || format!("timestamp `{s}` is not a non-negative decimal number");
+    if secs.is_empty() || !secs.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(bad());
+    }
+    if frac.len() > 9 || !frac.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(bad());
+    }
+    let secs: u64 = secs.parse().map_err(|_| bad())?;
+    let mut frac_ns: u64 = 0;
+    for (i, b) in frac
+        .bytes()
+        .chain(std::iter::repeat(b'0'))
+        .take(9)
+        .enumerate()
+    {
+        let _ = i;
+        frac_ns = frac_ns * 10 + u64::from(b - b'0');
+    }
+    secs.checked_mul(1_000_000_000)
+        .and_then(|n| n.checked_add(frac_ns))
+        .ok_or_else(bad)
+}
+
+fn parse_hex_bytes(s: &str) -> Result<Vec<u8>, String> {
+    if !s.len().is_multiple_of(2) {
+        return Err(format!("data `{s}` has an odd number of hex digits"));
+    }
+    if s.len() > 16 {
+        return Err(format!("data `{s}` is longer than 8 bytes"));
+    }
+    (0..s.len())
+        .step_by(2)
+        .map(|i| {
+            s.get(i..i + 2)
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .ok_or_else(|| format!("data `{s}` is not hex"))
+        })
+        .collect()
+}
+
+/// Parse one line (without the newline).
+///
+/// # Errors
+/// A description of the first problem; [`read_log`] wraps it in a [`LineError`].
+pub fn parse_line(line: &str) -> Result<LogRecord, String> {
+    let mut parts = line.split_whitespace();
+    let (Some(ts), Some(channel), Some(body)) = (parts.next(), parts.next(), parts.next()) else {
+        return Err("expected `(TIMESTAMP) CHANNEL ID#DATA`".to_string());
+    };
+    let direction = match parts.next() {
+        None => None,
+        Some("R" | "r") => Some(Direction::Rx),
+        Some("T" | "t") => Some(Direction::Tx),
+        Some(other) => return Err(format!("unexpected `{other}` after the frame")),
+    };
+    if let Some(extra) = parts.next() {
+        return Err(format!("unexpected `{extra}` after the frame"));
+    }
+    let timestamp_ns = parse_timestamp(ts)?;
+    let (id_s, data_s) = body
+        .split_once('#')
+        .ok_or_else(|| format!("frame `{body}` has no `#`"))?;
+    if data_s.starts_with('#') {
+        return Err("CAN FD frames (`##`) are not supported".to_string());
+    }
+    let extended = match id_s.len() {
+        3 => false,
+        8 => true,
+        _ => return Err(format!("identifier `{id_s}` must have 3 or 8 hex digits")),
+    };
+    let id = u32::from_str_radix(id_s, 16)
+        .map_err(|_| format!("identifier `{id_s}` is not hexadecimal"))?;
+    let frame = if let Some(r) = data_s.strip_prefix(['R', 'r']) {
+        let dlc = if r.is_empty() {
+            0
+        } else {
+            r.parse::<u8>()
+                .ok()
+                .filter(|d| *d <= 8)
+                .ok_or_else(|| format!("remote length `{r}` is not 0..8"))?
+        };
+        LogFrame::Remote { id, extended, dlc }
+    } else {
+        let data = parse_hex_bytes(data_s)?;
+        if extended && id & CAN_ERR_FLAG != 0 {
+            LogFrame::Error {
+                class: id & !CAN_ERR_FLAG,
+                data,
+            }
+        } else if extended {
+            if id > 0x1FFF_FFFF {
+                return Err(format!("identifier `{id_s}` exceeds 29 bits"));
+            }
+            LogFrame::Extended { id, data }
+        } else {
+            LogFrame::Standard(Frame::new(id, &data).map_err(|e| e.to_string())?)
+        }
+    };
+    Ok(LogRecord {
+        timestamp_ns,
+        channel: channel.to_string(),
+        frame,
+        direction,
+    })
+}
+
+/// Read every record; bad lines are reported, the others kept. Blank lines are skipped.
+///
+/// # Errors
+/// [`ReadError::Io`] when the reader fails (not for bad lines).
+pub fn read_log<R: BufRead>(reader: R) -> Result<(Vec<LogRecord>, Vec<LineError>), ReadError> {
+    let mut records = Vec::new();
+    let mut errors = Vec::new();
+    for (i, line) in reader.lines().enumerate() {
+        let line = line?;
+        let t = line.trim();
+        if t.is_empty() {
+            continue;
+        }
+        match parse_line(t) {
+            Ok(r) => records.push(r),
+            Err(reason) => errors.push(LineError {
+                line_no: i + 1,
+                line: line.clone(),
+                reason,
+            }),
+        }
+    }
+    Ok((records, errors))
+}
+
+fn hex(data: &[u8]) -> String {
+    data.iter().map(|b| format!("{b:02X}")).collect()
+}
+
+/// Format one record as a line (without the newline).
+pub fn format_record(r: &LogRecord) -> String {
+    let ts = format!(
+        "({}.{:06})",
+        r.timestamp_ns / 1_000_000_000,
+        (r.timestamp_ns % 1_000_000_000) / 1_000
+    );
+    let body = match &r.frame {
+        LogFrame::Standard(f) => format!("{:03X}#{}", f.id(), hex(f.data())),
+        LogFrame::Extended { id, data } => format!("{id:08X}#{}", hex(data)),
+        LogFrame::Remote { id, extended, dlc } => {
+            let id = if *extended {
+                format!("{id:08X}")
+            } else {
+                format!("{id:03X}")
+            };
+            if *dlc == 0 {
+                format!("{id}#R")
+            } else {
+                format!("{id}#R{dlc}")
+            }
+        }
+        LogFrame::Error { class, data } => format!("{:08X}#{}", class | CAN_ERR_FLAG, hex(data)),
+    };
+    let dir = match r.direction {
+        None => "",
+        Some(Direction::Rx) => " R",
+        Some(Direction::Tx) => " T",
+    };
+    format!("{ts} {} {body}{dir}", r.channel)
+}
+
+/// Writes bus events as a candump log.
+#[derive(Debug)]
+pub struct CandumpWriter<W: Write> {
+    out: W,
+    channel: String,
+    origin_ns: u64,
+}
+
+impl<W: Write> CandumpWriter<W> {
+    /// A writer on `channel` whose timestamps are `origin_ns` + simulated time.
+    pub fn new(out: W, channel: &str, origin_ns: u64) -> Self {
+        CandumpWriter {
+            out,
+            channel: channel.to_string(),
+            origin_ns,
+        }
+    }
+
+    /// Write one record.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn write_record(&mut self, r: &LogRecord) -> io::Result<()> {
+        writeln!(self.out, "{}", format_record(r))
+    }
+
+    /// The record for a bus event: a delivered frame (stamped at the end of its interframe
+    /// space), an error frame (`CAN_ERR_PROT | CAN_ERR_BUSERROR`, data byte 2 =
+    /// `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF | CAN_ERR_BUSERROR`).
+    pub fn record_for(&self, ev: &BusEvent) -> LogRecord {
+        let (t, frame) = match ev {
+            BusEvent::Delivered(d) => (d.t_end_ns, LogFrame::Standard(d.frame)),
+            BusEvent::ErrorFrame { t_end_ns, .. } => (
+                *t_end_ns,
+                LogFrame::Error {
+                    class: CAN_ERR_PROT | CAN_ERR_BUSERROR,
+                    data: vec![0, 0, 0x01, 0, 0, 0, 0, 0],
+                },
+            ),
+            BusEvent::BusOff { t_ns, .. } => (
+                *t_ns,
+                LogFrame::Error {
+                    class: CAN_ERR_BUSOFF | CAN_ERR_BUSERROR,
+                    data: vec![0; 8],
+                },
+            ),
+        };
+        LogRecord {
+            timestamp_ns: self.origin_ns + t,
+            channel: self.channel.clone(),
+            frame,
+            direction: None,
+        }
+    }
+
+    /// Write one bus event.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn write_event(&mut self, ev: &BusEvent) -> io::Result<()> {
+        let r = self.record_for(ev);
+        self.write_record(&r)
+    }
+
+    /// Flush and return the writer.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn finish(mut self) -> io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn parses_the_reference_line() {
+        let r = parse_line("(1700000000.123456) vcan0 123#DEADBEEF").unwrap();
+        assert_eq!(r.timestamp_ns, 1_700_000_000_123_456_000);
+        assert_eq!(r.channel, "vcan0");
+        assert_eq!(
+            r.frame,
+            LogFrame::Standard(Frame::new(0x123, &[0xDE, 0xAD, 0xBE, 0xEF]).unwrap())
+        );
+        assert_eq!(format_record(&r), "(1700000000.123456) vcan0 123#DEADBEEF");
+    }
+
+    #[test]
+    fn python_can_variants() {
+        let r = parse_line("(0.000000) can0 072#01 R").unwrap();
+        assert_eq!(r.direction, Some(Direction::Rx));
+        let r = parse_line("(1.5) vcan0 20000080#").unwrap();
+        assert_eq!(
+            r.frame,
+            LogFrame::Error {
+                class: CAN_ERR_BUSERROR,
+                data: vec![]
+            }
+        );
+        let r = parse_line("(1.0) vcan0 12345678#00").unwrap();
+        assert!(matches!(
+            r.frame,
+            LogFrame::Extended {
+                id: 0x1234_5678,
+                ..
+            }
+        ));
+        let r = parse_line("(1.0) vcan0 123#R4").unwrap();
+        assert_eq!(
+            r.frame,
+            LogFrame::Remote {
+                id: 0x123,
+                extended: false,
+                dlc: 4
+            }
+        );
+        assert_eq!(format_record(&r), "(1.000000) vcan0 123#R4");
+    }
+
+    #[test]
+    fn bad_lines_are_named_and_nothing_else_is_lost() {
+        let text = "(1.000000) vcan0 062#0100000A000000\n\
+                    garbage\n\
+                    \n\
+                    (2.000000) vcan0 8000#00\n\
+                    (x.1) vcan0 062#00\n\
+                    (3.000000) vcan0 062#0G\n\
+                    (4.000000) vcan0 800#00\n\
+                    (5.000000) vcan0 072#000102030405060708\n\
+                    (6.000000) vcan0 072#0102 Q\n\
+                    (7.000000) vcan0 073#0102030405060A\n";
+        let (recs, errs) = read_log(text.as_bytes()).unwrap();
+        assert_eq!(recs.len(), 2);
+        assert_eq!(recs[1].timestamp_ns, 7_000_000_000);
+        let lines: Vec<usize> = errs.iter().map(|e| e.line_no).collect();
+        assert_eq!(lines, vec![2, 4, 5, 6, 7, 8, 9]);
+        let msg = errs[0].to_string();
+        assert!(
+            msg.starts_with("line 2:") && msg.contains("garbage"),
+            "{msg}"
+        );
+        assert!(errs[1].reason.contains("8000"), "{}", errs[1].reason);
+        assert!(errs[4].reason.contains("0x800"), "{}", errs[4].reason);
+        assert!(errs[5].reason.contains("8 bytes"), "{}", errs[5].reason);
+    }
+
+    proptest! {
+        #[test]
+        fn standard_frames_round_trip(ts in 0u64..4_000_000_000_000_000, id in 0u32..0x800,
+                                      data in proptest::collection::vec(any::<u8>(), 0..=8)) {
+            let r = LogRecord {
+                timestamp_ns: ts / 1000 * 1000,
+                channel: "vcan0".into(),
+                frame: LogFrame::Standard(Frame::new(id, &data).unwrap()),
+                direction: None,
+            };
+            let line = format_record(&r);
+            prop_assert_eq!(parse_line(&line), Ok(r));
+        }
+
+        #[test]
+        fn arbitrary_lines_never_panic(s in ".{0,60}") {
+            let _ = parse_line(&s);
+        }
+    }
+}
