@@ -277,6 +277,20 @@ def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float])
         yield msg
 
 
+def parse_send(text: str) -> can.Message:
+    """`ID#HEXDATA` (cansend syntax, standard identifiers) as a can.Message."""
+    ident, _, data = text.partition("#")
+    try:
+        arb = int(ident, 16)
+        payload = bytes.fromhex(data)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(f"--send {text!r}: expected ID#HEXDATA ({e})") from e
+    if len(ident) > 3 or arb > 0x7FF or len(payload) > 8:
+        raise argparse.ArgumentTypeError(
+            f"--send {text!r}: 11-bit identifier (3 hex digits) and at most 8 data bytes")
+    return can.Message(arbitration_id=arb, data=payload, is_extended_id=False)
+
+
 def open_bus(args) -> can.BusABC:
     kwargs = {"interface": args.interface, "channel": args.channel}
     if args.interface == "socketcand":
@@ -305,7 +319,11 @@ def main(argv: Optional[list] = None) -> int:
     p.add_argument("--stale", type=float, default=0.3,
                    help="a node is not alive when its last heartbeat is older than this [s]")
     p.add_argument("--json", action="store_true", help="print one JSON summary at the end")
+    p.add_argument("--send", type=parse_send, action="append", default=[], metavar="ID#DATA",
+                   help="live: send this frame once after connecting (repeatable), e.g. 013#03")
     args = p.parse_args(argv)
+    if args.send and args.log:
+        p.error("--send needs a live --interface, not --log")
 
     db = cantools.database.load_file(args.dbc, strict=True)
     mon = Monitor(db, bitrate=args.bitrate, stale_s=args.stale)
@@ -317,6 +335,8 @@ def main(argv: Optional[list] = None) -> int:
             source: Iterable[can.Message] = read_log(args.log, bad_lines)
         else:
             bus = open_bus(args)
+            for m in args.send:
+                bus.send(m)
             source = live(bus, args.duration, args.idle_exit)
         next_print = time.monotonic() + args.interval
         for msg in source:

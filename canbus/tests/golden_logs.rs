@@ -73,7 +73,8 @@ fn fixtures_are_fresh_and_read_back() {
                     assert_eq!(*f, d.frame);
                     assert_eq!(r.timestamp_ns, ORIGIN_NS + d.t_end_ns / 1000 * 1000);
                 }
-                (BusEvent::ErrorFrame { .. } | BusEvent::BusOff { .. }, LogFrame::Error { .. }) => {}
+                (BusEvent::ErrorFrame { .. } | BusEvent::BusOff { .. }, LogFrame::Error { .. }) => {
+                }
                 other => panic!("{other:?}"),
             }
         }
