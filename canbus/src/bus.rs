@@ -219,6 +219,8 @@ pub struct NodeStats {
     pub tx_errors: u64,
     /// Frames discarded by `drop` faults or because the node was bus-off.
     pub dropped: u64,
+    /// Frames refused because its transmit queue was full ([`BusError::QueueFull`]).
+    pub queue_overflows: u64,
     /// Transmit error counter.
     pub tec: u16,
     /// Fault-confinement state.
@@ -244,6 +246,8 @@ pub struct BusStats {
     pub error_frames: u64,
     /// Frames discarded by faults.
     pub dropped: u64,
+    /// Frames refused by full transmit queues.
+    pub queue_overflows: u64,
     /// Per identifier (key: the identifier).
     pub per_id: BTreeMap<u16, IdStats>,
     /// Per node, in attach order.
@@ -268,6 +272,7 @@ struct Node {
     tx_frames: u64,
     tx_errors: u64,
     dropped: u64,
+    queue_overflows: u64,
 }
 
 #[derive(Clone, Debug)]
@@ -312,6 +317,7 @@ pub struct Bus {
     frames: u64,
     error_frames: u64,
     dropped: u64,
+    queue_overflows: u64,
 }
 
 impl Bus {
@@ -337,6 +343,7 @@ impl Bus {
             frames: 0,
             error_frames: 0,
             dropped: 0,
+            queue_overflows: 0,
         })
     }
 
@@ -362,6 +369,7 @@ impl Bus {
             tx_frames: 0,
             tx_errors: 0,
             dropped: 0,
+            queue_overflows: 0,
         });
         NodeHandle(self.nodes.len() - 1)
     }
@@ -508,10 +516,15 @@ impl Bus {
             return Ok(SendOutcome::BusOff);
         }
         if n.queue.len() >= self.config.tx_queue_capacity {
-            return Err(BusError::QueueFull {
+            let err = BusError::QueueFull {
                 node: n.name.clone(),
                 capacity: self.config.tx_queue_capacity,
-            });
+            };
+            self.queue_overflows += 1;
+            if let Some(n) = self.nodes.get_mut(node.0) {
+                n.queue_overflows += 1;
+            }
+            return Err(err);
         }
         let mut ready_ns = t_ns;
         for i in 0..self.faults.len() {
@@ -803,6 +816,7 @@ impl Bus {
             frames: self.frames,
             error_frames: self.error_frames,
             dropped: self.dropped,
+            queue_overflows: self.queue_overflows,
             per_id,
             nodes: self
                 .nodes
@@ -813,6 +827,7 @@ impl Bus {
                     tx_frames: n.tx_frames,
                     tx_errors: n.tx_errors,
                     dropped: n.dropped,
+                    queue_overflows: n.queue_overflows,
                     tec: n.tec,
                     state: n.state,
                     queued: n.queue.len(),

@@ -270,6 +270,7 @@ fn babbling_node_fills_the_bus() {
     }
     assert!(matches!(full, Some(BusError::QueueFull { .. })), "{full:?}");
     let s = b.stats();
+    assert_eq!((s.queue_overflows, s.nodes[0].queue_overflows), (1, 1));
     assert_eq!(s.per_id.get(&0x72).map_or(0, |x| x.frames), 0);
     assert!(s.load > 0.99);
 }

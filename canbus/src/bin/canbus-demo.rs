@@ -181,10 +181,11 @@ fn main() -> Result<()> {
         writeln!(out)?;
     } else {
         eprintln!(
-            "{sim_s:.3} s simulated in {wall_s:.3} s: {} frames, {} error frames, {} dropped, bus load {:.2} %",
+            "{sim_s:.3} s simulated in {wall_s:.3} s: {} frames, {} error frames, {} dropped, {} queue overflows, bus load {:.2} %",
             stats.frames,
             stats.error_frames,
             stats.dropped,
+            stats.queue_overflows,
             100.0 * stats.load
         );
     }
