@@ -478,6 +478,8 @@ impl Walker {
     ) -> Result<StrideResult, StrideFailure> {
         let mut integrator = self.integrator.build();
         integrator.reset();
+        // Evaluations of earlier phases (the integrator restarts after each impact).
+        let mut evaluations = 0;
         let mut phase = Phase::new(&self.model);
         for c in &self.initially_locked {
             phase.active[c.0] = false;
@@ -733,6 +735,7 @@ impl Walker {
                         name: "string_engaged".into(),
                         time_s: at.t_s,
                     });
+                    evaluations += integrator.evaluations();
                     integrator.reset();
                     if options.record {
                         trajectory.push(cur.clone());
@@ -768,6 +771,7 @@ impl Walker {
                         name: format!("knee_lock:{}", self.model.coordinates[c].name),
                         time_s: at.t_s,
                     });
+                    evaluations += integrator.evaluations();
                     integrator.reset();
                     if options.record {
                         trajectory.push(cur.clone());
@@ -806,6 +810,7 @@ impl Walker {
                     if options.record {
                         trajectory.push(at.clone());
                     }
+                    evaluations += integrator.evaluations();
                     let mut r = self.finish_stride(
                         at,
                         &phase.active,
@@ -814,6 +819,7 @@ impl Walker {
                         integrator.as_ref(),
                     )?;
                     r.actuator_work_j = power.work_j;
+                    r.evaluations = evaluations;
                     r.contact = contact;
                     r.damping_dissipation_j = power.dissipation_j;
                     return Ok(r);

@@ -576,7 +576,7 @@ fn accuracy_table(study: &accuracy::AccuracyStudy) -> String {
     let fmt = |v: Option<f64>| v.map_or("—".to_string(), |x| format!("{x:.2e}"));
     let mut t = format!(
         "Scene `{}`, reference: dopri5 at rtol = atol = 1e-13, step period {:.6} s.\n\n\
-         | integrator | step [s] or rtol | CPU per stride [µs] | evaluations | fixed point | eigenvalues | heel-strike time [s] |\n\
+         | integrator | step [s] or rtol | CPU per stride [µs] | evaluations | fixed point | eigenvalues (modulus ≥ 0.05) | heel-strike time [s] |\n\
          | --- | --- | --- | --- | --- | --- | --- |\n",
         study.scene, study.reference_step_period_s
     );
