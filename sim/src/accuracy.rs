@@ -138,7 +138,10 @@ pub fn study(
         // with fixed steps or loose tolerances a step of 1e-6 turns truncation error into
         // eigenvalue noise (the 3D walker's eigenvalues are sensitive), so the study perturbs
         // by `STUDY_PERTURBATION` (central differences: its own error is of order 1e-8).
-        let study_newton = NewtonSettings { perturbation: STUDY_PERTURBATION, ..*newton };
+        let study_newton = NewtonSettings {
+            perturbation: STUDY_PERTURBATION,
+            ..*newton
+        };
         let gait = w.find_gait(&x_ref, &study_newton);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (
