@@ -34,6 +34,10 @@ pub struct Dynamics {
     pub force_infinitesimal: DVector<f64>,
     jv: DMatrix<f64>,
     jw: DMatrix<f64>,
+    iw_jw: DMatrix<f64>,
+    /// Scratch for the active-set solve (row-major k × k, then k).
+    work_m: Vec<f64>,
+    work_b: Vec<f64>,
     has_infinitesimal: bool,
 }
 
@@ -49,6 +53,9 @@ impl Dynamics {
             force_infinitesimal: DVector::zeros(n),
             jv: DMatrix::zeros(3, n),
             jw: DMatrix::zeros(3, n),
+            iw_jw: DMatrix::zeros(3, n),
+            work_m: vec![0.0; n * n],
+            work_b: vec![0.0; n],
             has_infinitesimal: model.has_infinitesimal_bodies(),
         }
     }
@@ -95,10 +102,8 @@ impl Dynamics {
                 let i_w = r * b.inertia_com_kg_m2 * r.transpose();
                 let w = self.kin.omega_floor_rad_s[i];
                 let torque = -(i_w * self.kin.alpha_bias_rad_s2[i]) - w.cross(&(i_w * w));
-                let iw_jw = DMatrix::from_fn(3, self.jw.ncols(), |r_, c| {
-                    (i_w.row(r_) * self.jw.column(c))[(0, 0)]
-                });
-                mm.gemm_tr(1.0, &self.jw, &iw_jw, 1.0);
+                self.iw_jw.gemm(1.0, &i_w, &self.jw, 0.0);
+                mm.gemm_tr(1.0, &self.jw, &self.iw_jw, 1.0);
                 ff.gemv_tr(1.0, &self.jw, &torque, 1.0);
             }
         }
@@ -129,33 +134,58 @@ impl Dynamics {
             return Err(DynamicsError::NonFinite);
         }
         self.assemble(model, q, qd, None);
-        let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
-        let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
-        let mut f0 = self.force.select_rows(&idx);
-        if let Some(qdd_p) = qdd_prescribed {
-            let fixed: Vec<usize> = (0..q.len()).filter(|&i| !active[i]).collect();
-            let m_ap = self.mass_matrix.select_rows(&idx).select_columns(&fixed);
-            f0 -= m_ap * qdd_p.select_rows(&fixed);
-        }
-        let x = if self.has_infinitesimal {
+        let n = q.len();
+        let mut qdd = match qdd_prescribed {
+            Some(p) => p.clone(),
+            None => DVector::zeros(n),
+        };
+        if self.has_infinitesimal {
+            let idx: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
+            let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
+            let mut f0 = self.force.select_rows(&idx);
+            if let Some(qdd_p) = qdd_prescribed {
+                let fixed: Vec<usize> = (0..n).filter(|&i| !active[i]).collect();
+                let m_ap = self.mass_matrix.select_rows(&idx).select_columns(&fixed);
+                f0 -= m_ap * qdd_p.select_rows(&fixed);
+            }
             let m1 = self
                 .mass_matrix_infinitesimal
                 .select_rows(&idx)
                 .select_columns(&idx);
             let f1 = self.force_infinitesimal.select_rows(&idx);
-            solve_limit(&m0, &m1, &f0, &f1, 1e-12)?
-        } else {
-            match m0.clone().cholesky() {
-                Some(ch) => ch.solve(&f0),
-                None => return Err(LimitSolveError::Degenerate { nullity: 1 }.into()),
+            let x = solve_limit(&m0, &m1, &f0, &f1, 1e-12)?;
+            for (k, &i) in idx.iter().enumerate() {
+                qdd[i] = x[k];
             }
-        };
-        let mut qdd = match qdd_prescribed {
-            Some(p) => p.clone(),
-            None => DVector::zeros(q.len()),
-        };
-        for (k, &i) in idx.iter().enumerate() {
-            qdd[i] = x[k];
+        } else {
+            // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers.
+            let mut k = 0;
+            for i in 0..n {
+                if !active[i] {
+                    continue;
+                }
+                let mut b = self.force[i];
+                if qdd_prescribed.is_some() {
+                    for j in (0..n).filter(|&j| !active[j]) {
+                        b -= self.mass_matrix[(i, j)] * qdd[j];
+                    }
+                }
+                self.work_b[k] = b;
+                for (l, j) in (0..n).filter(|&j| active[j]).enumerate() {
+                    self.work_m[k * n + l] = self.mass_matrix[(i, j)];
+                }
+                k += 1;
+            }
+            if !cholesky_solve_in_place(&mut self.work_m, n, k, &mut self.work_b) {
+                return Err(LimitSolveError::Degenerate { nullity: 1 }.into());
+            }
+            let mut r = 0;
+            for i in 0..n {
+                if active[i] {
+                    qdd[i] = self.work_b[r];
+                    r += 1;
+                }
+            }
         }
         if qdd.iter().any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
@@ -199,5 +229,67 @@ impl Dynamics {
             h += (p - p_floor_m).cross(&(v * b.mass_kg)) + i_w * self.kin.omega_floor_rad_s[i];
         }
         h
+    }
+}
+
+/// Solves `A x = b` for the leading `k × k` block of a symmetric positive definite `A` stored
+/// row-major with row stride `stride`, overwriting `A` with its Cholesky factor and `b` with
+/// `x`. Returns false if `A` is not positive definite.
+fn cholesky_solve_in_place(a: &mut [f64], stride: usize, k: usize, b: &mut [f64]) -> bool {
+    for j in 0..k {
+        let mut d = a[j * stride + j];
+        for p in 0..j {
+            d -= a[j * stride + p] * a[j * stride + p];
+        }
+        // Also rejects NaN.
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * stride + j] = d;
+        for i in j + 1..k {
+            let mut v = a[i * stride + j];
+            for p in 0..j {
+                v -= a[i * stride + p] * a[j * stride + p];
+            }
+            a[i * stride + j] = v / d;
+        }
+    }
+    for i in 0..k {
+        let mut v = b[i];
+        for p in 0..i {
+            v -= a[i * stride + p] * b[p];
+        }
+        b[i] = v / a[i * stride + i];
+    }
+    for i in (0..k).rev() {
+        let mut v = b[i];
+        for p in i + 1..k {
+            v -= a[p * stride + i] * b[p];
+        }
+        b[i] = v / a[i * stride + i];
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn in_place_cholesky_solves_an_spd_block() {
+        // 3 x 3 SPD block inside a 4-wide buffer.
+        let m = [4.0, 1.0, 0.5, 9.0, 1.0, 3.0, 0.2, 9.0, 0.5, 0.2, 2.0, 9.0];
+        let mut a = m.to_vec();
+        let x = [1.0, -2.0, 0.5];
+        let mut b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| m[i * 4 + j] * x[j]).sum())
+            .collect();
+        assert!(cholesky_solve_in_place(&mut a, 4, 3, &mut b));
+        for i in 0..3 {
+            assert!((b[i] - x[i]).abs() < 1e-14);
+        }
+        let mut not_pd = vec![1.0, 2.0, 2.0, 1.0];
+        assert!(!cholesky_solve_in_place(&mut not_pd, 2, 2, &mut [1.0, 1.0]));
     }
 }

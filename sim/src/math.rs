@@ -5,8 +5,20 @@ use nalgebra::{Matrix3, Vector3};
 /// Rotation matrix for a rotation of `angle_rad` about the unit vector `axis` (Rodrigues).
 pub fn rotation_about(axis: &Vector3<f64>, angle_rad: f64) -> Matrix3<f64> {
     let (s, c) = angle_rad.sin_cos();
-    let k = skew(axis);
-    Matrix3::identity() + k * s + k * k * (1.0 - c)
+    let t = 1.0 - c;
+    let (x, y, z) = (axis.x, axis.y, axis.z);
+    // R = c I + s [k]× + (1 − c) k kᵀ, written out.
+    Matrix3::new(
+        c + t * x * x,
+        t * x * y - s * z,
+        t * x * z + s * y,
+        t * x * y + s * z,
+        c + t * y * y,
+        t * y * z - s * x,
+        t * x * z - s * y,
+        t * y * z + s * x,
+        c + t * z * z,
+    )
 }
 
 /// The cross-product matrix: `skew(a) * b == a.cross(b)`.
@@ -34,6 +46,15 @@ mod tests {
     fn rotation_about_z_turns_x_toward_y() {
         let r = rotation_about(&Vector3::z(), std::f64::consts::FRAC_PI_2);
         assert!((r * Vector3::x() - Vector3::y()).norm() < 1e-15);
+    }
+
+    #[test]
+    fn rotation_about_matches_rodrigues_with_matrices() {
+        let axis = Vector3::new(0.3, -0.5, 0.8).normalize();
+        let k = skew(&axis);
+        let a: f64 = 0.7;
+        let expected = Matrix3::identity() + k * a.sin() + k * k * (1.0 - a.cos());
+        assert!((rotation_about(&axis, a) - expected).amax() < 1e-15);
     }
 
     #[test]

@@ -319,9 +319,40 @@ struct Witnesses<'a> {
     kin: Kinematics,
 }
 
+/// Everything the stride loop watches, from one kinematics evaluation of a sample.
+#[derive(Clone, Copy, Debug)]
+struct WitnessValues {
+    t_s: f64,
+    foot_height_m: f64,
+    foot_height_rate_m_s: f64,
+    hip_height_margin_m: f64,
+    hip_ahead_m: f64,
+    hip_forward_velocity_m_s: f64,
+}
+
 impl Witnesses<'_> {
     fn update(&mut self, s: &Sample) {
         self.kin.update(&self.walker.model, &s.q, &s.qd);
+    }
+    fn eval(&mut self, s: &Sample) -> WitnessValues {
+        self.update(s);
+        let m = &self.walker.model;
+        let foot = &m.points[self.walker.heel_strike.swing_foot.0];
+        let p_foot = self.kin.position_of(foot.link, &foot.p_link_m);
+        let hip = &m.points[self.walker.fall.hip.0];
+        let p_hip = self.kin.position_of(hip.link, &hip.p_link_m);
+        let p_contact = self
+            .kin
+            .point_position(m, self.walker.heel_strike.stance_contact);
+        let heading = self.heading();
+        WitnessValues {
+            t_s: s.t_s,
+            foot_height_m: p_foot.y,
+            foot_height_rate_m_s: self.kin.velocity_of(foot.link, &p_foot).y,
+            hip_height_margin_m: p_hip.y - self.walker.fall.min_hip_height_m,
+            hip_ahead_m: (p_hip - p_contact).dot(&heading),
+            hip_forward_velocity_m_s: self.kin.velocity_of(hip.link, &p_hip).dot(&heading),
+        }
     }
     fn foot_height(&mut self, s: &Sample) -> f64 {
         self.update(s);
@@ -493,6 +524,8 @@ impl Walker {
             .collect();
         let mut power = Power::default();
         let mut contact = ContactSummary::default();
+        // Witness values at `cur`, carried over from the previous step.
+        let mut w_cached: Option<WitnessValues> = None;
         let mut wit = Witnesses {
             walker: self,
             kin: Kinematics::new(&self.model),
@@ -534,29 +567,41 @@ impl Walker {
                 ));
             }
             // A grazing contact: the foot height is positive at both ends of the step but dips
-            // below the floor inside it. Check the Hermite interpolant at interior points; if the
-            // exact flow confirms a dip, shorten the step to end inside it.
-            let (g_cur, g_next) = (wit.foot_height(&cur), wit.foot_height(&next));
-            if g_cur > 0.0 && g_next > 0.0 {
+            // below the floor inside it. The cubic Hermite interpolant of the height (from its
+            // values and rates at both ends) is checked at interior points; if the exact flow
+            // confirms a dip, the step is shortened to end inside it.
+            let w_cur = match w_cached {
+                Some(w) if w.t_s == cur.t_s => w,
+                _ => wit.eval(&cur),
+            };
+            let mut w_next = wit.eval(&next);
+            if w_cur.foot_height_m > 0.0 && w_next.foot_height_m > 0.0 {
                 let n = self.event_tolerance.grazing_samples;
-                for k in 1..=n {
-                    let t = cur.t_s + (next.t_s - cur.t_s) * k as f64 / (n + 1) as f64;
-                    let (q, qd) = crate::events::hermite(&cur, &next, t);
-                    if wit.foot_height(&Sample { t_s: t, q, qd }) <= 0.0 {
-                        let mut s = integrator
-                            .step_exact(&mut phase, &cur, t - cur.t_s)
-                            .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
-                        phase.snap(&mut s);
-                        if wit.foot_height(&s) <= 0.0 {
-                            next = s;
-                        }
-                        break;
+                let h = next.t_s - cur.t_s;
+                let height_at = |x: f64| {
+                    let (x2, x3) = (x * x, x * x * x);
+                    (1.0 - 3.0 * x2 + 2.0 * x3) * w_cur.foot_height_m
+                        + (x - 2.0 * x2 + x3) * h * w_cur.foot_height_rate_m_s
+                        + (3.0 * x2 - 2.0 * x3) * w_next.foot_height_m
+                        + (-x2 + x3) * h * w_next.foot_height_rate_m_s
+                };
+                if let Some(k) = (1..=n).find(|&k| height_at(k as f64 / (n + 1) as f64) <= 0.0) {
+                    let t = cur.t_s + h * k as f64 / (n + 1) as f64;
+                    let mut s = integrator
+                        .step_exact(&mut phase, &cur, t - cur.t_s)
+                        .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+                    phase.snap(&mut s);
+                    let ws = wit.eval(&s);
+                    if ws.foot_height_m <= 0.0 {
+                        next = s;
+                        w_next = ws;
                     }
                 }
             }
+            w_cached = Some(w_next);
             // Which witnesses changed sign in the right direction over this step?
             let mut triggered: Vec<Watch> = Vec::new();
-            if Direction::Falling.triggered(g_cur, wit.foot_height(&next)) {
+            if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
                 triggered.push(Watch::Heel);
             }
             for (k, knee) in self.knees.iter().enumerate() {
@@ -569,13 +614,13 @@ impl Walker {
                     triggered.push(Watch::Knee(k));
                 }
             }
-            if Direction::Falling.triggered(wit.hip_height(&cur), wit.hip_height(&next)) {
+            if Direction::Falling.triggered(w_cur.hip_height_margin_m, w_next.hip_height_margin_m) {
                 triggered.push(Watch::HipLow);
             }
-            if wit.hip_ahead_m(&next) < 0.0
+            if w_next.hip_ahead_m < 0.0
                 && Direction::Falling.triggered(
-                    wit.hip_forward_velocity(&cur),
-                    wit.hip_forward_velocity(&next),
+                    w_cur.hip_forward_velocity_m_s,
+                    w_next.hip_forward_velocity_m_s,
                 )
             {
                 triggered.push(Watch::HipBack);

@@ -1,0 +1,23 @@
+//! Runs strides of a scene from its fixed point in a loop, for profilers
+//! (`cargo run --release -p sim --example profile_stride -- compass 200`).
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let name = args.next().unwrap_or_else(|| "compass".into());
+    let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let scene = sim::scene::Scene::load(&name).expect("scene");
+    let w = scene.build().expect("build");
+    let g = w
+        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &Default::default())
+        .expect("gait");
+    let (q, qd) = w.unpack(&g.fixed_point);
+    let start = std::time::Instant::now();
+    for _ in 0..n {
+        std::hint::black_box(w.stride(&q, &qd, Default::default()).expect("stride"));
+    }
+    println!(
+        "{name}: {:.1} µs per stride",
+        start.elapsed().as_secs_f64() * 1e6 / n as f64
+    );
+}
