@@ -6,6 +6,7 @@ pub mod accuracy;
 pub mod actuator;
 pub mod contact;
 pub mod continuation;
+pub mod control;
 pub mod dynamics;
 pub mod events;
 pub mod figures;

@@ -1,0 +1,124 @@
+//! Closing the loop on the stance ankle: a controller (the firmware's ankle nodes, or any other)
+//! is sampled at fixed control ticks, sample-and-hold, and moves the string's limit on the
+//! stance ankle angle. Ticks are breakpoints of the integration, not approximated.
+//!
+//! The string is a unilateral constraint: the stance ankle angle cannot fall below the limit.
+//! While the angle is above it the ankle is free and the foot flat; reaching it is the string
+//! engagement (an inelastic impact), after which the foot pivots on its toe and the ankle
+//! follows the limit. A limit that is released (string slack) never engages; released during
+//! push-off, the heel comes back down, which ends the stride as `heel_returned_to_floor`.
+
+use serde::Serialize;
+
+/// What the stance ankle's sensors see at a tick (true physical values; a controller quantises
+/// and filters them as its hardware would).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AnkleSensing {
+    /// Time since the start of the walk [s].
+    pub t_s: f64,
+    /// Stance ankle angle [rad] (negative with the hip ahead of the ankle).
+    pub stance_ankle_rad: f64,
+    /// Stance ankle rate [rad/s].
+    pub stance_ankle_rate_rad_s: f64,
+    /// The stance foot is on the floor (always, in single stance).
+    pub stance_foot_on_floor: bool,
+    /// The swing foot touches the floor (its height is not above it).
+    pub swing_foot_on_floor: bool,
+    /// The string is taut (engaged) on the stance ankle.
+    pub string_engaged: bool,
+}
+
+/// The stance string's limit over one tick: a cubic Hermite from `(p0, v0)` at `t0` to
+/// `(p1, v1)` at `t1` (continuous position and rate across ticks), or released.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ActuatorSegment {
+    /// Start of the tick [s].
+    pub t0_s: f64,
+    /// End of the tick [s].
+    pub t1_s: f64,
+    /// Limit angle at the start [rad].
+    pub p0_rad: f64,
+    /// Limit rate at the start [rad/s].
+    pub v0_rad_s: f64,
+    /// Limit angle at the end [rad].
+    pub p1_rad: f64,
+    /// Limit rate at the end [rad/s].
+    pub v1_rad_s: f64,
+    /// The string is slack: no limit.
+    pub released: bool,
+}
+
+impl ActuatorSegment {
+    /// A constant limit over `[t0, t1]`.
+    pub fn hold(t0_s: f64, t1_s: f64, p_rad: f64) -> Self {
+        Self {
+            t0_s,
+            t1_s,
+            p0_rad: p_rad,
+            v0_rad_s: 0.0,
+            p1_rad: p_rad,
+            v1_rad_s: 0.0,
+            released: false,
+        }
+    }
+
+    /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (clamped to the tick).
+    pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
+        let h = self.t1_s - self.t0_s;
+        if h <= 0.0 {
+            return (self.p1_rad, self.v1_rad_s, 0.0);
+        }
+        let x = ((t_s - self.t0_s) / h).clamp(0.0, 1.0);
+        let (x2, x3) = (x * x, x * x * x);
+        let p = (1.0 - 3.0 * x2 + 2.0 * x3) * self.p0_rad
+            + (x - 2.0 * x2 + x3) * h * self.v0_rad_s
+            + (3.0 * x2 - 2.0 * x3) * self.p1_rad
+            + (-x2 + x3) * h * self.v1_rad_s;
+        let v = ((-6.0 * x + 6.0 * x2) * self.p0_rad + (6.0 * x - 6.0 * x2) * self.p1_rad) / h
+            + (1.0 - 4.0 * x + 3.0 * x2) * self.v0_rad_s
+            + (-2.0 * x + 3.0 * x2) * self.v1_rad_s;
+        let a = ((-6.0 + 12.0 * x) * self.p0_rad + (6.0 - 12.0 * x) * self.p1_rad) / (h * h)
+            + ((-4.0 + 6.0 * x) * self.v0_rad_s + (-2.0 + 6.0 * x) * self.v1_rad_s) / h;
+        (p, v, a)
+    }
+}
+
+/// Why a controller could not run a tick.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("controller: {0}")]
+pub struct ControlError(pub String);
+
+/// A controller of the stance ankle's string, sampled every `period_s`.
+pub trait AnkleController {
+    /// Control period [s].
+    fn period_s(&self) -> f64;
+    /// One tick at `sensing.t_s`: returns the string's limit until the next tick.
+    fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError>;
+    /// Heel strike at `t_s`: the swing leg becomes the stance leg (the legs swap roles).
+    fn heel_strike(&mut self, t_s: f64);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_is_a_c1_cubic_with_consistent_derivatives() {
+        let s = ActuatorSegment {
+            t0_s: 1.0,
+            t1_s: 1.001,
+            p0_rad: -0.08,
+            v0_rad_s: 0.5,
+            p1_rad: -0.079,
+            v1_rad_s: 1.5,
+            released: false,
+        };
+        assert_eq!(s.eval(1.0).0, -0.08);
+        assert!((s.eval(1.001).0 + 0.079).abs() < 1e-15);
+        assert!((s.eval(1.0).1 - 0.5).abs() < 1e-9 && (s.eval(1.001).1 - 1.5).abs() < 1e-9);
+        let h = 1e-8;
+        let t = 1.0004;
+        assert!(((s.eval(t + h).0 - s.eval(t - h).0) / (2.0 * h) - s.eval(t).1).abs() < 1e-5);
+        assert!(((s.eval(t + h).1 - s.eval(t - h).1) / (2.0 * h) - s.eval(t).2).abs() < 1e-2);
+    }
+}
