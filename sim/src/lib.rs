@@ -20,6 +20,7 @@ pub mod plot;
 pub mod relabel;
 pub mod report;
 pub mod scene;
+pub mod sil;
 pub mod singular_limit;
 pub mod stability;
 pub mod stride;
