@@ -98,6 +98,74 @@ pub trait AnkleController {
     fn heel_strike(&mut self, t_s: f64);
 }
 
+/// A sampled version of the ideal stretch reflex: the limit is held at the engagement angle
+/// until a tick sees the string taut, then follows the ideal smooth extension from that tick,
+/// and is re-armed at heel strike. The reference controller for the control-tick machinery: it
+/// differs from the ideal actuator only by the sample-and-hold delay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampledReflex {
+    /// Control period [s].
+    pub period_s: f64,
+    /// Engagement (taut) angle [rad].
+    pub engage_rad: f64,
+    /// Final angle [rad].
+    pub final_rad: f64,
+    /// Extension duration [s].
+    pub duration_s: f64,
+    started_at_s: Option<f64>,
+}
+
+impl SampledReflex {
+    /// A reflex with the given period and the ideal reflex's angles and duration.
+    pub fn new(period_s: f64, reflex: &crate::actuator::AnkleReflex) -> Self {
+        Self {
+            period_s,
+            engage_rad: reflex.engage_rad,
+            final_rad: reflex.final_rad,
+            duration_s: reflex.duration_s,
+            started_at_s: None,
+        }
+    }
+}
+
+impl AnkleController for SampledReflex {
+    fn period_s(&self) -> f64 {
+        self.period_s
+    }
+    fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
+        let t = sensing.t_s;
+        if self.started_at_s.is_none() && sensing.string_engaged {
+            self.started_at_s = Some(t);
+        }
+        let t1 = t + self.period_s;
+        Ok(match self.started_at_s {
+            None => ActuatorSegment::hold(t, t1, self.engage_rad),
+            Some(start_s) => {
+                let profile = crate::actuator::AnkleProfile {
+                    start_s,
+                    duration_s: self.duration_s,
+                    from_rad: self.engage_rad,
+                    to_rad: self.final_rad,
+                };
+                let (p0, v0, _) = profile.eval(t);
+                let (p1, v1, _) = profile.eval(t1);
+                ActuatorSegment {
+                    t0_s: t,
+                    t1_s: t1,
+                    p0_rad: p0,
+                    v0_rad_s: v0,
+                    p1_rad: p1,
+                    v1_rad_s: v1,
+                    released: false,
+                }
+            }
+        })
+    }
+    fn heel_strike(&mut self, _t_s: f64) {
+        self.started_at_s = None;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -34,6 +34,21 @@ pub fn resolve(
     g_rows: &DMatrix<f64>,
     restitution: f64,
 ) -> Result<ImpactResult, ImpactError> {
+    let target = g_rows * qd_minus * (-restitution);
+    resolve_to(dynamics, model, q, qd_minus, active, g_rows, &target)
+}
+
+/// As [`resolve`], with the constrained velocities after the impact given: `G q̇⁺ = target`
+/// (e.g. a string whose far end moves at a known rate).
+pub fn resolve_to(
+    dynamics: &mut Dynamics,
+    model: &Model,
+    q: &DVector<f64>,
+    qd_minus: &DVector<f64>,
+    active: &[bool],
+    g_rows: &DMatrix<f64>,
+    target: &DVector<f64>,
+) -> Result<ImpactResult, ImpactError> {
     dynamics.assemble(model, q, qd_minus, None);
     let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
     let n = idx.len();
@@ -53,13 +68,13 @@ pub fn resolve(
     a1.view_mut((0, 0), (n, n)).copy_from(&m1);
     let mut b0 = DVector::zeros(n + k);
     b0.rows_mut(0, n).copy_from(&(&m0 * &v));
-    // Newton's law on the whole contact velocity, G q̇⁺ = −e G q̇⁻, with the coordinates that
-    // are not free (locked, or driven by an actuator) keeping their rates through the impact.
+    // The constraint on the whole velocity, G q̇⁺ = target, with the coordinates that are not
+    // free (locked, or driven by an actuator) keeping their rates through the impact.
     let mut v_fixed = qd_minus.clone();
     for &i in &idx {
         v_fixed[i] = 0.0;
     }
-    let rhs = g_rows * qd_minus * (-restitution) - g_rows * &v_fixed;
+    let rhs = target - g_rows * &v_fixed;
     b0.rows_mut(n, k).copy_from(&rhs);
     let mut b1 = DVector::zeros(n + k);
     b1.rows_mut(0, n).copy_from(&(&m1 * &v));

@@ -2,9 +2,10 @@
 //! with knee locks on the way, then relabel (the stride function of eq. 22).
 
 use crate::actuator::AnkleProfile;
+use crate::control::{ActuatorSegment, AnkleController, AnkleSensing};
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::events::{locate, Direction, EventError};
-use crate::impact::{resolve, ImpactError};
+use crate::impact::{resolve, resolve_to, ImpactError};
 use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
 use crate::kinematics::Kinematics;
 use crate::model::{CoordIndex, LinkIndex, Model};
@@ -179,6 +180,25 @@ impl Power {
     }
 }
 
+/// How a driven coordinate moves (times are from the start of the stride).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drive {
+    /// The ideal actuator's smooth extension.
+    Profile(AnkleProfile),
+    /// A controller's actuator over the current control tick.
+    Segment(ActuatorSegment),
+}
+
+impl Drive {
+    /// Angle [rad], rate [rad/s], acceleration [rad/s²] at `t_s`.
+    pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
+        match self {
+            Drive::Profile(p) => p.eval(t_s),
+            Drive::Segment(s) => s.eval(t_s),
+        }
+    }
+}
+
 /// The smooth dynamics of one phase (which coordinates are free).
 pub struct Phase<'a> {
     model: &'a Model,
@@ -186,7 +206,7 @@ pub struct Phase<'a> {
     /// Which coordinates are free to move.
     pub active: Vec<bool>,
     /// A coordinate driven along a profile (not free, not locked).
-    pub prescribed: Option<(CoordIndex, AnkleProfile)>,
+    pub prescribed: Option<(CoordIndex, Drive)>,
 }
 
 impl<'a> Phase<'a> {
@@ -507,6 +527,40 @@ impl Walker {
         options: StrideOptions,
         trajectory: &mut Vec<Sample>,
     ) -> Result<StrideResult, StrideFailure> {
+        self.stride_inner(q0, qd0, options, trajectory, None)
+    }
+
+    /// As [`Self::stride_recording`], with the stance ankle's string moved by `controller`,
+    /// sampled at its control ticks (on the grid `k · period` of walk time); `t_walk_s` is the
+    /// walk time at the start of this stride. The scene's `ankle_reflex` names the ankle and
+    /// toe coordinates; its angles and duration are not used.
+    pub fn stride_controlled(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        options: StrideOptions,
+        trajectory: &mut Vec<Sample>,
+        controller: &mut dyn AnkleController,
+        t_walk_s: f64,
+    ) -> Result<StrideResult, StrideFailure> {
+        if self.ankle.is_none() {
+            return Err(StrideFailure::new(
+                FailureKind::NonFiniteState,
+                0.0,
+                "a controlled stride needs a scene with an ankle_reflex section",
+            ));
+        }
+        self.stride_inner(q0, qd0, options, trajectory, Some((controller, t_walk_s)))
+    }
+
+    fn stride_inner(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        options: StrideOptions,
+        trajectory: &mut Vec<Sample>,
+        mut control: Option<(&mut dyn AnkleController, f64)>,
+    ) -> Result<StrideResult, StrideFailure> {
         let mut integrator = self.integrator.build();
         integrator.reset();
         // Evaluations of earlier phases (the integrator restarts after each impact).
@@ -547,7 +601,54 @@ impl Walker {
         if options.record {
             trajectory.push(cur.clone());
         }
+        // Control ticks: on the walk-time grid k · period, handled in stride time.
+        let (period_s, t_walk0) = match &control {
+            Some((c, t0)) => (c.period_s(), *t0),
+            None => (f64::INFINITY, 0.0),
+        };
+        let mut next_tick = if period_s.is_finite() {
+            (t_walk0 / period_s - 1e-9).ceil() * period_s - t_walk0
+        } else {
+            f64::INFINITY
+        };
+        // The stance string's limit over the current tick (stride time), from the controller.
+        let mut segment: Option<ActuatorSegment> = None;
         loop {
+            if let Some((c, t0)) = control.as_mut() {
+                if cur.t_s >= next_tick - 1e-12 {
+                    let w = wit.eval(&cur);
+                    let (a, engaged) = match &self.ankle {
+                        Some(r) => (r.ankle.0, phase.prescribed.is_some()),
+                        None => (0, false),
+                    };
+                    let sensing = AnkleSensing {
+                        t_s: *t0 + cur.t_s,
+                        stance_ankle_rad: cur.q[a],
+                        stance_ankle_rate_rad_s: cur.qd[a],
+                        stance_foot_on_floor: true,
+                        swing_foot_on_floor: w.foot_height_m <= 1e-9,
+                        string_engaged: engaged,
+                    };
+                    let mut seg = c.tick(&sensing).map_err(|e| {
+                        StrideFailure::new(FailureKind::NonFiniteState, cur.t_s, e.to_string())
+                    })?;
+                    seg.t0_s -= *t0;
+                    seg.t1_s -= *t0;
+                    if let Some((coord, Drive::Segment(_))) = phase.prescribed {
+                        if seg.released {
+                            return Err(StrideFailure::new(
+                                FailureKind::HeelReturnedToFloor,
+                                cur.t_s,
+                                "the actuator released the string during push-off",
+                            ));
+                        }
+                        phase.prescribed = Some((coord, Drive::Segment(seg)));
+                        phase.snap(&mut cur);
+                    }
+                    segment = Some(seg);
+                    next_tick += period_s;
+                }
+            }
             if cur.t_s > self.max_stride_time_s {
                 return Err(StrideFailure::new(
                     FailureKind::NoImpactWithinTime,
@@ -556,7 +657,7 @@ impl Walker {
                 ));
             }
             let mut next = integrator
-                .advance(&mut phase, &cur, f64::INFINITY)
+                .advance(&mut phase, &cur, (next_tick - cur.t_s).max(1e-12))
                 .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
             phase.snap(&mut next);
             if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
@@ -628,11 +729,15 @@ impl Walker {
             if let Some(r) = &self.ankle {
                 let (a, toe) = (r.ankle.0, r.toe_pitch.0);
                 let flat = !phase.active[toe] && phase.prescribed.is_none();
-                if flat
-                    && Direction::Falling
-                        .triggered(cur.q[a] - r.engage_rad, next.q[a] - r.engage_rad)
-                {
-                    triggered.push(Watch::Engage);
+                let limit = |t: f64| match (&control, &segment) {
+                    (None, _) => Some(r.engage_rad),
+                    (Some(_), Some(seg)) if !seg.released => Some(seg.eval(t).0),
+                    (Some(_), _) => None,
+                };
+                if let (true, Some(l0), Some(l1)) = (flat, limit(cur.t_s), limit(next.t_s)) {
+                    if Direction::Falling.triggered(cur.q[a] - l0, next.q[a] - l1) {
+                        triggered.push(Watch::Engage);
+                    }
                 }
                 if phase.active[toe] && Direction::Rising.triggered(cur.q[toe], next.q[toe]) {
                     triggered.push(Watch::HeelDrop);
@@ -674,7 +779,12 @@ impl Walker {
                             .ankle
                             .as_ref()
                             .map_or((0, 0.0), |r| (r.ankle.0, r.engage_rad));
-                        Box::new(move |s: &Sample| s.q[a] - e)
+                        match (&control, segment) {
+                            (Some(_), Some(seg)) => {
+                                Box::new(move |s: &Sample| s.q[a] - seg.eval(s.t_s).0)
+                            }
+                            _ => Box::new(move |s: &Sample| s.q[a] - e),
+                        }
                     }
                     Watch::HeelDrop => {
                         let toe = self.ankle.as_ref().map_or(0, |r| r.toe_pitch.0);
@@ -740,16 +850,33 @@ impl Walker {
                     act[toe] = true;
                     let mut g = DMatrix::zeros(1, self.model.dof());
                     g[(0, a)] = 1.0;
+                    // The string's far end: fixed (ideal reflex) or moving with the actuator.
+                    let drive = match (&control, segment) {
+                        (Some(_), Some(seg)) => Drive::Segment(seg),
+                        _ => Drive::Profile(AnkleProfile {
+                            start_s: at.t_s,
+                            duration_s: r.duration_s,
+                            from_rad: r.engage_rad,
+                            to_rad: r.final_rad,
+                        }),
+                    };
+                    let (p_rad, v_rad_s, _) = drive.eval(at.t_s);
                     let mut dynamics = Dynamics::new(&self.model);
                     let before = energy(&mut dynamics, &self.model, &at);
-                    let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, 0.0)
-                        .map_err(|e| {
-                            StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
-                        })?;
+                    let target = DVector::from_element(1, v_rad_s);
+                    let imp =
+                        resolve_to(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, &target)
+                            .map_err(|e| {
+                                StrideFailure::new(
+                                    FailureKind::ImpactSingular,
+                                    at.t_s,
+                                    e.to_string(),
+                                )
+                            })?;
                     let mut q = at.q.clone();
-                    q[a] = r.engage_rad;
+                    q[a] = p_rad;
                     let mut qd = imp.qd_plus;
-                    qd[a] = 0.0;
+                    qd[a] = v_rad_s;
                     if qd[toe] > 0.0 {
                         return Err(StrideFailure::new(
                             FailureKind::HeelDidNotLift,
@@ -764,15 +891,7 @@ impl Walker {
                     energy_loss += before - energy(&mut dynamics, &self.model, &cur);
                     act[a] = false;
                     phase.active = act;
-                    phase.prescribed = Some((
-                        r.ankle,
-                        AnkleProfile {
-                            start_s: at.t_s,
-                            duration_s: r.duration_s,
-                            from_rad: r.engage_rad,
-                            to_rad: r.final_rad,
-                        },
-                    ));
+                    phase.prescribed = Some((r.ankle, drive));
                     power.restart(&mut phase, &cur).map_err(|e| {
                         StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string())
                     })?;
@@ -847,6 +966,9 @@ impl Walker {
                                 self.model.coordinates[knee.coordinate.0].name
                             ),
                         ));
+                    }
+                    if let Some((c, t0)) = control.as_mut() {
+                        c.heel_strike(*t0 + at.t_s);
                     }
                     events.push(StrideEvent {
                         name: "heel_strike".into(),

@@ -4,6 +4,7 @@
 //! walkers reflected at every step). [`FloorFrame`] composes those frames so that paths are
 //! reported in one fixed floor frame.
 
+use crate::control::AnkleController;
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
 use crate::math::{rotation_about, sagittal_reflection};
@@ -120,6 +121,30 @@ pub struct Walk {
 impl Walker {
     /// Walks up to `steps` strides from `q0`, `qd0`; records the path when `record`.
     pub fn walk(&self, q0: &DVector<f64>, qd0: &DVector<f64>, steps: usize, record: bool) -> Walk {
+        self.walk_inner(q0, qd0, steps, record, None)
+    }
+
+    /// As [`Self::walk`], with the stance ankle's string moved by `controller` at its control
+    /// ticks (see [`crate::control`]); the controller is told of every heel strike.
+    pub fn walk_controlled(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        steps: usize,
+        record: bool,
+        controller: &mut dyn AnkleController,
+    ) -> Walk {
+        self.walk_inner(q0, qd0, steps, record, Some(controller))
+    }
+
+    fn walk_inner(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        steps: usize,
+        record: bool,
+        mut controller: Option<&mut dyn AnkleController>,
+    ) -> Walk {
         let mut frame = FloorFrame::default();
         let (mut q, mut qd) = (q0.clone(), qd0.clone());
         let v0 = self.pack(q0, qd0);
@@ -135,15 +160,14 @@ impl Walker {
         let mut samples = Vec::new();
         for step in 0..steps {
             samples.clear();
-            let result = self.stride_recording(
-                &q,
-                &qd,
-                StrideOptions {
-                    record,
-                    contact: false,
-                },
-                &mut samples,
-            );
+            let options = StrideOptions {
+                record,
+                contact: false,
+            };
+            let result = match controller.as_deref_mut() {
+                Some(c) => self.stride_controlled(&q, &qd, options, &mut samples, c, t0),
+                None => self.stride_recording(&q, &qd, options, &mut samples),
+            };
             for s in &samples {
                 out.path
                     .push(self.path_sample(&mut kin, &frame, step, t0, s));
