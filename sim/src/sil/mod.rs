@@ -1,2 +1,627 @@
 //! Firmware in the loop: the ankle nodes' firmware, on a simulated CAN bus, controlling the
-//! simulated walker's stance ankle (see `crate::control`).
+//! simulated walker's stance ankle (see `crate::control` and `docs/sil.md`).
+//!
+//! Two [`firmware::AnkleNode`]s (left, node 2, and right, node 3) and a host (node 1) sit on a
+//! [`canbus::Bus`]. Every control tick:
+//!
+//! 1. the bus runs up to the tick time; each delivered frame is decoded and queued for every
+//!    node but its sender (at most 8 are read per tick, as on the board; the rest wait), the
+//!    host sees everything; the candump log and the socketcand server get every event;
+//! 2. the host sends its due commands (`Enable` to every ankle at the first tick, the
+//!    scheduled ones, frames from socketcand clients);
+//! 3. each node reads its simulated sensors ([`sensors`]) and ticks; its messages are encoded
+//!    and queued on the bus at the tick time; its actuator command moves its string
+//!    ([`actuator`]); the stance ankle's string is the tick's [`ActuatorSegment`].
+//!
+//! The walker model always has its stance leg on the right of its mirrored frame; physically
+//! the stance alternates, starting with [`SilConfig::first_stance`], and
+//! [`AnkleController::heel_strike`] swaps it.
+
+pub mod actuator;
+pub mod config;
+pub mod report;
+pub mod sensors;
+
+#[cfg(test)]
+mod tests;
+
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+
+use canbus::candump::CandumpWriter;
+use canbus::socketcand::{ServerConfig, SocketcandServer};
+use canbus::{Bus, BusError, BusEvent, ErrorState, Frame, NodeHandle, SendOutcome};
+use firmware::node::MAX_RX_PER_TICK;
+use firmware::sensors::Debouncer;
+use firmware::{ActuatorCommand, AnkleNode, DriverHealth, Instant, NodeConfig, TickInputs};
+use protocol::{
+    Command, CommandKind, FaultCode, FaultTransition, Message, NodeId, NodeState, ReflexPhase,
+    Target,
+};
+
+use crate::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
+
+pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
+pub use config::{HostCommand, Side, SilConfig, SwingAnkleModel};
+pub use report::{
+    FaultRecord, HostReport, NodeReport, PhaseChange, SilReport, SocketcandReport, StateChange,
+};
+pub use sensors::{SensorFault, SimEncoder, SwingAnkle};
+
+/// Why a firmware-in-the-loop controller could not be built or finished.
+#[derive(Debug, thiserror::Error)]
+pub enum SilError {
+    /// The bus refused its configuration or a fault.
+    #[error("bus: {0}")]
+    Bus(#[from] BusError),
+    /// The firmware refused its node configuration.
+    #[error("firmware node {node:?}: {reason}")]
+    Node {
+        /// The node.
+        node: NodeId,
+        /// The firmware's error, as text.
+        reason: String,
+    },
+    /// The control period is not a positive number of microseconds.
+    #[error("control period {period_s} s is not a positive whole number of microseconds")]
+    Period {
+        /// The offending period [s].
+        period_s: f64,
+    },
+    /// The candump log could not be written.
+    #[error("candump log: {0}")]
+    Candump(#[from] std::io::Error),
+    /// The socketcand server could not start.
+    #[error("{0}")]
+    Socketcand(#[from] canbus::socketcand::ServerError),
+}
+
+/// One ankle: its node, sensors, actuator and counters.
+struct Ankle {
+    side: Side,
+    node: AnkleNode,
+    handle: NodeHandle,
+    encoder: SimEncoder,
+    swing: Option<SwingAnkle>,
+    debouncer: Option<Debouncer>,
+    actuator: ActuatorModel,
+    inbox: VecDeque<Message>,
+    can_error: bool,
+    last_state: NodeState,
+    last_phase: ReflexPhase,
+    report: NodeReport,
+}
+
+/// The firmware of both ankle nodes, on a simulated CAN bus, as the stance ankle's
+/// [`AnkleController`].
+pub struct FirmwareInTheLoop {
+    config: SilConfig,
+    period_us: u64,
+    bus: Bus,
+    host: NodeHandle,
+    ankles: [Ankle; 2],
+    stance: Side,
+    last_t_ns: Option<u64>,
+    last_t_s: f64,
+    last_heel_strike_s: Option<f64>,
+    landing_rad: Option<f64>,
+    schedule: Vec<HostCommand>,
+    next_command: usize,
+    enabled_sent: bool,
+    candump: Option<CandumpWriter<BufWriter<File>>>,
+    server: Option<SocketcandServer>,
+    ticks: u64,
+    heel_strikes: u64,
+    frames_delivered: u64,
+    bus_off: Vec<(f64, String)>,
+    state_history: Vec<StateChange>,
+    phase_history: Vec<PhaseChange>,
+    faults: Vec<FaultRecord>,
+    host_report: HostReport,
+}
+
+fn ctl(e: impl std::fmt::Display) -> ControlError {
+    ControlError(format!("firmware in the loop: {e}"))
+}
+
+fn names(flags: protocol::FaultFlags) -> Vec<String> {
+    FaultCode::ALL
+        .iter()
+        .filter(|c| flags.contains(**c))
+        .map(|c| format!("{c:?}"))
+        .collect()
+}
+
+impl FirmwareInTheLoop {
+    /// Build the bus, the host and both nodes (disabled until the host's `Enable` at the first
+    /// tick), open the candump log and start the socketcand server if asked.
+    ///
+    /// # Errors
+    /// [`SilError`]: a bad period, bus configuration or fault (an unknown node, say), a node
+    /// the firmware refuses, a log that cannot be created, a server that cannot bind.
+    pub fn new(config: SilConfig) -> Result<Self, SilError> {
+        let period_us_f = config.period_s * 1e6;
+        if !(period_us_f.is_finite() && period_us_f >= 1.0 && period_us_f.fract() == 0.0) {
+            return Err(SilError::Period {
+                period_s: config.period_s,
+            });
+        }
+        let mut bus = Bus::new(config.bus.clone())?;
+        let host = bus.attach("host", Some(NodeId::Host.raw()));
+        let mut make = |side: Side| -> Result<Ankle, SilError> {
+            let node =
+                AnkleNode::new(NodeConfig::nominal(side.node())).map_err(|e| SilError::Node {
+                    node: side.node(),
+                    reason: format!("{e:?}"),
+                })?;
+            let handle = bus.attach(side.bus_name(), Some(side.node().raw()));
+            let faults = config
+                .sensor_faults
+                .iter()
+                .filter(|f| f.side() == side)
+                .copied()
+                .collect();
+            Ok(Ankle {
+                side,
+                node,
+                handle,
+                encoder: SimEncoder::new(config.calibration[side.index()], faults),
+                swing: None,
+                debouncer: None,
+                actuator: ActuatorModel::new(config.actuator),
+                inbox: VecDeque::new(),
+                can_error: false,
+                last_state: NodeState::Disabled,
+                last_phase: ReflexPhase::Inactive,
+                report: NodeReport::default(),
+            })
+        };
+        let ankles = [make(Side::Left)?, make(Side::Right)?];
+        for f in &config.bus_faults {
+            bus.add_fault(f.clone())?;
+        }
+        let mut schedule = config.host_commands.clone();
+        schedule.sort_by(|a, b| a.at_s.total_cmp(&b.at_s));
+        let candump = match &config.candump {
+            Some(path) => Some(CandumpWriter::new(
+                BufWriter::new(File::create(path)?),
+                "vcan0",
+                0,
+            )),
+            None => None,
+        };
+        let server = match &config.socketcand {
+            Some(addr) => Some(SocketcandServer::bind(
+                addr.as_str(),
+                ServerConfig::default(),
+            )?),
+            None => None,
+        };
+        Ok(FirmwareInTheLoop {
+            period_us: period_us_f as u64,
+            stance: config.first_stance,
+            config,
+            bus,
+            host,
+            ankles,
+            last_t_ns: None,
+            last_t_s: 0.0,
+            last_heel_strike_s: None,
+            landing_rad: None,
+            schedule,
+            next_command: 0,
+            enabled_sent: false,
+            candump,
+            server,
+            ticks: 0,
+            heel_strikes: 0,
+            frames_delivered: 0,
+            bus_off: Vec::new(),
+            state_history: Vec::new(),
+            phase_history: Vec::new(),
+            faults: Vec::new(),
+            host_report: HostReport::default(),
+        })
+    }
+
+    /// Schedule a host command at `t_s` (sent at the first tick at or after it; commands at
+    /// equal times keep their order).
+    pub fn host_command_at(&mut self, t_s: f64, command: Command) {
+        let at = self
+            .schedule
+            .iter()
+            .enumerate()
+            .skip(self.next_command)
+            .find(|(_, c)| c.at_s > t_s)
+            .map_or(self.schedule.len(), |(i, _)| i);
+        self.schedule.insert(at, HostCommand { at_s: t_s, command });
+    }
+
+    /// Schedule an emergency stop to every ankle at `t_s`.
+    pub fn emergency_stop_at(&mut self, t_s: f64) {
+        self.host_command_at(
+            t_s,
+            Command {
+                target: Target::Broadcast,
+                kind: CommandKind::EmergencyStop,
+            },
+        );
+    }
+
+    /// The side whose foot is the stance foot.
+    pub fn stance_side(&self) -> Side {
+        self.stance
+    }
+
+    /// One node's firmware (read-only).
+    pub fn node(&self, side: Side) -> &AnkleNode {
+        &self.ankle(side).node
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SilConfig {
+        &self.config
+    }
+
+    /// The bus (read-only: statistics, node error states).
+    pub fn bus(&self) -> &Bus {
+        &self.bus
+    }
+
+    /// The live socketcand server's address, if one runs.
+    pub fn socketcand_addr(&self) -> Option<std::net::SocketAddr> {
+        self.server.as_ref().map(SocketcandServer::local_addr)
+    }
+
+    fn ankle(&self, side: Side) -> &Ankle {
+        let [l, r] = &self.ankles;
+        match side {
+            Side::Left => l,
+            Side::Right => r,
+        }
+    }
+
+    /// The report so far.
+    pub fn report(&self) -> SilReport {
+        let nodes = self
+            .ankles
+            .iter()
+            .map(|a| {
+                let mut r = a.report.clone();
+                r.state = format!("{:?}", a.node.state());
+                r.phase = format!("{:?}", a.node.phase());
+                r.active_faults = names(a.node.faults());
+                r.firmware_dropped_tx = a.node.dropped_tx();
+                r.actuator = *a.actuator.stats();
+                (a.side, r)
+            })
+            .collect();
+        SilReport {
+            ticks: self.ticks,
+            heel_strikes: self.heel_strikes,
+            stance: self.stance,
+            t_end_s: self.last_t_s,
+            nodes,
+            state_history: self.state_history.clone(),
+            phase_history: self.phase_history.clone(),
+            faults: self.faults.clone(),
+            frames_delivered: self.frames_delivered,
+            bus_off: self.bus_off.clone(),
+            bus: self.bus.stats(),
+            host: self.host_report.clone(),
+            socketcand: self.server.as_ref().map(|s| {
+                let st = s.stats();
+                SocketcandReport {
+                    clients_accepted: st.clients_accepted,
+                    frames_sent: st.frames_sent,
+                    frames_dropped: st.frames_dropped,
+                    frames_received: st.frames_received,
+                }
+            }),
+        }
+    }
+
+    /// Flush the candump log, stop the server and return the report.
+    ///
+    /// # Errors
+    /// [`SilError::Candump`] when the log cannot be flushed.
+    pub fn finish(mut self) -> Result<SilReport, SilError> {
+        let report = self.report();
+        if let Some(w) = self.candump.take() {
+            w.finish()?.flush()?;
+        }
+        if let Some(mut s) = self.server.take() {
+            s.shutdown();
+        }
+        Ok(report)
+    }
+
+    fn host_send(&mut self, t_ns: u64, t_s: f64, m: &Message) -> Result<(), ControlError> {
+        let raw = m.encode().map_err(|e| ctl(format!("{e:?}")))?;
+        match self.bus.send(self.host, Frame::from(raw), t_ns) {
+            Ok(_) | Err(BusError::QueueFull { .. }) => {}
+            Err(e) => return Err(ctl(e)),
+        }
+        self.host_report.commands_sent.push((t_s, format!("{m:?}")));
+        Ok(())
+    }
+
+    /// Step 1: the bus up to `t_ns`, deliveries to the inboxes and the host.
+    fn run_bus(&mut self, t_ns: u64) -> Result<(), ControlError> {
+        let events = self.bus.advance_to(t_ns).map_err(ctl)?;
+        for ev in &events {
+            if let Some(w) = self.candump.as_mut() {
+                w.write_event(ev).map_err(ctl)?;
+            }
+            match ev {
+                BusEvent::Delivered(d) => {
+                    self.frames_delivered += 1;
+                    if let Some(s) = &self.server {
+                        s.publish(&d.frame, d.t_end_ns);
+                    }
+                    let decoded = Message::decode(d.frame.id(), d.frame.data());
+                    if d.from != self.host {
+                        self.host_observe(d.t_end_ns, &decoded);
+                    }
+                    if let Ok(m) = decoded {
+                        for a in self.ankles.iter_mut().filter(|a| a.handle != d.from) {
+                            a.inbox.push_back(m);
+                        }
+                    }
+                }
+                BusEvent::BusOff { node, t_ns } => {
+                    let name = self.bus.node_name(*node).unwrap_or("?").to_string();
+                    self.bus_off.push((*t_ns as f64 * 1e-9, name));
+                }
+                BusEvent::ErrorFrame { .. } => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn host_observe(&mut self, t_ns: u64, m: &Result<Message, protocol::DecodeError>) {
+        let h = &mut self.host_report;
+        h.frames_seen += 1;
+        let Ok(m) = m else {
+            h.undecodable_frames += 1;
+            return;
+        };
+        *h.per_class.entry(format!("{:?}", m.class())).or_default() += 1;
+        match m {
+            Message::Heartbeat(hb) => {
+                h.last_heartbeat.insert(
+                    format!("{:?}", hb.node),
+                    (
+                        t_ns as f64 * 1e-9,
+                        format!("{:?}", hb.state),
+                        names(hb.faults),
+                    ),
+                );
+            }
+            Message::Fault(_) => h.fault_events_seen += 1,
+            _ => {}
+        }
+    }
+
+    /// Step 2: the host's commands due at `t_s`.
+    fn run_host(&mut self, t_ns: u64, t_s: f64) -> Result<(), ControlError> {
+        if !self.enabled_sent {
+            self.enabled_sent = true;
+            let enable = Message::Command(Command {
+                target: Target::Broadcast,
+                kind: CommandKind::Enable,
+            });
+            self.host_send(t_ns, t_s, &enable)?;
+        }
+        while let Some(c) = self.schedule.get(self.next_command).copied() {
+            if c.at_s > t_s {
+                break;
+            }
+            self.next_command += 1;
+            self.host_send(t_ns, t_s, &Message::Command(c.command))?;
+        }
+        let inbound = self
+            .server
+            .as_ref()
+            .map(SocketcandServer::take_inbound)
+            .unwrap_or_default();
+        for f in inbound {
+            self.host_report.frames_from_clients += 1;
+            match self.bus.send(self.host, f, t_ns) {
+                Ok(_) | Err(BusError::QueueFull { .. }) => {}
+                Err(e) => return Err(ctl(e)),
+            }
+        }
+        Ok(())
+    }
+
+    /// Step 3 for one ankle: sensors, firmware tick, transmissions, actuator.
+    fn run_ankle(
+        &mut self,
+        side: Side,
+        t_ns: u64,
+        sensing: &AnkleSensing,
+    ) -> Result<ActuatorSegment, ControlError> {
+        let t_s = sensing.t_s;
+        let stance = side == self.stance;
+        let landing = self.landing_rad.unwrap_or(sensing.stance_ankle_rad);
+        let trailing = !stance
+            && self
+                .last_heel_strike_s
+                .is_some_and(|h| t_s - h < self.config.trailing_contact_s);
+        let swing_model = self.config.swing_ankle;
+        let debounce = self.config.debounce_samples;
+        let t1_s = t_s + self.period_us as f64 * 1e-6;
+        let bus_off = matches!(
+            self.bus
+                .node_error_state(self.ankle(side).handle)
+                .map(|(s, _)| s),
+            Some(ErrorState::BusOff)
+        );
+        let [l, r] = &mut self.ankles;
+        let a = match side {
+            Side::Left => l,
+            Side::Right => r,
+        };
+        // Sensors.
+        let angle_true = if stance {
+            a.swing = Some(SwingAnkle::new(swing_model, t_s, sensing.stance_ankle_rad));
+            sensing.stance_ankle_rad
+        } else {
+            a.swing
+                .get_or_insert_with(|| SwingAnkle::new(swing_model, t_s, landing))
+                .angle_at(t_s, landing)
+        };
+        let raw_contact = if stance {
+            sensing.stance_foot_on_floor
+        } else {
+            sensing.swing_foot_on_floor || trailing
+        };
+        let contact = a
+            .debouncer
+            .get_or_insert_with(|| Debouncer::new(raw_contact, debounce))
+            .update(raw_contact);
+        let angle = a.encoder.read(t_s, angle_true);
+        let n_rx = a.inbox.len().min(MAX_RX_PER_TICK);
+        let received: Vec<Message> = a.inbox.drain(..n_rx).collect();
+        a.report.max_rx_backlog = a.report.max_rx_backlog.max(a.inbox.len());
+        a.report.messages_read += received.len() as u64;
+        let peer = side.other().node();
+        let peer_heel_strike = received
+            .iter()
+            .any(|m| matches!(m, Message::HeelStrike(h) if h.node == peer));
+        // The firmware.
+        let out = a.node.tick(
+            Instant::from_micros(t_ns / 1000),
+            &TickInputs {
+                angle,
+                contact_closed: contact,
+                received: &received,
+                drivers: DriverHealth {
+                    actuator_error: false,
+                    can_error: a.can_error || bus_off,
+                },
+            },
+        );
+        // Records.
+        if out.state != a.last_state {
+            self.state_history.push(StateChange {
+                t_s,
+                side,
+                state: format!("{:?}", out.state),
+            });
+            a.last_state = out.state;
+        }
+        if out.phase != a.last_phase {
+            let was_loaded = matches!(
+                a.last_phase,
+                ReflexPhase::Free | ReflexPhase::Push | ReflexPhase::Hold
+            );
+            if was_loaded && out.phase == ReflexPhase::Swing {
+                if peer_heel_strike {
+                    a.report.releases_by_peer_heel_strike += 1;
+                } else {
+                    a.report.releases_by_lift_off += 1;
+                }
+            }
+            if a.last_phase == ReflexPhase::Free && out.phase == ReflexPhase::Push {
+                a.report.engagements += 1;
+            }
+            self.phase_history.push(PhaseChange {
+                t_s,
+                side,
+                phase: format!("{:?}", out.phase),
+                stance,
+            });
+            a.last_phase = out.phase;
+        }
+        // Transmissions.
+        a.can_error = false;
+        for m in out.transmit.iter() {
+            match m {
+                Message::Fault(f) => {
+                    let raised = f.transition == FaultTransition::Raised;
+                    if raised {
+                        *a.report
+                            .fault_raises
+                            .entry(format!("{:?}", f.code))
+                            .or_default() += 1;
+                    }
+                    self.faults.push(FaultRecord {
+                        t_s,
+                        side,
+                        code: format!("{:?}", f.code),
+                        raised,
+                        detail: f.detail,
+                    });
+                }
+                Message::HeelStrike(_) => a.report.heel_strikes_sent += 1,
+                _ => {}
+            }
+            let raw = m.encode().map_err(|e| ctl(format!("{e:?}")))?;
+            match self.bus.send(a.handle, Frame::from(raw), t_ns) {
+                Ok(SendOutcome::Queued) => a.report.frames_queued += 1,
+                Ok(SendOutcome::Dropped) => a.report.frames_dropped += 1,
+                Ok(SendOutcome::BusOff) => a.report.frames_refused_bus_off += 1,
+                Err(BusError::QueueFull { .. }) => {
+                    a.report.frames_refused_queue_full += 1;
+                    a.can_error = true;
+                }
+                Err(e) => return Err(ctl(e)),
+            }
+        }
+        // The actuator.
+        let setpoint = match out.actuator {
+            ActuatorCommand::Released => None,
+            ActuatorCommand::Position { ankle_angle_rad } => Some(f64::from(ankle_angle_rad)),
+        };
+        Ok(a.actuator.tick(t_s, t1_s, setpoint, angle_true))
+    }
+}
+
+impl AnkleController for FirmwareInTheLoop {
+    fn period_s(&self) -> f64 {
+        self.period_us as f64 * 1e-6
+    }
+
+    fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
+        let t_s = sensing.t_s;
+        if !(t_s.is_finite() && t_s >= 0.0) {
+            return Err(ctl(format!("tick at t = {t_s} s")));
+        }
+        let t_ns = (t_s * 1e9).round() as u64;
+        if let Some(prev) = self.last_t_ns {
+            if t_ns < prev {
+                return Err(ctl(format!(
+                    "tick at {t_s} s is before the previous tick at {} s",
+                    prev as f64 * 1e-9
+                )));
+            }
+        }
+        self.last_t_ns = Some(t_ns);
+        self.last_t_s = t_s;
+        if self.landing_rad.is_none() {
+            self.landing_rad = Some(sensing.stance_ankle_rad);
+        }
+        self.run_bus(t_ns)?;
+        self.run_host(t_ns, t_s)?;
+        let mut stance_segment = None;
+        for side in Side::BOTH {
+            let seg = self.run_ankle(side, t_ns, sensing)?;
+            if side == self.stance {
+                stance_segment = Some(seg);
+            }
+        }
+        self.ticks += 1;
+        stance_segment.ok_or_else(|| ctl("no stance ankle"))
+    }
+
+    fn heel_strike(&mut self, t_s: f64) {
+        self.stance = self.stance.other();
+        self.last_heel_strike_s = Some(t_s);
+        // The landing angle is the new stance angle at the next tick.
+        self.landing_rad = None;
+        self.heel_strikes += 1;
+    }
+}

@@ -1,0 +1,179 @@
+//! Parameters of a firmware-in-the-loop run, field by field with defaults and units.
+
+use std::path::PathBuf;
+
+use canbus::{BusConfig, FaultSpec};
+use firmware::scenarios::CALIBRATION;
+use firmware::sensors::AngleCalibration;
+use protocol::NodeId;
+use serde::Serialize;
+
+use super::actuator::ActuatorParams;
+use super::sensors::SensorFault;
+
+/// A physical side of the robot, i.e. one ankle node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub enum Side {
+    /// The left ankle ([`NodeId::LeftAnkle`], node 2).
+    Left,
+    /// The right ankle ([`NodeId::RightAnkle`], node 3).
+    Right,
+}
+
+impl Side {
+    /// Both sides, left first (the order nodes are ticked and reported in).
+    pub const BOTH: [Side; 2] = [Side::Left, Side::Right];
+
+    /// The protocol's node.
+    pub const fn node(self) -> NodeId {
+        match self {
+            Side::Left => NodeId::LeftAnkle,
+            Side::Right => NodeId::RightAnkle,
+        }
+    }
+
+    /// The other side.
+    pub const fn other(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+
+    /// Index 0 (left) or 1 (right).
+    pub const fn index(self) -> usize {
+        match self {
+            Side::Left => 0,
+            Side::Right => 1,
+        }
+    }
+
+    /// The bus node name (`left`, `right`), as `FaultSpec`s name it.
+    pub const fn bus_name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+}
+
+/// What the swing ankle's encoder reads. The swing foot is massless and not in the model, so
+/// its ankle angle is not simulated.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum SwingAnkleModel {
+    /// A fixed angle [rad]. A step between this and the stance angle at every heel strike
+    /// and lift-off: with 0 rad and the stance ankle at 0.2 rad that is 200 rad/s at 1 kHz,
+    /// which trips the firmware's 40 rad/s plausibility check (`EncoderRate`) every stride.
+    Fixed {
+        /// The angle [rad].
+        angle_rad: f64,
+    },
+    /// From its angle at lift-off, the ankle moves at `rate_rad_per_s` towards the angle the
+    /// last foot landed at (the stance angle at the last heel strike), so that on a periodic
+    /// gait the reading is continuous when this foot lands in turn.
+    ToLandingAngle {
+        /// Rate of the move [rad/s].
+        rate_rad_per_s: f64,
+    },
+}
+
+impl Default for SwingAnkleModel {
+    /// `ToLandingAngle` at 2 rad/s: 0.3 rad in 0.15 s, a twentieth of the plausibility
+    /// limit.
+    fn default() -> Self {
+        SwingAnkleModel::ToLandingAngle {
+            rate_rad_per_s: 2.0,
+        }
+    }
+}
+
+/// A host command to put on the bus at a given time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HostCommand {
+    /// When [s] (sent at the first tick at or after it).
+    pub at_s: f64,
+    /// What.
+    pub command: protocol::Command,
+}
+
+/// Everything a [`super::FirmwareInTheLoop`] run needs.
+#[derive(Clone, Debug)]
+pub struct SilConfig {
+    /// Control period of both nodes [s]. Default 1 ms (the board's 1 kHz).
+    pub period_s: f64,
+    /// The bus (bit rate default 500 kbit/s, stuffing, seed of the probabilistic faults,
+    /// transmit queue capacity).
+    pub bus: BusConfig,
+    /// Side of the first stride's stance foot. Default left.
+    pub first_stance: Side,
+    /// Encoder calibration of the left and right ankle. Default the firmware's scenario
+    /// calibration (`zero_counts` 4000, not reversed) for both.
+    pub calibration: [AngleCalibration; 2],
+    /// The swing ankle's reading. Default [`SwingAnkleModel::ToLandingAngle`] at 2 rad/s.
+    pub swing_ankle: SwingAnkleModel,
+    /// Raw samples that must agree before the debounced contact flips. Default 3 (the
+    /// board's).
+    pub debounce_samples: u8,
+    /// The trailing foot's contact switch stays closed this long after the other foot's heel
+    /// strike [s]. Default 10 ms. The model's double support is instantaneous; a real foot
+    /// unloads over milliseconds. With 0 the own lift-off is debounced in the same tick as
+    /// the other foot's heel strike and beats its message by one tick: the firmware then
+    /// releases every stride by its fallback and raises `PeerHeelStrikeLate`.
+    pub trailing_contact_s: f64,
+    /// The string actuator.
+    pub actuator: ActuatorParams,
+    /// Faults on the bus (`drop`, `delay`, `corrupt`, `babble`, `busoff`; nodes `host`,
+    /// `left`, `right` or 1, 2, 3).
+    pub bus_faults: Vec<FaultSpec>,
+    /// Encoder faults.
+    pub sensor_faults: Vec<SensorFault>,
+    /// Host commands besides the `Enable` to every ankle at the first tick.
+    pub host_commands: Vec<HostCommand>,
+    /// Write every bus event to this candump log.
+    pub candump: Option<PathBuf>,
+    /// Serve the bus over socketcand on this loopback address (`127.0.0.1:PORT`).
+    pub socketcand: Option<String>,
+}
+
+impl Default for SilConfig {
+    fn default() -> Self {
+        SilConfig {
+            period_s: 1e-3,
+            bus: BusConfig::default(),
+            first_stance: Side::Left,
+            calibration: [CALIBRATION, CALIBRATION],
+            swing_ankle: SwingAnkleModel::default(),
+            debounce_samples: 3,
+            trailing_contact_s: 0.010,
+            actuator: ActuatorParams::default(),
+            bus_faults: Vec::new(),
+            sensor_faults: Vec::new(),
+            host_commands: Vec::new(),
+            candump: None,
+            socketcand: None,
+        }
+    }
+}
+
+impl SilConfig {
+    /// Add a bus fault from its text form (`drop:id=0x022`, `busoff:node=right,from_ms=500`).
+    ///
+    /// # Errors
+    /// The parse error, naming the offending part.
+    pub fn with_fault_str(mut self, spec: &str) -> Result<Self, canbus::FaultParseError> {
+        self.bus_faults.push(spec.parse()?);
+        Ok(self)
+    }
+
+    /// Add a host command at `at_s`.
+    pub fn with_host_command(mut self, at_s: f64, command: protocol::Command) -> Self {
+        self.host_commands.push(HostCommand { at_s, command });
+        self
+    }
+
+    /// Add an encoder fault.
+    pub fn with_sensor_fault(mut self, fault: SensorFault) -> Self {
+        self.sensor_faults.push(fault);
+        self
+    }
+}

@@ -1,0 +1,178 @@
+//! Simulated ankle sensors: the magnetic encoder (quantised exactly as the real one, through
+//! the firmware's own [`AngleCalibration`]), its injected faults, the swing ankle's angle (the
+//! swing foot is not modelled) and the foot contact switch before the firmware's debouncer.
+
+use firmware::sensors::{AngleCalibration, AngleSample, EncoderError};
+use serde::Serialize;
+
+use super::config::{Side, SwingAnkleModel};
+
+/// An encoder fault injected for tests.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum SensorFault {
+    /// One sample (the first at or after `at_s`) reads `delta_rad` away from the truth.
+    Glitch {
+        /// Which ankle.
+        side: Side,
+        /// When [s].
+        at_s: f64,
+        /// Size of the jump [rad].
+        delta_rad: f64,
+    },
+    /// From `from_s` on, the counts stay frozen at the last reading before it.
+    Stuck {
+        /// Which ankle.
+        side: Side,
+        /// From when [s].
+        from_s: f64,
+    },
+}
+
+impl SensorFault {
+    /// The ankle it affects.
+    pub fn side(&self) -> Side {
+        match self {
+            SensorFault::Glitch { side, .. } | SensorFault::Stuck { side, .. } => *side,
+        }
+    }
+}
+
+/// One ankle's simulated encoder.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimEncoder {
+    calibration: AngleCalibration,
+    faults: Vec<(SensorFault, bool)>,
+    last_counts: Option<u16>,
+    frozen: Option<u16>,
+}
+
+impl SimEncoder {
+    /// An encoder with `calibration` and the faults that concern it.
+    pub fn new(calibration: AngleCalibration, faults: Vec<SensorFault>) -> Self {
+        SimEncoder {
+            calibration,
+            faults: faults.into_iter().map(|f| (f, false)).collect(),
+            last_counts: None,
+            frozen: None,
+        }
+    }
+
+    /// The read at `t_s` of a true ankle angle `angle_rad`: counts from the angle
+    /// (`calibration.counts`), then the firmware's own conversion back to an angle.
+    pub fn read(&mut self, t_s: f64, angle_rad: f64) -> Result<AngleSample, EncoderError> {
+        let mut angle = angle_rad;
+        for (f, fired) in &mut self.faults {
+            match *f {
+                SensorFault::Glitch {
+                    at_s, delta_rad, ..
+                } if !*fired && t_s >= at_s => {
+                    *fired = true;
+                    angle += delta_rad;
+                }
+                SensorFault::Stuck { from_s, .. } if !*fired && t_s >= from_s => {
+                    *fired = true;
+                    self.frozen = Some(
+                        self.last_counts
+                            .unwrap_or_else(|| self.calibration.counts(angle_rad as f32)),
+                    );
+                }
+                _ => {}
+            }
+        }
+        let counts = self
+            .frozen
+            .unwrap_or_else(|| self.calibration.counts(angle as f32));
+        self.last_counts = Some(counts);
+        Ok(AngleSample {
+            counts,
+            angle_rad: self.calibration.angle_rad(counts),
+        })
+    }
+}
+
+/// The swing ankle's angle: the swing foot is massless and not in the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwingAnkle {
+    model: SwingAnkleModel,
+    angle_rad: f64,
+    last_t_s: f64,
+}
+
+impl SwingAnkle {
+    /// A swing ankle at `angle_rad` at `t_s`.
+    pub fn new(model: SwingAnkleModel, t_s: f64, angle_rad: f64) -> Self {
+        SwingAnkle {
+            model,
+            angle_rad,
+            last_t_s: t_s,
+        }
+    }
+
+    /// The angle at `t_s` given the landing angle of the last heel strike [rad].
+    pub fn angle_at(&mut self, t_s: f64, landing_rad: f64) -> f64 {
+        let dt = (t_s - self.last_t_s).max(0.0);
+        self.last_t_s = t_s;
+        self.angle_rad = match self.model {
+            SwingAnkleModel::Fixed { angle_rad } => angle_rad,
+            SwingAnkleModel::ToLandingAngle { rate_rad_per_s } => {
+                let step = rate_rad_per_s.abs() * dt;
+                self.angle_rad + (landing_rad - self.angle_rad).clamp(-step, step)
+            }
+        };
+        self.angle_rad
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use firmware::scenarios::CALIBRATION;
+
+    #[test]
+    fn encoder_quantises_like_the_firmware() {
+        let mut e = SimEncoder::new(CALIBRATION, vec![]);
+        let lsb = std::f64::consts::TAU / 16384.0;
+        for a in [-0.3, -0.08, -0.0801, 0.0, 0.123_456, 0.2] {
+            let s = e.read(0.0, a).unwrap();
+            assert_eq!(s.counts, CALIBRATION.counts(a as f32));
+            assert_eq!(s.angle_rad, CALIBRATION.angle_rad(s.counts));
+            assert!((f64::from(s.angle_rad) - a).abs() <= 0.5 * lsb + 1e-6);
+        }
+    }
+
+    #[test]
+    fn glitch_is_one_sample_and_stuck_freezes() {
+        let faults = vec![
+            SensorFault::Glitch {
+                side: Side::Left,
+                at_s: 0.0015,
+                delta_rad: 0.1,
+            },
+            SensorFault::Stuck {
+                side: Side::Left,
+                from_s: 0.004,
+            },
+        ];
+        let mut e = SimEncoder::new(CALIBRATION, faults);
+        let reads: Vec<f32> = (0..7)
+            .map(|k| e.read(k as f64 * 1e-3, -0.01 * k as f64).unwrap().angle_rad)
+            .collect();
+        assert!((reads[1] + 0.01).abs() < 1e-3);
+        assert!((reads[2] - 0.08).abs() < 1e-3, "glitch: -0.02 + 0.1");
+        assert!((reads[3] + 0.03).abs() < 1e-3, "one sample only");
+        assert_eq!(reads[4], reads[3], "frozen at the last reading before 4 ms");
+        assert_eq!(reads[6], reads[3]);
+    }
+
+    #[test]
+    fn swing_ankle_moves_at_a_bounded_rate() {
+        let m = SwingAnkleModel::ToLandingAngle {
+            rate_rad_per_s: 2.0,
+        };
+        let mut s = SwingAnkle::new(m, 0.0, 0.2);
+        assert!((s.angle_at(0.001, -0.1) - 0.198).abs() < 1e-12);
+        assert!((s.angle_at(1.0, -0.1) + 0.1).abs() < 1e-12);
+        let mut f = SwingAnkle::new(SwingAnkleModel::Fixed { angle_rad: 0.0 }, 0.0, 0.2);
+        assert_eq!(f.angle_at(0.001, 0.3), 0.0);
+    }
+}

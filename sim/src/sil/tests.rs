@@ -1,0 +1,402 @@
+//! The controller driven by synthetic sensing, without physics: the stance ankle falls at
+//! 0.5 rad/s from 0.1 rad after each heel strike, and follows the string's limit once the
+//! limit is above it (the string holds the ankle).
+
+use super::*;
+
+const DT_S: f64 = 1e-3;
+const RAMP_START_RAD: f64 = 0.1;
+const RAMP_RATE_RAD_S: f64 = -0.5;
+/// The free ramp reaches the taut angle −0.08 rad at 0.36 s after the stride's start.
+const TAUT_AFTER_S: f64 = 0.36;
+
+#[derive(Clone, Debug, PartialEq)]
+struct Tick {
+    t_s: f64,
+    stance: Side,
+    angle_rad: f64,
+    seg: ActuatorSegment,
+}
+
+/// Run from 0 to `until_s` with heel strikes at `strikes_s`.
+fn run(sil: &mut FirmwareInTheLoop, until_s: f64, strikes_s: &[f64]) -> Vec<Tick> {
+    let mut out = Vec::new();
+    let mut stride_start = 0.0;
+    let mut limit: Option<ActuatorSegment> = None;
+    let mut strikes = strikes_s.iter().copied().peekable();
+    let n = (until_s / DT_S).round() as usize;
+    for k in 0..=n {
+        let t_s = k as f64 * DT_S;
+        if let Some(h) = strikes.next_if(|h| *h <= t_s) {
+            sil.heel_strike(h);
+            stride_start = h;
+            limit = None;
+        }
+        let free = RAMP_START_RAD + RAMP_RATE_RAD_S * (t_s - stride_start);
+        let angle = match limit {
+            Some(s) if !s.released => free.max(s.eval(t_s).0),
+            _ => free,
+        };
+        let sensing = AnkleSensing {
+            t_s,
+            stance_ankle_rad: angle,
+            stance_ankle_rate_rad_s: RAMP_RATE_RAD_S,
+            stance_foot_on_floor: true,
+            swing_foot_on_floor: false,
+            string_engaged: limit.is_some_and(|s| !s.released && s.eval(t_s).0 >= free),
+        };
+        let seg = sil.tick(&sensing).unwrap();
+        limit = Some(seg);
+        out.push(Tick {
+            t_s,
+            stance: sil.stance_side(),
+            angle_rad: angle,
+            seg,
+        });
+    }
+    out
+}
+
+fn first_phase(r: &SilReport, side: Side, phase: &str, from_s: f64) -> Option<f64> {
+    r.phase_history
+        .iter()
+        .find(|p| p.side == side && p.phase == phase && p.t_s >= from_s)
+        .map(|p| p.t_s)
+}
+
+fn sil(config: SilConfig) -> FirmwareInTheLoop {
+    FirmwareInTheLoop::new(config).unwrap()
+}
+
+#[test]
+fn host_enables_both_nodes_and_the_stance_node_engages_and_extends() {
+    let mut c = sil(SilConfig::default());
+    let ticks = run(&mut c, 0.65, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        assert_eq!(
+            r.first_state_at_or_after(side, "Enabled", 0.0),
+            Some(0.001),
+            "Enable sent at 0, read at the next tick"
+        );
+    }
+    assert_eq!(first_phase(&r, Side::Left, "Free", 0.0), Some(0.001));
+    assert_eq!(first_phase(&r, Side::Right, "Swing", 0.0), Some(0.001));
+    // Engagement: the estimate reaches -0.08 within a few ticks of the true angle.
+    let push = first_phase(&r, Side::Left, "Push", 0.0).unwrap();
+    assert!(
+        (TAUT_AFTER_S..=TAUT_AFTER_S + 0.005).contains(&push),
+        "{push}"
+    );
+    let hold = first_phase(&r, Side::Left, "Hold", 0.0).unwrap();
+    assert!(
+        (hold - push - 0.15).abs() <= 0.0015,
+        "150 ms profile: {hold}"
+    );
+    // Segments: released before the push, then C¹ and within the rate limit, reaching 0.2.
+    let max_rate = ActuatorParams::default().max_rate_rad_per_s;
+    let mut prev: Option<ActuatorSegment> = None;
+    for t in &ticks {
+        assert_eq!(t.stance, Side::Left);
+        if t.t_s < push {
+            assert!(t.seg.released, "released at {}", t.t_s);
+            continue;
+        }
+        assert!(!t.seg.released, "held at {}", t.t_s);
+        assert!(t.seg.v1_rad_s.abs() <= max_rate + 1e-9);
+        assert!(t.seg.p1_rad <= 0.2 + 1e-6 && t.seg.p1_rad >= -0.1);
+        if let Some(p) = prev.filter(|p| !p.released) {
+            assert!((p.p1_rad - t.seg.p0_rad).abs() < 1e-12);
+            assert!((p.v1_rad_s - t.seg.v0_rad_s).abs() < 1e-9);
+            assert!(t.seg.p1_rad >= p.p1_rad - 1e-12, "monotone push");
+        }
+        prev = Some(t.seg);
+    }
+    let last = ticks.last().unwrap().seg;
+    assert!((last.p1_rad - 0.2).abs() < 1e-3, "{}", last.p1_rad);
+    let st = r.node(Side::Left).unwrap();
+    assert_eq!(st.engagements, 1);
+    // The firmware's profile peaks at 1.875 × 0.28 / 0.15 = 3.5 rad/s: no saturation, a lag
+    // of about τ × 3.5 rad/s = 17.5 mrad.
+    assert_eq!(st.actuator.saturated_ticks, 0);
+    assert!(st.actuator.max_tracking_error_rad < 0.02);
+    assert!(st.actuator.max_rate_rad_per_s < 3.6);
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    assert_eq!(r.nodes[&Side::Right].engagements, 0);
+}
+
+#[test]
+fn the_other_foots_heel_strike_message_releases_the_string() {
+    let mut c = sil(SilConfig::default());
+    let ticks = run(&mut c, 1.5, &[0.7, 1.4]);
+    let r = c.report();
+    // The right foot lands at 0.7: its node announces it at the third debounced sample
+    // (0.700, 0.701, 0.702), the left node reads the message at the next tick.
+    let hs = r
+        .phase_history
+        .iter()
+        .find(|p| p.side == Side::Right && p.phase == "Free" && p.t_s > 0.7)
+        .unwrap()
+        .t_s;
+    assert!((hs - 0.702).abs() < 1e-9, "{hs}");
+    let released = first_phase(&r, Side::Left, "Swing", 0.7).unwrap();
+    assert!((released - 0.703).abs() < 1e-9, "{released}");
+    let left = r.node(Side::Left).unwrap();
+    assert_eq!(left.releases_by_peer_heel_strike, 1);
+    assert_eq!(left.releases_by_lift_off, 0);
+    assert_eq!(r.node(Side::Right).unwrap().heel_strikes_sent, 1);
+    // The right node engages in its own stance and is released by the left's heel strike.
+    assert_eq!(r.node(Side::Right).unwrap().engagements, 1);
+    assert_eq!(r.node(Side::Right).unwrap().releases_by_peer_heel_strike, 1);
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    // The stance segment after the swap is the right ankle's, released until its push.
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s > 0.7 && t.t_s < 0.7 + TAUT_AFTER_S)
+        .all(|t| t.stance == Side::Right && t.seg.released));
+    assert_eq!(r.heel_strikes, 2);
+    assert_eq!(r.stance, Side::Left);
+    // Determinism: a second run gives the same ticks and the same report.
+    let mut c2 = sil(SilConfig::default());
+    assert_eq!(run(&mut c2, 1.5, &[0.7, 1.4]), ticks);
+    assert_eq!(
+        serde_json::to_string(&c2.report()).unwrap(),
+        serde_json::to_string(&r).unwrap()
+    );
+}
+
+#[test]
+fn without_the_heel_strike_frames_the_contact_switch_releases() {
+    let config = SilConfig::default()
+        .with_fault_str("drop:id=0x022")
+        .unwrap()
+        .with_fault_str("drop:id=0x023")
+        .unwrap();
+    let mut c = sil(config);
+    run(&mut c, 1.0, &[0.7]);
+    let r = c.report();
+    // Trailing contact held 10 ms (to 0.709), then 3 debounced samples (0.710 to 0.712).
+    let released = first_phase(&r, Side::Left, "Swing", 0.7).unwrap();
+    assert!((released - 0.712).abs() < 1e-9, "{released}");
+    let left = r.node(Side::Left).unwrap();
+    assert_eq!(left.releases_by_lift_off, 1);
+    assert_eq!(left.releases_by_peer_heel_strike, 0);
+    assert_eq!(
+        r.first_raise(Side::Left, "PeerHeelStrikeLate"),
+        Some(released)
+    );
+    assert_eq!(left.state, "Enabled", "not safety-relevant");
+    assert_eq!(r.node(Side::Right).unwrap().frames_dropped, 1);
+    assert_eq!(r.bus.dropped, 1);
+}
+
+#[test]
+fn an_instant_lift_off_beats_the_message_by_one_tick() {
+    let config = SilConfig {
+        trailing_contact_s: 0.0,
+        ..SilConfig::default()
+    };
+    let mut c = sil(config);
+    run(&mut c, 1.0, &[0.7]);
+    let r = c.report();
+    let released = first_phase(&r, Side::Left, "Swing", 0.7).unwrap();
+    assert!((released - 0.702).abs() < 1e-9, "{released}");
+    assert_eq!(r.node(Side::Left).unwrap().releases_by_lift_off, 1);
+    assert!(r.first_raise(Side::Left, "PeerHeelStrikeLate").is_some());
+}
+
+#[test]
+fn emergency_stop_releases_both_strings_within_two_ticks() {
+    let mut c = sil(SilConfig::default());
+    c.emergency_stop_at(0.45);
+    let ticks = run(&mut c, 0.8, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        let t = r
+            .first_state_at_or_after(side, "EmergencyStop", 0.0)
+            .unwrap();
+        assert!(t > 0.45 && t <= 0.45 + 2.0 * DT_S + 1e-9, "{side:?} {t}");
+        assert_eq!(r.node(side).unwrap().state, "EmergencyStop");
+        assert_eq!(r.node(side).unwrap().phase, "Inactive");
+    }
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s > 0.45 + 2.0 * DT_S)
+        .all(|t| t.seg.released));
+    assert!(ticks
+        .iter()
+        .any(|t| t.t_s > 0.36 && t.t_s < 0.45 && !t.seg.released));
+    assert_eq!(r.host.commands_sent.len(), 2, "Enable and the stop");
+}
+
+/// The left node must reach `Safe` with `PeerHeartbeatLost` no later than 0.3 s + one tick
+/// after the last heartbeat of the right node it received.
+fn check_heartbeat_bound(r: &SilReport, last_heartbeat_sent_s: f64) {
+    let lost = r.first_raise(Side::Left, "PeerHeartbeatLost").unwrap();
+    let safe = r.first_state_at_or_after(Side::Left, "Safe", 0.0).unwrap();
+    assert_eq!(lost, safe);
+    // Received at the tick after it was sent.
+    let bound = last_heartbeat_sent_s + DT_S + 0.3 + DT_S;
+    assert!(
+        safe > last_heartbeat_sent_s + 0.3 && safe <= bound + 1e-9,
+        "{safe} vs {bound}"
+    );
+}
+
+#[test]
+fn a_bus_off_peer_puts_both_nodes_in_the_safe_state() {
+    let config = SilConfig::default()
+        .with_fault_str("busoff:node=right,from_ms=200")
+        .unwrap();
+    let mut c = sil(config);
+    let ticks = run(&mut c, 0.8, &[]);
+    let r = c.report();
+    assert_eq!(r.bus_off.len(), 1);
+    assert_eq!(r.bus_off[0].1, "right");
+    // The right node's controller is bus-off: CanBus fault, safe at once.
+    let right_safe = r.first_state_at_or_after(Side::Right, "Safe", 0.0).unwrap();
+    assert!(right_safe > 0.2 && right_safe < 0.2 + 0.012, "{right_safe}");
+    assert!(r.first_raise(Side::Right, "CanBus").is_some());
+    // Its last heartbeat to get through was the one at 0.15 s (the one at 0.2 s is lost in the
+    // errors).
+    check_heartbeat_bound(&r, 0.15);
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s > 0.452)
+        .all(|t| t.seg.released));
+}
+
+#[test]
+fn dropped_peer_heartbeats_put_the_node_in_the_safe_state() {
+    let config = SilConfig::default()
+        .with_fault_str("drop:id=0x063,from_ms=200")
+        .unwrap();
+    let mut c = sil(config);
+    let ticks = run(&mut c, 0.8, &[]);
+    let r = c.report();
+    check_heartbeat_bound(&r, 0.15);
+    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    let safe = r.first_state_at_or_after(Side::Left, "Safe", 0.0).unwrap();
+    // 0.451 s: the left node was pushing; the string is released at once.
+    assert!(ticks.iter().any(|t| t.t_s < safe && !t.seg.released));
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s >= safe)
+        .all(|t| t.seg.released));
+}
+
+#[test]
+fn an_encoder_glitch_raises_a_rate_fault() {
+    let config = SilConfig::default().with_sensor_fault(SensorFault::Glitch {
+        side: Side::Left,
+        at_s: 0.1,
+        delta_rad: 0.1,
+    });
+    let mut c = sil(config);
+    let ticks = run(&mut c, 0.8, &[]);
+    let r = c.report();
+    assert_eq!(r.first_raise(Side::Left, "EncoderRate"), Some(0.1));
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", 0.0),
+        Some(0.1)
+    );
+    // Cleared two samples later, but the node stays safe until the host enables it again.
+    assert!(r
+        .faults
+        .iter()
+        .any(|f| f.code == "EncoderRate" && !f.raised && f.t_s <= 0.103));
+    assert_eq!(r.node(Side::Left).unwrap().state, "Safe");
+    assert!(ticks.iter().all(|t| t.seg.released));
+    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+}
+
+#[test]
+fn a_stuck_encoder_is_caught_while_pushing() {
+    let config = SilConfig::default().with_sensor_fault(SensorFault::Stuck {
+        side: Side::Left,
+        from_s: 0.37,
+    });
+    let mut c = sil(config);
+    let ticks = run(&mut c, 0.8, &[]);
+    let r = c.report();
+    let push = first_phase(&r, Side::Left, "Push", 0.0).unwrap();
+    let stuck = r.first_raise(Side::Left, "EncoderStuck").unwrap();
+    // Frozen at the reading of 0.369 s: 50 ms from its last change, plus one tick.
+    assert!(
+        stuck > push + 0.05 && stuck <= 0.37 + 0.051 + 1e-9,
+        "50 ms stuck timeout: push {push}, stuck {stuck}"
+    );
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", 0.0),
+        Some(stuck)
+    );
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s >= stuck)
+        .all(|t| t.seg.released));
+}
+
+#[test]
+fn bad_configurations_and_times_are_refused() {
+    let bad = SilConfig {
+        period_s: 1.5e-7,
+        ..SilConfig::default()
+    };
+    assert!(matches!(
+        FirmwareInTheLoop::new(bad),
+        Err(SilError::Period { .. })
+    ));
+    let unknown = SilConfig::default()
+        .with_fault_str("busoff:node=middle")
+        .unwrap();
+    let e = FirmwareInTheLoop::new(unknown).err().unwrap();
+    assert!(e.to_string().contains("middle"), "{e}");
+    let mut c = sil(SilConfig::default());
+    run(&mut c, 0.01, &[]);
+    let s = AnkleSensing {
+        t_s: 0.005,
+        stance_ankle_rad: 0.0,
+        stance_ankle_rate_rad_s: 0.0,
+        stance_foot_on_floor: true,
+        swing_foot_on_floor: false,
+        string_engaged: false,
+    };
+    assert!(c.tick(&s).is_err());
+    assert!(c.tick(&AnkleSensing { t_s: f64::NAN, ..s }).is_err());
+}
+
+#[test]
+fn candump_log_and_socketcand_server_see_the_traffic() {
+    let dir = std::env::temp_dir().join(format!("sil-candump-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("run.log");
+    let config = SilConfig {
+        candump: Some(path.clone()),
+        socketcand: Some("127.0.0.1:0".into()),
+        ..SilConfig::default()
+    };
+    let mut c = sil(config);
+    assert!(c.socketcand_addr().is_some_and(|a| a.ip().is_loopback()));
+    run(&mut c, 0.2, &[]);
+    let r = c.finish().unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (records, bad) = canbus::candump::read_log(text.as_bytes()).unwrap();
+    assert!(bad.is_empty());
+    assert_eq!(records.len() as u64, r.frames_delivered);
+    assert!(r.socketcand.is_some());
+    std::fs::remove_dir_all(&dir).unwrap();
+    // 200 Hz AnkleState ×2, 20 Hz heartbeats ×2, the Enable and two versions in 0.2 s.
+    assert!(
+        r.frames_delivered > 80 && r.frames_delivered < 100,
+        "{}",
+        r.frames_delivered
+    );
+    let refused = SilConfig {
+        socketcand: Some("0.0.0.0:0".into()),
+        ..SilConfig::default()
+    };
+    assert!(matches!(
+        FirmwareInTheLoop::new(refused),
+        Err(SilError::Socketcand(_))
+    ));
+}
