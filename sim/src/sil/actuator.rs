@@ -27,6 +27,12 @@ pub struct ActuatorParams {
     /// Time constant of the servo's first-order lag [s]. Default 5 ms (a position loop of
     /// about 30 Hz bandwidth, typical of a small geared DC motor with an encoder).
     pub time_constant_s: f64,
+    /// Slack left when a released string is taken up [rad]: the limit starts this far below
+    /// the ankle angle. Default 0.1 mrad (a quarter of an encoder count). The simulator
+    /// engages the string as an event, the ankle reaching the limit from above; a limit
+    /// starting exactly at the ankle would be a grazing start that it does not detect, and
+    /// one above the ankle would violate the constraint.
+    pub take_up_slack_rad: f64,
 }
 
 impl Default for ActuatorParams {
@@ -34,6 +40,7 @@ impl Default for ActuatorParams {
         ActuatorParams {
             max_rate_rad_per_s: 10.0,
             time_constant_s: 0.005,
+            take_up_slack_rad: 1e-4,
         }
     }
 }
@@ -135,7 +142,7 @@ impl ActuatorModel {
 
     /// One tick over `[t0_s, t1_s]` with `setpoint_rad` (`None`: released). `take_up_rad` is
     /// where the string becomes taut if it was slack (the current ankle angle): a string
-    /// that was released starts from `min(setpoint, take_up)` at rest, never above the
+    /// that was released starts at rest from `min(setpoint, take_up − slack)`, below the
     /// ankle, then tracks the setpoint.
     pub fn tick(
         &mut self,
@@ -157,7 +164,7 @@ impl ActuatorModel {
         let (p0, v0) = match (self.state, self.limit_at(t0_s)) {
             (Some(_), Some(pv)) => pv,
             (Some(pv), None) => pv,
-            (None, _) => (s.min(take_up_rad), 0.0),
+            (None, _) => (s.min(take_up_rad - self.params.take_up_slack_rad), 0.0),
         };
         let h = (t1_s - t0_s).max(0.0);
         let end = integrate(&self.params, p0, s, h);
@@ -213,9 +220,10 @@ mod tests {
         let mut m = ActuatorModel::new(ActuatorParams::default());
         let r = m.tick(0.0, 0.001, None, -0.05);
         assert!(r.released);
-        // Engaging with the ankle at -0.085 below the setpoint -0.08: starts at the ankle.
+        // Engaging with the ankle at -0.085 below the setpoint -0.08: starts at the ankle,
+        // less the slack.
         let a = m.tick(0.001, 0.002, Some(-0.08), -0.085);
-        assert_eq!((a.p0_rad, a.v0_rad_s), (-0.085, 0.0));
+        assert_eq!((a.p0_rad, a.v0_rad_s), (-0.085 - 1e-4, 0.0));
         assert!(a.p1_rad > -0.085 && a.p1_rad < -0.08);
         let b = m.tick(0.002, 0.003, Some(0.2), 0.0);
         assert_eq!((b.p0_rad, b.v0_rad_s), (a.p1_rad, a.v1_rad_s));

@@ -68,9 +68,9 @@ pub enum SwingAnkleModel {
         /// The angle [rad].
         angle_rad: f64,
     },
-    /// From its angle at lift-off, the ankle moves at `rate_rad_per_s` towards the angle the
-    /// last foot landed at (the stance angle at the last heel strike), so that on a periodic
-    /// gait the reading is continuous when this foot lands in turn.
+    /// From its angle at lift-off, the ankle moves at `rate_rad_per_s` towards the angle this
+    /// foot last landed at (the other foot's until it has landed once), so that on a periodic
+    /// gait (period one or two strides) the reading is continuous when it lands again.
     ToLandingAngle {
         /// Rate of the move [rad/s].
         rate_rad_per_s: f64,
@@ -127,7 +127,10 @@ pub struct SilConfig {
     pub bus_faults: Vec<FaultSpec>,
     /// Encoder faults.
     pub sensor_faults: Vec<SensorFault>,
-    /// Host commands besides the `Enable` to every ankle at the first tick.
+    /// Commands the host sends to the still disabled ankles at the first tick, before its
+    /// `Enable` to every ankle (parameters: see [`SilConfig::with_reflex`]).
+    pub setup_commands: Vec<protocol::Command>,
+    /// Host commands besides the setup and the `Enable`.
     pub host_commands: Vec<HostCommand>,
     /// Write every bus event to this candump log.
     pub candump: Option<PathBuf>,
@@ -148,6 +151,7 @@ impl Default for SilConfig {
             actuator: ActuatorParams::default(),
             bus_faults: Vec::new(),
             sensor_faults: Vec::new(),
+            setup_commands: Vec::new(),
             host_commands: Vec::new(),
             candump: None,
             socketcand: None,
@@ -163,6 +167,40 @@ impl SilConfig {
     pub fn with_fault_str(mut self, spec: &str) -> Result<Self, canbus::FaultParseError> {
         self.bus_faults.push(spec.parse()?);
         Ok(self)
+    }
+
+    /// Set a reflex parameter of both ankles at start-up (a broadcast `SetParam` before the
+    /// `Enable`).
+    ///
+    /// # Errors
+    /// The value is outside the parameter's range ([`protocol::ParamId::range_si`]).
+    pub fn with_param(
+        mut self,
+        param: protocol::ParamId,
+        value_si: f64,
+    ) -> Result<Self, protocol::EncodeError> {
+        self.setup_commands.push(protocol::Command::set_param(
+            protocol::Target::Broadcast,
+            param,
+            value_si as f32,
+        )?);
+        Ok(self)
+    }
+
+    /// Set both ankles' taut angle, extended angle and push duration to a scene's ideal
+    /// reflex (the firmware's defaults are Table I's −0.08 rad, 0.2 rad and 0.15 s; the
+    /// `wisse3d` scene engages at −0.055 rad and extends over 0.2 s).
+    ///
+    /// # Errors
+    /// A value outside the firmware's parameter range.
+    pub fn with_reflex(
+        self,
+        reflex: &crate::actuator::AnkleReflex,
+    ) -> Result<Self, protocol::EncodeError> {
+        use protocol::ParamId;
+        self.with_param(ParamId::TautAngle, reflex.engage_rad)?
+            .with_param(ParamId::ExtendedAngle, reflex.final_rad)?
+            .with_param(ParamId::PushDuration, reflex.duration_s)
     }
 
     /// Add a host command at `at_s`.

@@ -45,7 +45,8 @@ use crate::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlErro
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
 pub use config::{HostCommand, Side, SilConfig, SwingAnkleModel};
 pub use report::{
-    FaultRecord, HostReport, NodeReport, PhaseChange, SilReport, SocketcandReport, StateChange,
+    FaultRecord, HostReport, Landing, NodeReport, PhaseChange, SilReport, SocketcandReport,
+    StateChange,
 };
 pub use sensors::{SensorFault, SimEncoder, SwingAnkle};
 
@@ -105,7 +106,10 @@ pub struct FirmwareInTheLoop {
     last_t_ns: Option<u64>,
     last_t_s: f64,
     last_heel_strike_s: Option<f64>,
-    landing_rad: Option<f64>,
+    /// The stance angle at which each side's foot last landed [rad].
+    landing_rad: [Option<f64>; 2],
+    landing_pending: bool,
+    landings: Vec<Landing>,
     schedule: Vec<HostCommand>,
     next_command: usize,
     enabled_sent: bool,
@@ -208,7 +212,9 @@ impl FirmwareInTheLoop {
             last_t_ns: None,
             last_t_s: 0.0,
             last_heel_strike_s: None,
-            landing_rad: None,
+            landing_rad: [None, None],
+            landing_pending: true,
+            landings: Vec::new(),
             schedule,
             next_command: 0,
             enabled_sent: false,
@@ -306,6 +312,7 @@ impl FirmwareInTheLoop {
             state_history: self.state_history.clone(),
             phase_history: self.phase_history.clone(),
             faults: self.faults.clone(),
+            landings: self.landings.clone(),
             frames_delivered: self.frames_delivered,
             bus_off: self.bus_off.clone(),
             bus: self.bus.stats(),
@@ -400,6 +407,14 @@ impl FirmwareInTheLoop {
                 );
             }
             Message::Fault(_) => h.fault_events_seen += 1,
+            Message::ParamAck(a) => h.param_acks.push(format!(
+                "{:.3} s {:?} {:?} {:?} {}",
+                t_ns as f64 * 1e-9,
+                a.node,
+                a.param,
+                a.status,
+                a.value.to_si()
+            )),
             _ => {}
         }
     }
@@ -408,6 +423,9 @@ impl FirmwareInTheLoop {
     fn run_host(&mut self, t_ns: u64, t_s: f64) -> Result<(), ControlError> {
         if !self.enabled_sent {
             self.enabled_sent = true;
+            for c in self.config.setup_commands.clone() {
+                self.host_send(t_ns, t_s, &Message::Command(c))?;
+            }
             let enable = Message::Command(Command {
                 target: Target::Broadcast,
                 kind: CommandKind::Enable,
@@ -445,7 +463,9 @@ impl FirmwareInTheLoop {
     ) -> Result<ActuatorSegment, ControlError> {
         let t_s = sensing.t_s;
         let stance = side == self.stance;
-        let landing = self.landing_rad.unwrap_or(sensing.stance_ankle_rad);
+        let landing = self.landing_rad[side.index()]
+            .or(self.landing_rad[side.other().index()])
+            .unwrap_or(sensing.stance_ankle_rad);
         let trailing = !stance
             && self
                 .last_heel_strike_s
@@ -601,8 +621,14 @@ impl AnkleController for FirmwareInTheLoop {
         }
         self.last_t_ns = Some(t_ns);
         self.last_t_s = t_s;
-        if self.landing_rad.is_none() {
-            self.landing_rad = Some(sensing.stance_ankle_rad);
+        if self.landing_pending {
+            self.landing_pending = false;
+            self.landing_rad[self.stance.index()] = Some(sensing.stance_ankle_rad);
+            self.landings.push(Landing {
+                t_s,
+                side: self.stance,
+                angle_rad: sensing.stance_ankle_rad,
+            });
         }
         self.run_bus(t_ns)?;
         self.run_host(t_ns, t_s)?;
@@ -621,7 +647,7 @@ impl AnkleController for FirmwareInTheLoop {
         self.stance = self.stance.other();
         self.last_heel_strike_s = Some(t_s);
         // The landing angle is the new stance angle at the next tick.
-        self.landing_rad = None;
+        self.landing_pending = true;
         self.heel_strikes += 1;
     }
 }

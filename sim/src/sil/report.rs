@@ -49,6 +49,18 @@ pub struct PhaseChange {
     pub stance: bool,
 }
 
+/// A foot landing: the stance ankle angle at the first tick after a heel strike (and at the
+/// first tick of the run).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Landing {
+    /// Tick time [s].
+    pub t_s: f64,
+    /// The foot that landed.
+    pub side: Side,
+    /// Its ankle angle [rad].
+    pub angle_rad: f64,
+}
+
 /// One ankle node over the run.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct NodeReport {
@@ -99,6 +111,8 @@ pub struct HostReport {
     pub last_heartbeat: BTreeMap<String, (f64, String, Vec<String>)>,
     /// `Fault` events seen.
     pub fault_events_seen: u64,
+    /// Parameter acknowledgements seen (time, node, parameter, status, value in force).
+    pub param_acks: Vec<String>,
     /// Commands the host put on the bus: (time [s], command).
     pub commands_sent: Vec<(f64, String)>,
     /// Frames injected by socketcand clients.
@@ -137,6 +151,8 @@ pub struct SilReport {
     pub phase_history: Vec<PhaseChange>,
     /// Every fault raised or cleared.
     pub faults: Vec<FaultRecord>,
+    /// Every landing.
+    pub landings: Vec<Landing>,
     /// Frames delivered on the bus.
     pub frames_delivered: u64,
     /// Bus-off events: (time [s], node name).
