@@ -229,3 +229,40 @@ pub fn sweep_json(
             .collect::<Vec<_>>(),
     })
 }
+
+/// Gait figures averaged over the last `last` completed steps of a walk: `step_period_s`,
+/// `step_length_m`, `speed_m_s`, `cost_of_transport_J_per_kg_m`, `heading_change_rad_per_step`
+/// (mean magnitude), with the number of steps used. `Null` if no step completed.
+pub fn walk_gait_json(walker: &Walker, walk: &Walk, last: usize) -> Value {
+    let n = walk.steps.len().min(last);
+    if n == 0 {
+        return Value::Null;
+    }
+    let steps = &walk.steps[walk.steps.len() - n..];
+    let mean =
+        |f: &dyn Fn(&crate::walk::StepSummary) -> f64| steps.iter().map(f).sum::<f64>() / n as f64;
+    let period = mean(&|s| s.duration_s);
+    let length = mean(&|s| s.step_length_m);
+    let work = mean(&|s| s.actuator_work_j);
+    json!({
+        "steps_averaged": n,
+        "step_period_s": period,
+        "step_length_m": length,
+        "speed_m_s": length / period,
+        "cost_of_transport_J_per_kg_m": work / (walker.model.total_mass_kg() * length),
+        "heading_change_rad_per_step": mean(&|s| s.heading_change_rad.abs()),
+    })
+}
+
+/// The same figures for a gait's fixed point.
+pub fn ideal_gait_json(walker: &Walker, gait: &Gait) -> Value {
+    let n = gait_numbers(gait);
+    json!({
+        "step_period_s": n.step_period_s,
+        "step_length_m": n.step_length_m,
+        "speed_m_s": n.speed_m_s,
+        "cost_of_transport_J_per_kg_m": gait.stride.actuator_work_j / (walker.model.total_mass_kg() * n.step_length_m),
+        "heading_change_rad_per_step": gait.stride.heading_change_rad.abs(),
+        "max_abs_eigenvalue": gait.max_abs_eigenvalue(),
+    })
+}

@@ -73,6 +73,8 @@ pub struct StepSummary {
     pub state_deviation: f64,
     /// Impact energy loss [J].
     pub impact_energy_loss_j: f64,
+    /// Work of the ankle actuator [J].
+    pub actuator_work_j: f64,
     /// Events.
     pub events: Vec<StrideEvent>,
     /// Stride-map state at the end of the step, by name.
@@ -195,6 +197,7 @@ impl Walker {
                         hip_floor_m: [p_hip.x, p_hip.y, p_hip.z],
                         state_deviation: (&v - &v0).amax(),
                         impact_energy_loss_j: r.impact_energy_loss_j,
+                        actuator_work_j: r.actuator_work_j,
                         events: r.events.clone(),
                         state: names.iter().cloned().zip(v.iter().copied()).collect(),
                     });
