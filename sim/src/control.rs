@@ -98,6 +98,42 @@ pub trait AnkleController {
     fn heel_strike(&mut self, t_s: f64);
 }
 
+/// Wraps a controller so that walk time keeps pace with wall-clock time (times `factor`): each
+/// tick sleeps until its walk time is due. For watching a simulation live.
+pub struct Paced<'a> {
+    inner: &'a mut dyn AnkleController,
+    factor: f64,
+    start: std::time::Instant,
+}
+
+impl<'a> Paced<'a> {
+    /// Paces `inner` at `factor` × real time from `start`.
+    pub fn new(inner: &'a mut dyn AnkleController, factor: f64, start: std::time::Instant) -> Self {
+        Self {
+            inner,
+            factor,
+            start,
+        }
+    }
+}
+
+impl AnkleController for Paced<'_> {
+    fn period_s(&self) -> f64 {
+        self.inner.period_s()
+    }
+    fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
+        let due = std::time::Duration::from_secs_f64((sensing.t_s / self.factor).max(0.0));
+        let elapsed = self.start.elapsed();
+        if due > elapsed {
+            std::thread::sleep(due - elapsed);
+        }
+        self.inner.tick(sensing)
+    }
+    fn heel_strike(&mut self, t_s: f64) {
+        self.inner.heel_strike(t_s);
+    }
+}
+
 /// A sampled version of the ideal stretch reflex: the limit is held at the engagement angle
 /// until a tick sees the string taut, then follows the ideal smooth extension from that tick,
 /// and is re-armed at heel strike. The reference controller for the control-tick machinery: it

@@ -107,6 +107,31 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<std::path::PathBuf>,
     },
+    /// Software in the loop: the ankle firmware (two nodes on a simulated CAN bus) actuates
+    /// the walker; compared with the ideal-actuator gait.
+    Sil {
+        #[command(flatten)]
+        common: Common,
+        /// Number of steps.
+        #[arg(long)]
+        steps: usize,
+        /// A bus fault, e.g. `drop:id=0x101,count=5` (repeatable; docs/canbus.md).
+        #[arg(long = "fault", value_name = "SPEC")]
+        faults: Vec<String>,
+        /// Host emergency stop to every ankle at this walk time [s].
+        #[arg(long, value_name = "SECONDS")]
+        estop_at: Option<f64>,
+        /// Write the bus traffic as a candump log.
+        #[arg(long, value_name = "FILE")]
+        candump: Option<std::path::PathBuf>,
+        /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
+        #[arg(long, value_name = "ADDR")]
+        socketcand: Option<String>,
+        /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor); by
+        /// default it runs as fast as it can.
+        #[arg(long, value_name = "FACTOR")]
+        realtime: Option<f64>,
+    },
     /// List the scenes and their parameters.
     Scenes {
         /// Print JSON.
@@ -435,6 +460,128 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     let plot = figures::accuracy(&study, f, what);
                     std::fs::write(dir.join(file), plot.to_svg(720.0, 480.0))?;
                 }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Sil {
+            common,
+            steps,
+            faults,
+            estop_at,
+            candump,
+            socketcand,
+            realtime,
+        } => {
+            let scene = common.scene()?;
+            let walker = common.walker(&scene)?;
+            let Some(reflex) = walker.ankle.clone() else {
+                return Err(InputError::Other(format!(
+                    "scene `{}` has no actuated ankles (ankle_reflex)",
+                    scene.name()
+                ))
+                .into());
+            };
+            let mut config = sim::sil::config::SilConfig::default()
+                .with_reflex(&reflex)
+                .map_err(|e| InputError::Other(format!("reflex parameters: {e}")))?;
+            for f in &faults {
+                config = config
+                    .with_fault_str(f)
+                    .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
+            }
+            if let Some(addr) = &socketcand {
+                let parsed: std::net::SocketAddr = addr.parse().map_err(|_| {
+                    InputError::Other(format!("--socketcand `{addr}`: expected IP:PORT"))
+                })?;
+                if !parsed.ip().is_loopback() {
+                    return Err(InputError::Other(format!(
+                        "--socketcand `{addr}`: only loopback addresses are served"
+                    ))
+                    .into());
+                }
+            }
+            if let Some(r) = realtime {
+                if !(r.is_finite() && r > 0.0) {
+                    return Err(
+                        InputError::Other(format!("--realtime must be positive, got {r}")).into(),
+                    );
+                }
+            }
+            config.candump = candump;
+            config.socketcand = socketcand;
+            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+            let ideal = match walker.find_gait(&v0, &common.newton()) {
+                Ok(g) => g,
+                Err(e) => {
+                    eprintln!("error: no ideal-actuator gait to start from: {e}");
+                    return Ok(ExitCode::from(1));
+                }
+            };
+            let mut ctl = sim::sil::FirmwareInTheLoop::new(config)
+                .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
+            if let Some(t) = estop_at {
+                ctl.emergency_stop_at(t);
+            }
+            if let Some(addr) = ctl.socketcand_addr() {
+                eprintln!("socketcand: serving the bus on {addr} (channel vcan0)");
+            }
+            let (q, qd) = walker.unpack(&ideal.fixed_point);
+            let walk = match realtime {
+                None => walker.walk_controlled(&q, &qd, steps, false, &mut ctl),
+                Some(factor) => {
+                    // Step by step, sleeping so that walk time keeps pace with wall time.
+                    let start = std::time::Instant::now();
+                    let mut paced = sim::control::Paced::new(&mut ctl, factor, start);
+                    walker.walk_controlled(&q, &qd, steps, false, &mut paced)
+                }
+            };
+            let report = ctl
+                .finish()
+                .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
+            let sil_gait = sim::report::walk_gait_json(&walker, &walk, 10);
+            let ideal_gait = sim::report::ideal_gait_json(&walker, &ideal);
+            let out = json!({
+                "scene": scene.name(),
+                "steps_completed": walk.steps.len(),
+                "failure": walk.failure,
+                "gait": sil_gait,
+                "ideal_gait": ideal_gait,
+                "node_faults": report.faults,
+                "nodes": report.nodes,
+                "bus_load": report.bus.load,
+                "bus": report.bus,
+                "frames": report.frames_delivered,
+                "steps": walk.steps,
+            });
+            if common.json {
+                print_json(&out)?;
+            } else {
+                println!(
+                    "scene {}: {} of {steps} steps with the firmware actuating",
+                    scene.name(),
+                    walk.steps.len()
+                );
+                if let Some(f) = &walk.failure {
+                    println!(
+                        "failure: {:?} in step {} at t = {:.4} s: {}",
+                        f.kind, f.step, f.time_s, f.detail
+                    );
+                }
+                for (label, g) in [("firmware", &out["gait"]), ("ideal", &out["ideal_gait"])] {
+                    println!(
+                        "{label:>9}: period {:.5} s, step {:.5} m, speed {:.5} m/s, cost of transport {:.5} J/(kg m)",
+                        g["step_period_s"].as_f64().unwrap_or(f64::NAN),
+                        g["step_length_m"].as_f64().unwrap_or(f64::NAN),
+                        g["speed_m_s"].as_f64().unwrap_or(f64::NAN),
+                        g["cost_of_transport_J_per_kg_m"].as_f64().unwrap_or(f64::NAN),
+                    );
+                }
+                println!(
+                    "bus load {:.2} %, {} frames, {} node fault events",
+                    100.0 * report.bus.load,
+                    report.frames_delivered,
+                    report.faults.len()
+                );
             }
             Ok(ExitCode::SUCCESS)
         }
