@@ -4,9 +4,9 @@
 //! `F,q` is its c.m. linear Jacobian and angular Jacobian, and `F,qq q̇ q̇` its bias acceleration.
 
 use crate::kinematics::Kinematics;
-use crate::model::{LinkIndex, Model};
+use crate::model::{JointKind, LinkIndex, Model};
 use crate::singular_limit::{solve_limit, LimitSolveError};
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// Why the accelerations could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -32,9 +32,10 @@ pub struct Dynamics {
     pub force: DVector<f64>,
     /// `f̄` per unit of infinitesimal mass.
     pub force_infinitesimal: DVector<f64>,
-    jv: DMatrix<f64>,
-    jw: DMatrix<f64>,
-    iw_jw: DMatrix<f64>,
+    /// For each link, `(coordinate, link owning it)` along its ancestry.
+    chains: Vec<Vec<(usize, usize)>>,
+    /// Scratch: one body's nonzero Jacobian columns `(coordinate, linear, angular)`.
+    cols: Vec<(usize, Vector3<f64>, Vector3<f64>)>,
     /// Scratch for the active-set solve (row-major k × k, then k).
     work_m: Vec<f64>,
     work_b: Vec<f64>,
@@ -51,9 +52,16 @@ impl Dynamics {
             mass_matrix_infinitesimal: DMatrix::zeros(n, n),
             force: DVector::zeros(n),
             force_infinitesimal: DVector::zeros(n),
-            jv: DMatrix::zeros(3, n),
-            jw: DMatrix::zeros(3, n),
-            iw_jw: DMatrix::zeros(3, n),
+            chains: (0..model.links.len())
+                .map(|i| {
+                    model
+                        .ancestry(LinkIndex(i))
+                        .into_iter()
+                        .filter_map(|l| model.links[l.0].coordinate.map(|c| (c.0, l.0)))
+                        .collect()
+                })
+                .collect(),
+            cols: Vec::with_capacity(n),
             work_m: vec![0.0; n * n],
             work_b: vec![0.0; n],
             has_infinitesimal: model.has_infinitesimal_bodies(),
@@ -82,9 +90,20 @@ impl Dynamics {
             }
             let li = LinkIndex(i);
             let p_com = self.kin.position_of(li, &b.p_link_com_m);
-            self.kin
-                .point_jacobian_into(model, li, &p_com, &mut self.jv);
             let a_bias = self.kin.bias_acceleration_of(li, &p_com);
+            // The body's Jacobian columns, only for the coordinates of its ancestry (the other
+            // columns are zero): linear at the c.m. and angular.
+            self.cols.clear();
+            for &(c, l) in &self.chains[i] {
+                let a = self.kin.axis_floor[l];
+                let (jv, jw) = match model.links[l].joint {
+                    JointKind::Revolute { .. } => {
+                        (a.cross(&(p_com - self.kin.p_floor_link_m[l])), a)
+                    }
+                    _ => (a, Vector3::zeros()),
+                };
+                self.cols.push((c, jv, jw));
+            }
             let (mm, ff) = if b.infinitesimal {
                 (
                     &mut self.mass_matrix_infinitesimal,
@@ -93,18 +112,29 @@ impl Dynamics {
             } else {
                 (&mut self.mass_matrix, &mut self.force)
             };
-            // Linear part: m Jvᵀ Jv, Jvᵀ m (g − a_bias).
-            mm.gemm_tr(b.mass_kg, &self.jv, &self.jv, 1.0);
-            ff.gemv_tr(b.mass_kg, &self.jv, &(g - a_bias), 1.0);
-            if has_rot {
-                self.kin.angular_jacobian_into(model, li, &mut self.jw);
+            // m Jvᵀ Jv + Jwᵀ I Jw and Jvᵀ m (g − a_bias) + Jwᵀ (−I α_bias − ω × I ω).
+            let f_lin = (g - a_bias) * b.mass_kg;
+            let (i_w, torque) = if has_rot {
                 let r = self.kin.r_floor_link[i];
                 let i_w = r * b.inertia_com_kg_m2 * r.transpose();
                 let w = self.kin.omega_floor_rad_s[i];
-                let torque = -(i_w * self.kin.alpha_bias_rad_s2[i]) - w.cross(&(i_w * w));
-                self.iw_jw.gemm(1.0, &i_w, &self.jw, 0.0);
-                mm.gemm_tr(1.0, &self.jw, &self.iw_jw, 1.0);
-                ff.gemv_tr(1.0, &self.jw, &torque, 1.0);
+                (
+                    i_w,
+                    -(i_w * self.kin.alpha_bias_rad_s2[i]) - w.cross(&(i_w * w)),
+                )
+            } else {
+                (Matrix3::zeros(), Vector3::zeros())
+            };
+            for (x, &(ci, jvi, jwi)) in self.cols.iter().enumerate() {
+                ff[ci] += jvi.dot(&f_lin) + jwi.dot(&torque);
+                let iw_jwi = i_w * jwi;
+                for &(cj, jvj, jwj) in &self.cols[..=x] {
+                    let v = b.mass_kg * jvi.dot(&jvj) + jwj.dot(&iw_jwi);
+                    mm[(ci, cj)] += v;
+                    if ci != cj {
+                        mm[(cj, ci)] += v;
+                    }
+                }
             }
         }
         for link in &model.links {

@@ -201,9 +201,12 @@ fn golden_fixed_points_and_eigenvalues() {
             c["eigenvalue_moduli"].as_array().unwrap(),
         );
         assert_eq!(ge.len(), ce.len());
+        // The perturbation Jacobian reproduces the nearly undamped pelvic modes to about 1e-4:
+        // reordering the floating-point operations of the equations moves them by 3e-5
+        // (docs/accuracy.md).
         for (a, b) in ge.iter().zip(ce) {
             assert!(
-                (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-5,
+                (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-4,
                 "{n}: {a} vs {b}"
             );
         }
