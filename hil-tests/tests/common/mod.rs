@@ -1,0 +1,110 @@
+//! Shared set-up: the `wisse3d` walker on its limit cycle, and a firmware-in-the-loop walk.
+#![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::sync::OnceLock;
+
+use nalgebra::DVector;
+use sim::limit_cycle::NewtonSettings;
+use sim::scene::Scene;
+use sim::sil::{FirmwareInTheLoop, SilConfig, SilReport};
+use sim::walk::Walk;
+use sim::walker::Walker;
+
+/// The scene every test walks.
+pub const SCENE: &str = "wisse3d";
+/// Control period of the nodes [s].
+pub const TICK_S: f64 = 1e-3;
+
+pub struct Setup {
+    pub walker: Walker,
+    pub q0: DVector<f64>,
+    pub qd0: DVector<f64>,
+    /// Stride period of the ideal reflex's limit cycle [s].
+    pub period_s: f64,
+}
+
+/// The walker and its gait, found once per test binary.
+pub fn setup() -> &'static Setup {
+    static S: OnceLock<Setup> = OnceLock::new();
+    S.get_or_init(|| {
+        let scene = Scene::load(SCENE).expect("scene loads");
+        let walker = scene.build().expect("scene builds");
+        let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+        let gait = walker
+            .find_gait(&v0, &NewtonSettings::default())
+            .expect("gait converges");
+        let (q0, qd0) = walker.unpack(&gait.fixed_point);
+        Setup {
+            period_s: gait.stride.duration_s,
+            walker,
+            q0,
+            qd0,
+        }
+    })
+}
+
+/// The firmware's reflex parameters set to the scene's ideal reflex (taut −0.055 rad, extended
+/// 0.2 rad, 0.2 s), as the host would before enabling.
+pub fn matched() -> SilConfig {
+    let w = &setup().walker;
+    SilConfig::default()
+        .with_reflex(w.ankle.as_ref().expect("wisse3d has actuated ankles"))
+        .expect("scene's reflex within the firmware's parameter ranges")
+}
+
+/// Walk `steps` strides from the limit cycle with the firmware in the loop.
+pub fn walk(config: SilConfig, steps: usize) -> (Walk, SilReport) {
+    walk_with(
+        FirmwareInTheLoop::new(config).expect("controller builds"),
+        steps,
+    )
+}
+
+/// Walk with a prepared controller.
+pub fn walk_with(mut ctl: FirmwareInTheLoop, steps: usize) -> (Walk, SilReport) {
+    let s = setup();
+    let walk = s
+        .walker
+        .walk_controlled(&s.q0, &s.qd0, steps, false, &mut ctl);
+    let report = ctl.finish().expect("report");
+    eprintln!("{}", summary(&walk, &report));
+    (walk, report)
+}
+
+/// A one-screen summary for the test log.
+pub fn summary(walk: &Walk, r: &SilReport) -> String {
+    let nodes: Vec<String> = r
+        .nodes
+        .iter()
+        .map(|(side, n)| {
+            format!(
+                "{side:?}: {} {} faults {:?} raises {:?} engaged {} released by message {} by lift-off {} dropped {} refused(queue) {}",
+                n.state,
+                n.phase,
+                n.active_faults,
+                n.fault_raises,
+                n.engagements,
+                n.releases_by_peer_heel_strike,
+                n.releases_by_lift_off,
+                n.frames_dropped,
+                n.frames_refused_queue_full
+            )
+        })
+        .collect();
+    format!(
+        "steps {} failure {:?}\n  t_end {:.3} s, heel strikes {}, frames {}, bus load {:.2} %, error frames {}, bus-off {:?}\n  {}\n  states {:?}",
+        walk.steps.len(),
+        walk.failure.as_ref().map(|f| (f.kind, f.step, f.time_s)),
+        r.t_end_s,
+        r.heel_strikes,
+        r.frames_delivered,
+        100.0 * r.bus.load,
+        r.bus.error_frames,
+        r.bus_off,
+        nodes.join("\n  "),
+        r.state_history
+            .iter()
+            .map(|c| format!("{:.3} {:?} {}", c.t_s, c.side, c.state))
+            .collect::<Vec<_>>()
+    )
+}

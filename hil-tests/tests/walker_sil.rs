@@ -1,0 +1,296 @@
+//! The `wisse3d` walker with both ankle nodes' firmware in the loop, on the simulated CAN bus:
+//! nominal walking, and what each bus or sensor fault does to the nodes and to the robot.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use common::{matched, setup, walk, walk_with, TICK_S};
+use sim::sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport};
+use sim::stride::FailureKind;
+
+/// Time of the stride `k`'s start on the nominal gait, plus `frac` of a stride [s].
+fn in_stride(k: usize, frac: f64) -> f64 {
+    (k as f64 + frac) * setup().period_s
+}
+
+fn safe_at(r: &SilReport, side: Side) -> Option<f64> {
+    r.first_state_at_or_after(side, "Safe", 0.0)
+}
+
+#[test]
+fn nominal_200_steps_with_the_firmware_in_the_loop() {
+    let (walk, r) = walk(matched(), 200);
+    assert!(walk.failure.is_none(), "{:?}", walk.failure);
+    assert_eq!(walk.steps.len(), 200);
+    let ideal = setup().period_s;
+    for s in &walk.steps {
+        // Engagement is detected by the firmware (estimator, 1 kHz): the period moves by
+        // about a millisecond.
+        assert!(
+            (s.duration_s - ideal).abs() < 2e-3,
+            "step {} lasted {} s, ideal {ideal}",
+            s.step,
+            s.duration_s
+        );
+        assert!(s.events.iter().any(|e| e.name == "string_engaged"));
+    }
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    assert_eq!(r.heel_strikes, 200);
+    for side in Side::BOTH {
+        let n = r.node(side).unwrap();
+        assert_eq!(n.state, "Enabled");
+        assert!(n.active_faults.is_empty());
+        assert_eq!(n.engagements, 100, "{side:?}");
+        assert_eq!(n.releases_by_lift_off, 0);
+        assert_eq!(n.firmware_dropped_tx, 0);
+        assert_eq!(n.frames_dropped + n.frames_refused_queue_full, 0);
+        assert_eq!(n.actuator.saturated_ticks, 0);
+    }
+    // Every stance but the last ends with a release by the other foot's message (the walk
+    // stops at the 200th heel strike, before that message is read).
+    let by_message: u32 = Side::BOTH
+        .iter()
+        .map(|s| r.node(*s).unwrap().releases_by_peer_heel_strike)
+        .sum();
+    assert_eq!(by_message, 199);
+    assert_eq!(r.host.param_acks.len(), 6);
+    assert!(r.host.param_acks.iter().all(|a| a.contains("Accepted")));
+    // 200 Hz AnkleState and 20 Hz heartbeats per ankle, heel strikes, versions: about 10 %.
+    assert!(r.bus.load > 0.08 && r.bus.load < 0.12, "{}", r.bus.load);
+    assert_eq!(r.bus.error_frames, 0);
+    // The host's own frames: three SetParam and the Enable.
+    assert_eq!(r.frames_delivered, r.host.frames_seen + 4);
+}
+
+#[test]
+fn the_firmware_defaults_do_not_sustain_the_wisse3d_gait() {
+    // Table I's −0.08 rad and 0.15 s, the firmware's defaults: the gait this reflex would need
+    // is not the scene's (which engages at −0.055 rad over 0.2 s), and the walk drifts off.
+    let (walk, r) = walk(SilConfig::default(), 60);
+    let f = walk.failure.expect("the walk fails");
+    assert!(f.step < 60);
+    assert!(r.landings.len() > 5);
+}
+
+#[test]
+fn heel_strike_frames_dropped_the_contact_switches_release() {
+    let config = matched()
+        .with_fault_str("drop:id=0x022")
+        .unwrap()
+        .with_fault_str("drop:id=0x023")
+        .unwrap();
+    let (walk, r) = walk(config, 40);
+    // The release of the trailing foot's string happens after the stride's heel strike,
+    // when that foot is the (massless) swing foot: the robot walks as before.
+    assert!(walk.failure.is_none(), "{:?}", walk.failure);
+    assert_eq!(r.host.per_class.get("HeelStrike"), None, "none got through");
+    let mut fallbacks = 0;
+    for side in Side::BOTH {
+        let n = r.node(side).unwrap();
+        assert_eq!(n.state, "Enabled");
+        assert_eq!(n.releases_by_peer_heel_strike, 0);
+        assert_eq!(n.frames_dropped, u64::from(n.heel_strikes_sent));
+        assert!(n.heel_strikes_sent >= 19);
+        // Raised at the first fallback, cleared only by a normal release: once.
+        assert_eq!(n.fault_raises.get("PeerHeelStrikeLate"), Some(&1));
+        fallbacks += n.releases_by_lift_off;
+    }
+    assert_eq!(fallbacks, 39, "every heel strike's but the last");
+    // The fallback comes 10 ms (trailing contact) + 3 debounced samples after the strike.
+    let strike = r.landings.get(1).unwrap().t_s;
+    let late = r.first_raise(Side::Left, "PeerHeelStrikeLate").unwrap();
+    assert!(late - strike <= 0.013 + 1e-9, "{strike} {late}");
+}
+
+#[test]
+fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
+    let from_s = in_stride(10, 0.3);
+    let config = matched()
+        .with_fault_str(&format!("drop:id=0x063,from_ms={}", (from_s * 1e3) as u64))
+        .unwrap();
+    let (walk, r) = walk(config, 40);
+    let lost = r.first_raise(Side::Left, "PeerHeartbeatLost").unwrap();
+    let safe = safe_at(&r, Side::Left).unwrap();
+    assert_eq!(lost, safe);
+    // Heartbeats every 50 ms: the last one before the drop went out at most 50 ms before it;
+    // lost 0.3 s after the last one received, plus delivery and one tick.
+    assert!(
+        safe > from_s + 0.3 - 0.05 && safe <= from_s + 0.3 + 2.0 * TICK_S,
+        "{safe}"
+    );
+    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    // Without the left ankle's push-off the walker does not keep going.
+    let f = walk.failure.expect("typed failure");
+    assert!(f.time_s > safe, "{f:?}");
+}
+
+#[test]
+fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() {
+    let from_s = in_stride(10, 0.3);
+    let config = matched()
+        .with_fault_str(&format!(
+            "busoff:node=right,from_ms={}",
+            (from_s * 1e3) as u64
+        ))
+        .unwrap();
+    let (walk, r) = walk(config, 40);
+    assert_eq!(r.bus_off.len(), 1);
+    let right = safe_at(&r, Side::Right).unwrap();
+    assert!(right >= from_s && right < from_s + 0.012, "{right}");
+    assert!(r.first_raise(Side::Right, "CanBus").is_some());
+    let left = safe_at(&r, Side::Left).unwrap();
+    assert!(
+        left > from_s + 0.25 && left <= from_s + 0.3 + 2.0 * TICK_S,
+        "{left}"
+    );
+    let f = walk.failure.expect("typed failure");
+    assert!(f.time_s > right, "{f:?}");
+}
+
+#[test]
+fn a_low_priority_babbler_fills_the_bus_but_the_robot_walks() {
+    let from_s = in_stride(5, 0.0);
+    let config = matched()
+        .with_fault_str(&format!(
+            "babble:node=right,id=0x7FF,from_ms={}",
+            (from_s * 1e3) as u64
+        ))
+        .unwrap();
+    let (walk, r) = walk(config, 30);
+    assert!(walk.failure.is_none(), "{:?}", walk.failure);
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    // 100 % from the fifth stride on.
+    assert!(r.bus.load > 0.8, "{}", r.bus.load);
+    assert!(r.host.undecodable_frames > 10_000);
+}
+
+#[test]
+fn a_high_priority_babbler_starves_the_nodes_into_the_safe_state() {
+    let from_s = in_stride(5, 0.0);
+    let config = matched()
+        .with_fault_str(&format!(
+            "babble:node=right,id=0x000,from_ms={}",
+            (from_s * 1e3) as u64
+        ))
+        .unwrap();
+    let (walk, r) = walk(config, 30);
+    // Nothing else gets through: the transmit queues fill (a CanBus fault) and the peer's
+    // heartbeats stop (PeerHeartbeatLost); both nodes end safe.
+    for side in Side::BOTH {
+        let safe = safe_at(&r, side).unwrap();
+        assert!(
+            safe > from_s && safe <= from_s + 0.3 + 2.0 * TICK_S,
+            "{side:?} {safe}"
+        );
+        assert!(r.node(side).unwrap().frames_refused_queue_full > 0);
+    }
+    let f = walk.failure.expect("typed failure");
+    assert!(f.time_s > from_s);
+    // Busy all the time from the babble's start.
+    let share = (r.t_end_s - from_s) / r.t_end_s;
+    assert!(r.bus.load > 0.9 * share, "{} vs {share}", r.bus.load);
+}
+
+#[test]
+fn an_encoder_glitch_raises_a_rate_fault_and_the_node_goes_safe() {
+    let at_s = in_stride(10, 0.3);
+    let config = matched().with_sensor_fault(SensorFault::Glitch {
+        side: Side::Left,
+        at_s,
+        delta_rad: 0.1,
+    });
+    let (walk, r) = walk(config, 40);
+    let raised = r.first_raise(Side::Left, "EncoderRate").unwrap();
+    assert!(raised >= at_s && raised < at_s + TICK_S + 1e-9);
+    assert_eq!(safe_at(&r, Side::Left), Some(raised));
+    // The fault clears two samples later, but the node stays safe until re-enabled.
+    assert_eq!(r.node(Side::Left).unwrap().state, "Safe");
+    assert!(r.node(Side::Left).unwrap().active_faults.is_empty());
+    let f = walk.failure.expect("typed failure");
+    assert!(f.time_s > raised);
+}
+
+/// Time of the string's engagement in stride `k` of the nominal walk [s].
+fn engagement_in_stride(k: usize) -> f64 {
+    let (walk, _) = walk(matched(), k + 1);
+    let s = &walk.steps[k];
+    let e = s
+        .events
+        .iter()
+        .find(|e| e.name == "string_engaged")
+        .unwrap();
+    s.start_time_s + e.time_s
+}
+
+#[test]
+fn a_stuck_encoder_is_caught_in_the_push_and_the_node_goes_safe() {
+    // Frozen 20 ms into stride 10's push (left stance, even strides): caught 50 ms after the
+    // reading last changed (a tick or two before the freeze), within a tick.
+    let from_s = engagement_in_stride(10) + 0.02;
+    let config = matched().with_sensor_fault(SensorFault::Stuck {
+        side: Side::Left,
+        from_s,
+    });
+    let (walk, r) = walk(config, 40);
+    let stuck = r.first_raise(Side::Left, "EncoderStuck").unwrap();
+    assert!(
+        stuck > from_s + 0.05 - 3.0 * TICK_S && stuck <= from_s + 0.05 + 2.0 * TICK_S,
+        "{from_s} {stuck}"
+    );
+    assert_eq!(safe_at(&r, Side::Left), Some(stuck));
+    // Released mid-push: the heel comes down at once.
+    let f = walk.failure.expect("typed failure");
+    assert_eq!(f.kind, FailureKind::HeelReturnedToFloor, "{f:?}");
+    assert!(f.time_s >= stuck && f.time_s < stuck + TICK_S, "{f:?}");
+}
+
+#[test]
+fn an_encoder_stuck_before_the_push_is_not_detected_and_the_robot_falls() {
+    // Frozen at 30 % of stride 10, above the taut angle: the firmware never sees the ankle
+    // reach it, never pushes, and its stuck check (which runs only while pushing) never
+    // fires. The walk ends in a typed failure with the node still enabled.
+    let from_s = in_stride(10, 0.3);
+    let config = matched().with_sensor_fault(SensorFault::Stuck {
+        side: Side::Left,
+        from_s,
+    });
+    let (walk, r) = walk(config, 40);
+    assert_eq!(r.first_raise(Side::Left, "EncoderStuck"), None);
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    assert_eq!(r.node(Side::Left).unwrap().state, "Enabled");
+    assert_eq!(
+        r.node(Side::Left).unwrap().engagements,
+        5,
+        "strides 0, 2, .., 8"
+    );
+    let f = walk.failure.expect("typed failure");
+    assert!(f.step <= 11 && f.time_s > from_s, "{f:?}");
+}
+
+#[test]
+fn emergency_stop_mid_push_releases_both_strings_within_two_ticks() {
+    let mut ctl = FirmwareInTheLoop::new(matched()).unwrap();
+    // Stride 12 (left stance), 80 % through: in the push.
+    let at_s = in_stride(12, 0.8);
+    ctl.emergency_stop_at(at_s);
+    let (walk, r) = walk_with(ctl, 40);
+    let phase_before = r
+        .phase_history
+        .iter()
+        .rfind(|p| p.side == Side::Left && p.t_s < at_s)
+        .map(|p| p.phase.clone());
+    assert!(
+        matches!(phase_before.as_deref(), Some("Push" | "Hold")),
+        "{phase_before:?}"
+    );
+    for side in Side::BOTH {
+        let t = r
+            .first_state_at_or_after(side, "EmergencyStop", 0.0)
+            .unwrap();
+        assert!(t > at_s && t <= at_s + 2.0 * TICK_S + 1e-9, "{side:?} {t}");
+        assert_eq!(r.node(side).unwrap().state, "EmergencyStop");
+    }
+    let f = walk.failure.expect("typed failure");
+    assert_eq!(f.step, 12, "{f:?}");
+    assert_eq!(f.kind, FailureKind::HeelReturnedToFloor, "{f:?}");
+}
