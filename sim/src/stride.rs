@@ -644,6 +644,8 @@ impl Walker {
                         }
                         phase.prescribed = Some((coord, Drive::Segment(seg)));
                         phase.snap(&mut cur);
+                        // The drive's acceleration jumps at a tick: restart the power quadrature.
+                        power.jumped = true;
                     }
                     segment = Some(seg);
                     next_tick += period_s;
