@@ -509,14 +509,26 @@ fn run(cli: Cli) -> Result<ExitCode> {
             }
             config.candump = candump;
             config.socketcand = socketcand;
-            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-            let ideal = match walker.find_gait(&v0, &common.newton()) {
+            // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
+            // the firmware uses DOPRI5 at 1e-9 (one or two steps per 1 ms control tick) unless
+            // an integrator is given on the command line.
+            let ideal_walker = scene.build()?;
+            let v0 = ideal_walker.pack(&ideal_walker.guess_q, &ideal_walker.guess_qd);
+            let ideal = match ideal_walker.find_gait(&v0, &common.newton()) {
                 Ok(g) => g,
                 Err(e) => {
                     eprintln!("error: no ideal-actuator gait to start from: {e}");
                     return Ok(ExitCode::from(1));
                 }
             };
+            let mut walker = walker;
+            if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
+                walker.integrator = IntegratorChoice::Dopri5 {
+                    rtol: 1e-9,
+                    atol: 1e-9,
+                    h_max_s: 0.01,
+                };
+            }
             let mut ctl = sim::sil::FirmwareInTheLoop::new(config)
                 .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
             if let Some(t) = estop_at {
@@ -539,9 +551,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 .finish()
                 .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
             let sil_gait = sim::report::walk_gait_json(&walker, &walk, 10);
-            let ideal_gait = sim::report::ideal_gait_json(&walker, &ideal);
+            let ideal_gait = sim::report::ideal_gait_json(&ideal_walker, &ideal);
             let out = json!({
                 "scene": scene.name(),
+                "integrator": walker.integrator,
                 "steps_completed": walk.steps.len(),
                 "failure": walk.failure,
                 "gait": sil_gait,
