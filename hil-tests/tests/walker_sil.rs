@@ -1,5 +1,9 @@
 //! The `wisse3d` walker with both ankle nodes' firmware in the loop, on the simulated CAN bus:
 //! nominal walking, and what each bus or sensor fault does to the nodes and to the robot.
+//!
+//! Each test walks the 3D walker for up to 200 strides with a control tick every millisecond:
+//! seconds in a release build, many minutes unoptimised, so they are ignored in debug builds
+//! (`scripts/test-all` runs `cargo test --workspace --release`).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
@@ -18,6 +22,10 @@ fn safe_at(r: &SilReport, side: Side) -> Option<f64> {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn nominal_200_steps_with_the_firmware_in_the_loop() {
     let (walk, r) = walk(matched(), 200);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
@@ -63,6 +71,10 @@ fn nominal_200_steps_with_the_firmware_in_the_loop() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn the_firmware_defaults_do_not_sustain_the_wisse3d_gait() {
     // Table I's −0.08 rad and 0.15 s, the firmware's defaults: the gait this reflex would need
     // is not the scene's (which engages at −0.055 rad over 0.2 s), and the walk drifts off.
@@ -73,6 +85,10 @@ fn the_firmware_defaults_do_not_sustain_the_wisse3d_gait() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn heel_strike_frames_dropped_the_contact_switches_release() {
     let config = matched()
         .with_fault_str("drop:id=0x022")
@@ -103,6 +119,10 @@ fn heel_strike_frames_dropped_the_contact_switches_release() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
     let from_s = in_stride(10, 0.3);
     let config = matched()
@@ -125,6 +145,10 @@ fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() {
     let from_s = in_stride(10, 0.3);
     let config = matched()
@@ -148,6 +172,10 @@ fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() 
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn a_low_priority_babbler_fills_the_bus_but_the_robot_walks() {
     let from_s = in_stride(5, 0.0);
     let config = matched()
@@ -165,6 +193,10 @@ fn a_low_priority_babbler_fills_the_bus_but_the_robot_walks() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn a_high_priority_babbler_starves_the_nodes_into_the_safe_state() {
     let from_s = in_stride(5, 0.0);
     let config = matched()
@@ -192,6 +224,10 @@ fn a_high_priority_babbler_starves_the_nodes_into_the_safe_state() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn an_encoder_glitch_raises_a_rate_fault_and_the_node_goes_safe() {
     let at_s = in_stride(10, 0.3);
     let config = matched().with_sensor_fault(SensorFault::Glitch {
@@ -223,6 +259,10 @@ fn engagement_in_stride(k: usize) -> f64 {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn a_stuck_encoder_is_caught_in_the_push_and_the_node_goes_safe() {
     // Frozen 20 ms into stride 10's push (left stance, even strides): caught 50 ms after the
     // reading last changed (a tick or two before the freeze), within a tick.
@@ -245,6 +285,10 @@ fn a_stuck_encoder_is_caught_in_the_push_and_the_node_goes_safe() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn an_encoder_stuck_before_the_push_is_not_detected_and_the_robot_falls() {
     // Frozen at 30 % of stride 10, above the taut angle: the firmware never sees the ankle
     // reach it, never pushes, and its stuck check (which runs only while pushing) never
@@ -268,6 +312,10 @@ fn an_encoder_stuck_before_the_push_is_not_detected_and_the_robot_falls() {
 }
 
 #[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
 fn emergency_stop_mid_push_releases_both_strings_within_two_ticks() {
     let mut ctl = FirmwareInTheLoop::new(matched()).unwrap();
     // Stride 12 (left stance), 80 % through: in the push.
