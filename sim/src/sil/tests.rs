@@ -400,3 +400,97 @@ fn candump_log_and_socketcand_server_see_the_traffic() {
         Err(SilError::Socketcand(_))
     ));
 }
+
+#[test]
+fn a_fixed_swing_ankle_angle_trips_the_rate_check_at_heel_strike() {
+    // The brief's fixed neutral reading: the stance ankle holds 0.2 rad when the other foot
+    // lands; its reading then steps to 0 (200 rad/s) and the new stance ankle's from 0 to
+    // 0.1 rad (100 rad/s), both above the firmware's 40 rad/s plausibility limit.
+    let config = SilConfig {
+        swing_ankle: SwingAnkleModel::Fixed { angle_rad: 0.0 },
+        ..SilConfig::default()
+    };
+    let mut c = sil(config);
+    run(&mut c, 0.8, &[0.7]);
+    let r = c.report();
+    for side in Side::BOTH {
+        let t = r.first_raise(side, "EncoderRate").unwrap();
+        assert!((t - 0.7).abs() < 1e-9, "{side:?} {t}");
+        assert_eq!(r.node(side).unwrap().state, "Safe");
+    }
+}
+
+#[test]
+fn a_socketcand_client_sees_the_frames_and_its_emergency_stop_reaches_the_nodes() {
+    use std::io::{Read, Write};
+    use std::net::TcpStream;
+    use std::time::{Duration, Instant as WallClock};
+
+    fn read_until(c: &mut TcpStream, pat: &str, buf: &mut String) -> bool {
+        let deadline = WallClock::now() + Duration::from_secs(5);
+        let mut chunk = [0u8; 4096];
+        while !buf.contains(pat) {
+            if WallClock::now() > deadline {
+                return false;
+            }
+            if let Ok(n) = c.read(&mut chunk) {
+                buf.push_str(&String::from_utf8_lossy(&chunk[..n]));
+            }
+        }
+        true
+    }
+
+    let config = SilConfig {
+        socketcand: Some("127.0.0.1:0".into()),
+        ..SilConfig::default()
+    };
+    let mut c = sil(config);
+    let mut client = TcpStream::connect(c.socketcand_addr().unwrap()).unwrap();
+    client
+        .set_read_timeout(Some(Duration::from_millis(20)))
+        .unwrap();
+    let mut buf = String::new();
+    assert!(read_until(&mut client, "< hi >", &mut buf));
+    client.write_all(b"< open vcan0 >< rawmode >").unwrap();
+    assert!(read_until(&mut client, "< ok >< ok >", &mut buf));
+    // Tick the controller (simulated time, paced by nothing) until the client has seen a
+    // frame, then send the emergency stop (0x01F, opcode 3) and tick until it arrives.
+    let mut t_ms = 0u64;
+    let tick = |c: &mut FirmwareInTheLoop, t_ms: &mut u64| {
+        let s = AnkleSensing {
+            t_s: *t_ms as f64 * DT_S,
+            stance_ankle_rad: 0.05,
+            stance_ankle_rate_rad_s: 0.0,
+            stance_foot_on_floor: true,
+            swing_foot_on_floor: false,
+            string_engaged: false,
+        };
+        c.tick(&s).unwrap();
+        *t_ms += 1;
+    };
+    let deadline = WallClock::now() + Duration::from_secs(10);
+    while !buf.contains("< frame 072") && WallClock::now() < deadline {
+        tick(&mut c, &mut t_ms);
+        std::thread::sleep(Duration::from_millis(1));
+        let mut chunk = [0u8; 4096];
+        if let Ok(n) = client.read(&mut chunk) {
+            buf.push_str(&String::from_utf8_lossy(&chunk[..n]));
+        }
+    }
+    assert!(buf.contains("< frame 072"), "left AnkleState: {buf}");
+    client.write_all(b"< send 01F 1 03 >").unwrap();
+    while c.node(Side::Right).state() != protocol::NodeState::EmergencyStop
+        && WallClock::now() < deadline
+    {
+        tick(&mut c, &mut t_ms);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let r = c.finish().unwrap();
+    for side in Side::BOTH {
+        assert_eq!(r.node(side).unwrap().state, "EmergencyStop", "{side:?}");
+    }
+    assert_eq!(r.host.frames_from_clients, 1);
+    let s = r.socketcand.unwrap();
+    assert_eq!((s.clients_accepted, s.frames_received), (1, 1));
+    assert!(s.frames_sent > 0);
+}
