@@ -342,3 +342,36 @@ fn emergency_stop_mid_push_releases_both_strings_within_two_ticks() {
     assert_eq!(f.step, 12, "{f:?}");
     assert_eq!(f.kind, FailureKind::HeelReturnedToFloor, "{f:?}");
 }
+
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
+fn the_same_faults_give_the_same_walk_and_report() {
+    let config = || {
+        matched()
+            .with_fault_str("corrupt:prob=0.01")
+            .unwrap()
+            .with_fault_str("drop:id=0x072,prob=0.1")
+            .unwrap()
+    };
+    let (a, ra) = walk(config(), 20);
+    let (b, rb) = walk(config(), 20);
+    assert!(ra.bus.error_frames > 10 && ra.bus.dropped > 10);
+    assert_eq!(
+        format!(
+            "{:?}",
+            a.steps.iter().map(|s| s.duration_s).collect::<Vec<_>>()
+        ),
+        format!(
+            "{:?}",
+            b.steps.iter().map(|s| s.duration_s).collect::<Vec<_>>()
+        )
+    );
+    assert_eq!(a.failure.is_none(), b.failure.is_none());
+    assert_eq!(
+        serde_json::to_string(&ra).unwrap(),
+        serde_json::to_string(&rb).unwrap()
+    );
+}
