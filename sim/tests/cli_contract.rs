@@ -68,6 +68,43 @@ fn bad_input_is_named_and_exits_2() {
             "euler",
         ),
         (&["walk", "--scene", "compass", "--steps", "many"], "many"),
+        (&["sil", "--scene", "compass", "--steps", "2"], "ankle"),
+        (
+            &[
+                "sil",
+                "--scene",
+                "wisse3d",
+                "--steps",
+                "2",
+                "--fault",
+                "drop:idx=5",
+            ],
+            "idx",
+        ),
+        (
+            &[
+                "sil",
+                "--scene",
+                "wisse3d",
+                "--steps",
+                "2",
+                "--fault",
+                "busoff:node=leftt",
+            ],
+            "leftt",
+        ),
+        (
+            &[
+                "sil",
+                "--scene",
+                "wisse3d",
+                "--steps",
+                "2",
+                "--socketcand",
+                "10.0.0.1:5",
+            ],
+            "loopback",
+        ),
     ];
     for (args, needle) in cases {
         let out = walker(args);

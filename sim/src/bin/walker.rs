@@ -529,8 +529,9 @@ fn run(cli: Cli) -> Result<ExitCode> {
                     h_max_s: 0.01,
                 };
             }
+            // Its errors are about the configuration given (fault nodes, log path, address).
             let mut ctl = sim::sil::FirmwareInTheLoop::new(config)
-                .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
+                .map_err(|e| InputError::Other(format!("software in the loop: {e}")))?;
             if let Some(t) = estop_at {
                 ctl.emergency_stop_at(t);
             }
