@@ -12,12 +12,15 @@ fn main() {
         .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &Default::default())
         .expect("gait");
     let (q, qd) = w.unpack(&g.fixed_point);
+    let mut evals = 0;
     let start = std::time::Instant::now();
     for _ in 0..n {
-        std::hint::black_box(w.stride(&q, &qd, Default::default()).expect("stride"));
+        let r = w.stride(&q, &qd, Default::default()).expect("stride");
+        evals = r.evaluations;
+        std::hint::black_box(r);
     }
     println!(
-        "{name}: {:.1} µs per stride",
+        "{name}: {:.1} µs per stride, {evals} evaluations",
         start.elapsed().as_secs_f64() * 1e6 / n as f64
     );
 }

@@ -648,6 +648,7 @@ impl Walker {
                         power.jumped = true;
                     }
                     segment = Some(seg);
+                    integrator.system_changed();
                     next_tick += period_s;
                 }
             }

@@ -45,6 +45,9 @@ const E: [f64; 7] = [
     -1.0 / 40.0,
 ];
 
+/// A kept end derivative: time, positions, velocities, accelerations.
+type Fsal = (f64, DVector<f64>, DVector<f64>, DVector<f64>);
+
 /// Adaptive Dormand-Prince 5(4) with a standard step-size controller.
 #[derive(Clone, Debug)]
 pub struct Dopri5 {
@@ -55,6 +58,21 @@ pub struct Dopri5 {
     evaluations: usize,
     /// Smallest step before giving up [s].
     pub h_min_s: f64,
+    /// First same as last: the last stage of a step is the derivative at its end, reused as
+    /// the first stage of a step from exactly that sample (same time, same state).
+    fsal: Option<Fsal>,
+    /// The last trial step's seventh stage.
+    last_k7: Option<DVector<f64>>,
+}
+
+impl Dopri5 {
+    /// Keeps the accepted step's end derivative for the next step.
+    fn accept(&mut self, next: &Sample) {
+        self.fsal = self
+            .last_k7
+            .take()
+            .map(|k| (next.t_s, next.q.clone(), next.qd.clone(), k));
+    }
 }
 
 impl Dopri5 {
@@ -67,6 +85,8 @@ impl Dopri5 {
             h_next_s: 0.0,
             evaluations: 0,
             h_min_s: 1e-14,
+            fsal: None,
+            last_k7: None,
         }
     }
 
@@ -95,8 +115,19 @@ impl Dopri5 {
                 }
                 (q, v)
             };
-            let acc = sys.accelerations(s.t_s + C[i] * h, &q, &v)?;
-            self.evaluations += 1;
+            let cached = match (&self.fsal, i) {
+                (Some((t, cq, cv, a)), 0) if *t == s.t_s && *cq == s.q && *cv == s.qd => {
+                    Some(a.clone())
+                }
+                _ => None,
+            };
+            let acc = match cached {
+                Some(a) => a,
+                None => {
+                    self.evaluations += 1;
+                    sys.accelerations(s.t_s + C[i] * h, &q, &v)?
+                }
+            };
             kq.push(v);
             kv.push(acc);
         }
@@ -119,6 +150,9 @@ impl Dopri5 {
             err2 += (h * eq / sq).powi(2) + (h * ev / sv).powi(2);
         }
         let err = (err2 / (2 * n).max(1) as f64).sqrt();
+        // The seventh stage was evaluated at the fifth-order solution at t + h: kept for the
+        // next step if this one is accepted.
+        self.last_k7 = kv.pop();
         Ok((
             Sample {
                 t_s: s.t_s + h,
@@ -137,6 +171,10 @@ impl Integrator for Dopri5 {
     fn reset(&mut self) {
         self.evaluations = 0;
         self.h_next_s = 0.0;
+        self.fsal = None;
+    }
+    fn system_changed(&mut self) {
+        self.fsal = None;
     }
     fn proposed_step_s(&self) -> f64 {
         if self.h_next_s > 0.0 {
@@ -162,6 +200,7 @@ impl Integrator for Dopri5 {
             };
             if err <= 1.0 && err.is_finite() {
                 self.h_next_s = (h * factor).min(self.h_max_s);
+                self.accept(&next);
                 return Ok(next);
             }
             h *= if err.is_finite() {
@@ -183,7 +222,9 @@ impl Integrator for Dopri5 {
         from: &Sample,
         h_s: f64,
     ) -> Result<Sample, IntegrationError> {
-        Ok(self.try_step(sys, from, h_s)?.0)
+        let next = self.try_step(sys, from, h_s)?.0;
+        self.accept(&next);
+        Ok(next)
     }
     fn evaluations(&self) -> usize {
         self.evaluations

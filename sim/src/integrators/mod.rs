@@ -180,4 +180,7 @@ pub trait Integrator {
     ) -> Result<Sample, IntegrationError>;
     /// Number of right-hand-side evaluations since `reset`.
     fn evaluations(&self) -> usize;
+    /// The equations changed without the state changing (e.g. a control tick moved an
+    /// actuator): forget any derivative kept from the last step.
+    fn system_changed(&mut self) {}
 }
