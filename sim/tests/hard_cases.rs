@@ -191,3 +191,51 @@ fn a_non_finite_velocity_is_a_typed_failure() {
         .unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
+
+#[test]
+fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay_typed() {
+    // Bisect a start perturbation of the kneed walker between a stride whose knee locks before
+    // heel strike and one whose heel strikes first, down to 1e-12 rad: every stride on the way
+    // ends in one of the two typed outcomes, never anything else. (At this boundary the two
+    // events do not coincide: the heel strike jumps earlier, the swing foot touching down
+    // while the knee is still bent, so the boundary is a discontinuity of the stride map.)
+    let (_, w) = common::walker("kneed2d");
+    let g = common::gait(&w);
+    let i = w
+        .map_names()
+        .iter()
+        .position(|n| n == "stance_leg")
+        .unwrap();
+    let outcome = |d: f64| {
+        let mut v = g.fixed_point.clone();
+        v[i] += d;
+        let (q, qd) = w.unpack(&v);
+        w.stride(&q, &qd, StrideOptions::default())
+    };
+    let (mut ok, mut bad) = (0.0, -0.5);
+    for _ in 0..40 {
+        let mid = 0.5 * (ok + bad);
+        match outcome(mid) {
+            Ok(r) => {
+                assert_eq!(r.events[0].name, "knee_lock:swing_knee");
+                assert!(r
+                    .q_next
+                    .iter()
+                    .chain(r.qd_next.iter())
+                    .all(|v| v.is_finite()));
+                ok = mid;
+            }
+            Err(e) if e.kind == FailureKind::HeelStrikeBeforeKneeLock => bad = mid,
+            Err(e) => panic!("unexpected outcome at {mid}: {e}"),
+        }
+    }
+    assert!((ok - bad).abs() < 1e-12);
+    let (t_ok, t_bad) = (
+        outcome(ok).unwrap().duration_s,
+        outcome(bad).unwrap_err().time_s,
+    );
+    assert!(
+        t_bad < t_ok,
+        "heel strike jumps earlier across the boundary: {t_bad} vs {t_ok}"
+    );
+}
