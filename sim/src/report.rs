@@ -31,19 +31,37 @@ pub struct GaitNumbers {
     pub step_period_s: f64,
     /// Step length [m].
     pub step_length_m: f64,
+    /// Distance walked per step, forward [m].
+    pub progress_m: f64,
     /// Speed [m/s].
     pub speed_m_s: f64,
 }
 
 /// Period, step length and speed of a gait.
-pub fn gait_numbers(gait: &Gait) -> GaitNumbers {
+pub fn gait_numbers(walker: &Walker, gait: &Gait) -> GaitNumbers {
     let step_period_s = gait.stride.duration_s;
     let step_length_m = gait.stride.step_m.norm();
+    let progress_m = forward_progress_m(walker, gait);
     GaitNumbers {
         step_period_s,
         step_length_m,
-        speed_m_s: step_length_m / step_period_s,
+        progress_m,
+        speed_m_s: progress_m / step_period_s,
     }
+}
+
+/// Distance walked per step [m]: half the displacement over two periodic steps, `|c + M c| / 2`
+/// with `c` the step between contacts and `M` the map from one stance frame to the next
+/// (reflection and heading). For a 3D walker this leaves out the sideways zigzag between the
+/// feet, which `step_length_m` (the distance between the contacts) includes.
+pub fn forward_progress_m(walker: &Walker, gait: &Gait) -> f64 {
+    let c = gait.stride.step_m;
+    let next = crate::walk::FloorFrame::default().next(
+        &c,
+        gait.stride.heading_change_rad,
+        walker.relabel.mirror,
+    );
+    (c + next.r * c).norm() / 2.0
 }
 
 /// The `walker gait --json` object.
@@ -79,7 +97,7 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             o.insert("newton_iterations".into(), iterations);
         }
         Ok(g) => {
-            let n = gait_numbers(g);
+            let n = gait_numbers(walker, g);
             let mass = walker.model.total_mass_kg();
             let g_m_s2 = walker.model.gravity_floor_m_s2.norm();
             o.insert("converged".into(), json!(true));
@@ -96,6 +114,7 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             o.insert("stable".into(), json!(g.stable()));
             o.insert("step_period_s".into(), json!(n.step_period_s));
             o.insert("step_length_m".into(), json!(n.step_length_m));
+            o.insert("progress_m_per_step".into(), json!(n.progress_m));
             o.insert("speed_m_s".into(), json!(n.speed_m_s));
             o.insert("newton_iterations".into(), json!(g.iterations));
             o.insert("residual".into(), json!(g.residual));
@@ -134,7 +153,7 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
                 );
                 o.insert(
                     "cost_of_transport_J_per_kg_m".into(),
-                    json!(s.actuator_work_j / (mass * n.step_length_m)),
+                    json!(s.actuator_work_j / (mass * n.progress_m)),
                 );
                 // Over a periodic stride on level ground the actuator's work is what the impacts
                 // and dampers take: the difference checks the quadrature.
@@ -244,24 +263,36 @@ pub fn walk_gait_json(walker: &Walker, walk: &Walk, last: usize) -> Value {
     let period = mean(&|s| s.duration_s);
     let length = mean(&|s| s.step_length_m);
     let work = mean(&|s| s.actuator_work_j);
+    // Distance walked per step: hip displacement over an even number of steps (so that the
+    // sideways zigzag cancels), divided by that number.
+    let k = if n >= 3 { (n - 1) / 2 * 2 } else { n - 1 };
+    let progress = if k == 0 {
+        length
+    } else {
+        let a = &steps[n - 1 - k].hip_floor_m;
+        let b = &steps[n - 1].hip_floor_m;
+        ((b[0] - a[0]).powi(2) + (b[2] - a[2]).powi(2)).sqrt() / k as f64
+    };
     json!({
         "steps_averaged": n,
         "step_period_s": period,
         "step_length_m": length,
-        "speed_m_s": length / period,
-        "cost_of_transport_J_per_kg_m": work / (walker.model.total_mass_kg() * length),
+        "progress_m_per_step": progress,
+        "speed_m_s": progress / period,
+        "cost_of_transport_J_per_kg_m": work / (walker.model.total_mass_kg() * progress),
         "heading_change_rad_per_step": mean(&|s| s.heading_change_rad.abs()),
     })
 }
 
 /// The same figures for a gait's fixed point.
 pub fn ideal_gait_json(walker: &Walker, gait: &Gait) -> Value {
-    let n = gait_numbers(gait);
+    let n = gait_numbers(walker, gait);
     json!({
         "step_period_s": n.step_period_s,
         "step_length_m": n.step_length_m,
         "speed_m_s": n.speed_m_s,
-        "cost_of_transport_J_per_kg_m": gait.stride.actuator_work_j / (walker.model.total_mass_kg() * n.step_length_m),
+        "cost_of_transport_J_per_kg_m": gait.stride.actuator_work_j / (walker.model.total_mass_kg() * n.progress_m),
+        "progress_m_per_step": n.progress_m,
         "heading_change_rad_per_step": gait.stride.heading_change_rad.abs(),
         "max_abs_eigenvalue": gait.max_abs_eigenvalue(),
     })

@@ -65,7 +65,9 @@ pub struct StepSummary {
     pub duration_s: f64,
     /// Distance between the contacts [m].
     pub step_length_m: f64,
-    /// Heading change [rad].
+    /// Yaw of the new stance foot relative to the old one, in the step's own (mirrored) stance
+    /// frame [rad]: for a 3D walker the world heading alternates in sign from step to step, so a
+    /// constant value here is a straight zigzag, not a turn.
     pub heading_change_rad: f64,
     /// Hip position in the floor frame at the end of the step [m].
     pub hip_floor_m: [f64; 3],
