@@ -345,6 +345,7 @@ struct WitnessValues {
     t_s: f64,
     foot_height_m: f64,
     foot_height_rate_m_s: f64,
+    foot_ahead_m: f64,
     hip_height_margin_m: f64,
     hip_ahead_m: f64,
     hip_forward_velocity_m_s: f64,
@@ -369,16 +370,11 @@ impl Witnesses<'_> {
             t_s: s.t_s,
             foot_height_m: p_foot.y,
             foot_height_rate_m_s: self.kin.velocity_of(foot.link, &p_foot).y,
+            foot_ahead_m: (p_foot - p_contact).dot(&heading),
             hip_height_margin_m: p_hip.y - self.walker.fall.min_hip_height_m,
             hip_ahead_m: (p_hip - p_contact).dot(&heading),
             hip_forward_velocity_m_s: self.kin.velocity_of(hip.link, &p_hip).dot(&heading),
         }
-    }
-    fn foot_height(&mut self, s: &Sample) -> f64 {
-        self.update(s);
-        self.kin
-            .point_position(&self.walker.model, self.walker.heel_strike.swing_foot)
-            .y
     }
     /// The walking direction: the stance contact link's forward axis, level with the floor.
     fn heading(&self) -> Vector3<f64> {
@@ -392,36 +388,6 @@ impl Witnesses<'_> {
         } else {
             Vector3::x()
         }
-    }
-    /// How far ahead of the stance contact, along the walking direction, a point is [m].
-    fn ahead_of_stance_m(&mut self, s: &Sample, point: crate::model::PointIndex) -> f64 {
-        self.update(s);
-        let m = &self.walker.model;
-        let d = self.kin.point_position(m, point)
-            - self
-                .kin
-                .point_position(m, self.walker.heel_strike.stance_contact);
-        d.dot(&self.heading())
-    }
-    fn foot_ahead_m(&mut self, s: &Sample) -> f64 {
-        self.ahead_of_stance_m(s, self.walker.heel_strike.swing_foot)
-    }
-    fn hip_height(&mut self, s: &Sample) -> f64 {
-        self.update(s);
-        self.kin
-            .point_position(&self.walker.model, self.walker.fall.hip)
-            .y
-            - self.walker.fall.min_hip_height_m
-    }
-    fn hip_ahead_m(&mut self, s: &Sample) -> f64 {
-        self.ahead_of_stance_m(s, self.walker.fall.hip)
-    }
-    fn hip_forward_velocity(&mut self, s: &Sample) -> f64 {
-        self.update(s);
-        let m = &self.walker.model;
-        let p = &m.points[self.walker.fall.hip.0];
-        let x = self.kin.position_of(p.link, &p.p_link_m);
-        self.kin.velocity_of(p.link, &x).dot(&self.heading())
     }
 }
 
@@ -495,9 +461,9 @@ impl ContactSummary {
         self.lateral_cop_trace.push((s.t_s, cop));
         self.max_lateral_cop_m = self.max_lateral_cop_m.max(cop.abs());
         self.min_normal_force_n = self.min_normal_force_n.min(load.force_n.y);
-        let ahead = wit.foot_ahead_m(&s2);
-        if ahead.abs() < 0.1 {
-            let h = wit.foot_height(&s2);
+        let w = wit.eval(&s2);
+        if w.foot_ahead_m.abs() < 0.1 {
+            let h = w.foot_height_m;
             self.mid_swing_clearance_m = Some(self.mid_swing_clearance_m.map_or(h, |m| m.min(h)));
         }
         Ok(())
@@ -769,14 +735,14 @@ impl Walker {
             let mut first: Option<(Watch, Sample)> = None;
             for w in triggered {
                 let mut g: Box<dyn FnMut(&Sample) -> f64> = match w {
-                    Watch::Heel => Box::new(|s: &Sample| wit.foot_height(s)),
+                    Watch::Heel => Box::new(|s: &Sample| wit.eval(s).foot_height_m),
                     Watch::Knee(k) => {
                         let c = self.knees[k].coordinate.0;
                         let stop = self.knees[k].stop_rad;
                         Box::new(move |s: &Sample| s.q[c] - stop)
                     }
-                    Watch::HipLow => Box::new(|s: &Sample| wit.hip_height(s)),
-                    Watch::HipBack => Box::new(|s: &Sample| wit.hip_forward_velocity(s)),
+                    Watch::HipLow => Box::new(|s: &Sample| wit.eval(s).hip_height_margin_m),
+                    Watch::HipBack => Box::new(|s: &Sample| wit.eval(s).hip_forward_velocity_m_s),
                     Watch::Engage => {
                         let (a, e) = self
                             .ankle
@@ -819,7 +785,7 @@ impl Walker {
                 })?;
             match watch {
                 Watch::HipLow => {
-                    let kind = if wit.hip_ahead_m(&at) >= 0.0 {
+                    let kind = if wit.eval(&at).hip_ahead_m >= 0.0 {
                         FailureKind::FellForward
                     } else {
                         FailureKind::FellBackward
@@ -945,7 +911,7 @@ impl Walker {
                     }
                 }
                 Watch::Heel => {
-                    let ahead = wit.foot_ahead_m(&at);
+                    let ahead = wit.eval(&at).foot_ahead_m;
                     if ahead < self.heel_strike.min_ahead_m {
                         if self.heel_strike.ignore_scuffing {
                             cur = next;
