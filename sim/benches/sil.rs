@@ -4,7 +4,6 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use sim::integrators::IntegratorChoice;
 use sim::scene::Scene;
 use sim::sil::config::SilConfig;
 use sim::sil::FirmwareInTheLoop;
@@ -19,11 +18,7 @@ fn bench(c: &mut Criterion) {
         )
         .unwrap();
     let (q, qd) = walker.unpack(&gait.fixed_point);
-    walker.integrator = IntegratorChoice::Dopri5 {
-        rtol: 1e-9,
-        atol: 1e-9,
-        h_max_s: 0.01,
-    };
+    walker.integrator = sim::sil::SIL_INTEGRATOR;
     let reflex = walker.ankle.clone().unwrap();
     let mut group = c.benchmark_group("sil");
     group.sample_size(10);

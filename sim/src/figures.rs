@@ -56,7 +56,7 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
         .map(|(i, (label, w))| Series {
             label: match &w.failure {
                 Some(f) => format!("{label} (fails in step {}: {:?})", f.step + 1, f.kind),
-                None => format!("{label} ({} steps)", w.steps.len()),
+                None => format!("{label} ({} steps)", w.steps_completed),
             },
             points: w
                 .path

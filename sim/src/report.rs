@@ -194,7 +194,7 @@ pub fn walk_json(scene: &Scene, walk: &Walk) -> Value {
     json!({
         "scene": scene.name(),
         "parameters": scene.values,
-        "steps_completed": walk.steps.len(),
+        "steps_completed": walk.steps_completed,
         "failure": walk.failure,
         "steps": walk.steps,
     })

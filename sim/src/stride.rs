@@ -120,7 +120,7 @@ pub struct StrideResult {
     pub evaluations: usize,
     /// Accepted samples, when recording.
     pub trajectory: Vec<Sample>,
-    /// Work done by the ankle actuator (trapezoidal quadrature on accepted steps) [J].
+    /// Work done by the ankle actuator (from the energy balance of the engaged intervals) [J].
     pub actuator_work_j: f64,
     /// Energy dissipated by joint dampers (trapezoidal quadrature) [J].
     pub damping_dissipation_j: f64,
@@ -129,35 +129,45 @@ pub struct StrideResult {
 }
 
 /// Running actuator work and damper dissipation over accepted steps.
-#[derive(Default)]
+///
+/// The damper's dissipation `∫ c q̇² dt` is a trapezoidal quadrature (smooth integrand). The
+/// actuator's work is taken from the energy balance of each interval over which the string
+/// stays engaged without an impact, `W = E(end) − E(start) + D(start, end)`: exact up to the
+/// state's own integration error, whatever the step sizes. (A quadrature of the actuator power
+/// `τ q̇` is not: with a controller the drive's acceleration jumps at every control tick, and a
+/// trapezoid over one or two steps per tick lost 1.6 % of the work at DOPRI5 1e-9.)
 struct Power {
     work_j: f64,
     dissipation_j: f64,
-    /// Actuator power at the start of the current step, if known.
-    last_w: Option<f64>,
-    /// Velocities jumped (impact) since the last sample: restart the quadrature.
-    jumped: bool,
+    /// Energy and dissipation so far at the start of the open engaged interval.
+    open: Option<(f64, f64)>,
+    dynamics: Dynamics,
 }
 
 impl Power {
-    fn actuator_power(phase: &mut Phase, s: &Sample) -> Result<f64, DynamicsError> {
-        let (tau, rate) = phase.actuator_torque(s)?;
-        Ok(tau * rate)
+    fn new(model: &Model) -> Self {
+        Self {
+            work_j: 0.0,
+            dissipation_j: 0.0,
+            open: None,
+            dynamics: Dynamics::new(model),
+        }
     }
 
-    fn restart(&mut self, phase: &mut Phase, s: &Sample) -> Result<(), DynamicsError> {
-        self.last_w = Some(Self::actuator_power(phase, s)?);
-        self.jumped = false;
-        Ok(())
+    /// An engaged interval starts at `s` (after the engagement or a knee-lock impact).
+    fn open(&mut self, model: &Model, s: &Sample) {
+        self.open = Some((energy(&mut self.dynamics, model, s), self.dissipation_j));
     }
 
-    fn accumulate(
-        &mut self,
-        phase: &mut Phase,
-        damping: &[(usize, f64)],
-        from: &Sample,
-        to: &Sample,
-    ) -> Result<(), DynamicsError> {
+    /// The open interval, if any, ends at `s` (before an impact or at heel strike).
+    fn close(&mut self, model: &Model, s: &Sample) {
+        if let Some((e0, d0)) = self.open.take() {
+            let e1 = energy(&mut self.dynamics, model, s);
+            self.work_j += e1 - e0 + (self.dissipation_j - d0);
+        }
+    }
+
+    fn accumulate(&mut self, damping: &[(usize, f64)], from: &Sample, to: &Sample) {
         let h = to.t_s - from.t_s;
         let diss = |s: &Sample| {
             damping
@@ -166,17 +176,6 @@ impl Power {
                 .sum::<f64>()
         };
         self.dissipation_j += 0.5 * h * (diss(from) + diss(to));
-        if phase.prescribed.is_some() {
-            let w0 = match (self.last_w, self.jumped) {
-                (Some(w), false) => w,
-                _ => Self::actuator_power(phase, from)?,
-            };
-            let w1 = Self::actuator_power(phase, to)?;
-            self.work_j += 0.5 * h * (w0 + w1);
-            self.last_w = Some(w1);
-        }
-        self.jumped = false;
-        Ok(())
     }
 }
 
@@ -542,7 +541,7 @@ impl Walker {
             .filter_map(|l| l.coordinate.map(|c| (c.0, l.joint_force.damping)))
             .filter(|(_, d)| *d != 0.0)
             .collect();
-        let mut power = Power::default();
+        let mut power = Power::new(&self.model);
         let mut contact = ContactSummary::default();
         // Witness values at `cur`, carried over from the previous step.
         let mut w_cached: Option<WitnessValues> = None;
@@ -610,11 +609,14 @@ impl Walker {
                         }
                         phase.prescribed = Some((coord, Drive::Segment(seg)));
                         phase.snap(&mut cur);
-                        // The drive's acceleration jumps at a tick: restart the power quadrature.
-                        power.jumped = true;
+                    }
+                    // Only an engaged string's new segment changes the vector field; while
+                    // the ankle is free the tick only moves the engagement witness, and the
+                    // integrator keeps its last stage (first same as last).
+                    if phase.prescribed.is_some() {
+                        integrator.system_changed();
                     }
                     segment = Some(seg);
-                    integrator.system_changed();
                     next_tick += period_s;
                 }
             }
@@ -713,11 +715,7 @@ impl Walker {
                 }
             }
             if triggered.is_empty() {
-                power
-                    .accumulate(&mut phase, &damping, &cur, &next)
-                    .map_err(|e| {
-                        StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
-                    })?;
+                power.accumulate(&damping, &cur, &next);
                 if options.contact {
                     contact
                         .add(self, &mut phase, &mut wit, &next)
@@ -778,11 +776,7 @@ impl Walker {
                 continue;
             };
             phase.snap(&mut at);
-            power
-                .accumulate(&mut phase, &damping, &cur, &at)
-                .map_err(|e| {
-                    StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string())
-                })?;
+            power.accumulate(&damping, &cur, &at);
             match watch {
                 Watch::HipLow => {
                     let kind = if wit.eval(&at).hip_ahead_m >= 0.0 {
@@ -861,9 +855,7 @@ impl Walker {
                     act[a] = false;
                     phase.active = act;
                     phase.prescribed = Some((r.ankle, drive));
-                    power.restart(&mut phase, &cur).map_err(|e| {
-                        StrideFailure::new(FailureKind::NonFiniteState, at.t_s, e.to_string())
-                    })?;
+                    power.open(&self.model, &cur);
                     events.push(StrideEvent {
                         name: "string_engaged".into(),
                         time_s: at.t_s,
@@ -878,6 +870,7 @@ impl Walker {
                     let c = self.knees[k].coordinate.0;
                     let mut g = DMatrix::zeros(1, self.model.dof());
                     g[(0, c)] = 1.0;
+                    power.close(&self.model, &at);
                     let mut dynamics = Dynamics::new(&self.model);
                     let before = energy(&mut dynamics, &self.model, &at);
                     let imp = resolve(
@@ -894,11 +887,13 @@ impl Walker {
                     })?;
                     phase.active[c] = false;
                     let mut qd = imp.qd_plus;
-                    power.jumped = true;
                     qd[c] = 0.0;
                     let mut q = at.q.clone();
                     q[c] = self.knees[k].stop_rad;
                     cur = Sample { t_s: at.t_s, q, qd };
+                    if phase.prescribed.is_some() {
+                        power.open(&self.model, &cur);
+                    }
                     energy_loss += before - energy(&mut dynamics, &self.model, &cur);
                     events.push(StrideEvent {
                         name: format!("knee_lock:{}", self.model.coordinates[c].name),
@@ -914,6 +909,7 @@ impl Walker {
                     let ahead = wit.eval(&at).foot_ahead_m;
                     if ahead < self.heel_strike.min_ahead_m {
                         if self.heel_strike.ignore_scuffing {
+                            power.accumulate(&damping, &at, &next);
                             cur = next;
                             if options.record {
                                 trajectory.push(cur.clone());
@@ -936,6 +932,7 @@ impl Walker {
                             ),
                         ));
                     }
+                    power.close(&self.model, &at);
                     if let Some((c, t0)) = control.as_mut() {
                         c.heel_strike(*t0 + at.t_s);
                     }

@@ -77,6 +77,8 @@ pub struct StepSummary {
     pub impact_energy_loss_j: f64,
     /// Work of the ankle actuator [J].
     pub actuator_work_j: f64,
+    /// Right-hand-side evaluations the step cost (event location and impacts included).
+    pub evaluations: usize,
     /// Events.
     pub events: Vec<StrideEvent>,
     /// Stride-map state at the end of the step, by name.
@@ -111,10 +113,23 @@ pub struct PathSample {
     pub hip_floor_m: Vector3<f64>,
 }
 
+/// What a walk keeps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WalkOptions {
+    /// Record the path (every integration sample).
+    pub record: bool,
+    /// Keep only the summaries of the last this many steps in [`Walk::steps`] (`None`: all).
+    /// A long walk (a soak) then runs in bounded memory; [`Walk::steps_completed`] still
+    /// counts every step and the per-step callback of [`Walker::walk_streaming`] sees each.
+    pub keep_steps: Option<usize>,
+}
+
 /// The outcome of a walk.
 #[derive(Clone, Debug)]
 pub struct Walk {
     /// Steps completed.
+    pub steps_completed: usize,
+    /// Summaries of the steps completed (the last [`WalkOptions::keep_steps`] of them).
     pub steps: Vec<StepSummary>,
     /// The first failure, if any.
     pub failure: Option<WalkFailure>,
@@ -125,7 +140,11 @@ pub struct Walk {
 impl Walker {
     /// Walks up to `steps` strides from `q0`, `qd0`; records the path when `record`.
     pub fn walk(&self, q0: &DVector<f64>, qd0: &DVector<f64>, steps: usize, record: bool) -> Walk {
-        self.walk_inner(q0, qd0, steps, record, None)
+        let options = WalkOptions {
+            record,
+            keep_steps: None,
+        };
+        self.walk_streaming(q0, qd0, steps, options, None, &mut |_| {})
     }
 
     /// As [`Self::walk`], with the stance ankle's string moved by `controller` at its control
@@ -138,23 +157,34 @@ impl Walker {
         record: bool,
         controller: &mut dyn AnkleController,
     ) -> Walk {
-        self.walk_inner(q0, qd0, steps, record, Some(controller))
+        let options = WalkOptions {
+            record,
+            keep_steps: None,
+        };
+        self.walk_streaming(q0, qd0, steps, options, Some(controller), &mut |_| {})
     }
 
-    fn walk_inner(
+    /// Walks up to `steps` strides, handing each step's summary to `on_step` as it completes;
+    /// with a controller the stance ankle's string is moved by it (as
+    /// [`Self::walk_controlled`]). With [`WalkOptions::keep_steps`] and no recording the
+    /// memory stays bounded however long the walk.
+    pub fn walk_streaming(
         &self,
         q0: &DVector<f64>,
         qd0: &DVector<f64>,
         steps: usize,
-        record: bool,
+        options: WalkOptions,
         mut controller: Option<&mut dyn AnkleController>,
+        on_step: &mut dyn FnMut(&StepSummary),
     ) -> Walk {
+        let (record, keep_steps) = (options.record, options.keep_steps);
         let mut frame = FloorFrame::default();
         let (mut q, mut qd) = (q0.clone(), qd0.clone());
         let v0 = self.pack(q0, qd0);
         let names = self.map_names();
         let mut kin = Kinematics::new(&self.model);
         let mut out = Walk {
+            steps_completed: 0,
             steps: Vec::new(),
             failure: None,
             path: Vec::new(),
@@ -190,7 +220,7 @@ impl Walker {
                     kin.update(&self.model, &r.pre_impact.q, &r.pre_impact.qd);
                     let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
                     let v = self.pack(&r.q_next, &r.qd_next);
-                    out.steps.push(StepSummary {
+                    let summary = StepSummary {
                         step,
                         start_time_s: t0,
                         duration_s: r.duration_s,
@@ -200,15 +230,29 @@ impl Walker {
                         state_deviation: (&v - &v0).amax(),
                         impact_energy_loss_j: r.impact_energy_loss_j,
                         actuator_work_j: r.actuator_work_j,
+                        evaluations: r.evaluations,
                         events: r.events.clone(),
                         state: names.iter().cloned().zip(v.iter().copied()).collect(),
-                    });
+                    };
+                    on_step(&summary);
+                    out.steps_completed += 1;
+                    out.steps.push(summary);
+                    // Bounded: drop the oldest half once twice the kept number accumulate.
+                    if let Some(keep) = keep_steps {
+                        if out.steps.len() >= 2 * keep.max(1) {
+                            out.steps.drain(..out.steps.len() - keep);
+                        }
+                    }
                     frame = frame.next(&r.step_m, r.heading_change_rad, self.relabel.mirror);
                     t0 += r.duration_s;
                     q = r.q_next;
                     qd = r.qd_next;
                 }
             }
+        }
+        if let Some(keep) = keep_steps {
+            let excess = out.steps.len().saturating_sub(keep);
+            out.steps.drain(..excess);
         }
         out
     }

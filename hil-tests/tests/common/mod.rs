@@ -28,12 +28,14 @@ pub fn setup() -> &'static Setup {
     static S: OnceLock<Setup> = OnceLock::new();
     S.get_or_init(|| {
         let scene = Scene::load(SCENE).expect("scene loads");
-        let walker = scene.build().expect("scene builds");
+        let mut walker = scene.build().expect("scene builds");
         let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
         let gait = walker
             .find_gait(&v0, &NewtonSettings::default())
             .expect("gait converges");
         let (q0, qd0) = walker.unpack(&gait.fixed_point);
+        // The gait with the scene's integrator; the walks with the firmware's.
+        walker.integrator = sim::sil::SIL_INTEGRATOR;
         Setup {
             period_s: gait.stride.duration_s,
             walker,
@@ -93,7 +95,7 @@ pub fn summary(walk: &Walk, r: &SilReport) -> String {
         .collect();
     format!(
         "steps {} failure {:?}\n  t_end {:.3} s, heel strikes {}, frames {}, bus load {:.2} %, error frames {}, bus-off {:?}\n  {}\n  states {:?}",
-        walk.steps.len(),
+        walk.steps_completed,
         walk.failure.as_ref().map(|f| (f.kind, f.step, f.time_s)),
         r.t_end_s,
         r.heel_strikes,

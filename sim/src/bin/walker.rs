@@ -386,7 +386,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 println!(
                     "scene {}: {} of {steps} steps",
                     scene.name(),
-                    walk.steps.len()
+                    walk.steps_completed
                 );
                 println!(
                     "{:>5} {:>10} {:>10} {:>10} {:>12}",
@@ -510,8 +510,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
             config.candump = candump;
             config.socketcand = socketcand;
             // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
-            // the firmware uses DOPRI5 at 1e-9 (one or two steps per 1 ms control tick) unless
-            // an integrator is given on the command line.
+            // the firmware uses `sim::sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
+            // per 1 ms control tick) unless an integrator is given on the command line.
             let ideal_walker = scene.build()?;
             let v0 = ideal_walker.pack(&ideal_walker.guess_q, &ideal_walker.guess_qd);
             let ideal = match ideal_walker.find_gait(&v0, &common.newton()) {
@@ -523,11 +523,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             };
             let mut walker = walker;
             if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
-                walker.integrator = IntegratorChoice::Dopri5 {
-                    rtol: 1e-9,
-                    atol: 1e-9,
-                    h_max_s: 0.01,
-                };
+                walker.integrator = sim::sil::SIL_INTEGRATOR;
             }
             // Its errors are about the configuration given (fault nodes, log path, address).
             let mut ctl = sim::sil::FirmwareInTheLoop::new(config)
@@ -556,7 +552,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             let out = json!({
                 "scene": scene.name(),
                 "integrator": walker.integrator,
-                "steps_completed": walk.steps.len(),
+                "steps_completed": walk.steps_completed,
                 "failure": walk.failure,
                 "gait": sil_gait,
                 "ideal_gait": ideal_gait,
@@ -573,7 +569,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 println!(
                     "scene {}: {} of {steps} steps with the firmware actuating",
                     scene.name(),
-                    walk.steps.len()
+                    walk.steps_completed
                 );
                 if let Some(f) = &walk.failure {
                     println!(
