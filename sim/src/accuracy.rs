@@ -51,7 +51,8 @@ pub struct AccuracyStudy {
     pub points: Vec<AccuracyPoint>,
 }
 
-/// The settings studied: fixed steps for Meijaard and RK4 (halving), tolerances for DOPRI5.
+/// The settings studied: fixed steps for Meijaard and RK4 (halving), tolerances for DOPRI5
+/// and DOP853.
 pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
     let mut out = Vec::new();
     for k in 0..6 {
@@ -75,6 +76,18 @@ pub fn default_settings(period_s: f64) -> Vec<(String, f64, IntegratorChoice)> {
             "dopri5".into(),
             tol,
             IntegratorChoice::Dopri5 {
+                rtol: tol,
+                atol: tol,
+                h_max_s: period_s / 10.0,
+            },
+        ));
+    }
+    for k in [4, 6, 8, 10, 12] {
+        let tol = 10f64.powi(-k);
+        out.push((
+            "dop853".into(),
+            tol,
+            IntegratorChoice::Dop853 {
                 rtol: tol,
                 atol: tol,
                 h_max_s: period_s / 10.0,

@@ -151,13 +151,13 @@ struct Common {
     /// Print JSON.
     #[arg(long)]
     json: bool,
-    /// Integrator: meijaard, rk4 or dopri5 (default: the scene's).
+    /// Integrator: meijaard, rk4, dopri5 or dop853 (default: the scene's).
     #[arg(long)]
     integrator: Option<String>,
     /// Fixed step for meijaard/rk4 [s].
     #[arg(long)]
     step_s: Option<f64>,
-    /// Relative and absolute tolerance for dopri5.
+    /// Relative and absolute tolerance for dopri5 and dop853.
     #[arg(long)]
     rtol: Option<f64>,
     /// Newton tolerance on |Δv|.
@@ -205,13 +205,21 @@ impl Common {
             w.integrator = IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None)
                 .ok_or_else(|| {
                     InputError::Other(format!(
-                        "--integrator `{kind}`: expected meijaard, rk4 or dopri5"
+                        "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
                     ))
                 })?;
         } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) =
             (self.rtol, &w.integrator)
         {
             w.integrator = IntegratorChoice::Dopri5 {
+                rtol: r,
+                atol: r,
+                h_max_s: *h_max_s,
+            };
+        } else if let (Some(r), IntegratorChoice::Dop853 { h_max_s, .. }) =
+            (self.rtol, &w.integrator)
+        {
+            w.integrator = IntegratorChoice::Dop853 {
                 rtol: r,
                 atol: r,
                 h_max_s: *h_max_s,

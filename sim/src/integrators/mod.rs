@@ -3,10 +3,12 @@
 //! Every integrator advances a [`SecondOrderSystem`] by one accepted step and can take an
 //! exact step of any smaller size, which the event locator uses to refine event times.
 
+mod dop853;
 mod dopri5;
 mod meijaard;
 mod rk4;
 
+pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use meijaard::{Meijaard, StabilityLimit};
 pub use rk4::Rk4;
@@ -92,6 +94,15 @@ pub enum IntegratorChoice {
         /// Step [s].
         h_s: f64,
     },
+    /// Dormand-Prince 8(5,3), adaptive (Hairer's DOP853).
+    Dop853 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance.
+        atol: f64,
+        /// Largest step [s].
+        h_max_s: f64,
+    },
     /// Dormand-Prince 5(4), adaptive.
     Dopri5 {
         /// Relative tolerance.
@@ -116,10 +127,15 @@ impl IntegratorChoice {
                 atol,
                 h_max_s,
             } => Box::new(Dopri5::new(rtol, atol, h_max_s)),
+            IntegratorChoice::Dop853 {
+                rtol,
+                atol,
+                h_max_s,
+            } => Box::new(Dop853::new(rtol, atol, h_max_s)),
         }
     }
 
-    /// An integrator by kind name (`meijaard`, `rk4`, `dopri5`) with optional settings; the
+    /// An integrator by kind name (`meijaard`, `rk4`, `dopri5`, `dop853`) with optional settings; the
     /// defaults are a 1 ms step, tolerances 1e-12 and a 0.05 s largest step. `None` for an
     /// unknown kind.
     pub fn from_kind(
@@ -141,6 +157,11 @@ impl IntegratorChoice {
                 atol: atol.or(rtol).unwrap_or(1e-12),
                 h_max_s: h_max_s.unwrap_or(0.05),
             }),
+            "dop853" => Some(IntegratorChoice::Dop853 {
+                rtol: rtol.unwrap_or(1e-12),
+                atol: atol.or(rtol).unwrap_or(1e-12),
+                h_max_s: h_max_s.unwrap_or(0.05),
+            }),
             _ => None,
         }
     }
@@ -151,6 +172,7 @@ impl IntegratorChoice {
             IntegratorChoice::Meijaard { h_s, .. } => format!("meijaard h={h_s:e}"),
             IntegratorChoice::Rk4 { h_s } => format!("rk4 h={h_s:e}"),
             IntegratorChoice::Dopri5 { rtol, .. } => format!("dopri5 rtol={rtol:e}"),
+            IntegratorChoice::Dop853 { rtol, .. } => format!("dop853 rtol={rtol:e}"),
         }
     }
 }
