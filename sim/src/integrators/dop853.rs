@@ -2,6 +2,9 @@
 //! eighth-order Runge-Kutta pair with the combined fifth- and third-order error estimate. At
 //! tight tolerances its steps are several times longer than DOPRI5's for the same error.
 
+// The coefficients are written with the digits Hairer published, beyond f64's precision.
+#![allow(clippy::excessive_precision)]
+
 use super::{IntegrationError, Integrator, Sample, SecondOrderSystem};
 use nalgebra::DVector;
 
