@@ -390,6 +390,12 @@ impl Bus {
         self.nodes.get(node.0).map(|n| n.name.as_str())
     }
 
+    /// Frames waiting in a node's transmit queue (its capacity is
+    /// [`BusConfig::tx_queue_capacity`]).
+    pub fn queued_frames(&self, node: NodeHandle) -> Option<usize> {
+        self.nodes.get(node.0).map(|n| n.queue.len())
+    }
+
     /// A node's fault-confinement state and transmit error counter.
     pub fn node_error_state(&self, node: NodeHandle) -> Option<(ErrorState, u16)> {
         self.nodes.get(node.0).map(|n| (n.state, n.tec))

@@ -122,6 +122,9 @@ pub struct SilConfig {
     pub trailing_contact_s: f64,
     /// The string actuator.
     pub actuator: ActuatorParams,
+    /// Depth of each node's CAN receive FIFO [frames]. Default 16 (the board's `RxBuf<16>`);
+    /// a frame that finds it full is lost and counted (`NodeReport::rx_overflows`).
+    pub rx_queue_frames: usize,
     /// Faults on the bus (`drop`, `delay`, `corrupt`, `babble`, `busoff`; nodes `host`,
     /// `left`, `right` or 1, 2, 3).
     pub bus_faults: Vec<FaultSpec>,
@@ -132,6 +135,11 @@ pub struct SilConfig {
     pub setup_commands: Vec<protocol::Command>,
     /// Host commands besides the setup and the `Enable`.
     pub host_commands: Vec<HostCommand>,
+    /// Entries each history of the report keeps (state and phase changes, faults, landings,
+    /// bus-off events, host commands, parameter acknowledgements): the first half and the
+    /// most recent half; the rest are counted in `SilReport::history_elided`. Default 10,000,
+    /// so that the memory of a long run (a soak) stays bounded.
+    pub history_capacity: usize,
     /// Write every bus event to this candump log.
     pub candump: Option<PathBuf>,
     /// Serve the bus over socketcand on this loopback address (`127.0.0.1:PORT`).
@@ -149,10 +157,12 @@ impl Default for SilConfig {
             debounce_samples: 3,
             trailing_contact_s: 0.010,
             actuator: ActuatorParams::default(),
+            rx_queue_frames: 16,
             bus_faults: Vec::new(),
             sensor_faults: Vec::new(),
             setup_commands: Vec::new(),
             host_commands: Vec::new(),
+            history_capacity: 10_000,
             candump: None,
             socketcand: None,
         }

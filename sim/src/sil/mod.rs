@@ -9,9 +9,16 @@
 //!    host sees everything; the candump log and the socketcand server get every event;
 //! 2. the host sends its due commands (`Enable` to every ankle at the first tick, the
 //!    scheduled ones, frames from socketcand clients);
-//! 3. each node reads its simulated sensors ([`sensors`]) and ticks; its messages are encoded
-//!    and queued on the bus at the tick time; its actuator command moves its string
-//!    ([`actuator`]); the stance ankle's string is the tick's [`ActuatorSegment`].
+//! 3. each node runs one [`firmware::runner::AnkleDrivers::step`], as on the board, over
+//!    sim-backed hardware ([`hal`]): the orchestrator sets the shaft angle (the encoder's SPI
+//!    device quantises it, [`sensors`]), the raw contact switch, the clock and the room in the
+//!    bus node's transmit queue, steps the drivers, queues the frames the node's CAN
+//!    controller accepted on the bus at the tick time, and takes the segment its actuator
+//!    ([`actuator`] behind [`hal::SimActuator`]) moved the string through; the stance ankle's
+//!    segment is the tick's [`ActuatorSegment`].
+//!
+//! The board's `PwmDirActuator` (a P loop over PWM duty and a direction pin) is replaced by the
+//! servo model: see [`hal`] for why.
 //!
 //! The walker model always has its stance leg on the right of its mirrored frame; physically
 //! the stance alternates, starting with [`SilConfig::first_stance`], and
@@ -19,22 +26,27 @@
 
 pub mod actuator;
 pub mod config;
+pub mod hal;
+pub mod history;
 pub mod report;
 pub mod sensors;
 
 #[cfg(test)]
 mod tests;
 
-use std::collections::VecDeque;
+use std::cell::RefCell;
 use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::rc::Rc;
 
 use canbus::candump::CandumpWriter;
 use canbus::socketcand::{ServerConfig, SocketcandServer};
 use canbus::{Bus, BusError, BusEvent, ErrorState, Frame, NodeHandle, SendOutcome};
-use firmware::node::MAX_RX_PER_TICK;
-use firmware::sensors::Debouncer;
-use firmware::{ActuatorCommand, AnkleNode, DriverHealth, Instant, NodeConfig, TickInputs};
+use firmware::drivers::can::CanPort;
+use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
+use firmware::drivers::encoder::MagneticEncoder;
+use firmware::runner::AnkleDrivers;
+use firmware::{AnkleNode, Instant, NodeConfig};
 use protocol::{
     Command, CommandKind, FaultCode, FaultTransition, Message, NodeId, NodeState, ReflexPhase,
     Target,
@@ -44,11 +56,14 @@ use crate::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlErro
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
 pub use config::{HostCommand, Side, SilConfig, SwingAnkleModel};
+pub use history::BoundedLog;
 pub use report::{
-    FaultRecord, HostReport, Landing, NodeReport, PhaseChange, SilReport, SocketcandReport,
-    StateChange,
+    FaultRecord, HistoryElided, HostReport, Landing, NodeReport, PhaseChange, SilReport,
+    SocketcandReport, StateChange,
 };
 pub use sensors::{SensorFault, SimEncoder, SwingAnkle};
+
+use hal::{ActuatorLink, CanLink, Shaft, SimActuator, SimCan, SimClock, SimContactPin, SimSpi};
 
 /// The integrator of a firmware-in-the-loop walk: DOPRI5 at rtol = atol = 1e-6.
 ///
@@ -93,17 +108,23 @@ pub enum SilError {
     Socketcand(#[from] canbus::socketcand::ServerError),
 }
 
-/// One ankle: its node, sensors, actuator and counters.
+/// The board's drivers over the simulator's hardware.
+type SimDrivers = AnkleDrivers<SimSpi, SimContactPin, SimActuator, SimCan, SimClock>;
+
+/// One ankle: its firmware behind its drivers, the orchestrator's ends of the hardware, and
+/// counters.
 struct Ankle {
     side: Side,
-    node: AnkleNode,
     handle: NodeHandle,
-    encoder: SimEncoder,
+    drivers: SimDrivers,
+    shaft: Shaft,
+    contact: SimContactPin,
+    clock: SimClock,
+    can: Rc<RefCell<CanLink>>,
+    actuator: Rc<RefCell<ActuatorLink>>,
     swing: Option<SwingAnkle>,
-    debouncer: Option<Debouncer>,
-    actuator: ActuatorModel,
-    inbox: VecDeque<Message>,
-    can_error: bool,
+    /// The contact switch has been sampled for the debounce length before the first tick.
+    settled: bool,
     last_state: NodeState,
     last_phase: ReflexPhase,
     report: NodeReport,
@@ -124,7 +145,7 @@ pub struct FirmwareInTheLoop {
     /// The stance angle at which each side's foot last landed [rad].
     landing_rad: [Option<f64>; 2],
     landing_pending: bool,
-    landings: Vec<Landing>,
+    landings: BoundedLog<Landing>,
     schedule: Vec<HostCommand>,
     next_command: usize,
     enabled_sent: bool,
@@ -133,10 +154,12 @@ pub struct FirmwareInTheLoop {
     ticks: u64,
     heel_strikes: u64,
     frames_delivered: u64,
-    bus_off: Vec<(f64, String)>,
-    state_history: Vec<StateChange>,
-    phase_history: Vec<PhaseChange>,
-    faults: Vec<FaultRecord>,
+    bus_off: BoundedLog<(f64, String)>,
+    state_history: BoundedLog<StateChange>,
+    phase_history: BoundedLog<PhaseChange>,
+    faults: BoundedLog<FaultRecord>,
+    commands_sent: BoundedLog<(f64, String)>,
+    param_acks: BoundedLog<String>,
     host_report: HostReport,
 }
 
@@ -181,16 +204,34 @@ impl FirmwareInTheLoop {
                 .filter(|f| f.side() == side)
                 .copied()
                 .collect();
+            let calibration = config.calibration[side.index()];
+            let shaft = Shaft::new();
+            let spi = SimSpi::new(SimEncoder::new(calibration, faults), shaft.clone());
+            let contact = SimContactPin::new();
+            let clock = SimClock::new();
+            let can = Rc::new(RefCell::new(CanLink::new(config.rx_queue_frames)));
+            let actuator = Rc::new(RefCell::new(ActuatorLink::new(ActuatorModel::new(
+                config.actuator,
+            ))));
+            let drivers = AnkleDrivers::new(
+                node,
+                MagneticEncoder::new(spi, calibration),
+                ContactSwitch::new(contact.clone(), ActiveLevel::Low, config.debounce_samples),
+                SimActuator::new(Rc::clone(&actuator)),
+                CanPort::new(SimCan::new(Rc::clone(&can))),
+                clock.clone(),
+            );
             Ok(Ankle {
                 side,
-                node,
                 handle,
-                encoder: SimEncoder::new(config.calibration[side.index()], faults),
+                drivers,
+                shaft,
+                contact,
+                clock,
+                can,
+                actuator,
                 swing: None,
-                debouncer: None,
-                actuator: ActuatorModel::new(config.actuator),
-                inbox: VecDeque::new(),
-                can_error: false,
+                settled: false,
                 last_state: NodeState::Disabled,
                 last_phase: ReflexPhase::Inactive,
                 report: NodeReport::default(),
@@ -217,6 +258,7 @@ impl FirmwareInTheLoop {
             )?),
             None => None,
         };
+        let cap = config.history_capacity;
         Ok(FirmwareInTheLoop {
             period_us: period_us_f as u64,
             stance: config.first_stance,
@@ -229,7 +271,7 @@ impl FirmwareInTheLoop {
             last_heel_strike_s: None,
             landing_rad: [None, None],
             landing_pending: true,
-            landings: Vec::new(),
+            landings: BoundedLog::new(cap),
             schedule,
             next_command: 0,
             enabled_sent: false,
@@ -238,10 +280,12 @@ impl FirmwareInTheLoop {
             ticks: 0,
             heel_strikes: 0,
             frames_delivered: 0,
-            bus_off: Vec::new(),
-            state_history: Vec::new(),
-            phase_history: Vec::new(),
-            faults: Vec::new(),
+            bus_off: BoundedLog::new(cap),
+            state_history: BoundedLog::new(cap),
+            phase_history: BoundedLog::new(cap),
+            faults: BoundedLog::new(cap),
+            commands_sent: BoundedLog::new(cap),
+            param_acks: BoundedLog::new(cap),
             host_report: HostReport::default(),
         })
     }
@@ -277,7 +321,7 @@ impl FirmwareInTheLoop {
 
     /// One node's firmware (read-only).
     pub fn node(&self, side: Side) -> &AnkleNode {
-        &self.ankle(side).node
+        &self.ankle(side).drivers.node
     }
 
     /// The configuration.
@@ -310,11 +354,21 @@ impl FirmwareInTheLoop {
             .iter()
             .map(|a| {
                 let mut r = a.report.clone();
-                r.state = format!("{:?}", a.node.state());
-                r.phase = format!("{:?}", a.node.phase());
-                r.active_faults = names(a.node.faults());
-                r.firmware_dropped_tx = a.node.dropped_tx();
-                r.actuator = *a.actuator.stats();
+                let node = &a.drivers.node;
+                r.state = format!("{:?}", node.state());
+                r.phase = format!("{:?}", node.phase());
+                r.active_faults = names(node.faults());
+                r.firmware_dropped_tx = node.dropped_tx();
+                let port = a.drivers.can.stats();
+                r.messages_read = u64::from(port.received);
+                r.frames_malformed = u64::from(port.malformed);
+                r.port_dropped = u64::from(port.dropped);
+                r.port_bus_errors = u64::from(port.bus_errors);
+                let link = a.can.borrow();
+                r.frames_refused_queue_full = link.refused_queue_full();
+                r.frames_refused_bus_off = link.refused_bus_off();
+                r.rx_overflows = link.rx_overflows();
+                r.actuator = *a.actuator.borrow().model().stats();
                 (a.side, r)
             })
             .collect();
@@ -324,14 +378,27 @@ impl FirmwareInTheLoop {
             stance: self.stance,
             t_end_s: self.last_t_s,
             nodes,
-            state_history: self.state_history.clone(),
-            phase_history: self.phase_history.clone(),
-            faults: self.faults.clone(),
-            landings: self.landings.clone(),
+            state_history: self.state_history.to_vec(),
+            phase_history: self.phase_history.to_vec(),
+            faults: self.faults.to_vec(),
+            landings: self.landings.to_vec(),
             frames_delivered: self.frames_delivered,
-            bus_off: self.bus_off.clone(),
+            bus_off: self.bus_off.to_vec(),
+            history_elided: HistoryElided {
+                state_history: self.state_history.elided(),
+                phase_history: self.phase_history.elided(),
+                faults: self.faults.elided(),
+                landings: self.landings.elided(),
+                bus_off: self.bus_off.elided(),
+                commands_sent: self.commands_sent.elided(),
+                param_acks: self.param_acks.elided(),
+            },
             bus: self.bus.stats(),
-            host: self.host_report.clone(),
+            host: HostReport {
+                commands_sent: self.commands_sent.to_vec(),
+                param_acks: self.param_acks.to_vec(),
+                ..self.host_report.clone()
+            },
             socketcand: self.server.as_ref().map(|s| {
                 let st = s.stats();
                 SocketcandReport {
@@ -365,12 +432,19 @@ impl FirmwareInTheLoop {
             Ok(_) | Err(BusError::QueueFull { .. }) => {}
             Err(e) => return Err(ctl(e)),
         }
-        self.host_report.commands_sent.push((t_s, format!("{m:?}")));
+        self.commands_sent.push((t_s, format!("{m:?}")));
         Ok(())
     }
 
     /// Step 1: the bus up to `t_ns`, deliveries to the inboxes and the host.
     fn run_bus(&mut self, t_ns: u64) -> Result<(), ControlError> {
+        // A bus-off controller takes no part in the bus: it receives nothing from then on.
+        let mut off = self.ankles.each_ref().map(|a| {
+            matches!(
+                self.bus.node_error_state(a.handle),
+                Some((ErrorState::BusOff, _))
+            )
+        });
         let events = self.bus.advance_to(t_ns).map_err(ctl)?;
         for ev in &events {
             if let Some(w) = self.candump.as_mut() {
@@ -382,17 +456,20 @@ impl FirmwareInTheLoop {
                     if let Some(s) = &self.server {
                         s.publish(&d.frame, d.t_end_ns);
                     }
-                    let decoded = Message::decode(d.frame.id(), d.frame.data());
                     if d.from != self.host {
+                        let decoded = Message::decode(d.frame.id(), d.frame.data());
                         self.host_observe(d.t_end_ns, &decoded);
                     }
-                    if let Ok(m) = decoded {
-                        for a in self.ankles.iter_mut().filter(|a| a.handle != d.from) {
-                            a.inbox.push_back(m);
+                    for (a, off) in self.ankles.iter_mut().zip(off) {
+                        if a.handle != d.from && !off {
+                            a.can.borrow_mut().deliver(d.frame);
                         }
                     }
                 }
                 BusEvent::BusOff { node, t_ns } => {
+                    for (a, off) in self.ankles.iter().zip(off.iter_mut()) {
+                        *off |= a.handle == *node;
+                    }
                     let name = self.bus.node_name(*node).unwrap_or("?").to_string();
                     self.bus_off.push((*t_ns as f64 * 1e-9, name));
                 }
@@ -404,6 +481,7 @@ impl FirmwareInTheLoop {
 
     fn host_observe(&mut self, t_ns: u64, m: &Result<Message, protocol::DecodeError>) {
         let h = &mut self.host_report;
+        let acks = &mut self.param_acks;
         h.frames_seen += 1;
         let Ok(m) = m else {
             h.undecodable_frames += 1;
@@ -422,7 +500,7 @@ impl FirmwareInTheLoop {
                 );
             }
             Message::Fault(_) => h.fault_events_seen += 1,
-            Message::ParamAck(a) => h.param_acks.push(format!(
+            Message::ParamAck(a) => acks.push(format!(
                 "{:.3} s {:?} {:?} {:?} {}",
                 t_ns as f64 * 1e-9,
                 a.node,
@@ -469,7 +547,8 @@ impl FirmwareInTheLoop {
         Ok(())
     }
 
-    /// Step 3 for one ankle: sensors, firmware tick, transmissions, actuator.
+    /// Step 3 for one ankle: the hardware's state, one driver step, transmissions, the
+    /// actuator's segment.
     fn run_ankle(
         &mut self,
         side: Side,
@@ -488,18 +567,22 @@ impl FirmwareInTheLoop {
         let swing_model = self.config.swing_ankle;
         let debounce = self.config.debounce_samples;
         let t1_s = t_s + self.period_us as f64 * 1e-6;
+        let handle = self.ankle(side).handle;
         let bus_off = matches!(
-            self.bus
-                .node_error_state(self.ankle(side).handle)
-                .map(|(s, _)| s),
-            Some(ErrorState::BusOff)
+            self.bus.node_error_state(handle),
+            Some((ErrorState::BusOff, _))
         );
+        let room = self
+            .config
+            .bus
+            .tx_queue_capacity
+            .saturating_sub(self.bus.queued_frames(handle).unwrap_or(0));
         let [l, r] = &mut self.ankles;
         let a = match side {
             Side::Left => l,
             Side::Right => r,
         };
-        // Sensors.
+        // The hardware's state at this tick.
         let angle_true = if stance {
             a.swing = Some(SwingAnkle::new(swing_model, t_s, sensing.stance_ankle_rad));
             sensing.stance_ankle_rad
@@ -513,33 +596,34 @@ impl FirmwareInTheLoop {
         } else {
             sensing.swing_foot_on_floor || trailing
         };
-        let contact = a
-            .debouncer
-            .get_or_insert_with(|| Debouncer::new(raw_contact, debounce))
-            .update(raw_contact);
-        let angle = a.encoder.read(t_s, angle_true);
-        let n_rx = a.inbox.len().min(MAX_RX_PER_TICK);
-        let received: Vec<Message> = a.inbox.drain(..n_rx).collect();
-        a.report.max_rx_backlog = a.report.max_rx_backlog.max(a.inbox.len());
-        a.report.messages_read += received.len() as u64;
-        let peer = side.other().node();
-        let peer_heel_strike = received
-            .iter()
-            .any(|m| matches!(m, Message::HeelStrike(h) if h.node == peer));
-        // The firmware.
-        let out = a.node.tick(
-            Instant::from_micros(t_ns / 1000),
-            &TickInputs {
-                angle,
-                contact_closed: contact,
-                received: &received,
-                drivers: DriverHealth {
-                    actuator_error: false,
-                    can_error: a.can_error || bus_off,
-                },
-            },
-        );
+        a.shaft.set(t_s, angle_true);
+        a.contact.set_closed(raw_contact);
+        a.clock.set(Instant::from_micros(t_ns / 1000));
+        {
+            let mut can = a.can.borrow_mut();
+            can.set_tx_room(room);
+            can.set_bus_off(bus_off);
+        }
+        a.actuator.borrow_mut().set_tick(t_s, t1_s, angle_true);
+        if !a.settled {
+            // Power-up: the switch is sampled for the debounce length before the first tick,
+            // so that the firmware's debounced state (which starts open) is the foot's.
+            a.settled = true;
+            for _ in 0..debounce {
+                let _ = a.drivers.contact.sample();
+            }
+        }
+        // The firmware, as on the board.
+        let out = a.drivers.step();
         // Records.
+        let peer = side.other().node();
+        let peer_heel_strike = a.can.borrow_mut().take_read().any(|f| {
+            matches!(
+                Message::decode(f.id(), f.data()),
+                Ok(Message::HeelStrike(h)) if h.node == peer
+            )
+        });
+        a.report.max_rx_backlog = a.report.max_rx_backlog.max(a.can.borrow().rx_backlog());
         if out.state != a.last_state {
             self.state_history.push(StateChange {
                 t_s,
@@ -571,8 +655,6 @@ impl FirmwareInTheLoop {
             });
             a.last_phase = out.phase;
         }
-        // Transmissions.
-        a.can_error = false;
         for m in out.transmit.iter() {
             match m {
                 Message::Fault(f) => {
@@ -594,24 +676,25 @@ impl FirmwareInTheLoop {
                 Message::HeelStrike(_) => a.report.heel_strikes_sent += 1,
                 _ => {}
             }
-            let raw = m.encode().map_err(|e| ctl(format!("{e:?}")))?;
-            match self.bus.send(a.handle, Frame::from(raw), t_ns) {
+        }
+        // Transmissions: what the controller accepted, on the bus at the tick time.
+        for frame in a.can.borrow_mut().take_tx() {
+            match self.bus.send(a.handle, frame, t_ns) {
                 Ok(SendOutcome::Queued) => a.report.frames_queued += 1,
                 Ok(SendOutcome::Dropped) => a.report.frames_dropped += 1,
-                Ok(SendOutcome::BusOff) => a.report.frames_refused_bus_off += 1,
-                Err(BusError::QueueFull { .. }) => {
-                    a.report.frames_refused_queue_full += 1;
-                    a.can_error = true;
+                // Not offered: the controller refuses while bus-off, and it took no more than
+                // the queue's room.
+                Ok(SendOutcome::BusOff) | Err(BusError::QueueFull { .. }) => {
+                    a.report.frames_lost_at_bus += 1;
                 }
                 Err(e) => return Err(ctl(e)),
             }
         }
-        // The actuator.
-        let setpoint = match out.actuator {
-            ActuatorCommand::Released => None,
-            ActuatorCommand::Position { ankle_angle_rad } => Some(f64::from(ankle_angle_rad)),
-        };
-        Ok(a.actuator.tick(t_s, t1_s, setpoint, angle_true))
+        // The actuator's segment over this tick.
+        a.actuator
+            .borrow_mut()
+            .take_segment()
+            .ok_or_else(|| ctl("the firmware applied no actuator command"))
     }
 }
 

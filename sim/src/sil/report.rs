@@ -84,13 +84,30 @@ pub struct NodeReport {
     pub frames_queued: u64,
     /// Frames discarded at the sender by a `drop` fault.
     pub frames_dropped: u64,
-    /// Frames refused because the node is bus-off.
+    /// Frames the controller accepted that the bus did not take (should stay 0: the
+    /// controller refuses while bus-off and takes no more than the queue's room).
+    pub frames_lost_at_bus: u64,
+    /// Transmit attempts the controller refused because the node is bus-off (the firmware's
+    /// CAN port keeps the frame queued and reports a bus error).
     pub frames_refused_bus_off: u64,
-    /// Frames refused because the transmit queue was full.
+    /// Transmit attempts the controller refused with `WouldBlock` because the bus node's
+    /// transmit queue was full (the firmware's CAN port keeps the frame and offers it again
+    /// at the next tick).
     pub frames_refused_queue_full: u64,
-    /// Messages received (read by the node).
+    /// Messages the firmware's CAN port decoded (its `received` counter).
     pub messages_read: u64,
-    /// Largest backlog of received messages left for a later tick (more than 8 in a tick).
+    /// Frames the firmware's CAN port read that were not protocol messages (its `malformed`
+    /// counter: a babbler's, say).
+    pub frames_malformed: u64,
+    /// Frames the firmware's CAN port dropped (its own transmit queue of 32 full); each sets
+    /// the node's `CanBus` fault.
+    pub port_dropped: u64,
+    /// Controller errors the firmware's CAN port counted (bus-off).
+    pub port_bus_errors: u64,
+    /// Delivered frames lost because the node's receive FIFO was full.
+    pub rx_overflows: u64,
+    /// Largest number of frames left in the receive FIFO after a tick (the port reads at most
+    /// 8 messages, 16 frames, per tick).
     pub max_rx_backlog: usize,
     /// Messages the node's transmit list could not hold (firmware counter, should stay 0).
     pub firmware_dropped_tx: u32,
@@ -111,12 +128,46 @@ pub struct HostReport {
     pub last_heartbeat: BTreeMap<String, (f64, String, Vec<String>)>,
     /// `Fault` events seen.
     pub fault_events_seen: u64,
-    /// Parameter acknowledgements seen (time, node, parameter, status, value in force).
+    /// Parameter acknowledgements seen (time, node, parameter, status, value in force; bounded
+    /// like the histories).
     pub param_acks: Vec<String>,
-    /// Commands the host put on the bus: (time [s], command).
+    /// Commands the host put on the bus: (time [s], command; bounded like the histories).
     pub commands_sent: Vec<(f64, String)>,
     /// Frames injected by socketcand clients.
     pub frames_from_clients: u64,
+}
+
+/// Entries left out of each bounded history of a [`SilReport`] (between its first and its most
+/// recent entries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct HistoryElided {
+    /// Of `state_history`.
+    pub state_history: u64,
+    /// Of `phase_history`.
+    pub phase_history: u64,
+    /// Of `faults`.
+    pub faults: u64,
+    /// Of `landings`.
+    pub landings: u64,
+    /// Of `bus_off`.
+    pub bus_off: u64,
+    /// Of `host.commands_sent`.
+    pub commands_sent: u64,
+    /// Of `host.param_acks`.
+    pub param_acks: u64,
+}
+
+impl HistoryElided {
+    /// Entries elided over every history.
+    pub fn total(&self) -> u64 {
+        self.state_history
+            + self.phase_history
+            + self.faults
+            + self.landings
+            + self.bus_off
+            + self.commands_sent
+            + self.param_acks
+    }
 }
 
 /// Counters of the live socketcand server.
@@ -145,18 +196,21 @@ pub struct SilReport {
     pub t_end_s: f64,
     /// The left and the right node.
     pub nodes: BTreeMap<Side, NodeReport>,
-    /// Every node-state change.
+    /// Node-state changes (the first and the most recent, up to
+    /// `SilConfig::history_capacity`; so for every history below).
     pub state_history: Vec<StateChange>,
-    /// Every reflex-phase change.
+    /// Reflex-phase changes.
     pub phase_history: Vec<PhaseChange>,
-    /// Every fault raised or cleared.
+    /// Faults raised or cleared.
     pub faults: Vec<FaultRecord>,
-    /// Every landing.
+    /// Landings.
     pub landings: Vec<Landing>,
     /// Frames delivered on the bus.
     pub frames_delivered: u64,
     /// Bus-off events: (time [s], node name).
     pub bus_off: Vec<(f64, String)>,
+    /// Entries each history left out to stay within its capacity.
+    pub history_elided: HistoryElided,
     /// Bus statistics (load, per identifier and per node).
     pub bus: BusStats,
     /// The host's view.

@@ -1,6 +1,8 @@
-//! Simulated ankle sensors: the magnetic encoder (quantised exactly as the real one, through
-//! the firmware's own [`AngleCalibration`]), its injected faults, the swing ankle's angle (the
-//! swing foot is not modelled) and the foot contact switch before the firmware's debouncer.
+//! Simulated ankle sensors: the magnetic encoder's counts (quantised exactly as the real one,
+//! through the firmware's own [`AngleCalibration`]), its injected faults (glitch, stuck, and
+//! on its SPI link: failed transfers, a parity error) and the swing ankle's angle (the swing
+//! foot is not modelled). The SPI device that serves these counts to the firmware's driver is
+//! [`super::hal::SimSpi`].
 
 use firmware::sensors::{AngleCalibration, AngleSample, EncoderError};
 use serde::Serialize;
@@ -26,13 +28,33 @@ pub enum SensorFault {
         /// From when [s].
         from_s: f64,
     },
+    /// Every SPI transaction in `[from_s, until_s)` fails (the driver's `EncoderError::Bus`).
+    SpiFailure {
+        /// Which ankle.
+        side: Side,
+        /// From when [s].
+        from_s: f64,
+        /// Until when [s].
+        until_s: f64,
+    },
+    /// One angle answer (the first at or after `at_s`) arrives with a flipped bit, so its
+    /// parity is wrong (the driver's `EncoderError::Parity`).
+    Parity {
+        /// Which ankle.
+        side: Side,
+        /// When [s].
+        at_s: f64,
+    },
 }
 
 impl SensorFault {
     /// The ankle it affects.
     pub fn side(&self) -> Side {
         match self {
-            SensorFault::Glitch { side, .. } | SensorFault::Stuck { side, .. } => *side,
+            SensorFault::Glitch { side, .. }
+            | SensorFault::Stuck { side, .. }
+            | SensorFault::SpiFailure { side, .. }
+            | SensorFault::Parity { side, .. } => *side,
         }
     }
 }
@@ -88,6 +110,34 @@ impl SimEncoder {
             angle_rad: self.calibration.angle_rad(counts),
         })
     }
+
+    /// The SPI link's faults at `t_s`: whether a transaction fails, and whether the angle
+    /// answer latched now must be corrupted (a [`SensorFault::Parity`] fires once).
+    pub fn link_fault(&mut self, t_s: f64, latching_angle: bool) -> LinkFault {
+        let mut out = LinkFault::default();
+        for (f, fired) in &mut self.faults {
+            match *f {
+                SensorFault::SpiFailure {
+                    from_s, until_s, ..
+                } if t_s >= from_s && t_s < until_s => out.fail = true,
+                SensorFault::Parity { at_s, .. } if latching_angle && !*fired && t_s >= at_s => {
+                    *fired = true;
+                    out.corrupt = true;
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+}
+
+/// What the SPI link does to one transaction (see [`SimEncoder::link_fault`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LinkFault {
+    /// The transaction fails.
+    pub fail: bool,
+    /// The answer latched by this transaction has a flipped bit.
+    pub corrupt: bool,
 }
 
 /// The swing ankle's angle: the swing foot is massless and not in the model.

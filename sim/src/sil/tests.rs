@@ -116,6 +116,10 @@ fn host_enables_both_nodes_and_the_stance_node_engages_and_extends() {
     assert!((last.p1_rad - 0.2).abs() < 1e-3, "{}", last.p1_rad);
     let st = r.node(Side::Left).unwrap();
     assert_eq!(st.engagements, 1);
+    // The contact switches were settled before the first tick: no spurious heel strike from
+    // the firmware's debouncer starting open.
+    assert_eq!(st.heel_strikes_sent, 0);
+    assert_eq!(r.node(Side::Right).unwrap().heel_strikes_sent, 0);
     // The firmware's profile peaks at 1.875 × 0.28 / 0.15 = 3.5 rad/s: no saturation, a lag
     // of about τ × 3.5 rad/s = 17.5 mrad.
     assert_eq!(st.actuator.saturated_ticks, 0);
@@ -493,4 +497,83 @@ fn a_socketcand_client_sees_the_frames_and_its_emergency_stop_reaches_the_nodes(
     let s = r.socketcand.unwrap();
     assert_eq!((s.clients_accepted, s.frames_received), (1, 1));
     assert!(s.frames_sent > 0);
+}
+
+#[test]
+fn spi_failures_and_parity_errors_raise_the_encoder_comms_fault() {
+    let config = SilConfig::default().with_sensor_fault(SensorFault::SpiFailure {
+        side: Side::Left,
+        from_s: 0.1,
+        until_s: 0.103,
+    });
+    let mut c = sil(config);
+    run(&mut c, 0.2, &[]);
+    let r = c.report();
+    assert_eq!(r.first_raise(Side::Left, "EncoderComms"), Some(0.1));
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", 0.0),
+        Some(0.1)
+    );
+    let comms = r.faults.iter().find(|f| f.code == "EncoderComms").unwrap();
+    assert_eq!(comms.detail, 1, "bus error");
+    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    let config = SilConfig::default().with_sensor_fault(SensorFault::Parity {
+        side: Side::Right,
+        at_s: 0.05,
+    });
+    let mut c = sil(config);
+    run(&mut c, 0.2, &[]);
+    let r = c.report();
+    let comms = r.faults.iter().find(|f| f.code == "EncoderComms").unwrap();
+    assert_eq!(
+        (comms.side, comms.t_s, comms.detail),
+        (Side::Right, 0.05, 2)
+    );
+    assert_eq!(r.node(Side::Left).unwrap().state, "Enabled");
+}
+
+#[test]
+fn babble_frames_reach_the_firmware_as_malformed_frames() {
+    let config = SilConfig::default()
+        .with_fault_str("babble:node=host,id=0x7FF,from_ms=100")
+        .unwrap();
+    let mut c = sil(config);
+    run(&mut c, 0.3, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        let n = r.node(side).unwrap();
+        // About 4 babble frames per millisecond for 0.2 s; the port reads up to 16 frames a
+        // tick, so none is lost and the FIFO never holds more than a tick's worth.
+        assert!(n.frames_malformed > 700, "{side:?} {}", n.frames_malformed);
+        assert_eq!(n.rx_overflows, 0);
+        assert!(n.max_rx_backlog < 8, "{}", n.max_rx_backlog);
+        assert_eq!(n.state, "Enabled");
+    }
+}
+
+#[test]
+fn histories_are_bounded_and_count_what_they_leave_out() {
+    let config = SilConfig {
+        history_capacity: 6,
+        ..SilConfig::default()
+    };
+    let mut c = sil(config);
+    run(&mut c, 3.0, &[0.7, 1.4, 2.1, 2.8]);
+    let bounded = c.report();
+    let mut full = sil(SilConfig::default());
+    run(&mut full, 3.0, &[0.7, 1.4, 2.1, 2.8]);
+    let full = full.report();
+    assert_eq!(full.history_elided.total(), 0);
+    let n = full.phase_history.len();
+    assert!(n > 6, "{n}");
+    assert_eq!(bounded.phase_history.len(), 6);
+    assert_eq!(bounded.history_elided.phase_history, (n - 6) as u64);
+    // The first three and the last three.
+    assert_eq!(bounded.phase_history[..3], full.phase_history[..3]);
+    assert_eq!(bounded.phase_history[3..], full.phase_history[n - 3..]);
+    assert_eq!(bounded.landings.len(), full.landings.len().min(6));
+    assert_eq!(
+        bounded.history_elided.landings,
+        full.landings.len().saturating_sub(6) as u64
+    );
 }

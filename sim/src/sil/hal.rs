@@ -1,0 +1,46 @@
+//! Sim-backed implementations of the hardware traits the board's drivers use, so that each
+//! simulated ankle runs the firmware exactly as the board does: one
+//! [`firmware::runner::AnkleDrivers::step`] per control tick, over
+//!
+//! * [`SimSpi`] — an `embedded_hal::spi::SpiDevice` emulating the AS5047P encoder for
+//!   `firmware::drivers::encoder::MagneticEncoder`: 16-bit frames, most significant byte
+//!   first, the answer to a command in the *next* frame (pipelined), even parity in bit 15 and
+//!   the error flag in bit 14; the counts come from [`super::SimEncoder`] (its quantisation
+//!   and its faults);
+//! * [`SimContactPin`] — an `embedded_hal::digital::InputPin`, active low as on the board
+//!   (switch to ground, pull-up), for `firmware::drivers::contact::ContactSwitch`, which
+//!   debounces it;
+//! * [`SimCan`] — an `embedded_can::nb::Can` controller for `firmware::drivers::can::CanPort`:
+//!   `transmit` hands frames to the orchestrator, which queues them on the [`canbus::Bus`] at
+//!   the tick time (`WouldBlock` when the bus node's transmit queue has no room, an error when
+//!   the node is bus-off); `receive` yields the raw frames the bus delivered to this node
+//!   (the firmware decodes them and counts malformed ones itself);
+//! * [`SimClock`] — `firmware::time::Monotonic`, the tick time;
+//! * [`SimActuator`] — `firmware::drivers::actuator::Actuator` over the simulator's
+//!   [`super::ActuatorModel`].
+//!
+//! The actuator is where the simulator departs from the board: the board's `PwmDirActuator`
+//! is a proportional loop over PWM duty and a direction pin driving a DC motor; the
+//! simulator replaces it by a position servo (rate limit and first-order lag) that leaves the
+//! string slack when released. A DC motor at zero duty would not release the string in the
+//! model (it has no back-drive model), while the firmware's reflex relies on the string going
+//! slack at release; so [`SimActuator`] takes the firmware's command (a position setpoint or
+//! release) and the measured angle it is given, as any `Actuator` does, and moves the string's
+//! limit through the servo model.
+//!
+//! Every piece shares its state with the orchestrator ([`super::FirmwareInTheLoop`]) through
+//! `Rc<Cell<..>>` / `Rc<RefCell<..>>` handles: the simulation is single-threaded, and the
+//! orchestrator sets the sensor state before each `step` and collects frames and the
+//! actuator's segment after it.
+
+pub mod actuator;
+pub mod can;
+pub mod clock;
+pub mod contact;
+pub mod spi;
+
+pub use actuator::{ActuatorLink, SimActuator};
+pub use can::{CanLink, SimCan, SimCanError, SimFrame};
+pub use clock::SimClock;
+pub use contact::SimContactPin;
+pub use spi::{Shaft, SimSpi, SimSpiError};

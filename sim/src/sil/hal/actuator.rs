@@ -1,0 +1,145 @@
+//! The string actuator behind the firmware's own hardware-edge trait
+//! (`firmware::drivers::actuator::Actuator`).
+//!
+//! On the board, `PwmDirActuator` closes a proportional loop from the measured ankle angle to
+//! a PWM duty and a direction pin of a DC motor. The simulator replaces that motor and its
+//! loop by [`ActuatorModel`], a position servo with a rate limit and a first-order lag that
+//! leaves the string slack when released: the simulated string is rigid and unilateral and
+//! has no motor model, so a DC motor at zero duty would not release it, while the reflex
+//! relies on the string going slack at release. [`SimActuator::apply`] gets what any
+//! `Actuator` gets — the command (setpoint or release) and the measured angle — records both,
+//! and integrates the servo over the tick; the orchestrator takes the tick's
+//! [`ActuatorSegment`] afterwards. It never fails (`actuator_error` stays false).
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use firmware::drivers::actuator::{Actuator, ActuatorError};
+use firmware::ActuatorCommand;
+
+use crate::control::ActuatorSegment;
+use crate::sil::actuator::ActuatorModel;
+
+/// State shared by a [`SimActuator`] and the orchestrator.
+#[derive(Clone, Debug)]
+pub struct ActuatorLink {
+    model: ActuatorModel,
+    t0_s: f64,
+    t1_s: f64,
+    take_up_rad: f64,
+    segment: Option<ActuatorSegment>,
+    last_command: Option<ActuatorCommand>,
+    last_measured_rad: Option<f32>,
+    commands: u64,
+}
+
+impl ActuatorLink {
+    /// A link over a (released) servo model.
+    pub fn new(model: ActuatorModel) -> Self {
+        ActuatorLink {
+            model,
+            t0_s: 0.0,
+            t1_s: 0.0,
+            take_up_rad: 0.0,
+            segment: None,
+            last_command: None,
+            last_measured_rad: None,
+            commands: 0,
+        }
+    }
+
+    /// The coming tick `[t0_s, t1_s]` and the true ankle angle [rad] (where a slack string
+    /// becomes taut).
+    pub fn set_tick(&mut self, t0_s: f64, t1_s: f64, take_up_rad: f64) {
+        self.t0_s = t0_s;
+        self.t1_s = t1_s;
+        self.take_up_rad = take_up_rad;
+    }
+
+    /// The segment of the last command applied (taken: `None` until the next command).
+    pub fn take_segment(&mut self) -> Option<ActuatorSegment> {
+        self.segment.take()
+    }
+
+    /// The servo model (statistics).
+    pub fn model(&self) -> &ActuatorModel {
+        &self.model
+    }
+
+    /// The last command applied and the measured angle it came with [rad].
+    pub fn last_command(&self) -> Option<(ActuatorCommand, Option<f32>)> {
+        self.last_command.map(|c| (c, self.last_measured_rad))
+    }
+
+    /// Commands applied.
+    pub fn commands(&self) -> u64 {
+        self.commands
+    }
+}
+
+/// The actuator; it shares its [`ActuatorLink`] with the orchestrator.
+#[derive(Clone, Debug)]
+pub struct SimActuator(Rc<RefCell<ActuatorLink>>);
+
+impl SimActuator {
+    /// An actuator on `link`.
+    pub fn new(link: Rc<RefCell<ActuatorLink>>) -> Self {
+        SimActuator(link)
+    }
+}
+
+impl Actuator for SimActuator {
+    fn apply(
+        &mut self,
+        command: ActuatorCommand,
+        measured_angle_rad: Option<f32>,
+    ) -> Result<(), ActuatorError> {
+        let mut l = self.0.borrow_mut();
+        let setpoint = match command {
+            ActuatorCommand::Released => None,
+            ActuatorCommand::Position { ankle_angle_rad } => Some(f64::from(ankle_angle_rad)),
+        };
+        let (t0, t1, take_up) = (l.t0_s, l.t1_s, l.take_up_rad);
+        let seg = l.model.tick(t0, t1, setpoint, take_up);
+        l.segment = Some(seg);
+        l.last_command = Some(command);
+        l.last_measured_rad = measured_angle_rad;
+        l.commands += 1;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sil::actuator::ActuatorParams;
+
+    #[test]
+    fn commands_move_the_servo_and_are_recorded() {
+        let link = Rc::new(RefCell::new(ActuatorLink::new(ActuatorModel::new(
+            ActuatorParams::default(),
+        ))));
+        let mut a = SimActuator::new(Rc::clone(&link));
+        link.borrow_mut().set_tick(0.0, 0.001, -0.05);
+        a.apply(ActuatorCommand::Released, Some(-0.05)).unwrap();
+        assert!(link.borrow_mut().take_segment().unwrap().released);
+        link.borrow_mut().set_tick(0.001, 0.002, -0.06);
+        let pos = ActuatorCommand::Position {
+            ankle_angle_rad: -0.055,
+        };
+        a.apply(pos, Some(-0.0598)).unwrap();
+        let seg = link.borrow_mut().take_segment().unwrap();
+        assert!(!seg.released);
+        assert_eq!(
+            seg.p0_rad,
+            -0.06 - ActuatorParams::default().take_up_slack_rad
+        );
+        assert!(seg.p1_rad > seg.p0_rad && seg.p1_rad < -0.055);
+        let l = link.borrow();
+        assert_eq!(l.last_command(), Some((pos, Some(-0.0598))));
+        assert_eq!(l.commands(), 2);
+        assert_eq!(l.model().stats().position_ticks, 1);
+        drop(l);
+        assert_eq!(link.borrow_mut().take_segment(), None, "taken once");
+    }
+}

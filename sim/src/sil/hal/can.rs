@@ -1,0 +1,292 @@
+//! The node's CAN controller: an `embedded_can::nb::Can` between the firmware's
+//! `firmware::drivers::can::CanPort` and the simulated bus.
+//!
+//! The orchestrator and the controller share a [`CanLink`]:
+//!
+//! * before the node's tick the orchestrator sets the room left in the bus node's transmit
+//!   queue ([`CanLink::set_tx_room`]) and whether the node is bus-off;
+//! * `transmit` takes a frame while there is room (the orchestrator queues it on the bus at
+//!   the tick time after the tick), returns `WouldBlock` when there is none — the port keeps
+//!   the frame and offers it again at a later tick — and an error when the node is bus-off;
+//! * the orchestrator delivers the frames the bus delivered to this node
+//!   ([`CanLink::deliver`]) into a receive FIFO of the board's depth (16 frames by default,
+//!   `RxBuf<16>` in `firmware/board-g431`; a full FIFO loses the newest frame and counts it);
+//!   `receive` yields them raw, so frames that are not protocol messages reach the firmware's
+//!   own `malformed` counter. A bus-off controller receives nothing and reports an error.
+//!
+//! Remote and extended frames cannot be built ([`SimFrame`] is a standard data frame, as
+//! every frame on the simulated bus).
+
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::rc::Rc;
+
+use embedded_can::{ErrorKind, Id, StandardId};
+
+/// A standard data frame of the simulated bus as an `embedded_can::Frame`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SimFrame(pub canbus::Frame);
+
+impl embedded_can::Frame for SimFrame {
+    fn new(id: impl Into<Id>, data: &[u8]) -> Option<Self> {
+        match id.into() {
+            Id::Standard(s) => canbus::Frame::new(u32::from(s.as_raw()), data)
+                .ok()
+                .map(SimFrame),
+            Id::Extended(_) => None,
+        }
+    }
+
+    fn new_remote(_id: impl Into<Id>, _dlc: usize) -> Option<Self> {
+        None
+    }
+
+    fn is_extended(&self) -> bool {
+        false
+    }
+
+    fn is_remote_frame(&self) -> bool {
+        false
+    }
+
+    fn id(&self) -> Id {
+        Id::Standard(StandardId::new(self.0.id()).unwrap_or(StandardId::MAX))
+    }
+
+    fn dlc(&self) -> usize {
+        usize::from(self.0.dlc())
+    }
+
+    fn data(&self) -> &[u8] {
+        self.0.data()
+    }
+}
+
+/// Why the controller refused: the node is bus-off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimCanError {
+    /// The node's transmit error counter passed 255: it takes no part in the bus.
+    BusOff,
+}
+
+impl embedded_can::Error for SimCanError {
+    fn kind(&self) -> ErrorKind {
+        ErrorKind::Other
+    }
+}
+
+/// State shared by a [`SimCan`] and the orchestrator.
+#[derive(Clone, Debug)]
+pub struct CanLink {
+    rx: VecDeque<canbus::Frame>,
+    rx_capacity: usize,
+    rx_overflows: u64,
+    read: Vec<canbus::Frame>,
+    tx: Vec<canbus::Frame>,
+    tx_room: usize,
+    bus_off: bool,
+    refused_full: u64,
+    refused_bus_off: u64,
+}
+
+impl CanLink {
+    /// A link with a receive FIFO of `rx_capacity` frames (at least 1).
+    pub fn new(rx_capacity: usize) -> Self {
+        CanLink {
+            rx: VecDeque::with_capacity(rx_capacity.max(1)),
+            rx_capacity: rx_capacity.max(1),
+            rx_overflows: 0,
+            read: Vec::new(),
+            tx: Vec::new(),
+            tx_room: 0,
+            bus_off: false,
+            refused_full: 0,
+            refused_bus_off: 0,
+        }
+    }
+
+    /// A frame the bus delivered to this node; false (and counted) when the FIFO is full.
+    pub fn deliver(&mut self, frame: canbus::Frame) -> bool {
+        if self.rx.len() >= self.rx_capacity {
+            self.rx_overflows += 1;
+            return false;
+        }
+        self.rx.push_back(frame);
+        true
+    }
+
+    /// Frames waiting in the receive FIFO.
+    pub fn rx_backlog(&self) -> usize {
+        self.rx.len()
+    }
+
+    /// Frames lost to a full receive FIFO.
+    pub fn rx_overflows(&self) -> u64 {
+        self.rx_overflows
+    }
+
+    /// Room in the bus node's transmit queue for this tick's frames.
+    pub fn set_tx_room(&mut self, frames: usize) {
+        self.tx_room = frames;
+    }
+
+    /// Whether the node is bus-off.
+    pub fn set_bus_off(&mut self, bus_off: bool) {
+        self.bus_off = bus_off;
+    }
+
+    /// Frames the controller accepted since the last call, in order.
+    pub fn take_tx(&mut self) -> std::vec::Drain<'_, canbus::Frame> {
+        self.tx.drain(..)
+    }
+
+    /// Frames the firmware read since the last call, in order.
+    pub fn take_read(&mut self) -> std::vec::Drain<'_, canbus::Frame> {
+        self.read.drain(..)
+    }
+
+    /// Transmit calls refused with `WouldBlock` (no room in the bus node's queue).
+    pub fn refused_queue_full(&self) -> u64 {
+        self.refused_full
+    }
+
+    /// Transmit calls refused because the node is bus-off.
+    pub fn refused_bus_off(&self) -> u64 {
+        self.refused_bus_off
+    }
+}
+
+/// The controller; it shares its [`CanLink`] with the orchestrator.
+#[derive(Clone, Debug)]
+pub struct SimCan(Rc<RefCell<CanLink>>);
+
+impl SimCan {
+    /// A controller on `link`.
+    pub fn new(link: Rc<RefCell<CanLink>>) -> Self {
+        SimCan(link)
+    }
+}
+
+impl embedded_can::nb::Can for SimCan {
+    type Frame = SimFrame;
+    type Error = SimCanError;
+
+    fn transmit(&mut self, frame: &SimFrame) -> nb::Result<Option<SimFrame>, SimCanError> {
+        let mut l = self.0.borrow_mut();
+        if l.bus_off {
+            l.refused_bus_off += 1;
+            return Err(nb::Error::Other(SimCanError::BusOff));
+        }
+        if l.tx_room == 0 {
+            l.refused_full += 1;
+            return Err(nb::Error::WouldBlock);
+        }
+        l.tx_room -= 1;
+        l.tx.push(frame.0);
+        Ok(None)
+    }
+
+    fn receive(&mut self) -> nb::Result<SimFrame, SimCanError> {
+        let mut l = self.0.borrow_mut();
+        if l.bus_off {
+            return Err(nb::Error::Other(SimCanError::BusOff));
+        }
+        match l.rx.pop_front() {
+            Some(f) => {
+                l.read.push(f);
+                Ok(SimFrame(f))
+            }
+            None => Err(nb::Error::WouldBlock),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use embedded_can::Frame as _;
+    use firmware::drivers::can::CanPort;
+    use protocol::{Heartbeat, Message, NodeId, NodeState};
+
+    fn heartbeat(ms: u32) -> Message {
+        Message::Heartbeat(Heartbeat {
+            node: NodeId::LeftAnkle,
+            state: NodeState::Enabled,
+            faults: protocol::FaultFlags::NONE,
+            uptime_ms: ms,
+        })
+    }
+
+    #[test]
+    fn a_full_bus_queue_blocks_and_the_frame_goes_out_on_a_later_tick() {
+        let link = Rc::new(RefCell::new(CanLink::new(16)));
+        let mut port = CanPort::new(SimCan::new(Rc::clone(&link)));
+        // Tick 1: room for one frame, two messages.
+        link.borrow_mut().set_tx_room(1);
+        let error = port.transmit(&[heartbeat(1), heartbeat(2)]);
+        assert!(
+            !error,
+            "WouldBlock is not an error: the port keeps the frame"
+        );
+        let sent: Vec<_> = link.borrow_mut().take_tx().collect();
+        assert_eq!(sent.len(), 1);
+        assert_eq!(
+            Message::decode(sent[0].id(), sent[0].data()),
+            Ok(heartbeat(1))
+        );
+        assert_eq!(link.borrow().refused_queue_full(), 1);
+        // Tick 2: no room; nothing new either.
+        link.borrow_mut().set_tx_room(0);
+        assert!(!port.transmit(&[]));
+        assert_eq!(link.borrow_mut().take_tx().count(), 0);
+        // Tick 3: room again: the held frame goes first, then the new one.
+        link.borrow_mut().set_tx_room(8);
+        assert!(!port.transmit(&[heartbeat(3)]));
+        let sent: Vec<_> = link.borrow_mut().take_tx().collect();
+        let got: Vec<_> = sent
+            .iter()
+            .map(|f| Message::decode(f.id(), f.data()))
+            .collect();
+        assert_eq!(got, vec![Ok(heartbeat(2)), Ok(heartbeat(3))]);
+        assert_eq!(port.stats().sent, 3);
+        assert_eq!(port.stats().dropped, 0);
+    }
+
+    #[test]
+    fn bus_off_refuses_with_an_error_and_receives_nothing() {
+        let link = Rc::new(RefCell::new(CanLink::new(16)));
+        let mut port = CanPort::new(SimCan::new(Rc::clone(&link)));
+        link.borrow_mut()
+            .deliver(canbus::Frame::from(heartbeat(9).encode().unwrap()));
+        link.borrow_mut().set_tx_room(8);
+        link.borrow_mut().set_bus_off(true);
+        assert!(port.transmit(&[heartbeat(1)]), "error reported");
+        assert_eq!(link.borrow().refused_bus_off(), 1);
+        let mut rx = heapless::Vec::new();
+        assert!(port.receive(&mut rx), "error reported");
+        assert!(rx.is_empty());
+        assert_eq!(port.stats().bus_errors, 2);
+    }
+
+    #[test]
+    fn raw_frames_are_decoded_by_the_firmware_and_the_fifo_is_bounded() {
+        let link = Rc::new(RefCell::new(CanLink::new(3)));
+        let mut port = CanPort::new(SimCan::new(Rc::clone(&link)));
+        let babble = canbus::Frame::new(0x7FF, &[0xBA; 8]).unwrap();
+        let good = canbus::Frame::from(heartbeat(5).encode().unwrap());
+        let mut l = link.borrow_mut();
+        assert!(l.deliver(babble) && l.deliver(good) && l.deliver(babble));
+        assert!(!l.deliver(good), "FIFO of 3 full");
+        assert_eq!(l.rx_overflows(), 1);
+        drop(l);
+        let mut rx = heapless::Vec::new();
+        assert!(!port.receive(&mut rx));
+        assert_eq!(rx.as_slice(), &[heartbeat(5)]);
+        assert_eq!(port.stats().malformed, 2);
+        assert_eq!(link.borrow_mut().take_read().count(), 3);
+        assert_eq!(link.borrow().rx_backlog(), 0);
+        assert_eq!(SimFrame(babble).id(), Id::Standard(StandardId::MAX));
+        assert!(SimFrame::new_remote(StandardId::ZERO, 0).is_none());
+        assert!(SimFrame::new(embedded_can::ExtendedId::ZERO, &[]).is_none());
+    }
+}
