@@ -10,8 +10,10 @@ use nalgebra::Complex;
 use serde::Serialize;
 use std::time::Instant;
 
-/// Perturbation step of the stride Jacobian for the studied settings (the reference uses the
-/// caller's).
+/// Perturbation step of the stride Jacobian, for the reference and every studied setting
+/// alike: the central difference's own truncation error (order 1e-8) is then common to all and
+/// cancels in the comparison, while a larger step keeps loose settings' integration error from
+/// being divided into eigenvalue noise.
 pub const STUDY_PERTURBATION: f64 = 1e-4;
 
 /// One integrator setting and its errors.
@@ -126,7 +128,11 @@ pub fn study(
     let mut w = walker.clone();
     w.integrator = reference.clone();
     let v0 = w.pack(&w.guess_q, &w.guess_qd);
-    let reference_gait: Gait = w.find_gait(&v0, newton)?;
+    let study_newton = NewtonSettings {
+        perturbation: STUDY_PERTURBATION,
+        ..*newton
+    };
+    let reference_gait: Gait = w.find_gait(&v0, &study_newton)?;
     let x_ref = reference_gait.fixed_point.clone();
     let t_ref = reference_gait.stride.duration_s;
     let (q_ref, qd_ref) = w.unpack(&x_ref);
@@ -147,14 +153,6 @@ pub fn study(
             }
         }
         times.sort_by(f64::total_cmp);
-        // The perturbation Jacobian divides the integrator's error by the perturbation step:
-        // with fixed steps or loose tolerances a step of 1e-6 turns truncation error into
-        // eigenvalue noise (the 3D walker's eigenvalues are sensitive), so the study perturbs
-        // by `STUDY_PERTURBATION` (central differences: its own error is of order 1e-8).
-        let study_newton = NewtonSettings {
-            perturbation: STUDY_PERTURBATION,
-            ..*newton
-        };
         let gait = w.find_gait(&x_ref, &study_newton);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (

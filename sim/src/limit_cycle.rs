@@ -1,7 +1,7 @@
 //! Periodic gaits: the Newton-Raphson fixed point of the stride function, eq. (24)-(26), and
 //! the stride Jacobian by perturbation, whose eigenvalues decide stability, eq. (27).
 
-use crate::stride::{StrideFailure, StrideOptions, StrideResult};
+use crate::stride::{Schedule, StepSchedule, StrideFailure, StrideOptions, StrideResult};
 use crate::walker::Walker;
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
@@ -20,6 +20,10 @@ pub struct NewtonSettings {
     /// Step halvings allowed when a full Newton step lands where the stride fails or the
     /// residual grows (0: the plain iteration of eq. 26).
     pub max_halvings: usize,
+    /// Internal numerical differentiation: the perturbed strides of the Jacobian replay the
+    /// step sizes of the nominal stride ([`StepSchedule`]) instead of choosing their own, so
+    /// that the differences do not pick up the adaptive step selection's accept/reject flips.
+    pub frozen_steps: bool,
 }
 
 impl Default for NewtonSettings {
@@ -30,6 +34,7 @@ impl Default for NewtonSettings {
             perturbation: 1e-6,
             central: true,
             max_halvings: 8,
+            frozen_steps: false,
         }
     }
 }
@@ -112,15 +117,43 @@ impl Walker {
     ) -> Result<DMatrix<f64>, StrideFailure> {
         let n = v.len();
         let d = settings.perturbation;
+        let mut schedule = StepSchedule::default();
+        let nominal = if settings.frozen_steps {
+            let (q, qd) = self.unpack(v);
+            let r = self.stride_scheduled(
+                &q,
+                &qd,
+                StrideOptions::default(),
+                Schedule::Record(&mut schedule),
+            )?;
+            Some(self.pack(&r.q_next, &r.qd_next))
+        } else {
+            None
+        };
+        let s_v = nominal.as_ref().unwrap_or(s_v);
+        let map = |x: &DVector<f64>| -> Result<DVector<f64>, StrideFailure> {
+            if settings.frozen_steps {
+                let (q, qd) = self.unpack(x);
+                let r = self.stride_scheduled(
+                    &q,
+                    &qd,
+                    StrideOptions::default(),
+                    Schedule::Replay(&schedule),
+                )?;
+                Ok(self.pack(&r.q_next, &r.qd_next))
+            } else {
+                Ok(self.stride_map(x)?.0)
+            }
+        };
         let mut j = DMatrix::zeros(n, n);
         for k in 0..n {
             let mut vp = v.clone();
             vp[k] += d;
-            let sp = self.stride_map(&vp)?.0;
+            let sp = map(&vp)?;
             let col = if settings.central {
                 let mut vm = v.clone();
                 vm[k] -= d;
-                let sm = self.stride_map(&vm)?.0;
+                let sm = map(&vm)?;
                 (sp - sm) / (2.0 * d)
             } else {
                 (sp - s_v) / d
@@ -139,15 +172,25 @@ impl Walker {
         let mut v = v0.clone();
         let n = v.len();
         let mut last_step = f64::INFINITY;
+        // The Newton matrix is kept while the residual falls at least fourfold per iteration
+        // (a chord iteration); the eigenvalues always come from a Jacobian at the converged
+        // point.
+        let mut kept: Option<DMatrix<f64>> = None;
+        let mut last_residual = f64::INFINITY;
+        // The accepted trial's stride, reused as the next iteration's.
+        let mut carried: Option<(DVector<f64>, StrideResult)> = None;
         for it in 0..=settings.max_iterations {
             let fail = |failure| NewtonError::StrideFailed {
                 iteration: it,
                 failure,
             };
-            let (s, stride) = self.stride_map(&v).map_err(fail)?;
+            let (s, stride) = match carried.take() {
+                Some(c) => c,
+                None => self.stride_map(&v).map_err(fail)?,
+            };
             let r = &s - &v;
-            let j = self.stride_jacobian(&v, &s, settings).map_err(fail)?;
             if last_step < settings.tolerance {
+                let j = self.stride_jacobian(&v, &s, settings).map_err(fail)?;
                 let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
                 return Ok(Gait {
                     fixed_point: v,
@@ -161,6 +204,12 @@ impl Walker {
             if it == settings.max_iterations {
                 break;
             }
+            let r_norm_now = r.amax();
+            let j = match kept.take() {
+                Some(j) if r_norm_now <= 0.25 * last_residual => j,
+                _ => self.stride_jacobian(&v, &s, settings).map_err(fail)?,
+            };
+            last_residual = r_norm_now;
             let a = DMatrix::identity(n, n) - &j;
             let dv = a
                 .lu()
@@ -173,12 +222,16 @@ impl Walker {
             for _ in 0..settings.max_halvings {
                 let trial = &v + &dv * lambda;
                 match self.stride_map(&trial) {
-                    Ok((st, _)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => break,
+                    Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
+                        carried = Some((st, sr));
+                        break;
+                    }
                     _ => lambda *= 0.5,
                 }
             }
             last_step = dv.amax() * lambda;
             v += dv * lambda;
+            kept = Some(j);
         }
         Err(NewtonError::NotConverged {
             iterations: settings.max_iterations,

@@ -469,6 +469,31 @@ impl ContactSummary {
     }
 }
 
+/// The accepted step sizes of a stride, phase by phase (a phase ends at an impact).
+///
+/// For internal numerical differentiation (Bock): the perturbed strides of the stride
+/// Jacobian replay the nominal stride's steps, so that their differences are derivatives of
+/// one discrete flow rather than of the adaptive step selection, whose accept/reject decisions
+/// flip under a perturbation and make the central difference noisy.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepSchedule {
+    /// Step sizes [s] of each phase, in order.
+    pub phases: Vec<Vec<f64>>,
+}
+
+/// How a stride chooses its steps.
+#[derive(Debug, Default)]
+pub enum Schedule<'a> {
+    /// The integrator's own choice.
+    #[default]
+    Free,
+    /// The integrator's own choice, written down.
+    Record(&'a mut StepSchedule),
+    /// The steps written down (each phase's last step repeated if the phase runs longer);
+    /// the integrator's error control is not used.
+    Replay(&'a StepSchedule),
+}
+
 impl Walker {
     /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling).
     pub fn stride(
@@ -492,7 +517,21 @@ impl Walker {
         options: StrideOptions,
         trajectory: &mut Vec<Sample>,
     ) -> Result<StrideResult, StrideFailure> {
-        self.stride_inner(q0, qd0, options, trajectory, None)
+        self.stride_inner(q0, qd0, options, trajectory, None, Schedule::Free)
+    }
+
+    /// As [`Self::stride`], with its steps recorded or replayed ([`Schedule`]).
+    pub fn stride_scheduled(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        options: StrideOptions,
+        schedule: Schedule<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let mut trajectory = Vec::new();
+        let mut r = self.stride_inner(q0, qd0, options, &mut trajectory, None, schedule)?;
+        r.trajectory = trajectory;
+        Ok(r)
     }
 
     /// As [`Self::stride_recording`], with the stance ankle's string moved by `controller`,
@@ -515,7 +554,14 @@ impl Walker {
                 "a controlled stride needs a scene with an ankle_reflex section",
             ));
         }
-        self.stride_inner(q0, qd0, options, trajectory, Some((controller, t_walk_s)))
+        self.stride_inner(
+            q0,
+            qd0,
+            options,
+            trajectory,
+            Some((controller, t_walk_s)),
+            Schedule::Free,
+        )
     }
 
     fn stride_inner(
@@ -525,9 +571,16 @@ impl Walker {
         options: StrideOptions,
         trajectory: &mut Vec<Sample>,
         mut control: Option<(&mut dyn AnkleController, f64)>,
+        mut schedule: Schedule<'_>,
     ) -> Result<StrideResult, StrideFailure> {
         let mut integrator = self.integrator.build();
         integrator.reset();
+        // Phase (between impacts) and step within it, for the step schedule.
+        let (mut phase_no, mut step_no) = (0usize, 0usize);
+        if let Schedule::Record(s) = &mut schedule {
+            s.phases.clear();
+            s.phases.push(Vec::new());
+        }
         // Evaluations of earlier phases (the integrator restarts after each impact).
         let mut evaluations = 0;
         let mut phase = Phase::new(&self.model);
@@ -627,9 +680,29 @@ impl Walker {
                     format!("no heel strike within {} s", self.max_stride_time_s),
                 ));
             }
-            let mut next = integrator
-                .advance(&mut phase, &cur, (next_tick - cur.t_s).max(1e-12))
-                .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+            // The ideal drive's profile ends with a jump in its jerk: a breakpoint, so that no
+            // step straddles it (the step sizes stay smooth functions of the initial state,
+            // and replayed schedules stay accurate when the end moves).
+            let drive_end = match phase.prescribed {
+                Some((_, Drive::Profile(p))) if cur.t_s < p.start_s + p.duration_s - 1e-12 => {
+                    p.start_s + p.duration_s
+                }
+                _ => f64::INFINITY,
+            };
+            let h_limit = (next_tick.min(drive_end) - cur.t_s).max(1e-12);
+            let replayed = match &schedule {
+                Schedule::Replay(s) => s
+                    .phases
+                    .get(phase_no)
+                    .and_then(|p| p.get(step_no).or(p.last()))
+                    .copied(),
+                _ => None,
+            };
+            let mut next = match replayed {
+                Some(h) => integrator.step_exact(&mut phase, &cur, h.min(h_limit)),
+                None => integrator.advance(&mut phase, &cur, h_limit),
+            }
+            .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
             phase.snap(&mut next);
             if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
                 return Err(StrideFailure::new(
@@ -722,6 +795,21 @@ impl Walker {
                         .map_err(|e| {
                             StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
                         })?;
+                }
+                if let Schedule::Record(s) = &mut schedule {
+                    if let Some(p) = s.phases.last_mut() {
+                        p.push(next.t_s - cur.t_s);
+                    }
+                }
+                step_no += 1;
+                if next.t_s >= drive_end - 1e-12 {
+                    // A new smooth phase: the schedule and the integrator's memory restart.
+                    integrator.system_changed();
+                    phase_no += 1;
+                    step_no = 0;
+                    if let Schedule::Record(s) = &mut schedule {
+                        s.phases.push(Vec::new());
+                    }
                 }
                 cur = next;
                 if options.record {
@@ -862,6 +950,11 @@ impl Walker {
                     });
                     evaluations += integrator.evaluations();
                     integrator.reset();
+                    phase_no += 1;
+                    step_no = 0;
+                    if let Schedule::Record(s) = &mut schedule {
+                        s.phases.push(Vec::new());
+                    }
                     if options.record {
                         trajectory.push(cur.clone());
                     }
@@ -901,6 +994,11 @@ impl Walker {
                     });
                     evaluations += integrator.evaluations();
                     integrator.reset();
+                    phase_no += 1;
+                    step_no = 0;
+                    if let Schedule::Record(s) = &mut schedule {
+                        s.phases.push(Vec::new());
+                    }
                     if options.record {
                         trajectory.push(cur.clone());
                     }
@@ -910,6 +1008,12 @@ impl Walker {
                     if ahead < self.heel_strike.min_ahead_m {
                         if self.heel_strike.ignore_scuffing {
                             power.accumulate(&damping, &at, &next);
+                            if let Schedule::Record(s) = &mut schedule {
+                                if let Some(p) = s.phases.last_mut() {
+                                    p.push(next.t_s - cur.t_s);
+                                }
+                            }
+                            step_no += 1;
                             cur = next;
                             if options.record {
                                 trajectory.push(cur.clone());

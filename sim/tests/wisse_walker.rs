@@ -205,12 +205,13 @@ fn golden_fixed_points_and_eigenvalues() {
             c["eigenvalue_moduli"].as_array().unwrap(),
         );
         assert_eq!(ge.len(), ce.len());
-        // The perturbation Jacobian reproduces the nearly undamped pelvic modes to about 1e-4:
-        // reordering the floating-point operations of the equations moves them by 3e-5
-        // (docs/accuracy.md).
+        // With the drive's end a breakpoint of the integration the stride map is smooth and
+        // the central-difference Jacobian's eigenvalues agree to about 1e-8 over perturbations
+        // 1e-6 to 1e-5 and tolerances 1e-12 to 1e-13 (docs/accuracy.md): 1e-6 leaves room for
+        // reordered floating-point operations, not for a changed model.
         for (a, b) in ge.iter().zip(ce) {
             assert!(
-                (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-4,
+                (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-6,
                 "{n}: {a} vs {b}"
             );
         }

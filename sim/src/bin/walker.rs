@@ -169,6 +169,10 @@ struct Common {
     /// Perturbation step of the stride Jacobian.
     #[arg(long, default_value_t = 1e-6)]
     perturbation: f64,
+    /// The perturbed strides of the stride Jacobian replay the nominal stride's steps
+    /// (internal numerical differentiation) instead of choosing their own.
+    #[arg(long)]
+    frozen_steps: bool,
 }
 
 /// Bad input: exit code 2.
@@ -244,6 +248,7 @@ impl Common {
             perturbation: self.perturbation,
             central: true,
             max_halvings: 8,
+            frozen_steps: self.frozen_steps,
         }
     }
 }
