@@ -46,6 +46,14 @@ fn benches(c: &mut Criterion) {
                     h_max_s: period / 10.0,
                 },
             ),
+            (
+                "dop853_1e-8",
+                IntegratorChoice::Dop853 {
+                    rtol: 1e-8,
+                    atol: 1e-8,
+                    h_max_s: period / 10.0,
+                },
+            ),
         ] {
             let mut w = walker.clone();
             w.integrator = integrator;

@@ -170,3 +170,19 @@ fn newton_reports_its_spent_budget_and_failed_strides() {
         Err(NewtonError::StrideFailed { iteration: 0, .. })
     ));
 }
+
+#[test]
+fn a_drive_that_retracts_lets_the_heel_back_down() {
+    // The string engages at the usual angle, but the actuator then pulls the ankle back to
+    // -0.2 rad instead of extending it: the foot, pivoting about its toe, comes back down.
+    let (mut scene, w) = common::walker("wisse3d");
+    let g = common::gait(&w);
+    scene.set_text("ankle_final_rad=-0.2").unwrap();
+    let retracting = scene.build().unwrap();
+    let e = retracting
+        .stride_map(&g.fixed_point)
+        .expect_err("must fail");
+    assert_eq!(e.kind, FailureKind::HeelReturnedToFloor, "{e}");
+    // The same start with the scene's own drive walks on.
+    assert!(w.stride_map(&g.fixed_point).is_ok());
+}

@@ -239,3 +239,33 @@ fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay
         "heel strike jumps earlier across the boundary: {t_bad} vs {t_ok}"
     );
 }
+
+#[test]
+fn the_3d_walkers_stride_map_is_smooth_across_its_drives_end() {
+    // The ideal drive's extension ends with a jump in its jerk. Adaptive steps straddling it
+    // made the stride map rough: central differences at 1e-6 and 1e-5 gave pelvic-mode
+    // eigenvalues 4e-6 apart (and up to 3e-4 at 1e-13). With the end a breakpoint of the
+    // integration both perturbations give the same spectrum.
+    let (_, w) = common::walker("wisse3d");
+    let g = common::gait(&w);
+    let s = w.stride_map(&g.fixed_point).unwrap().0;
+    let moduli = |d: f64| {
+        let j = w
+            .stride_jacobian(
+                &g.fixed_point,
+                &s,
+                &NewtonSettings {
+                    perturbation: d,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+        let mut m: Vec<f64> = j.complex_eigenvalues().iter().map(|z| z.norm()).collect();
+        m.sort_by(|a, b| b.total_cmp(a));
+        m
+    };
+    let (a, b) = (moduli(1e-6), moduli(1e-5));
+    for (x, y) in a.iter().zip(&b).filter(|(x, _)| **x > 0.05) {
+        assert!((x - y).abs() < 1e-7, "{x} vs {y}");
+    }
+}
