@@ -1,6 +1,7 @@
 //! Walks the 3D walker with both ankle nodes' firmware and the simulated bus in the loop, for
 //! profilers: real-time factor and right-hand-side evaluations per control tick
-//! (`cargo run --release -p sim --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`).
+//! (`cargo run --release -p sim --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`;
+//! without an integrator, `walker sil`'s own, `sim::sil::SIL_INTEGRATOR`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use sim::integrators::IntegratorChoice;
@@ -11,7 +12,7 @@ use sim::walk::WalkOptions;
 fn main() {
     let mut args = std::env::args().skip(1);
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(30);
-    let kind = args.next().unwrap_or_else(|| "dopri5".into());
+    let kind = args.next().unwrap_or_else(|| "sil".into());
     let x: Option<f64> = args.next().and_then(|s| s.parse().ok());
     let scene = sim::scene::Scene::load("wisse3d").expect("scene");
     let mut w = scene.build().expect("build");
@@ -23,11 +24,12 @@ fn main() {
         "rk4" => IntegratorChoice::Rk4 {
             h_s: x.unwrap_or(1e-3),
         },
-        _ => IntegratorChoice::Dopri5 {
-            rtol: x.unwrap_or(1e-9),
-            atol: x.unwrap_or(1e-9),
+        "dopri5" => IntegratorChoice::Dopri5 {
+            rtol: x.unwrap_or(1e-6),
+            atol: x.unwrap_or(1e-6),
             h_max_s: 0.01,
         },
+        _ => sim::sil::SIL_INTEGRATOR,
     };
     let reflex = w.ankle.clone().unwrap();
     let mut ctl =
