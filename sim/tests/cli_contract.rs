@@ -224,3 +224,69 @@ fn compass_gait_json_has_goswami_angles() {
     assert_eq!(v["converged"], true);
     assert_eq!(v["stable"], true);
 }
+
+#[test]
+fn a_walk_starts_from_a_state_file_and_a_bad_file_is_named() {
+    let dir = std::env::temp_dir().join(format!("walker-start-state-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // The gait's own output is a valid start state, and gives the same walk as the default.
+    let gait = walker(&["gait", "--scene", "compass", "--json"]);
+    assert!(gait.status.success());
+    let file = dir.join("gait.json");
+    std::fs::write(&file, &gait.stdout).unwrap();
+    let steps = |extra: &[&str]| {
+        let mut args = vec!["walk", "--scene", "compass", "--steps", "2", "--json"];
+        args.extend_from_slice(extra);
+        json(&walker(&args))["steps"].clone()
+    };
+    let from_file = steps(&["--start-state", file.to_str().unwrap()]);
+    assert_eq!(from_file, steps(&[]));
+    // A partial file changes only what it names.
+    let partial = dir.join("partial.json");
+    std::fs::write(&partial, r#"{"stance_leg_dot": -1.2}"#).unwrap();
+    let w = json(&walker(&[
+        "walk",
+        "--scene",
+        "compass",
+        "--steps",
+        "1",
+        "--json",
+        "--start-state",
+        partial.to_str().unwrap(),
+    ]));
+    assert_ne!(w["steps"], from_file);
+    // Bad files: exit 2, naming the problem.
+    for (content, needle) in [
+        (r#"{"nosuch": 1.0}"#, "nosuch"),
+        (r#"{"stance_leg_dot": "fast"}"#, "stance_leg_dot"),
+        (r#"[1, 2]"#, "object"),
+        ("not json", "not JSON"),
+        ("{}", "no entry"),
+    ] {
+        let f = dir.join("bad.json");
+        std::fs::write(&f, content).unwrap();
+        let out = walker(&[
+            "walk",
+            "--scene",
+            "compass",
+            "--steps",
+            "1",
+            "--start-state",
+            f.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{content}: {err}");
+        assert!(err.contains(needle), "{content}: {err}");
+    }
+    let missing = walker(&[
+        "walk",
+        "--scene",
+        "compass",
+        "--steps",
+        "1",
+        "--start-state",
+        "/nonexistent/x.json",
+    ]);
+    assert_eq!(missing.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

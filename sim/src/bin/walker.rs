@@ -58,6 +58,12 @@ enum Command {
         /// leg state for the uncompensated one.
         #[arg(long, value_name = "SCENE")]
         start_from_scene: Option<String>,
+        /// Set start-state entries from a JSON file: an object of stride-map entries
+        /// (`coord` or `coord_dot`, as `walker gait --json` names them) to numbers, or a
+        /// `walker gait --json` output (its `fixed_point`). Entries it does not name keep
+        /// their values from `--start`; applied before `--perturb`.
+        #[arg(long, value_name = "FILE.json")]
+        start_state: Option<std::path::PathBuf>,
         /// Write the trajectory (every integrator sample) as CSV.
         #[arg(long, value_name = "FILE.csv")]
         out: Option<std::path::PathBuf>,
@@ -302,6 +308,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             perturb,
             start,
             start_from_scene,
+            start_state,
             out,
             plot,
             plot_with,
@@ -343,6 +350,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 }
             };
             let names = walker.map_names();
+            if let Some(path) = &start_state {
+                for (i, x) in read_start_state(path, &names)? {
+                    v[i] = x;
+                }
+            }
             for p in &perturb {
                 let (k, d) = p.split_once('=').ok_or_else(|| {
                     InputError::Other(format!("--perturb `{p}`: expected coord=delta"))
@@ -707,6 +719,47 @@ fn run(cli: Cli) -> Result<ExitCode> {
 
 /// The gait of scene `other` (with this scene's shared parameter values), mapped onto this
 /// walker's stride-map entries by name. `None` (after a message) if it has no gait.
+/// The entries a start-state file sets, as (stride-map index, value); every problem with the
+/// file is bad input naming it.
+fn read_start_state(
+    path: &std::path::Path,
+    names: &[String],
+) -> Result<Vec<(usize, f64)>, InputError> {
+    let bad = |why: String| InputError::Other(format!("--start-state `{}`: {why}", path.display()));
+    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    let doc: Value = serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
+    // A `walker gait --json` output also lists its scene's conventional outputs (e.g.
+    // Goswami's angles) in `fixed_point`: there, only the stride-map entries are read.
+    let (obj, from_gait) = match doc.get("fixed_point") {
+        Some(f) => (f, true),
+        None => (&doc, false),
+    };
+    let obj = obj
+        .as_object()
+        .ok_or_else(|| bad("expected an object of entry names to numbers".into()))?;
+    let mut out = Vec::with_capacity(obj.len());
+    for (k, x) in obj {
+        let Some(i) = names.iter().position(|n| n == k) else {
+            if from_gait {
+                continue;
+            }
+            return Err(bad(format!(
+                "unknown entry `{k}` (known: {})",
+                names.join(", ")
+            )));
+        };
+        let x = x
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| bad(format!("`{k}` = {x} is not a finite number")))?;
+        out.push((i, x));
+    }
+    if out.is_empty() {
+        return Err(bad("names no entry".into()));
+    }
+    Ok(out)
+}
+
 fn start_from_other(
     other: &str,
     scene: &Scene,
