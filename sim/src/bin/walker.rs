@@ -218,31 +218,8 @@ impl Common {
                         "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
                     ))
                 })?;
-        } else if let (Some(r), IntegratorChoice::Dopri5 { h_max_s, .. }) =
-            (self.rtol, &w.integrator)
-        {
-            w.integrator = IntegratorChoice::Dopri5 {
-                rtol: r,
-                atol: r,
-                h_max_s: *h_max_s,
-            };
-        } else if let (Some(r), IntegratorChoice::Dop853 { h_max_s, .. }) =
-            (self.rtol, &w.integrator)
-        {
-            w.integrator = IntegratorChoice::Dop853 {
-                rtol: r,
-                atol: r,
-                h_max_s: *h_max_s,
-            };
-        } else if let Some(h) = self.step_s {
-            w.integrator = match w.integrator {
-                IntegratorChoice::Meijaard { check_every, .. } => IntegratorChoice::Meijaard {
-                    h_s: h,
-                    check_every,
-                },
-                IntegratorChoice::Rk4 { .. } => IntegratorChoice::Rk4 { h_s: h },
-                other => other,
-            };
+        } else {
+            w.integrator = w.integrator.with_tolerance_or_step(self.rtol, self.step_s);
         }
         Ok(w)
     }

@@ -5,7 +5,7 @@
 // The coefficients are written with the digits Hairer published, beyond f64's precision.
 #![allow(clippy::excessive_precision)]
 
-use super::{IntegrationError, Integrator, Sample, SecondOrderSystem};
+use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
 use nalgebra::DVector;
 
 /// Stage nodes `c_1 … c_12` (index 0 is stage 1).
@@ -272,30 +272,17 @@ impl Integrator for Dop853 {
         from: &Sample,
         h_limit_s: f64,
     ) -> Result<Sample, IntegrationError> {
-        let mut h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
-        loop {
-            let (next, err) = self.try_step(sys, from, h)?;
-            let factor = if err == 0.0 {
-                6.0
-            } else {
-                (0.9 * err.powf(-0.125)).clamp(1.0 / 3.0, 6.0)
-            };
-            if err <= 1.0 && err.is_finite() {
-                self.h_next_s = (h * factor).min(self.h_max_s);
-                return Ok(next);
-            }
-            h *= if err.is_finite() {
-                factor.min(0.9)
-            } else {
-                0.2
-            };
-            if h < self.h_min_s {
-                return Err(IntegrationError::StepUnderflow {
-                    h_s: h,
-                    t_s: from.t_s,
-                });
-            }
-        }
+        let h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
+        let limits = StepLimits {
+            exponent: 0.125,
+            min_factor: 1.0 / 3.0,
+            max_factor: 6.0,
+            h_max_s: self.h_max_s,
+            h_min_s: self.h_min_s,
+        };
+        let (next, h_next) = adaptive_step(h, limits, from.t_s, |h| self.try_step(sys, from, h))?;
+        self.h_next_s = h_next;
+        Ok(next)
     }
     fn step_exact(
         &mut self,

@@ -1,6 +1,6 @@
 //! Dormand-Prince 5(4): an adaptive embedded Runge-Kutta pair, the accuracy reference.
 
-use super::{IntegrationError, Integrator, Sample, SecondOrderSystem};
+use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
 use nalgebra::DVector;
 
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -190,31 +190,18 @@ impl Integrator for Dopri5 {
         from: &Sample,
         h_limit_s: f64,
     ) -> Result<Sample, IntegrationError> {
-        let mut h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
-        loop {
-            let (next, err) = self.try_step(sys, from, h)?;
-            let factor = if err == 0.0 {
-                5.0
-            } else {
-                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-            };
-            if err <= 1.0 && err.is_finite() {
-                self.h_next_s = (h * factor).min(self.h_max_s);
-                self.accept(&next);
-                return Ok(next);
-            }
-            h *= if err.is_finite() {
-                factor.min(0.9)
-            } else {
-                0.2
-            };
-            if h < self.h_min_s {
-                return Err(IntegrationError::StepUnderflow {
-                    h_s: h,
-                    t_s: from.t_s,
-                });
-            }
-        }
+        let h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
+        let limits = StepLimits {
+            exponent: 0.2,
+            min_factor: 0.2,
+            max_factor: 5.0,
+            h_max_s: self.h_max_s,
+            h_min_s: self.h_min_s,
+        };
+        let (next, h_next) = adaptive_step(h, limits, from.t_s, |h| self.try_step(sys, from, h))?;
+        self.h_next_s = h_next;
+        self.accept(&next);
+        Ok(next)
     }
     fn step_exact(
         &mut self,

@@ -78,6 +78,52 @@ pub enum IntegrationError {
     },
 }
 
+/// The step-size controller of the embedded pairs (DOPRI5, DOP853): from `h`, try a step;
+/// accept it when its scaled error is at most 1 and propose the next step
+/// `h · clamp(0.9 · err^(−exponent), min, max)` (at most `h_max_s`); otherwise shrink and retry,
+/// down to `h_min_s`. Returns the accepted sample and the proposal.
+pub(crate) fn adaptive_step(
+    mut h: f64,
+    limits: StepLimits,
+    t_s: f64,
+    mut try_step: impl FnMut(f64) -> Result<(Sample, f64), IntegrationError>,
+) -> Result<(Sample, f64), IntegrationError> {
+    loop {
+        let (next, err) = try_step(h)?;
+        let factor = if err == 0.0 {
+            limits.max_factor
+        } else {
+            (0.9 * err.powf(-limits.exponent)).clamp(limits.min_factor, limits.max_factor)
+        };
+        if err <= 1.0 && err.is_finite() {
+            return Ok((next, (h * factor).min(limits.h_max_s)));
+        }
+        h *= if err.is_finite() {
+            factor.min(0.9)
+        } else {
+            0.2
+        };
+        if h < limits.h_min_s {
+            return Err(IntegrationError::StepUnderflow { h_s: h, t_s });
+        }
+    }
+}
+
+/// Bounds of [`adaptive_step`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StepLimits {
+    /// Error exponent: 1/(order + 1) of the lower-order estimate.
+    pub exponent: f64,
+    /// Smallest step-size factor.
+    pub min_factor: f64,
+    /// Largest step-size factor.
+    pub max_factor: f64,
+    /// Largest step [s].
+    pub h_max_s: f64,
+    /// Smallest step before giving up [s].
+    pub h_min_s: f64,
+}
+
 /// Which integrator to use, with its settings. Serialised in reports.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -163,6 +209,31 @@ impl IntegratorChoice {
                 h_max_s: h_max_s.unwrap_or(0.05),
             }),
             _ => None,
+        }
+    }
+
+    /// The same integrator with its tolerances (rtol = atol) or its fixed step replaced,
+    /// where it has one.
+    pub fn with_tolerance_or_step(&self, rtol: Option<f64>, h_s: Option<f64>) -> Self {
+        match (self.clone(), rtol, h_s) {
+            (IntegratorChoice::Dopri5 { h_max_s, .. }, Some(r), _) => IntegratorChoice::Dopri5 {
+                rtol: r,
+                atol: r,
+                h_max_s,
+            },
+            (IntegratorChoice::Dop853 { h_max_s, .. }, Some(r), _) => IntegratorChoice::Dop853 {
+                rtol: r,
+                atol: r,
+                h_max_s,
+            },
+            (IntegratorChoice::Meijaard { check_every, .. }, _, Some(h)) => {
+                IntegratorChoice::Meijaard {
+                    h_s: h,
+                    check_every,
+                }
+            }
+            (IntegratorChoice::Rk4 { .. }, _, Some(h)) => IntegratorChoice::Rk4 { h_s: h },
+            (other, _, _) => other,
         }
     }
 
