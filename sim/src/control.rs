@@ -26,6 +26,10 @@ pub struct AnkleSensing {
     pub swing_foot_on_floor: bool,
     /// The string is taut (engaged) on the stance ankle.
     pub string_engaged: bool,
+    /// Torque the engaged string exerts on the stance ankle at the tick, just before the new
+    /// segment [N·m] (the generalised force of the drive on the ankle coordinate; 0 while the
+    /// string is slack).
+    pub string_torque_n_m: f64,
 }
 
 /// The stance string's limit over one tick: a cubic Hermite from `(p0, v0)` at `t0` to

@@ -646,6 +646,20 @@ impl Walker {
                         stance_foot_on_floor: true,
                         swing_foot_on_floor: w.foot_height_m <= 1e-9,
                         string_engaged: engaged,
+                        string_torque_n_m: if engaged {
+                            phase
+                                .actuator_torque(&cur)
+                                .map_err(|e| {
+                                    StrideFailure::new(
+                                        FailureKind::NonFiniteState,
+                                        cur.t_s,
+                                        e.to_string(),
+                                    )
+                                })?
+                                .0
+                        } else {
+                            0.0
+                        },
                     };
                     let mut seg = c.tick(&sensing).map_err(|e| {
                         StrideFailure::new(FailureKind::NonFiniteState, cur.t_s, e.to_string())

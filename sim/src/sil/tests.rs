@@ -44,6 +44,7 @@ fn run(sil: &mut FirmwareInTheLoop, until_s: f64, strikes_s: &[f64]) -> Vec<Tick
             stance_foot_on_floor: true,
             swing_foot_on_floor: false,
             string_engaged: limit.is_some_and(|s| !s.released && s.eval(t_s).0 >= free),
+            string_torque_n_m: 0.0,
         };
         let seg = sil.tick(&sensing).unwrap();
         limit = Some(seg);
@@ -364,6 +365,7 @@ fn bad_configurations_and_times_are_refused() {
         stance_foot_on_floor: true,
         swing_foot_on_floor: false,
         string_engaged: false,
+        string_torque_n_m: 0.0,
     };
     assert!(c.tick(&s).is_err());
     assert!(c.tick(&AnkleSensing { t_s: f64::NAN, ..s }).is_err());
@@ -468,6 +470,7 @@ fn a_socketcand_client_sees_the_frames_and_its_emergency_stop_reaches_the_nodes(
             stance_foot_on_floor: true,
             swing_foot_on_floor: false,
             string_engaged: false,
+            string_torque_n_m: 0.0,
         };
         c.tick(&s).unwrap();
         *t_ms += 1;
