@@ -668,14 +668,22 @@ impl Walker {
                     seg.t1_s -= *t0;
                     if let Some((coord, Drive::Segment(_))) = phase.prescribed {
                         if seg.released {
-                            return Err(StrideFailure::new(
-                                FailureKind::HeelReturnedToFloor,
-                                cur.t_s,
-                                "the actuator released the string during push-off",
-                            ));
+                            // The string goes slack during the push (an emergency stop, a
+                            // fault): no impulse, the ankle is free again, and the foot keeps
+                            // pivoting about its toe until the heel comes back down or the
+                            // stride ends.
+                            power.close(&self.model, &cur);
+                            phase.prescribed = None;
+                            phase.active[coord.0] = true;
+                            integrator.system_changed();
+                            events.push(StrideEvent {
+                                name: "string_released".into(),
+                                time_s: cur.t_s,
+                            });
+                        } else {
+                            phase.prescribed = Some((coord, Drive::Segment(seg)));
+                            phase.snap(&mut cur);
                         }
-                        phase.prescribed = Some((coord, Drive::Segment(seg)));
-                        phase.snap(&mut cur);
                     }
                     // Only an engaged string's new segment changes the vector field; while
                     // the ankle is free the tick only moves the engagement witness, and the
@@ -900,11 +908,55 @@ impl Walker {
                     ));
                 }
                 Watch::HeelDrop => {
-                    return Err(StrideFailure::new(
-                        FailureKind::HeelReturnedToFloor,
-                        at.t_s,
-                        "the stance heel came back down during push-off",
-                    ));
+                    if phase.prescribed.is_some() {
+                        // The drive still holds the ankle: the push has failed.
+                        return Err(StrideFailure::new(
+                            FailureKind::HeelReturnedToFloor,
+                            at.t_s,
+                            "the stance heel came back down during push-off",
+                        ));
+                    }
+                    // The string is slack: the heel lands, an inelastic impact that stops the
+                    // foot's pitch about its toe; the foot is flat again, the ankle free.
+                    let Some(r) = &self.ankle else { continue };
+                    let toe = r.toe_pitch.0;
+                    let mut g = DMatrix::zeros(1, self.model.dof());
+                    g[(0, toe)] = 1.0;
+                    let mut dynamics = Dynamics::new(&self.model);
+                    let before = energy(&mut dynamics, &self.model, &at);
+                    let imp = resolve(
+                        &mut dynamics,
+                        &self.model,
+                        &at.q,
+                        &at.qd,
+                        &phase.active,
+                        &g,
+                        0.0,
+                    )
+                    .map_err(|e| {
+                        StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
+                    })?;
+                    phase.active[toe] = false;
+                    let mut qd = imp.qd_plus;
+                    qd[toe] = 0.0;
+                    let mut q = at.q.clone();
+                    q[toe] = 0.0;
+                    cur = Sample { t_s: at.t_s, q, qd };
+                    energy_loss += before - energy(&mut dynamics, &self.model, &cur);
+                    events.push(StrideEvent {
+                        name: "heel_down".into(),
+                        time_s: at.t_s,
+                    });
+                    evaluations += integrator.evaluations();
+                    integrator.reset();
+                    phase_no += 1;
+                    step_no = 0;
+                    if let Schedule::Record(s) = &mut schedule {
+                        s.phases.push(Vec::new());
+                    }
+                    if options.record {
+                        trajectory.push(cur.clone());
+                    }
                 }
                 Watch::Engage => {
                     let Some(r) = &self.ankle else { continue };
