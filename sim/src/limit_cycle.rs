@@ -219,17 +219,25 @@ impl Walker {
             // grows; keep the last trial if the budget runs out (the next iteration reports).
             let r_norm = r.amax();
             let mut lambda = 1.0;
+            let mut accepted = settings.max_halvings == 0;
             for _ in 0..settings.max_halvings {
                 let trial = &v + &dv * lambda;
                 match self.stride_map(&trial) {
                     Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
                         carried = Some((st, sr));
+                        accepted = true;
                         break;
                     }
                     _ => lambda *= 0.5,
                 }
             }
-            last_step = dv.amax() * lambda;
+            // A step that no halving made acceptable is not a sign of convergence, however
+            // short it has become.
+            last_step = if accepted {
+                dv.amax() * lambda
+            } else {
+                f64::INFINITY
+            };
             v += dv * lambda;
             kept = Some(j);
         }

@@ -251,7 +251,11 @@ pub fn sweep_json(
 
 /// Gait figures averaged over the last `last` completed steps of a walk: `step_period_s`,
 /// `step_length_m`, `speed_m_s`, `cost_of_transport_J_per_kg_m`, `heading_change_rad_per_step`
-/// (mean magnitude), with the number of steps used. `Null` if no step completed.
+/// (mean magnitude of the per-step yaw in each step's mirrored stance frame: the zigzag, not a
+/// turn), `heading_change_rad_per_step_signed` (its signed mean) and `heading_rad` (direction
+/// of travel of the hip over those steps in the floor frame, `atan2(Δz, Δx)`: 0 straight
+/// ahead along the first stance frame's x, positive toward +z; `null` with fewer than two
+/// steps), with the number of steps used. `Null` if no step completed.
 pub fn walk_gait_json(walker: &Walker, walk: &Walk, last: usize) -> Value {
     let n = walk.steps.len().min(last);
     if n == 0 {
@@ -266,12 +270,13 @@ pub fn walk_gait_json(walker: &Walker, walk: &Walk, last: usize) -> Value {
     // Distance walked per step: hip displacement over an even number of steps (so that the
     // sideways zigzag cancels), divided by that number.
     let k = if n >= 3 { (n - 1) / 2 * 2 } else { n - 1 };
-    let progress = if k == 0 {
-        length
+    let (progress, heading) = if k == 0 {
+        (length, Value::Null)
     } else {
         let a = &steps[n - 1 - k].hip_floor_m;
         let b = &steps[n - 1].hip_floor_m;
-        ((b[0] - a[0]).powi(2) + (b[2] - a[2]).powi(2)).sqrt() / k as f64
+        let (dx, dz) = (b[0] - a[0], b[2] - a[2]);
+        ((dx * dx + dz * dz).sqrt() / k as f64, json!(dz.atan2(dx)))
     };
     json!({
         "steps_averaged": n,
@@ -281,6 +286,8 @@ pub fn walk_gait_json(walker: &Walker, walk: &Walk, last: usize) -> Value {
         "speed_m_s": progress / period,
         "cost_of_transport_J_per_kg_m": work / (walker.model.total_mass_kg() * progress),
         "heading_change_rad_per_step": mean(&|s| s.heading_change_rad.abs()),
+        "heading_rad": heading,
+        "heading_change_rad_per_step_signed": mean(&|s| s.heading_change_rad),
     })
 }
 

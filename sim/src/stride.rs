@@ -990,6 +990,12 @@ impl Walker {
                                     e.to_string(),
                                 )
                             })?;
+                    // The string's impulse on the ankle, with its far end moving at the drive's
+                    // rate, is work the actuator does (zero for the ideal drive, which starts
+                    // at rest).
+                    let drive_work = imp.impulse[0] * v_rad_s;
+                    power.work_j += drive_work;
+                    energy_loss += drive_work;
                     let mut q = at.q.clone();
                     q[a] = p_rad;
                     let mut qd = imp.qd_plus;
@@ -1044,6 +1050,18 @@ impl Walker {
                     .map_err(|e| {
                         StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
                     })?;
+                    // A drive holding the ankle through the impact takes an impulse and does
+                    // work on it (impulse × its rate, which the impact does not change): the
+                    // actuator's work, not part of the impact's loss.
+                    let drive_work = match phase.prescribed {
+                        Some((a, _)) => {
+                            let dqd = &imp.qd_plus - &at.qd;
+                            (dynamics.mass_matrix.row(a.0) * dqd)[(0, 0)] * at.qd[a.0]
+                        }
+                        None => 0.0,
+                    };
+                    power.work_j += drive_work;
+                    energy_loss += drive_work;
                     phase.active[c] = false;
                     let mut qd = imp.qd_plus;
                     qd[c] = 0.0;

@@ -193,6 +193,20 @@ fn a_non_finite_velocity_is_a_typed_failure() {
 }
 
 #[test]
+fn equations_of_motion_that_overflow_are_a_typed_failure() {
+    // A finite start state (it passes the entry check) but gravity beyond f64's range: the
+    // first evaluation of the equations of motion overflows inside the integration, and the
+    // dynamics error becomes the same typed outcome, not a NaN state.
+    let (_, mut w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    w.model.gravity_floor_m_s2 *= 1e308;
+    let e = w.stride(&q, &qd, StrideOptions::default()).unwrap_err();
+    assert_eq!(e.kind, FailureKind::NonFiniteState, "{e}");
+    assert!(!e.detail.contains("initial state"), "{e}");
+}
+
+#[test]
 fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay_typed() {
     // Bisect a start perturbation of the kneed walker between a stride whose knee locks before
     // heel strike and one whose heel strikes first, down to 1e-12 rad: every stride on the way
@@ -267,5 +281,65 @@ fn the_3d_walkers_stride_map_is_smooth_across_its_drives_end() {
     let (a, b) = (moduli(1e-6), moduli(1e-5));
     for (x, y) in a.iter().zip(&b).filter(|(x, _)| **x > 0.05) {
         assert!((x - y).abs() < 1e-7, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn event_location_error_is_far_below_the_integration_error() {
+    // The heel strike of one stride, located on each integrator's own numerical solution with
+    // the default event tolerance and with a tolerance at the limit of f64: their difference
+    // is the event location's error. It must be far below the heel-strike time's integration
+    // error (against DOPRI5 at 1e-13), or the study's heel-strike column would measure the
+    // locator, not the integrator.
+    let (_, w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let mut reference = w.clone();
+    reference.integrator = IntegratorChoice::Dopri5 {
+        rtol: 1e-13,
+        atol: 1e-13,
+        h_max_s: 0.01,
+    };
+    let t_ref = reference
+        .stride(&q, &qd, StrideOptions::default())
+        .unwrap()
+        .duration_s;
+    let period = g.stride.duration_s;
+    for integrator in [
+        IntegratorChoice::Rk4 { h_s: period / 50.0 },
+        IntegratorChoice::Rk4 {
+            h_s: period / 200.0,
+        },
+        IntegratorChoice::Dopri5 {
+            rtol: 1e-8,
+            atol: 1e-8,
+            h_max_s: period / 10.0,
+        },
+        IntegratorChoice::Dop853 {
+            rtol: 1e-8,
+            atol: 1e-8,
+            h_max_s: period / 10.0,
+        },
+    ] {
+        let mut a = w.clone();
+        a.integrator = integrator.clone();
+        let t_default = a
+            .stride(&q, &qd, StrideOptions::default())
+            .unwrap()
+            .duration_s;
+        a.event_tolerance.time_s = 1e-16;
+        a.event_tolerance.witness = 0.0;
+        a.event_tolerance.max_iterations = 200;
+        let t_tight = a
+            .stride(&q, &qd, StrideOptions::default())
+            .unwrap()
+            .duration_s;
+        let location = (t_default - t_tight).abs();
+        let integration = (t_tight - t_ref).abs();
+        assert!(
+            location < 1e-3 * integration && location < 1e-12,
+            "{}: location {location:e}, integration {integration:e}",
+            integrator.label()
+        );
     }
 }

@@ -143,8 +143,9 @@ pub struct Dop853 {
     evaluations: usize,
     /// Smallest step before giving up [s].
     pub h_min_s: f64,
-    /// The derivative at the end of the last accepted step (evaluated after acceptance, as
-    /// DOP853 does), reused as the first stage of a step from exactly that sample.
+    /// The first stage (the derivative at a step's start), evaluated on demand and kept, so
+    /// that a retried step (after a rejection) and the next step from exactly the same sample
+    /// do not evaluate it again.
     fsal: Option<Fsal>,
 }
 
