@@ -80,7 +80,7 @@ pub fn summary(walk: &Walk, r: &SilReport) -> String {
         .iter()
         .map(|(side, n)| {
             format!(
-                "{side:?}: {} {} faults {:?} raises {:?} engaged {} released by message {} by lift-off {} dropped {} refused(queue) {}",
+                "{side:?}: {} {} faults {:?} raises {:?} engaged {} released by message {} by lift-off {} dropped {} refused(queue) {} peak torque {:.3} N·m, ticks over the limit {}",
                 n.state,
                 n.phase,
                 n.active_faults,
@@ -89,7 +89,9 @@ pub fn summary(walk: &Walk, r: &SilReport) -> String {
                 n.releases_by_peer_heel_strike,
                 n.releases_by_lift_off,
                 n.frames_dropped,
-                n.frames_refused_queue_full
+                n.frames_refused_queue_full,
+                n.actuator.peak_torque_n_m,
+                n.actuator.over_torque_ticks
             )
         })
         .collect();

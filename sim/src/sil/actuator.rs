@@ -8,9 +8,16 @@
 //! across ticks: each tick becomes a C¹ cubic Hermite [`ActuatorSegment`] from the previous
 //! end `(p, v)` to the new end.
 //!
-//! Force limits are not modelled: the simulator's string is rigid and unilateral, so it
-//! transmits whatever force keeps the ankle at the limit. The servo's tracking error and its
-//! rate saturation are recorded instead (see [`ActuatorStats`]).
+//! Torque limit: the simulator's string is rigid and unilateral, so it transmits whatever torque
+//! keeps the ankle at the limit. The model compares that torque (the string's torque on the
+//! stance ankle at the tick's start, [`crate::control::AnkleSensing::string_torque_n_m`]) with
+//! the servo's [`ActuatorParams::max_torque_n_m`]: over it, the servo cannot move its load and
+//! *stalls* for that tick — the limit stops advancing (it comes to rest within the tick, from
+//! its rate at the tick's start, C¹: `p1 = p0 + v0·h/2`, `v1 = 0`, and holds there while the
+//! torque stays over the limit). The string stays rigid: a servo that is backdriven by a load
+//! over its limit (the limit moving backwards) is not modelled, nor is any compliance.
+//! The servo's tracking error, its rate saturation and its torque are recorded
+//! (see [`ActuatorStats`]).
 
 use serde::Serialize;
 
@@ -33,6 +40,12 @@ pub struct ActuatorParams {
     /// starting exactly at the ankle would be a grazing start that it does not detect, and
     /// one above the ankle would violate the constraint.
     pub take_up_slack_rad: f64,
+    /// Largest torque the servo can drive its string against [N·m] (as a torque on the
+    /// ankle). While the string's torque at a tick exceeds it, the servo stalls for that tick
+    /// (see the module documentation). Default 2.5 N·m: 1.5 × the largest torque of the
+    /// nominal `wisse3d` push with the firmware in the loop (1.664 N·m over 200 steps,
+    /// docs/sil.md), so a healthy servo never reaches it.
+    pub max_torque_n_m: f64,
 }
 
 impl Default for ActuatorParams {
@@ -41,6 +54,7 @@ impl Default for ActuatorParams {
             max_rate_rad_per_s: 10.0,
             time_constant_s: 0.005,
             take_up_slack_rad: 1e-4,
+            max_torque_n_m: 2.5,
         }
     }
 }
@@ -58,6 +72,13 @@ pub struct ActuatorStats {
     pub max_tracking_error_rad: f64,
     /// Largest |limit rate| at the end of a tick [rad/s].
     pub max_rate_rad_per_s: f64,
+    /// Largest |string torque| seen at a tick with a setpoint [N·m].
+    pub peak_torque_n_m: f64,
+    /// Ticks with a setpoint at which |string torque| exceeded
+    /// [`ActuatorParams::max_torque_n_m`] (the servo stalled).
+    pub over_torque_ticks: u64,
+    /// First time the torque limit was exceeded [s], if ever.
+    pub first_over_torque_s: Option<f64>,
 }
 
 /// One ankle's actuator: the string's limit and its rate, and the run's statistics.
@@ -143,13 +164,16 @@ impl ActuatorModel {
     /// One tick over `[t0_s, t1_s]` with `setpoint_rad` (`None`: released). `take_up_rad` is
     /// where the string becomes taut if it was slack (the current ankle angle): a string
     /// that was released starts at rest from `min(setpoint, take_up − slack)`, below the
-    /// ankle, then tracks the setpoint.
+    /// ankle, then tracks the setpoint. `load_n_m` is the string's torque on the ankle at
+    /// `t0_s` (0 while slack): over [`ActuatorParams::max_torque_n_m`] the servo stalls for
+    /// this tick (the limit comes to rest, `v1 = 0`, and does not follow the setpoint).
     pub fn tick(
         &mut self,
         t0_s: f64,
         t1_s: f64,
         setpoint_rad: Option<f64>,
         take_up_rad: f64,
+        load_n_m: f64,
     ) -> ActuatorSegment {
         let Some(s) = setpoint_rad else {
             self.state = None;
@@ -167,10 +191,30 @@ impl ActuatorModel {
             (None, _) => (s.min(take_up_rad - self.params.take_up_slack_rad), 0.0),
         };
         let h = (t1_s - t0_s).max(0.0);
-        let end = integrate(&self.params, p0, s, h);
+        let load = load_n_m.abs();
+        // NaN compares false: an unknown load does not stall the servo.
+        let stalled = load > self.params.max_torque_n_m;
+        let end = if stalled {
+            // Stalled: the limit stops advancing, at rest by the tick's end (constant
+            // deceleration from its rate at the start, so position and rate stay continuous).
+            Step {
+                p_rad: p0 + 0.5 * v0 * h,
+                v_rad_s: 0.0,
+                saturated: false,
+            }
+        } else {
+            integrate(&self.params, p0, s, h)
+        };
         self.state = Some((end.p_rad, end.v_rad_s));
         let st = &mut self.stats;
         st.position_ticks += 1;
+        if load.is_finite() {
+            st.peak_torque_n_m = st.peak_torque_n_m.max(load);
+        }
+        if stalled {
+            st.over_torque_ticks += 1;
+            st.first_over_torque_s.get_or_insert(t0_s);
+        }
         if end.saturated {
             st.saturated_ticks += 1;
             st.first_saturation_s.get_or_insert(t0_s);
@@ -218,24 +262,58 @@ mod tests {
     #[test]
     fn segments_are_continuous_and_start_at_the_take_up_angle() {
         let mut m = ActuatorModel::new(ActuatorParams::default());
-        let r = m.tick(0.0, 0.001, None, -0.05);
+        let r = m.tick(0.0, 0.001, None, -0.05, 0.0);
         assert!(r.released);
         // Engaging with the ankle at -0.085 below the setpoint -0.08: starts at the ankle,
         // less the slack.
-        let a = m.tick(0.001, 0.002, Some(-0.08), -0.085);
+        let a = m.tick(0.001, 0.002, Some(-0.08), -0.085, 0.0);
         assert_eq!((a.p0_rad, a.v0_rad_s), (-0.085 - 1e-4, 0.0));
         assert!(a.p1_rad > -0.085 && a.p1_rad < -0.08);
-        let b = m.tick(0.002, 0.003, Some(0.2), 0.0);
+        let b = m.tick(0.002, 0.003, Some(0.2), 0.0, 0.0);
         assert_eq!((b.p0_rad, b.v0_rad_s), (a.p1_rad, a.v1_rad_s));
         assert!(b.v1_rad_s <= 10.0 + 1e-12);
         assert_eq!(m.stats().saturated_ticks, 1);
         assert_eq!(m.stats().first_saturation_s, Some(0.002));
         // A tick that comes early continues from where the last segment is at that time.
-        let c = m.tick(0.0025, 0.0035, Some(0.2), 0.0);
+        let c = m.tick(0.0025, 0.0035, Some(0.2), 0.0, 0.0);
         assert_eq!(c.p0_rad, b.eval(0.0025).0);
         // Engaging with the ankle above the setpoint: starts at the setpoint.
         let mut m = ActuatorModel::new(ActuatorParams::default());
-        let a = m.tick(0.0, 0.001, Some(-0.08), 0.1);
+        let a = m.tick(0.0, 0.001, Some(-0.08), 0.1, 0.0);
         assert_eq!(a.p0_rad, -0.08);
+    }
+
+    #[test]
+    fn over_the_torque_limit_the_servo_stalls_for_the_tick() {
+        let params = ActuatorParams {
+            max_torque_n_m: 1.0,
+            ..ActuatorParams::default()
+        };
+        let mut m = ActuatorModel::new(params);
+        m.tick(0.0, 0.001, Some(-0.08), -0.08, 0.0);
+        let a = m.tick(0.001, 0.002, Some(0.0), -0.08, 0.9);
+        assert!(a.v1_rad_s > 1.0, "moving towards the setpoint: {a:?}");
+        // Over the limit (either sign): the limit comes to rest within the tick, C¹.
+        let b = m.tick(0.002, 0.003, Some(0.0), -0.08, -1.5);
+        assert_eq!((b.p0_rad, b.v0_rad_s), (a.p1_rad, a.v1_rad_s));
+        assert_eq!(b.v1_rad_s, 0.0);
+        assert!((b.p1_rad - (a.p1_rad + 0.5 * a.v1_rad_s * 0.001)).abs() < 1e-15);
+        // Still over: it holds.
+        let c = m.tick(0.003, 0.004, Some(0.0), -0.08, 2.0);
+        assert_eq!(
+            (c.p0_rad, c.v0_rad_s, c.p1_rad, c.v1_rad_s),
+            (b.p1_rad, 0.0, b.p1_rad, 0.0)
+        );
+        // Under again: it follows the setpoint.
+        let d = m.tick(0.004, 0.005, Some(0.0), -0.08, 0.5);
+        assert!(d.p1_rad > c.p1_rad && d.v1_rad_s > 0.0);
+        let st = m.stats();
+        assert_eq!(st.over_torque_ticks, 2);
+        assert_eq!(st.first_over_torque_s, Some(0.002));
+        assert_eq!(st.peak_torque_n_m, 2.0);
+        // A released string carries nothing and is not counted.
+        m.tick(0.005, 0.006, None, -0.08, 5.0);
+        assert_eq!(m.stats().over_torque_ticks, 2);
+        assert_eq!(m.stats().peak_torque_n_m, 2.0);
     }
 }

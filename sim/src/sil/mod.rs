@@ -604,7 +604,16 @@ impl FirmwareInTheLoop {
             can.set_tx_room(room);
             can.set_bus_off(bus_off);
         }
-        a.actuator.borrow_mut().set_tick(t_s, t1_s, angle_true);
+        // The string's torque acts on the stance ankle's servo only (the swing foot is
+        // massless: its string carries nothing).
+        let load_n_m = if stance {
+            sensing.string_torque_n_m
+        } else {
+            0.0
+        };
+        a.actuator
+            .borrow_mut()
+            .set_tick(t_s, t1_s, angle_true, load_n_m);
         if !a.settled {
             // Power-up: the switch is sampled for the debounce length before the first tick,
             // so that the firmware's debounced state (which starts open) is the foot's.

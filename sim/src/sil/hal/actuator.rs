@@ -27,6 +27,7 @@ pub struct ActuatorLink {
     t0_s: f64,
     t1_s: f64,
     take_up_rad: f64,
+    load_n_m: f64,
     segment: Option<ActuatorSegment>,
     last_command: Option<ActuatorCommand>,
     last_measured_rad: Option<f32>,
@@ -41,6 +42,7 @@ impl ActuatorLink {
             t0_s: 0.0,
             t1_s: 0.0,
             take_up_rad: 0.0,
+            load_n_m: 0.0,
             segment: None,
             last_command: None,
             last_measured_rad: None,
@@ -48,12 +50,14 @@ impl ActuatorLink {
         }
     }
 
-    /// The coming tick `[t0_s, t1_s]` and the true ankle angle [rad] (where a slack string
-    /// becomes taut).
-    pub fn set_tick(&mut self, t0_s: f64, t1_s: f64, take_up_rad: f64) {
+    /// The coming tick `[t0_s, t1_s]`, the true ankle angle [rad] (where a slack string
+    /// becomes taut) and the string's torque on the ankle at the tick's start [N·m] (0 while
+    /// slack; over the servo's limit it stalls, see [`ActuatorModel::tick`]).
+    pub fn set_tick(&mut self, t0_s: f64, t1_s: f64, take_up_rad: f64, load_n_m: f64) {
         self.t0_s = t0_s;
         self.t1_s = t1_s;
         self.take_up_rad = take_up_rad;
+        self.load_n_m = load_n_m;
     }
 
     /// The segment of the last command applied (taken: `None` until the next command).
@@ -99,8 +103,8 @@ impl Actuator for SimActuator {
             ActuatorCommand::Released => None,
             ActuatorCommand::Position { ankle_angle_rad } => Some(f64::from(ankle_angle_rad)),
         };
-        let (t0, t1, take_up) = (l.t0_s, l.t1_s, l.take_up_rad);
-        let seg = l.model.tick(t0, t1, setpoint, take_up);
+        let (t0, t1, take_up, load) = (l.t0_s, l.t1_s, l.take_up_rad, l.load_n_m);
+        let seg = l.model.tick(t0, t1, setpoint, take_up, load);
         l.segment = Some(seg);
         l.last_command = Some(command);
         l.last_measured_rad = measured_angle_rad;
@@ -120,10 +124,10 @@ mod tests {
             ActuatorParams::default(),
         ))));
         let mut a = SimActuator::new(Rc::clone(&link));
-        link.borrow_mut().set_tick(0.0, 0.001, -0.05);
+        link.borrow_mut().set_tick(0.0, 0.001, -0.05, 0.0);
         a.apply(ActuatorCommand::Released, Some(-0.05)).unwrap();
         assert!(link.borrow_mut().take_segment().unwrap().released);
-        link.borrow_mut().set_tick(0.001, 0.002, -0.06);
+        link.borrow_mut().set_tick(0.001, 0.002, -0.06, 0.0);
         let pos = ActuatorCommand::Position {
             ankle_angle_rad: -0.055,
         };
