@@ -1,0 +1,112 @@
+//! `sim::sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6) against DOPRI5 at 1e-12 on the same
+//! firmware-in-the-loop walk: 12 steps of `wisse3d` from its limit cycle with both ankle nodes'
+//! firmware, and the gait figures averaged over all 12 steps. The bounds are 3 × the measured
+//! relative differences (docs/sil.md), so the accuracy claimed in `SIL_INTEGRATOR`'s
+//! documentation can fail.
+//!
+//! Release builds only, like `walker_sil.rs`.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod common;
+
+use common::{matched, setup};
+use sim::integrators::IntegratorChoice;
+use sim::sil::{FirmwareInTheLoop, SIL_INTEGRATOR};
+use sim::walk::Walk;
+
+const STEPS: usize = 12;
+
+struct Figures {
+    period_s: f64,
+    speed_m_s: f64,
+    step_length_m: f64,
+    cost_of_transport: f64,
+    work_j: f64,
+    impact_loss_j: f64,
+    evaluations: usize,
+}
+
+fn walk_with(integrator: IntegratorChoice) -> (Walk, Figures) {
+    let s = setup();
+    let mut walker = s.walker.clone();
+    walker.integrator = integrator;
+    let mut ctl = FirmwareInTheLoop::new(matched()).unwrap();
+    let walk = walker.walk_controlled(&s.q0, &s.qd0, STEPS, false, &mut ctl);
+    assert!(walk.failure.is_none(), "{:?}", walk.failure);
+    assert_eq!(walk.steps.len(), STEPS);
+    let g = sim::report::walk_gait_json(&walker, &walk, STEPS);
+    let f = |k: &str| g[k].as_f64().unwrap();
+    let mean = |x: &dyn Fn(&sim::walk::StepSummary) -> f64| {
+        walk.steps.iter().map(x).sum::<f64>() / STEPS as f64
+    };
+    let figures = Figures {
+        period_s: f("step_period_s"),
+        speed_m_s: f("speed_m_s"),
+        step_length_m: f("step_length_m"),
+        cost_of_transport: f("cost_of_transport_J_per_kg_m"),
+        work_j: mean(&|s| s.actuator_work_j),
+        impact_loss_j: mean(&|s| s.impact_energy_loss_j),
+        evaluations: walk.steps.iter().map(|s| s.evaluations).sum(),
+    };
+    (walk, figures)
+}
+
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
+fn the_sil_integrator_gives_the_12_step_gait_of_dopri5_at_1e_12() {
+    let (_, sil) = walk_with(SIL_INTEGRATOR);
+    let (_, reference) = walk_with(IntegratorChoice::Dopri5 {
+        rtol: 1e-12,
+        atol: 1e-12,
+        h_max_s: 0.01,
+    });
+    let rel = |a: f64, b: f64| ((a - b) / b).abs();
+    let figures = [
+        ("step period", sil.period_s, reference.period_s, 1.5e-7),
+        ("speed", sil.speed_m_s, reference.speed_m_s, 1.5e-7),
+        (
+            "step length",
+            sil.step_length_m,
+            reference.step_length_m,
+            1.5e-7,
+        ),
+        (
+            "cost of transport",
+            sil.cost_of_transport,
+            reference.cost_of_transport,
+            2.7e-5,
+        ),
+        (
+            "actuator work per step",
+            sil.work_j,
+            reference.work_j,
+            2.8e-5,
+        ),
+        (
+            "impact loss per step",
+            sil.impact_loss_j,
+            reference.impact_loss_j,
+            5e-7,
+        ),
+    ];
+    eprintln!(
+        "evaluations: SIL {} reference {}",
+        sil.evaluations, reference.evaluations
+    );
+    for (name, a, b, bound) in figures {
+        eprintln!(
+            "{name}: SIL {a:.12e} reference {b:.12e} relative {:.2e} (bound {bound:.1e})",
+            rel(a, b)
+        );
+    }
+    for (name, a, b, bound) in figures {
+        assert!(
+            rel(a, b) < bound,
+            "{name}: {a} vs {b}, relative {:.2e} (bound {bound:.1e})",
+            rel(a, b)
+        );
+    }
+}
