@@ -290,3 +290,58 @@ fn a_walk_starts_from_a_state_file_and_a_bad_file_is_named() {
     assert_eq!(missing.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn sil_takes_encoder_faults_and_names_a_bad_one() {
+    // Bad specs: exit 2, the message names the flag and the offending part.
+    for (spec, needle) in [
+        ("jitter:side=left,at_ms=5", "jitter"),
+        ("stuck:side=middle,from_ms=5", "middle"),
+        ("stuck:side=left", "from_ms"),
+        ("glitch:side=left,at_ms=soon", "soon"),
+        ("parity:side=left,at_ms=5,extra=1", "extra"),
+    ] {
+        let out = walker(&[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "2",
+            "--sensor-fault",
+            spec,
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{spec}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--sensor-fault") && err.contains(needle),
+            "{spec}: {err}"
+        );
+    }
+    // Two faults (the flag repeats): a glitch on the left ankle (rate fault the same tick) and
+    // a parity error on the right's encoder link (comms fault, detail 2).
+    let v = json(&walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "2",
+        "--sensor-fault",
+        "glitch:side=left,at_ms=300,delta_rad=0.1",
+        "--sensor-fault",
+        "parity:side=right,at_ms=400",
+        "--json",
+    ]));
+    let faults = v["node_faults"].as_array().expect("node_faults");
+    let raised = |side: &str, code: &str| {
+        faults
+            .iter()
+            .find(|f| f["side"] == side && f["code"] == code && f["raised"] == Value::Bool(true))
+    };
+    let rate = raised("Left", "EncoderRate").expect("the glitch raises EncoderRate");
+    let t = rate["t_s"].as_f64().unwrap();
+    assert!((0.3..0.3015).contains(&t), "{t}");
+    let comms = raised("Right", "EncoderComms").expect("the parity error raises EncoderComms");
+    assert_eq!(comms["detail"], 2);
+    let t = comms["t_s"].as_f64().unwrap();
+    assert!((0.4..0.4015).contains(&t), "{t}");
+}

@@ -124,6 +124,11 @@ enum Command {
         /// A bus fault, e.g. `drop:id=0x101,count=5` (repeatable; docs/canbus.md).
         #[arg(long = "fault", value_name = "SPEC")]
         faults: Vec<String>,
+        /// An encoder fault (repeatable; docs/sil.md):
+        /// `glitch:side=left,at_ms=500[,delta_rad=0.1]`, `stuck:side=left,from_ms=500`,
+        /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
+        #[arg(long = "sensor-fault", value_name = "SPEC")]
+        sensor_faults: Vec<String>,
         /// Host emergency stop to every ankle at this walk time [s].
         #[arg(long, value_name = "SECONDS")]
         estop_at: Option<f64>,
@@ -469,6 +474,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             common,
             steps,
             faults,
+            sensor_faults,
             estop_at,
             candump,
             socketcand,
@@ -490,6 +496,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 config = config
                     .with_fault_str(f)
                     .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
+            }
+            for f in &sensor_faults {
+                config = config
+                    .with_sensor_fault_str(f)
+                    .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
             }
             if let Some(addr) = &socketcand {
                 let parsed: std::net::SocketAddr = addr.parse().map_err(|_| {

@@ -224,4 +224,17 @@ impl SilConfig {
         self.sensor_faults.push(fault);
         self
     }
+
+    /// Add an encoder fault from its text form (`stuck:side=left,from_ms=500`,
+    /// `glitch:side=right,at_ms=300,delta_rad=0.1`, `spi:side=left,from_ms=500,until_ms=600`,
+    /// `parity:side=right,at_ms=300`; see [`SensorFault`]'s `FromStr`).
+    ///
+    /// # Errors
+    /// The parse error, naming the offending part.
+    pub fn with_sensor_fault_str(
+        self,
+        spec: &str,
+    ) -> Result<Self, super::sensors::SensorFaultParseError> {
+        Ok(self.with_sensor_fault(spec.parse()?))
+    }
 }

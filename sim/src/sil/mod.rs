@@ -61,7 +61,7 @@ pub use report::{
     FaultRecord, HistoryElided, HostReport, Landing, NodeReport, PhaseChange, SilReport,
     SocketcandReport, StateChange,
 };
-pub use sensors::{SensorFault, SimEncoder, SwingAnkle};
+pub use sensors::{SensorFault, SensorFaultParseError, SimEncoder, SwingAnkle};
 
 use hal::{ActuatorLink, CanLink, Shaft, SimActuator, SimCan, SimClock, SimContactPin, SimSpi};
 

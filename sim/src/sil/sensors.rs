@@ -59,6 +59,182 @@ impl SensorFault {
     }
 }
 
+/// Why an encoder fault's text form was refused ([`SensorFault`]'s `FromStr`). Every variant
+/// names the offending part.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SensorFaultParseError {
+    /// The text before `:` is not a fault kind.
+    #[error("unknown encoder fault `{kind}` (expected glitch, stuck, spi or parity)")]
+    UnknownKind {
+        /// The offending kind.
+        kind: String,
+    },
+    /// A part that is not `key=value`.
+    #[error("`{part}` in encoder fault `{kind}` is not of the form key=value")]
+    NotKeyValue {
+        /// The fault kind.
+        kind: String,
+        /// The offending part.
+        part: String,
+    },
+    /// A key this kind does not take.
+    #[error("encoder fault `{kind}` has no key `{key}` (allowed: {allowed})")]
+    UnknownKey {
+        /// The fault kind.
+        kind: String,
+        /// The offending key.
+        key: String,
+        /// The keys the kind takes.
+        allowed: &'static str,
+    },
+    /// A key given twice.
+    #[error("key `{key}` given twice in encoder fault `{kind}`")]
+    DuplicateKey {
+        /// The fault kind.
+        kind: String,
+        /// The repeated key.
+        key: String,
+    },
+    /// A value that does not parse or is out of range.
+    #[error("bad value `{value}` for `{key}` in encoder fault `{kind}`: {reason}")]
+    BadValue {
+        /// The fault kind.
+        kind: String,
+        /// The key.
+        key: String,
+        /// The offending value.
+        value: String,
+        /// What was expected.
+        reason: &'static str,
+    },
+    /// A key the kind requires is missing.
+    #[error("encoder fault `{kind}` needs `{key}=`")]
+    MissingKey {
+        /// The fault kind.
+        kind: String,
+        /// The missing key.
+        key: &'static str,
+    },
+}
+
+impl std::str::FromStr for SensorFault {
+    type Err = SensorFaultParseError;
+
+    /// The text form: `KIND:key=value,...` with times in milliseconds of walk time and the
+    /// ankle as `side=left|right` (required):
+    ///
+    /// * `glitch:side=left,at_ms=500[,delta_rad=0.1]` — [`SensorFault::Glitch`] (default
+    ///   jump 0.1 rad);
+    /// * `stuck:side=left,from_ms=500` — [`SensorFault::Stuck`];
+    /// * `spi:side=right,from_ms=500[,until_ms=700]` — [`SensorFault::SpiFailure`] (until the
+    ///   end of the run without `until_ms`);
+    /// * `parity:side=right,at_ms=500` — [`SensorFault::Parity`].
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        type E = SensorFaultParseError;
+        let (kind, rest) = match s.split_once(':') {
+            Some((k, r)) => (k.trim(), Some(r)),
+            None => (s.trim(), None),
+        };
+        let kind_s = kind.to_string();
+        let allowed: &'static str = match kind {
+            "glitch" => "side, at_ms, delta_rad",
+            "stuck" => "side, from_ms",
+            "spi" => "side, from_ms, until_ms",
+            "parity" => "side, at_ms",
+            _ => return Err(E::UnknownKind { kind: kind_s }),
+        };
+        let mut pairs: Vec<(&str, &str)> = Vec::new();
+        for part in rest.into_iter().flat_map(|r| r.split(',')) {
+            let part = part.trim();
+            let Some((k, v)) = part.split_once('=') else {
+                return Err(E::NotKeyValue {
+                    kind: kind_s,
+                    part: part.to_string(),
+                });
+            };
+            let (k, v) = (k.trim(), v.trim());
+            if !allowed.split(", ").any(|a| a == k) {
+                return Err(E::UnknownKey {
+                    kind: kind_s,
+                    key: k.to_string(),
+                    allowed,
+                });
+            }
+            if pairs.iter().any(|(pk, _)| *pk == k) {
+                return Err(E::DuplicateKey {
+                    kind: kind_s,
+                    key: k.to_string(),
+                });
+            }
+            pairs.push((k, v));
+        }
+        let get = |key: &str| pairs.iter().find(|(k, _)| *k == key).map(|(_, v)| *v);
+        let bad = |key: &str, value: &str, reason: &'static str| E::BadValue {
+            kind: kind_s.clone(),
+            key: key.to_string(),
+            value: value.to_string(),
+            reason,
+        };
+        let missing = |key: &'static str| E::MissingKey {
+            kind: kind_s.clone(),
+            key,
+        };
+        let side = match get("side").ok_or_else(|| missing("side"))? {
+            "left" => Side::Left,
+            "right" => Side::Right,
+            v => return Err(bad("side", v, "left or right")),
+        };
+        // A time in milliseconds, as seconds.
+        let ms = |key: &'static str| -> Result<Option<f64>, E> {
+            match get(key) {
+                None => Ok(None),
+                Some(v) => v
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|t| t.is_finite() && *t >= 0.0)
+                    .map(|t| Some(t * 1e-3))
+                    .ok_or_else(|| bad(key, v, "a non-negative number of milliseconds")),
+            }
+        };
+        let required = |key: &'static str| ms(key)?.ok_or_else(|| missing(key));
+        Ok(match kind {
+            "glitch" => SensorFault::Glitch {
+                side,
+                at_s: required("at_ms")?,
+                delta_rad: match get("delta_rad") {
+                    None => 0.1,
+                    Some(v) => v
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|d| d.is_finite())
+                        .ok_or_else(|| bad("delta_rad", v, "a finite angle in radians"))?,
+                },
+            },
+            "stuck" => SensorFault::Stuck {
+                side,
+                from_s: required("from_ms")?,
+            },
+            "spi" => {
+                let from_s = required("from_ms")?;
+                let until_s = ms("until_ms")?.unwrap_or(f64::INFINITY);
+                if until_s <= from_s {
+                    let v = get("until_ms").unwrap_or_default();
+                    return Err(bad("until_ms", v, "a time after from_ms"));
+                }
+                SensorFault::SpiFailure {
+                    side,
+                    from_s,
+                    until_s,
+                }
+            }
+            _ => SensorFault::Parity {
+                side,
+                at_s: required("at_ms")?,
+            },
+        })
+    }
+}
+
 /// One ankle's simulated encoder.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimEncoder {
@@ -224,5 +400,72 @@ mod tests {
         assert!((s.angle_at(1.0, -0.1) + 0.1).abs() < 1e-12);
         let mut f = SwingAnkle::new(SwingAnkleModel::Fixed { angle_rad: 0.0 }, 0.0, 0.2);
         assert_eq!(f.angle_at(0.001, 0.3), 0.0);
+    }
+
+    #[test]
+    fn text_forms_parse_and_bad_parts_are_named() {
+        let ok = |t: &str| t.parse::<SensorFault>().unwrap();
+        assert_eq!(
+            ok("glitch:side=left,at_ms=500"),
+            SensorFault::Glitch {
+                side: Side::Left,
+                at_s: 0.5,
+                delta_rad: 0.1
+            }
+        );
+        assert_eq!(
+            ok("glitch: side=right, at_ms=250, delta_rad=-0.2"),
+            SensorFault::Glitch {
+                side: Side::Right,
+                at_s: 0.25,
+                delta_rad: -0.2
+            }
+        );
+        assert_eq!(
+            ok("stuck:side=left,from_ms=8489"),
+            SensorFault::Stuck {
+                side: Side::Left,
+                from_s: 8.489
+            }
+        );
+        assert_eq!(
+            ok("spi:side=right,from_ms=100,until_ms=200"),
+            SensorFault::SpiFailure {
+                side: Side::Right,
+                from_s: 0.1,
+                until_s: 0.2
+            }
+        );
+        assert_eq!(
+            ok("spi:side=right,from_ms=100"),
+            SensorFault::SpiFailure {
+                side: Side::Right,
+                from_s: 0.1,
+                until_s: f64::INFINITY
+            }
+        );
+        assert_eq!(
+            ok("parity:side=left,at_ms=3"),
+            SensorFault::Parity {
+                side: Side::Left,
+                at_s: 0.003
+            }
+        );
+        for (text, needle) in [
+            ("jitter:side=left", "jitter"),
+            ("stuck", "side"),
+            ("stuck:side=left", "from_ms"),
+            ("stuck:side=middle,from_ms=1", "middle"),
+            ("stuck:side=left,from_ms=soon", "soon"),
+            ("stuck:side=left,from_ms=-1", "-1"),
+            ("stuck:side=left,at_ms=1", "at_ms"),
+            ("glitch:side=left,at_ms=1,at_ms=2", "at_ms"),
+            ("glitch:side=left,at_ms=1,delta_rad=inf", "inf"),
+            ("parity:side=left,1", "`1`"),
+            ("spi:side=left,from_ms=5,until_ms=5", "until_ms"),
+        ] {
+            let e = text.parse::<SensorFault>().unwrap_err().to_string();
+            assert!(e.contains(needle), "{text}: {e}");
+        }
     }
 }
