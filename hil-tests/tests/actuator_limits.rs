@@ -1,7 +1,8 @@
 //! The string servo's torque limit (`ActuatorParams::max_torque_n_m`) with the `wisse3d`
 //! walker and both ankle nodes' firmware in the loop: the nominal walk stays within the
 //! default limit; a servo too weak for the push stalls in it and the gait changes; one too
-//! weak to hold the robot at engagement never pushes and the robot falls.
+//! weak to hold the robot at engagement never pushes (the firmware's stuck-encoder check
+//! catches the motionless push) and the robot falls.
 //!
 //! Release builds only, like `walker_sil.rs` (seconds optimised, minutes unoptimised).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -106,6 +107,20 @@ fn a_servo_too_weak_to_hold_the_robot_never_pushes_and_it_falls() {
     let a = stats(&r, Side::Left);
     assert!(a.over_torque_ticks > 40, "{a:?}");
     assert!(a.max_rate_rad_per_s < 0.1, "{a:?}");
+    // The limit does not move, so neither does the encoder in the push: the firmware's stuck
+    // check catches it 50 ms after the engagement and the node goes safe.
+    let stuck = r
+        .first_raise(Side::Left, "EncoderStuck")
+        .expect("EncoderStuck");
+    let first = a.first_over_torque_s.unwrap();
+    assert!(
+        stuck > first + 0.045 && stuck < first + 0.055,
+        "{first} {stuck}"
+    );
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", 0.0),
+        Some(stuck)
+    );
     let f = w.failure.expect("typed failure");
     assert_eq!((f.kind, f.step), (FailureKind::FellBackward, 1), "{f:?}");
     // The work the drive did on the first stride is nothing like a push (0.166 J nominal).
