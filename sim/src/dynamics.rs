@@ -3,10 +3,10 @@
 //! `M̄ = F,qᵀ M F,q` and `f̄ = F,qᵀ (f − M F,qq q̇ q̇)` are summed body by body: for each body,
 //! `F,q` is its c.m. linear Jacobian and angular Jacobian, and `F,qq q̇ q̇` its bias acceleration.
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::KinematicsOf;
 use crate::model::{JointKind, LinkIndex, Model};
 use crate::singular_limit::{solve_limit, LimitSolveError};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, RealField, Scalar, Vector3};
 
 /// Why the accelerations could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -19,35 +19,39 @@ pub enum DynamicsError {
     NonFinite,
 }
 
-/// The equations of motion workspace: kinematics plus the assembled `M̄`, `f̄`.
+/// The equations of motion workspace in `f64`.
+pub type Dynamics = DynamicsOf<f64>;
+
+/// The equations of motion workspace: kinematics plus the assembled `M̄`, `f̄`, over any real
+/// scalar (`f64`, or dual numbers that carry derivatives).
 #[derive(Clone, Debug)]
-pub struct Dynamics {
+pub struct DynamicsOf<T: Scalar> {
     /// Kinematics at the last assembly.
-    pub kin: Kinematics,
+    pub kin: KinematicsOf<T>,
     /// `M̄` from bodies of finite mass [kg·m² for angles].
-    pub mass_matrix: DMatrix<f64>,
+    pub mass_matrix: DMatrix<T>,
     /// `M̄` per unit of infinitesimal mass (the `ε` part).
-    pub mass_matrix_infinitesimal: DMatrix<f64>,
+    pub mass_matrix_infinitesimal: DMatrix<T>,
     /// `f̄` from finite bodies and joint springs/dampers [N·m for angles].
-    pub force: DVector<f64>,
+    pub force: DVector<T>,
     /// `f̄` per unit of infinitesimal mass.
-    pub force_infinitesimal: DVector<f64>,
+    pub force_infinitesimal: DVector<T>,
     /// For each link, `(coordinate, link owning it)` along its ancestry.
     chains: Vec<Vec<(usize, usize)>>,
     /// Scratch: one body's nonzero Jacobian columns `(coordinate, linear, angular)`.
-    cols: Vec<(usize, Vector3<f64>, Vector3<f64>)>,
+    cols: Vec<(usize, Vector3<T>, Vector3<T>)>,
     /// Scratch for the active-set solve (row-major k × k, then k).
-    work_m: Vec<f64>,
-    work_b: Vec<f64>,
+    work_m: Vec<T>,
+    work_b: Vec<T>,
     has_infinitesimal: bool,
 }
 
-impl Dynamics {
+impl<T: RealField + Copy> DynamicsOf<T> {
     /// A workspace sized for `model`.
     pub fn new(model: &Model) -> Self {
         let n = model.dof();
         Self {
-            kin: Kinematics::new(model),
+            kin: KinematicsOf::new(model),
             mass_matrix: DMatrix::zeros(n, n),
             mass_matrix_infinitesimal: DMatrix::zeros(n, n),
             force: DVector::zeros(n),
@@ -62,8 +66,8 @@ impl Dynamics {
                 })
                 .collect(),
             cols: Vec::with_capacity(n),
-            work_m: vec![0.0; n * n],
-            work_b: vec![0.0; n],
+            work_m: vec![T::zero(); n * n],
+            work_b: vec![T::zero(); n],
             has_infinitesimal: model.has_infinitesimal_bodies(),
         }
     }
@@ -72,16 +76,17 @@ impl Dynamics {
     pub fn assemble(
         &mut self,
         model: &Model,
-        q: &DVector<f64>,
-        qd: &DVector<f64>,
-        tau_extra: Option<&DVector<f64>>,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        tau_extra: Option<&DVector<T>>,
     ) {
         self.kin.update(model, q, qd);
-        self.mass_matrix.fill(0.0);
-        self.mass_matrix_infinitesimal.fill(0.0);
-        self.force.fill(0.0);
-        self.force_infinitesimal.fill(0.0);
-        let g = model.gravity_floor_m_s2;
+        self.mass_matrix.fill(T::zero());
+        self.mass_matrix_infinitesimal.fill(T::zero());
+        self.force.fill(T::zero());
+        self.force_infinitesimal.fill(T::zero());
+        let c = |x: f64| -> T { nalgebra::convert(x) };
+        let g: Vector3<T> = model.gravity_floor_m_s2.map(c);
         for (i, link) in model.links.iter().enumerate() {
             let b = &link.body;
             let has_rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
@@ -113,10 +118,11 @@ impl Dynamics {
                 (&mut self.mass_matrix, &mut self.force)
             };
             // m Jvᵀ Jv + Jwᵀ I Jw and Jvᵀ m (g − a_bias) + Jwᵀ (−I α_bias − ω × I ω).
-            let f_lin = (g - a_bias) * b.mass_kg;
+            let mass = c(b.mass_kg);
+            let f_lin = (g - a_bias) * mass;
             let (i_w, torque) = if has_rot {
                 let r = self.kin.r_floor_link[i];
-                let i_w = r * b.inertia_com_kg_m2 * r.transpose();
+                let i_w = r * b.inertia_com_kg_m2.map(c) * r.transpose();
                 let w = self.kin.omega_floor_rad_s[i];
                 (
                     i_w,
@@ -129,7 +135,7 @@ impl Dynamics {
                 ff[ci] += jvi.dot(&f_lin) + jwi.dot(&torque);
                 let iw_jwi = i_w * jwi;
                 for &(cj, jvj, jwj) in &self.cols[..=x] {
-                    let v = b.mass_kg * jvi.dot(&jvj) + jwj.dot(&iw_jwi);
+                    let v = mass * jvi.dot(&jvj) + jwj.dot(&iw_jwi);
                     mm[(ci, cj)] += v;
                     if ci != cj {
                         mm[(cj, ci)] += v;
@@ -140,8 +146,9 @@ impl Dynamics {
         for link in &model.links {
             if let Some(c) = link.coordinate {
                 let jf = &link.joint_force;
-                self.force[c.0] -=
-                    jf.stiffness * (q[c.0] - jf.rest_position) + jf.damping * qd[c.0];
+                self.force[c.0] -= (q[c.0] - self::lift(jf.rest_position))
+                    * self::lift(jf.stiffness)
+                    + qd[c.0] * self::lift(jf.damping);
             }
         }
         if let Some(t) = tau_extra {
@@ -149,6 +156,67 @@ impl Dynamics {
         }
     }
 
+    /// Accelerations of a model without infinitesimal bodies (see [`Dynamics::accelerations`]),
+    /// in any scalar. Assembles first.
+    ///
+    /// # Errors
+    /// [`DynamicsError::Singular`] when the active block of `M̄` is not positive definite, or
+    /// the model has infinitesimal bodies (their limit is solved in `f64` only).
+    pub fn accelerations_finite(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<T>>,
+    ) -> Result<DVector<T>, DynamicsError> {
+        if self.has_infinitesimal {
+            return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
+        }
+        self.assemble(model, q, qd, None);
+        let n = q.len();
+        let mut qdd = match qdd_prescribed {
+            Some(p) => p.clone(),
+            None => DVector::zeros(n),
+        };
+        // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers.
+        let mut k = 0;
+        for i in 0..n {
+            if !active[i] {
+                continue;
+            }
+            let mut b = self.force[i];
+            if qdd_prescribed.is_some() {
+                for j in (0..n).filter(|&j| !active[j]) {
+                    b -= self.mass_matrix[(i, j)] * qdd[j];
+                }
+            }
+            self.work_b[k] = b;
+            for (l, j) in (0..n).filter(|&j| active[j]).enumerate() {
+                self.work_m[k * n + l] = self.mass_matrix[(i, j)];
+            }
+            k += 1;
+        }
+        if !cholesky_solve_in_place(&mut self.work_m, n, k, &mut self.work_b) {
+            return Err(LimitSolveError::Degenerate { nullity: 1 }.into());
+        }
+        let mut r = 0;
+        for i in 0..n {
+            if active[i] {
+                qdd[i] = self.work_b[r];
+                r += 1;
+            }
+        }
+        Ok(qdd)
+    }
+}
+
+/// A model constant in the scalar `T`.
+fn lift<T: RealField + Copy>(x: f64) -> T {
+    nalgebra::convert(x)
+}
+
+impl Dynamics {
     /// Accelerations `q̈` at `q`, `q̇`. Coordinates where `active` is false are not free: their
     /// accelerations are given by `qdd_prescribed` (zero if `None`: locked joints), and the
     /// free ones answer `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p`. Assembles first.
@@ -163,13 +231,20 @@ impl Dynamics {
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
+        if !self.has_infinitesimal {
+            let qdd = self.accelerations_finite(model, q, qd, active, qdd_prescribed)?;
+            if qdd.iter().any(|v| !v.is_finite()) {
+                return Err(DynamicsError::NonFinite);
+            }
+            return Ok(qdd);
+        }
         self.assemble(model, q, qd, None);
         let n = q.len();
         let mut qdd = match qdd_prescribed {
             Some(p) => p.clone(),
             None => DVector::zeros(n),
         };
-        if self.has_infinitesimal {
+        {
             let idx: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
             let m0 = self.mass_matrix.select_rows(&idx).select_columns(&idx);
             let mut f0 = self.force.select_rows(&idx);
@@ -186,35 +261,6 @@ impl Dynamics {
             let x = solve_limit(&m0, &m1, &f0, &f1, 1e-12)?;
             for (k, &i) in idx.iter().enumerate() {
                 qdd[i] = x[k];
-            }
-        } else {
-            // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers.
-            let mut k = 0;
-            for i in 0..n {
-                if !active[i] {
-                    continue;
-                }
-                let mut b = self.force[i];
-                if qdd_prescribed.is_some() {
-                    for j in (0..n).filter(|&j| !active[j]) {
-                        b -= self.mass_matrix[(i, j)] * qdd[j];
-                    }
-                }
-                self.work_b[k] = b;
-                for (l, j) in (0..n).filter(|&j| active[j]).enumerate() {
-                    self.work_m[k * n + l] = self.mass_matrix[(i, j)];
-                }
-                k += 1;
-            }
-            if !cholesky_solve_in_place(&mut self.work_m, n, k, &mut self.work_b) {
-                return Err(LimitSolveError::Degenerate { nullity: 1 }.into());
-            }
-            let mut r = 0;
-            for i in 0..n {
-                if active[i] {
-                    qdd[i] = self.work_b[r];
-                    r += 1;
-                }
             }
         }
         if qdd.iter().any(|v| !v.is_finite()) {
@@ -265,14 +311,19 @@ impl Dynamics {
 /// Solves `A x = b` for the leading `k × k` block of a symmetric positive definite `A` stored
 /// row-major with row stride `stride`, overwriting `A` with its Cholesky factor and `b` with
 /// `x`. Returns false if `A` is not positive definite.
-fn cholesky_solve_in_place(a: &mut [f64], stride: usize, k: usize, b: &mut [f64]) -> bool {
+fn cholesky_solve_in_place<T: RealField + Copy>(
+    a: &mut [T],
+    stride: usize,
+    k: usize,
+    b: &mut [T],
+) -> bool {
     for j in 0..k {
         let mut d = a[j * stride + j];
         for p in 0..j {
             d -= a[j * stride + p] * a[j * stride + p];
         }
-        // Also rejects NaN.
-        if d.is_nan() || d <= 0.0 {
+        // Also rejects NaN (which is not greater than zero).
+        if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
         let d = d.sqrt();

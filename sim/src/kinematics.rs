@@ -3,28 +3,37 @@
 
 use crate::math::rotation_about;
 use crate::model::{JointKind, LinkIndex, Model, PointIndex};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, RealField, Scalar, Vector3};
 
-/// The kinematic workspace for one model, refilled by [`Kinematics::update`].
+/// The kinematic workspace for one model in `f64`, refilled by [`KinematicsOf::update`].
+pub type Kinematics = KinematicsOf<f64>;
+
+/// The kinematic workspace for one model, over any real scalar (`f64`, or dual numbers that
+/// carry derivatives), refilled by [`KinematicsOf::update`].
 #[derive(Clone, Debug)]
-pub struct Kinematics {
+pub struct KinematicsOf<T: Scalar> {
     /// Rotation link frame → floor frame.
-    pub r_floor_link: Vec<Matrix3<f64>>,
+    pub r_floor_link: Vec<Matrix3<T>>,
     /// Link origin in the floor frame [m].
-    pub p_floor_link_m: Vec<Vector3<f64>>,
+    pub p_floor_link_m: Vec<Vector3<T>>,
     /// Joint axis in the floor frame (zero for welds).
-    pub axis_floor: Vec<Vector3<f64>>,
+    pub axis_floor: Vec<Vector3<T>>,
     /// Angular velocity of each link, floor frame [rad/s].
-    pub omega_floor_rad_s: Vec<Vector3<f64>>,
+    pub omega_floor_rad_s: Vec<Vector3<T>>,
     /// Velocity of each link origin, floor frame [m/s].
-    pub v_floor_link_m_s: Vec<Vector3<f64>>,
+    pub v_floor_link_m_s: Vec<Vector3<T>>,
     /// Angular acceleration with `q̈ = 0` [rad/s²].
-    pub alpha_bias_rad_s2: Vec<Vector3<f64>>,
+    pub alpha_bias_rad_s2: Vec<Vector3<T>>,
     /// Acceleration of each link origin with `q̈ = 0` [m/s²].
-    pub a_bias_link_m_s2: Vec<Vector3<f64>>,
+    pub a_bias_link_m_s2: Vec<Vector3<T>>,
 }
 
-impl Kinematics {
+/// A model vector in the scalar `T`.
+fn lift<T: RealField + Copy>(v: &Vector3<f64>) -> Vector3<T> {
+    v.map(nalgebra::convert)
+}
+
+impl<T: RealField + Copy> KinematicsOf<T> {
     /// A workspace sized for `model`.
     pub fn new(model: &Model) -> Self {
         let n = model.links.len();
@@ -40,7 +49,7 @@ impl Kinematics {
     }
 
     /// Recomputes poses, velocities and bias accelerations for `q`, `q̇`.
-    pub fn update(&mut self, model: &Model, q: &DVector<f64>, qd: &DVector<f64>) {
+    pub fn update(&mut self, model: &Model, q: &DVector<T>, qd: &DVector<T>) {
         for (i, link) in model.links.iter().enumerate() {
             let (r_p, p_p, w_p, v_p, al_p, a_p) = match link.parent {
                 Some(p) => (
@@ -60,17 +69,17 @@ impl Kinematics {
                     Vector3::zeros(),
                 ),
             };
-            let d = r_p * link.p_parent_joint_m;
+            let d = r_p * lift::<T>(&link.p_parent_joint_m);
             let o = p_p + d;
             let v_o = v_p + w_p.cross(&d);
             let a_o = a_p + al_p.cross(&d) + w_p.cross(&w_p.cross(&d));
             let (qi, qdi) = match link.coordinate {
                 Some(c) => (q[c.0], qd[c.0]),
-                None => (0.0, 0.0),
+                None => (T::zero(), T::zero()),
             };
             match &link.joint {
                 JointKind::Revolute { axis_parent } => {
-                    let a = r_p * axis_parent;
+                    let a = r_p * lift::<T>(axis_parent);
                     self.axis_floor[i] = a;
                     self.r_floor_link[i] = r_p * rotation_about(axis_parent, qi);
                     self.p_floor_link_m[i] = o;
@@ -80,7 +89,7 @@ impl Kinematics {
                     self.a_bias_link_m_s2[i] = a_o;
                 }
                 JointKind::Prismatic { axis_parent } => {
-                    let a = r_p * axis_parent;
+                    let a = r_p * lift::<T>(axis_parent);
                     self.axis_floor[i] = a;
                     self.r_floor_link[i] = r_p;
                     let s = a * qi;
@@ -91,7 +100,7 @@ impl Kinematics {
                     self.a_bias_link_m_s2[i] = a_o
                         + al_p.cross(&s)
                         + w_p.cross(&w_p.cross(&s))
-                        + w_p.cross(&a) * (2.0 * qdi);
+                        + w_p.cross(&a) * (qdi + qdi);
                 }
                 JointKind::Weld => {
                     self.axis_floor[i] = Vector3::zeros();
@@ -107,24 +116,24 @@ impl Kinematics {
     }
 
     /// Position in the floor frame of a point given in a link frame [m].
-    pub fn position_of(&self, link: LinkIndex, p_link_m: &Vector3<f64>) -> Vector3<f64> {
-        self.p_floor_link_m[link.0] + self.r_floor_link[link.0] * p_link_m
+    pub fn position_of(&self, link: LinkIndex, p_link_m: &Vector3<f64>) -> Vector3<T> {
+        self.p_floor_link_m[link.0] + self.r_floor_link[link.0] * lift::<T>(p_link_m)
     }
 
     /// Position of a marker point [m].
-    pub fn point_position(&self, model: &Model, point: PointIndex) -> Vector3<f64> {
+    pub fn point_position(&self, model: &Model, point: PointIndex) -> Vector3<T> {
         let p = &model.points[point.0];
         self.position_of(p.link, &p.p_link_m)
     }
 
     /// Velocity in the floor frame of a floor-frame point moving with `link` [m/s].
-    pub fn velocity_of(&self, link: LinkIndex, p_floor_m: &Vector3<f64>) -> Vector3<f64> {
+    pub fn velocity_of(&self, link: LinkIndex, p_floor_m: &Vector3<T>) -> Vector3<T> {
         self.v_floor_link_m_s[link.0]
             + self.omega_floor_rad_s[link.0].cross(&(p_floor_m - self.p_floor_link_m[link.0]))
     }
 
     /// Bias acceleration (`q̈ = 0`) of a floor-frame point moving with `link` [m/s²].
-    pub fn bias_acceleration_of(&self, link: LinkIndex, p_floor_m: &Vector3<f64>) -> Vector3<f64> {
+    pub fn bias_acceleration_of(&self, link: LinkIndex, p_floor_m: &Vector3<T>) -> Vector3<T> {
         let r = p_floor_m - self.p_floor_link_m[link.0];
         let w = self.omega_floor_rad_s[link.0];
         self.a_bias_link_m_s2[link.0]
@@ -137,8 +146,8 @@ impl Kinematics {
         &self,
         model: &Model,
         link: LinkIndex,
-        p_floor_m: &Vector3<f64>,
-    ) -> DMatrix<f64> {
+        p_floor_m: &Vector3<T>,
+    ) -> DMatrix<T> {
         let mut j = DMatrix::zeros(3, model.dof());
         self.point_jacobian_into(model, link, p_floor_m, &mut j);
         j
@@ -149,10 +158,10 @@ impl Kinematics {
         &self,
         model: &Model,
         link: LinkIndex,
-        p_floor_m: &Vector3<f64>,
-        j: &mut DMatrix<f64>,
+        p_floor_m: &Vector3<T>,
+        j: &mut DMatrix<T>,
     ) {
-        j.fill(0.0);
+        j.fill(T::zero());
         let mut cur = Some(link);
         while let Some(l) = cur {
             let lk = &model.links[l.0];
@@ -169,15 +178,15 @@ impl Kinematics {
     }
 
     /// Angular Jacobian `∂ω/∂q̇` (3 × n) of `link`.
-    pub fn angular_jacobian(&self, model: &Model, link: LinkIndex) -> DMatrix<f64> {
+    pub fn angular_jacobian(&self, model: &Model, link: LinkIndex) -> DMatrix<T> {
         let mut j = DMatrix::zeros(3, model.dof());
         self.angular_jacobian_into(model, link, &mut j);
         j
     }
 
     /// As [`Self::angular_jacobian`], writing into `j` (3 × n, overwritten).
-    pub fn angular_jacobian_into(&self, model: &Model, link: LinkIndex, j: &mut DMatrix<f64>) {
-        j.fill(0.0);
+    pub fn angular_jacobian_into(&self, model: &Model, link: LinkIndex, j: &mut DMatrix<T>) {
+        j.fill(T::zero());
         let mut cur = Some(link);
         while let Some(l) = cur {
             let lk = &model.links[l.0];
@@ -190,18 +199,19 @@ impl Kinematics {
     }
 
     /// Centre of mass of the whole model (infinitesimal bodies excluded) [m].
-    pub fn centre_of_mass(&self, model: &Model) -> Vector3<f64> {
+    pub fn centre_of_mass(&self, model: &Model) -> Vector3<T> {
         let mut sum = Vector3::zeros();
         let mut m = 0.0;
         for (i, l) in model.links.iter().enumerate() {
             if l.body.infinitesimal || l.body.mass_kg == 0.0 {
                 continue;
             }
-            sum += self.position_of(LinkIndex(i), &l.body.p_link_com_m) * l.body.mass_kg;
+            sum += self.position_of(LinkIndex(i), &l.body.p_link_com_m)
+                * nalgebra::convert::<f64, T>(l.body.mass_kg);
             m += l.body.mass_kg;
         }
         if m > 0.0 {
-            sum / m
+            sum / nalgebra::convert::<f64, T>(m)
         } else {
             Vector3::zeros()
         }

@@ -25,5 +25,6 @@ pub mod singular_limit;
 pub mod stability;
 pub mod stride;
 pub mod tune;
+pub mod variational;
 pub mod walk;
 pub mod walker;

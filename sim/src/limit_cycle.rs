@@ -2,6 +2,7 @@
 //! the stride Jacobian by perturbation, whose eigenvalues decide stability, eq. (27).
 
 use crate::stride::{Schedule, StepSchedule, StrideFailure, StrideOptions, StrideResult};
+use crate::variational::VariationalError;
 use crate::walker::Walker;
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
@@ -24,6 +25,21 @@ pub struct NewtonSettings {
     /// step sizes of the nominal stride ([`StepSchedule`]) instead of choosing their own, so
     /// that the differences do not pick up the adaptive step selection's accept/reject flips.
     pub frozen_steps: bool,
+    /// How the stride Jacobian is taken.
+    pub jacobian: JacobianMethod,
+}
+
+/// How the stride Jacobian is taken.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JacobianMethod {
+    /// Central differences of the stride map (2n strides).
+    #[default]
+    CentralDifferences,
+    /// The variational equations with saltation at every event (one stride with n
+    /// sensitivities by forward-mode automatic differentiation; [`crate::variational`]).
+    /// Strides it does not cover fall back to central differences, and the gait says so.
+    Variational,
 }
 
 impl Default for NewtonSettings {
@@ -35,6 +51,7 @@ impl Default for NewtonSettings {
             central: true,
             max_halvings: 8,
             frozen_steps: false,
+            jacobian: JacobianMethod::CentralDifferences,
         }
     }
 }
@@ -69,6 +86,8 @@ pub enum NewtonError {
 /// A periodic gait.
 #[derive(Clone, Debug)]
 pub struct Gait {
+    /// How the Jacobian (and so the eigenvalues) was taken.
+    pub jacobian_method: JacobianMethod,
     /// The fixed point (stride-map vector).
     pub fixed_point: DVector<f64>,
     /// The stride Jacobian at the fixed point.
@@ -106,6 +125,30 @@ impl Walker {
         let (q, qd) = self.unpack(v);
         let r = self.stride(&q, &qd, StrideOptions::default())?;
         Ok((self.pack(&r.q_next, &r.qd_next), r))
+    }
+
+    /// The stride Jacobian at `v` by `settings.jacobian`, with the method actually used (the
+    /// variational equations fall back to central differences where they do not apply).
+    ///
+    /// # Errors
+    /// A stride that fails.
+    pub fn stride_jacobian_by(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+        settings: &NewtonSettings,
+    ) -> Result<(DMatrix<f64>, JacobianMethod), StrideFailure> {
+        if settings.jacobian == JacobianMethod::Variational {
+            match self.stride_jacobian_variational(v) {
+                Ok((j, _)) => return Ok((j, JacobianMethod::Variational)),
+                Err(VariationalError::Stride(f)) => return Err(f),
+                Err(_) => {}
+            }
+        }
+        Ok((
+            self.stride_jacobian(v, s_v, settings)?,
+            JacobianMethod::CentralDifferences,
+        ))
     }
 
     /// The stride Jacobian at `v` by perturbation.
@@ -190,9 +233,11 @@ impl Walker {
             };
             let r = &s - &v;
             if last_step < settings.tolerance {
-                let j = self.stride_jacobian(&v, &s, settings).map_err(fail)?;
+                let (j, jacobian_method) =
+                    self.stride_jacobian_by(&v, &s, settings).map_err(fail)?;
                 let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
                 return Ok(Gait {
+                    jacobian_method,
                     fixed_point: v,
                     jacobian: j,
                     eigenvalues,
@@ -207,7 +252,7 @@ impl Walker {
             let r_norm_now = r.amax();
             let j = match kept.take() {
                 Some(j) if r_norm_now <= 0.25 * last_residual => j,
-                _ => self.stride_jacobian(&v, &s, settings).map_err(fail)?,
+                _ => self.stride_jacobian_by(&v, &s, settings).map_err(fail)?.0,
             };
             last_residual = r_norm_now;
             let a = DMatrix::identity(n, n) - &j;

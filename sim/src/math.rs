@@ -1,12 +1,17 @@
 //! Small rotation helpers shared by kinematics, relabelling and impacts.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, RealField, Vector3};
 
-/// Rotation matrix for a rotation of `angle_rad` about the unit vector `axis` (Rodrigues).
-pub fn rotation_about(axis: &Vector3<f64>, angle_rad: f64) -> Matrix3<f64> {
+/// Rotation matrix for a rotation of `angle_rad` about the unit vector `axis` (Rodrigues);
+/// generic over the scalar so that dual numbers carry derivatives through it.
+pub fn rotation_about<T: RealField + Copy>(axis: &Vector3<f64>, angle_rad: T) -> Matrix3<T> {
     let (s, c) = angle_rad.sin_cos();
-    let t = 1.0 - c;
-    let (x, y, z) = (axis.x, axis.y, axis.z);
+    let t = T::one() - c;
+    let (x, y, z): (T, T, T) = (
+        nalgebra::convert(axis.x),
+        nalgebra::convert(axis.y),
+        nalgebra::convert(axis.z),
+    );
     // R = c I + s [k]× + (1 − c) k kᵀ, written out.
     Matrix3::new(
         c + t * x * x,
@@ -27,9 +32,12 @@ pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// Small-angle orientation error `e` such that `R_target ≈ exp([e]×) R_actual` (world frame).
-pub fn orientation_error(r_target: &Matrix3<f64>, r_actual: &Matrix3<f64>) -> Vector3<f64> {
+pub fn orientation_error<T: RealField + Copy>(
+    r_target: &Matrix3<T>,
+    r_actual: &Matrix3<T>,
+) -> Vector3<T> {
     let d = r_target * r_actual.transpose();
-    let a = (d - d.transpose()) * 0.5;
+    let a = (d - d.transpose()) * nalgebra::convert::<f64, T>(0.5);
     Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)])
 }
 

@@ -117,6 +117,7 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             o.insert("progress_m_per_step".into(), json!(n.progress_m));
             o.insert("speed_m_s".into(), json!(n.speed_m_s));
             o.insert("newton_iterations".into(), json!(g.iterations));
+            o.insert("jacobian_method".into(), json!(g.jacobian_method));
             o.insert("residual".into(), json!(g.residual));
             o.insert("events".into(), json!(g.stride.events));
             o.insert(

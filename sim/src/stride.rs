@@ -98,6 +98,9 @@ pub struct StrideEvent {
 /// A completed stride.
 #[derive(Clone, Debug)]
 pub struct StrideResult {
+    /// The state just before and just after each event of [`Self::events`], in the same
+    /// order (for the heel strike both are the pre-impact state).
+    pub event_states: Vec<(Sample, Sample)>,
     /// Coordinates at the start of the next stride (relabelled).
     pub q_next: DVector<f64>,
     /// Velocities at the start of the next stride (relabelled).
@@ -615,6 +618,7 @@ impl Walker {
             ));
         }
         let mut events = Vec::new();
+        let mut event_states: Vec<(Sample, Sample)> = Vec::new();
         let mut energy_loss = 0.0;
         if options.record {
             trajectory.push(cur.clone());
@@ -680,6 +684,7 @@ impl Walker {
                                 name: "string_released".into(),
                                 time_s: cur.t_s,
                             });
+                            event_states.push((cur.clone(), cur.clone()));
                         } else {
                             phase.prescribed = Some((coord, Drive::Segment(seg)));
                             phase.snap(&mut cur);
@@ -947,6 +952,7 @@ impl Walker {
                         name: "heel_down".into(),
                         time_s: at.t_s,
                     });
+                    event_states.push((at.clone(), cur.clone()));
                     evaluations += integrator.evaluations();
                     integrator.reset();
                     phase_no += 1;
@@ -1020,6 +1026,7 @@ impl Walker {
                         name: "string_engaged".into(),
                         time_s: at.t_s,
                     });
+                    event_states.push((at.clone(), cur.clone()));
                     evaluations += integrator.evaluations();
                     integrator.reset();
                     phase_no += 1;
@@ -1076,6 +1083,7 @@ impl Walker {
                         name: format!("knee_lock:{}", self.model.coordinates[c].name),
                         time_s: at.t_s,
                     });
+                    event_states.push((at.clone(), cur.clone()));
                     evaluations += integrator.evaluations();
                     integrator.reset();
                     phase_no += 1;
@@ -1128,6 +1136,7 @@ impl Walker {
                         name: "heel_strike".into(),
                         time_s: at.t_s,
                     });
+                    event_states.push((at.clone(), at.clone()));
                     if options.record {
                         trajectory.push(at.clone());
                     }
@@ -1140,6 +1149,7 @@ impl Walker {
                         integrator.as_ref(),
                     )?;
                     r.actuator_work_j = power.work_j;
+                    r.event_states = event_states;
                     r.evaluations = evaluations;
                     r.contact = contact;
                     r.damping_dissipation_j = power.dissipation_j;
@@ -1272,6 +1282,7 @@ impl Walker {
             impact_energy_loss_j: energy_loss,
             evaluations: integrator.evaluations(),
             trajectory: Vec::new(),
+            event_states: Vec::new(),
             actuator_work_j: 0.0,
             damping_dissipation_j: 0.0,
             contact: ContactSummary::default(),

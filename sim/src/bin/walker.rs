@@ -11,6 +11,7 @@ use sim::accuracy;
 use sim::continuation::sweep;
 use sim::figures;
 use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::JacobianMethod;
 use sim::limit_cycle::NewtonSettings;
 use sim::report::{gait_json, sweep_json, walk_json};
 use sim::scene::{Scene, SceneError, BUILTIN};
@@ -184,6 +185,11 @@ struct Common {
     /// (internal numerical differentiation) instead of choosing their own.
     #[arg(long)]
     frozen_steps: bool,
+    /// The stride Jacobian: `central` differences or the `variational` equations (exact
+    /// derivatives; strides they do not cover fall back to central differences, and the JSON's
+    /// `jacobian_method` says which was used).
+    #[arg(long, default_value = "central")]
+    jacobian: String,
 }
 
 /// Bad input: exit code 2.
@@ -216,6 +222,12 @@ impl Common {
         positive("rtol", self.rtol)?;
         positive("newton-tol", Some(self.newton_tol))?;
         positive("perturbation", Some(self.perturbation))?;
+        if !matches!(self.jacobian.as_str(), "central" | "variational") {
+            return Err(InputError::Other(format!(
+                "--jacobian `{}`: expected central or variational",
+                self.jacobian
+            )));
+        }
         if let Some(kind) = &self.integrator {
             w.integrator = IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None)
                 .ok_or_else(|| {
@@ -237,6 +249,10 @@ impl Common {
             central: true,
             max_halvings: 8,
             frozen_steps: self.frozen_steps,
+            jacobian: match self.jacobian.as_str() {
+                "variational" => JacobianMethod::Variational,
+                _ => JacobianMethod::CentralDifferences,
+            },
         }
     }
 }
