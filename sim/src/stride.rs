@@ -845,7 +845,7 @@ impl Walker {
                 continue;
             }
             // Locate each and take the earliest.
-            let mut first: Option<(Watch, Sample)> = None;
+            let mut located: Vec<(Watch, Sample)> = Vec::new();
             for w in triggered {
                 let mut g: Box<dyn FnMut(&Sample) -> f64> = match w {
                     Watch::Heel => Box::new(|s: &Sample| wit.eval(s).foot_height_m),
@@ -883,11 +883,19 @@ impl Walker {
                 )
                 .map_err(|e| StrideFailure::from_event(e, cur.t_s))?;
                 drop(g);
-                if first.as_ref().is_none_or(|(_, f)| s.t_s < f.t_s) {
-                    first = Some((w, s));
-                }
+                located.push((w, s));
             }
-            let Some((watch, mut at)) = first else {
+            located.sort_by(|a, b| a.1.t_s.total_cmp(&b.1.t_s));
+            // A mid-swing scuff that is ignored must not hide a later event of the same step
+            // (a knee lock, the string's engagement): take that one instead.
+            if located.len() > 1
+                && located[0].0 == Watch::Heel
+                && self.heel_strike.ignore_scuffing
+                && wit.eval(&located[0].1).foot_ahead_m < self.heel_strike.min_ahead_m
+            {
+                located.remove(0);
+            }
+            let Some((watch, mut at)) = located.into_iter().next() else {
                 continue;
             };
             phase.snap(&mut at);
