@@ -420,6 +420,16 @@ pub struct HeelStrikeImpact {
     pub energy_loss_j: f64,
 }
 
+/// The outcome of [`Walker::lock_coordinate`].
+struct Locked {
+    /// The state after the impact.
+    after: Sample,
+    /// Mechanical energy dissipated [J] (the drive's work included).
+    loss_j: f64,
+    /// Work of a drive holding the ankle through the impact [J].
+    drive_work_j: f64,
+}
+
 /// Options for [`Walker::stride`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StrideOptions {
@@ -933,29 +943,10 @@ impl Walker {
                     // foot's pitch about its toe; the foot is flat again, the ankle free.
                     let Some(r) = &self.ankle else { continue };
                     let toe = r.toe_pitch.0;
-                    let mut g = DMatrix::zeros(1, self.model.dof());
-                    g[(0, toe)] = 1.0;
-                    let mut dynamics = Dynamics::new(&self.model);
-                    let before = energy(&mut dynamics, &self.model, &at);
-                    let imp = resolve(
-                        &mut dynamics,
-                        &self.model,
-                        &at.q,
-                        &at.qd,
-                        &phase.active,
-                        &g,
-                        0.0,
-                    )
-                    .map_err(|e| {
-                        StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
-                    })?;
+                    let l = self.lock_coordinate(&phase, &at, toe, 0.0)?;
                     phase.active[toe] = false;
-                    let mut qd = imp.qd_plus;
-                    qd[toe] = 0.0;
-                    let mut q = at.q.clone();
-                    q[toe] = 0.0;
-                    cur = Sample { t_s: at.t_s, q, qd };
-                    energy_loss += before - energy(&mut dynamics, &self.model, &cur);
+                    cur = l.after;
+                    energy_loss += l.loss_j;
                     events.push(StrideEvent {
                         name: "heel_down".into(),
                         time_s: at.t_s,
@@ -1048,45 +1039,15 @@ impl Walker {
                 }
                 Watch::Knee(k) => {
                     let c = self.knees[k].coordinate.0;
-                    let mut g = DMatrix::zeros(1, self.model.dof());
-                    g[(0, c)] = 1.0;
                     power.close(&self.model, &at);
-                    let mut dynamics = Dynamics::new(&self.model);
-                    let before = energy(&mut dynamics, &self.model, &at);
-                    let imp = resolve(
-                        &mut dynamics,
-                        &self.model,
-                        &at.q,
-                        &at.qd,
-                        &phase.active,
-                        &g,
-                        0.0,
-                    )
-                    .map_err(|e| {
-                        StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string())
-                    })?;
-                    // A drive holding the ankle through the impact takes an impulse and does
-                    // work on it (impulse × its rate, which the impact does not change): the
-                    // actuator's work, not part of the impact's loss.
-                    let drive_work = match phase.prescribed {
-                        Some((a, _)) => {
-                            let dqd = &imp.qd_plus - &at.qd;
-                            (dynamics.mass_matrix.row(a.0) * dqd)[(0, 0)] * at.qd[a.0]
-                        }
-                        None => 0.0,
-                    };
-                    power.work_j += drive_work;
-                    energy_loss += drive_work;
+                    let l = self.lock_coordinate(&phase, &at, c, self.knees[k].stop_rad)?;
                     phase.active[c] = false;
-                    let mut qd = imp.qd_plus;
-                    qd[c] = 0.0;
-                    let mut q = at.q.clone();
-                    q[c] = self.knees[k].stop_rad;
-                    cur = Sample { t_s: at.t_s, q, qd };
+                    cur = l.after;
+                    power.work_j += l.drive_work_j;
+                    energy_loss += l.loss_j;
                     if phase.prescribed.is_some() {
                         power.open(&self.model, &cur);
                     }
-                    energy_loss += before - energy(&mut dynamics, &self.model, &cur);
                     events.push(StrideEvent {
                         name: format!("knee_lock:{}", self.model.coordinates[c].name),
                         time_s: at.t_s,
@@ -1165,6 +1126,52 @@ impl Walker {
                 }
             }
         }
+    }
+
+    /// An inelastic impact that locks coordinate `c` at `value` (a knee at its stop, a foot
+    /// landing flat), the other free coordinates as `phase` has them.
+    fn lock_coordinate(
+        &self,
+        phase: &Phase,
+        at: &Sample,
+        c: usize,
+        value: f64,
+    ) -> Result<Locked, StrideFailure> {
+        let mut g = DMatrix::zeros(1, self.model.dof());
+        g[(0, c)] = 1.0;
+        let mut dynamics = Dynamics::new(&self.model);
+        let before = energy(&mut dynamics, &self.model, at);
+        let imp = resolve(
+            &mut dynamics,
+            &self.model,
+            &at.q,
+            &at.qd,
+            &phase.active,
+            &g,
+            0.0,
+        )
+        .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+        // A drive holding the ankle through the impact takes an impulse and does work on it
+        // (impulse × its rate, which the impact does not change): the actuator's work, not part
+        // of the impact's loss.
+        let drive_work_j = match phase.prescribed {
+            Some((a, _)) => {
+                let dqd = &imp.qd_plus - &at.qd;
+                (dynamics.mass_matrix.row(a.0) * dqd)[(0, 0)] * at.qd[a.0]
+            }
+            None => 0.0,
+        };
+        let mut qd = imp.qd_plus;
+        qd[c] = 0.0;
+        let mut q = at.q.clone();
+        q[c] = value;
+        let after = Sample { t_s: at.t_s, q, qd };
+        let loss_j = before - energy(&mut dynamics, &self.model, &after) + drive_work_j;
+        Ok(Locked {
+            after,
+            loss_j,
+            drive_work_j,
+        })
     }
 
     /// The heel-strike impact at `at` (stance labelling) with the stance contact released:
