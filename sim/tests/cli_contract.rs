@@ -345,3 +345,27 @@ fn sil_takes_encoder_faults_and_names_a_bad_one() {
     let t = comms["t_s"].as_f64().unwrap();
     assert!((0.4..0.4015).contains(&t), "{t}");
 }
+
+#[test]
+fn sil_keeps_only_the_last_step_summaries_when_asked() {
+    let all = json(&walker(&[
+        "sil", "--scene", "wisse3d", "--steps", "12", "--json",
+    ]));
+    let kept = json(&walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "12",
+        "--keep-steps",
+        "3",
+        "--json",
+    ]));
+    assert_eq!(all["steps"].as_array().unwrap().len(), 12);
+    assert_eq!(kept["steps_completed"], 12);
+    let k = kept["steps"].as_array().unwrap();
+    assert_eq!(k.len(), 3);
+    // The last three summaries, and the same gait figures (averaged over the last 10 steps).
+    assert_eq!(k[0]["step"], 9);
+    assert_eq!(kept["gait"], all["gait"]);
+}

@@ -143,6 +143,11 @@ enum Command {
         /// default it runs as fast as it can.
         #[arg(long, value_name = "FACTOR")]
         realtime: Option<f64>,
+        /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
+        /// figures use the last 10 and `steps_completed` counts every step. For long runs:
+        /// memory and output stay bounded.
+        #[arg(long, value_name = "N")]
+        keep_steps: Option<usize>,
     },
     /// List the scenes and their parameters.
     Scenes {
@@ -495,6 +500,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             candump,
             socketcand,
             realtime,
+            keep_steps,
         } => {
             let scene = common.scene()?;
             let walker = common.walker(&scene)?;
@@ -564,15 +570,22 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 eprintln!("socketcand: serving the bus on {addr} (channel vcan0)");
             }
             let (q, qd) = walker.unpack(&ideal.fixed_point);
+            // The gait figures average the last 10 steps: keep at least those.
+            let options = sim::walk::WalkOptions {
+                record: false,
+                keep_steps: keep_steps.map(|n| n.max(10)),
+            };
             let walk = match realtime {
-                None => walker.walk_controlled(&q, &qd, steps, false, &mut ctl),
+                None => walker.walk_streaming(&q, &qd, steps, options, Some(&mut ctl), &mut |_| {}),
                 Some(factor) => {
                     // Step by step, sleeping so that walk time keeps pace with wall time.
                     let start = std::time::Instant::now();
                     let mut paced = sim::control::Paced::new(&mut ctl, factor, start);
-                    walker.walk_controlled(&q, &qd, steps, false, &mut paced)
+                    walker.walk_streaming(&q, &qd, steps, options, Some(&mut paced), &mut |_| {})
                 }
             };
+            let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
+            let steps_json = &walk.steps[walk.steps.len() - kept..];
             let report = ctl
                 .finish()
                 .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
@@ -590,7 +603,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 "bus_load": report.bus.load,
                 "bus": report.bus,
                 "frames": report.frames_delivered,
-                "steps": walk.steps,
+                "steps": steps_json,
             });
             if common.json {
                 print_json(&out)?;
