@@ -507,6 +507,59 @@ pub enum Schedule<'a> {
     Replay(&'a StepSchedule),
 }
 
+/// A stride's place in its step schedule, phase by phase: where a replay reads its next step,
+/// where a recording writes it.
+struct ScheduleCursor<'a> {
+    schedule: Schedule<'a>,
+    phase: usize,
+    step: usize,
+}
+
+impl<'a> ScheduleCursor<'a> {
+    fn new(mut schedule: Schedule<'a>) -> Self {
+        if let Schedule::Record(s) = &mut schedule {
+            s.phases.clear();
+            s.phases.push(Vec::new());
+        }
+        Self {
+            schedule,
+            phase: 0,
+            step: 0,
+        }
+    }
+
+    /// The step to take next when replaying (the phase's last one if it runs longer).
+    fn replayed(&self) -> Option<f64> {
+        match &self.schedule {
+            Schedule::Replay(s) => s
+                .phases
+                .get(self.phase)
+                .and_then(|p| p.get(self.step).or(p.last()))
+                .copied(),
+            _ => None,
+        }
+    }
+
+    /// An accepted step of `h_s` [s].
+    fn stepped(&mut self, h_s: f64) {
+        if let Schedule::Record(s) = &mut self.schedule {
+            if let Some(p) = s.phases.last_mut() {
+                p.push(h_s);
+            }
+        }
+        self.step += 1;
+    }
+
+    /// A new smooth phase begins (after an impact or at a breakpoint).
+    fn next_phase(&mut self) {
+        self.phase += 1;
+        self.step = 0;
+        if let Schedule::Record(s) = &mut self.schedule {
+            s.phases.push(Vec::new());
+        }
+    }
+}
+
 impl Walker {
     /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling).
     pub fn stride(
@@ -584,16 +637,11 @@ impl Walker {
         options: StrideOptions,
         trajectory: &mut Vec<Sample>,
         mut control: Option<(&mut dyn AnkleController, f64)>,
-        mut schedule: Schedule<'_>,
+        schedule: Schedule<'_>,
     ) -> Result<StrideResult, StrideFailure> {
         let mut integrator = self.integrator.build();
         integrator.reset();
-        // Phase (between impacts) and step within it, for the step schedule.
-        let (mut phase_no, mut step_no) = (0usize, 0usize);
-        if let Schedule::Record(s) = &mut schedule {
-            s.phases.clear();
-            s.phases.push(Vec::new());
-        }
+        let mut schedule = ScheduleCursor::new(schedule);
         // Evaluations of earlier phases (the integrator restarts after each impact).
         let mut evaluations = 0;
         let mut phase = Phase::new(&self.model);
@@ -727,14 +775,7 @@ impl Walker {
                 _ => f64::INFINITY,
             };
             let h_limit = (next_tick.min(drive_end) - cur.t_s).max(1e-12);
-            let replayed = match &schedule {
-                Schedule::Replay(s) => s
-                    .phases
-                    .get(phase_no)
-                    .and_then(|p| p.get(step_no).or(p.last()))
-                    .copied(),
-                _ => None,
-            };
+            let replayed = schedule.replayed();
             let mut next = match replayed {
                 Some(h) => integrator.step_exact(&mut phase, &cur, h.min(h_limit)),
                 None => integrator.advance(&mut phase, &cur, h_limit),
@@ -833,20 +874,11 @@ impl Walker {
                             StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
                         })?;
                 }
-                if let Schedule::Record(s) = &mut schedule {
-                    if let Some(p) = s.phases.last_mut() {
-                        p.push(next.t_s - cur.t_s);
-                    }
-                }
-                step_no += 1;
+                schedule.stepped(next.t_s - cur.t_s);
                 if next.t_s >= drive_end - 1e-12 {
                     // A new smooth phase: the schedule and the integrator's memory restart.
                     integrator.system_changed();
-                    phase_no += 1;
-                    step_no = 0;
-                    if let Schedule::Record(s) = &mut schedule {
-                        s.phases.push(Vec::new());
-                    }
+                    schedule.next_phase();
                 }
                 cur = next;
                 if options.record {
@@ -910,7 +942,9 @@ impl Walker {
             };
             phase.snap(&mut at);
             power.accumulate(&damping, &cur, &at);
-            match watch {
+            // The arms that do not end the stride are impacts: each leaves `cur` after it and
+            // names the event.
+            let event: String = match watch {
                 Watch::HipLow => {
                     let kind = if wit.eval(&at).hip_ahead_m >= 0.0 {
                         FailureKind::FellForward
@@ -947,21 +981,7 @@ impl Walker {
                     phase.active[toe] = false;
                     cur = l.after;
                     energy_loss += l.loss_j;
-                    events.push(StrideEvent {
-                        name: "heel_down".into(),
-                        time_s: at.t_s,
-                    });
-                    event_states.push((at.clone(), cur.clone()));
-                    evaluations += integrator.evaluations();
-                    integrator.reset();
-                    phase_no += 1;
-                    step_no = 0;
-                    if let Schedule::Record(s) = &mut schedule {
-                        s.phases.push(Vec::new());
-                    }
-                    if options.record {
-                        trajectory.push(cur.clone());
-                    }
+                    "heel_down".into()
                 }
                 Watch::Engage => {
                     let Some(r) = &self.ankle else { continue };
@@ -1021,21 +1041,7 @@ impl Walker {
                     phase.active = act;
                     phase.prescribed = Some((r.ankle, drive));
                     power.open(&self.model, &cur);
-                    events.push(StrideEvent {
-                        name: "string_engaged".into(),
-                        time_s: at.t_s,
-                    });
-                    event_states.push((at.clone(), cur.clone()));
-                    evaluations += integrator.evaluations();
-                    integrator.reset();
-                    phase_no += 1;
-                    step_no = 0;
-                    if let Schedule::Record(s) = &mut schedule {
-                        s.phases.push(Vec::new());
-                    }
-                    if options.record {
-                        trajectory.push(cur.clone());
-                    }
+                    "string_engaged".into()
                 }
                 Watch::Knee(k) => {
                     let c = self.knees[k].coordinate.0;
@@ -1048,33 +1054,14 @@ impl Walker {
                     if phase.prescribed.is_some() {
                         power.open(&self.model, &cur);
                     }
-                    events.push(StrideEvent {
-                        name: format!("knee_lock:{}", self.model.coordinates[c].name),
-                        time_s: at.t_s,
-                    });
-                    event_states.push((at.clone(), cur.clone()));
-                    evaluations += integrator.evaluations();
-                    integrator.reset();
-                    phase_no += 1;
-                    step_no = 0;
-                    if let Schedule::Record(s) = &mut schedule {
-                        s.phases.push(Vec::new());
-                    }
-                    if options.record {
-                        trajectory.push(cur.clone());
-                    }
+                    format!("knee_lock:{}", self.model.coordinates[c].name)
                 }
                 Watch::Heel => {
                     let ahead = wit.eval(&at).foot_ahead_m;
                     if ahead < self.heel_strike.min_ahead_m {
                         if self.heel_strike.ignore_scuffing {
                             power.accumulate(&damping, &at, &next);
-                            if let Schedule::Record(s) = &mut schedule {
-                                if let Some(p) = s.phases.last_mut() {
-                                    p.push(next.t_s - cur.t_s);
-                                }
-                            }
-                            step_no += 1;
+                            schedule.stepped(next.t_s - cur.t_s);
                             cur = next;
                             if options.record {
                                 trajectory.push(cur.clone());
@@ -1124,6 +1111,18 @@ impl Walker {
                     r.damping_dissipation_j = power.dissipation_j;
                     return Ok(r);
                 }
+            };
+            events.push(StrideEvent {
+                name: event,
+                time_s: at.t_s,
+            });
+            event_states.push((at.clone(), cur.clone()));
+            // The integrator restarts after an impact; its evaluations so far are kept.
+            evaluations += integrator.evaluations();
+            integrator.reset();
+            schedule.next_phase();
+            if options.record {
+                trajectory.push(cur.clone());
             }
         }
     }

@@ -383,84 +383,74 @@ impl Walker {
                 let j = self.terminal_jacobian::<N>(&spec.active, before, &y)?;
                 return Ok((j, nominal));
             }
-            let (new_spec, tau, jump): (PhaseSpec, Vec<f64>, DMatrix<f64>) = if let Some(knee) =
-                name.strip_prefix("knee_lock:")
-            {
-                let k = self
-                    .knees
-                    .iter()
-                    .find(|k| self.model.coordinates[k.coordinate.0].name == knee)
-                    .ok_or_else(|| num(format!("unknown knee {knee}")))?;
-                let (c, stop) = (k.coordinate.0, k.stop_rad);
-                let tau =
-                    tau_of(&|x: &DVector<DualSVec64<N>>| x[c] - konst::<DualSVec64<N>>(stop))?;
-                let y = &phi + &f_minus * DMatrix::from_row_slice(1, m, &tau);
-                let active = spec.active.clone();
-                let jump = self.jump_derivative(
-                    &x_minus,
-                    &y,
-                    |q, qd, dy| {
-                        let target = DVector::zeros(1);
-                        let mut qd =
-                            impact(&self.model, dy, q, qd, &active, &unit_row(n, c), &target)?;
-                        let mut q = q.clone();
-                        q[c] = konst(stop);
-                        qd[c] = DualSVec64::<N>::from_re(0.0);
-                        Ok((q, qd))
-                    },
-                    &mut dy_d,
-                )?;
-                let mut s = spec.clone();
-                s.active[c] = false;
-                (s, tau, jump)
-            } else if name == "string_engaged" {
-                let r = self
-                    .ankle
-                    .as_ref()
-                    .ok_or_else(|| num("engagement without an ankle reflex"))?;
-                let (a, toe) = (r.ankle.0, r.toe_pitch.0);
-                let engage = r.engage_rad;
-                let tau =
-                    tau_of(&|x: &DVector<DualSVec64<N>>| x[a] - konst::<DualSVec64<N>>(engage))?;
-                let y = &phi + &f_minus * DMatrix::from_row_slice(1, m, &tau);
-                let mut act = spec.active.clone();
-                act[toe] = true;
-                let from_rad = r.engage_rad;
-                let act2 = act.clone();
-                let jump = self.jump_derivative(
-                    &x_minus,
-                    &y,
-                    |q, qd, dy| {
-                        // The ideal drive starts at rest: the string's far end does not move.
-                        let target = DVector::zeros(1);
-                        let mut qd =
-                            impact(&self.model, dy, q, qd, &act2, &unit_row(n, a), &target)?;
-                        let mut q = q.clone();
-                        q[a] = konst(from_rad);
-                        qd[a] = DualSVec64::<N>::from_re(0.0);
-                        Ok((q, qd))
-                    },
-                    &mut dy_d,
-                )?;
-                act[a] = false;
-                let s = PhaseSpec {
-                    active: act,
-                    drive: Some((
-                        a,
-                        AnkleProfile {
-                            start_s: t,
-                            duration_s: r.duration_s,
-                            from_rad: r.engage_rad,
-                            to_rad: r.final_rad,
-                        },
-                    )),
+            // Both remaining events are a coordinate reaching a value and an inelastic impact
+            // that stops it there: the knee at its stop; the ankle at the taut angle (the
+            // ideal drive starts at rest there, its far end not moving), the toe set free.
+            let (c, value, impact_active, new_spec) =
+                if let Some(knee) = name.strip_prefix("knee_lock:") {
+                    let k = self
+                        .knees
+                        .iter()
+                        .find(|k| self.model.coordinates[k.coordinate.0].name == knee)
+                        .ok_or_else(|| num(format!("unknown knee {knee}")))?;
+                    let c = k.coordinate.0;
+                    let mut s = spec.clone();
+                    s.active[c] = false;
+                    (c, k.stop_rad, spec.active.clone(), s)
+                } else if name == "string_engaged" {
+                    let r = self
+                        .ankle
+                        .as_ref()
+                        .ok_or_else(|| num("engagement without an ankle reflex"))?;
+                    let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+                    let mut act = spec.active.clone();
+                    act[toe] = true;
+                    let mut after_active = act.clone();
+                    after_active[a] = false;
+                    let s = PhaseSpec {
+                        active: after_active,
+                        drive: Some((
+                            a,
+                            AnkleProfile {
+                                start_s: t,
+                                duration_s: r.duration_s,
+                                from_rad: r.engage_rad,
+                                to_rad: r.final_rad,
+                            },
+                        )),
+                    };
+                    (a, r.engage_rad, act, s)
+                } else {
+                    return Err(VariationalError::Unsupported(format!("event `{name}`")));
                 };
+            let tau = tau_of(&|x: &DVector<DualSVec64<N>>| x[c] - konst::<DualSVec64<N>>(value))?;
+            let y = &phi + &f_minus * DMatrix::from_row_slice(1, m, &tau);
+            let jump = self.jump_derivative(
+                &x_minus,
+                &y,
+                |q, qd, dy| {
+                    let target = DVector::zeros(1);
+                    let mut qd = impact(
+                        &self.model,
+                        dy,
+                        q,
+                        qd,
+                        &impact_active,
+                        &unit_row(n, c),
+                        &target,
+                    )?;
+                    let mut q = q.clone();
+                    q[c] = konst(value);
+                    qd[c] = DualSVec64::<N>::from_re(0.0);
+                    Ok((q, qd))
+                },
+                &mut dy_d,
+            )?;
+            if new_spec.drive.is_some() && spec.drive.is_none() {
+                // The drive started at this event: its start time is a parameter from now on.
                 start = t;
                 start_sens = tau.clone();
-                (s, tau, jump)
-            } else {
-                return Err(VariationalError::Unsupported(format!("event `{name}`")));
-            };
+            }
             let f_plus = field(&new_spec, start, after, &mut dy_f)?;
             phi = jump - &f_plus * DMatrix::from_row_slice(1, m, &tau);
             spec = new_spec;
@@ -687,17 +677,18 @@ impl Walker {
         // Positions: one Gauss-Newton step from the converged pose (implicit function
         // theorem): Δq = J⁺ r(old), with J the pose Jacobian in f64.
         let model = &self.model;
+        let nd = model.dof();
         let np = rel.pairs.len();
         let nrows = 3 * (np + rel.point_pairs.len());
         let mut kf: KinematicsOf<f64> = KinematicsOf::new(model);
-        kf.update(model, q_new, &DVector::zeros(n_of(model)));
-        let mut jac = DMatrix::zeros(nrows, n_of(model));
+        kf.update(model, q_new, &DVector::zeros(nd));
+        let mut jac = DMatrix::zeros(nrows, nd);
         let mut res = DVector::<DualSVec64<N>>::zeros(nrows);
         for (k, &(new, old_l)) in rel.pairs.iter().enumerate() {
             let r_new: Matrix3<DualSVec64<N>> = kf.r_floor_link[new.0].map(konst);
             res.fixed_rows_mut::<3>(3 * k)
                 .copy_from(&orientation_error(&old_r[old_l.0], &r_new));
-            jac.view_mut((3 * k, 0), (3, n_of(model)))
+            jac.view_mut((3 * k, 0), (3, nd))
                 .copy_from(&kf.angular_jacobian(model, new));
         }
         for (k, &(np_, _)) in rel.point_pairs.iter().enumerate() {
@@ -705,7 +696,7 @@ impl Walker {
             let p = kf.position_of(pt.link, &pt.p_link_m);
             res.fixed_rows_mut::<3>(3 * (np + k))
                 .copy_from(&(old_points[k].0 - p.map(konst::<DualSVec64<N>>)));
-            jac.view_mut((3 * (np + k), 0), (3, n_of(model)))
+            jac.view_mut((3 * (np + k), 0), (3, nd))
                 .copy_from(&kf.point_jacobian(model, pt.link, &p));
         }
         for c in &rel.fixed {
@@ -718,25 +709,25 @@ impl Walker {
         let q_new_d: DVector<DualSVec64<N>> = q_new.map(konst::<DualSVec64<N>>) + pinv_d * res;
         // Velocities: J(q_new) q̇ = [ω of old twins; v of old points], J now in dual numbers.
         let mut kd: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(model);
-        kd.update(model, &q_new_d, &DVector::zeros(n_of(model)));
-        let mut jd = DMatrix::<DualSVec64<N>>::zeros(nrows, n_of(model));
+        kd.update(model, &q_new_d, &DVector::zeros(nd));
+        let mut jd = DMatrix::<DualSVec64<N>>::zeros(nrows, nd);
         let mut target = DVector::<DualSVec64<N>>::zeros(nrows);
         for (k, &(new, old_l)) in rel.pairs.iter().enumerate() {
-            jd.view_mut((3 * k, 0), (3, n_of(model)))
+            jd.view_mut((3 * k, 0), (3, nd))
                 .copy_from(&kd.angular_jacobian(model, new));
             target.fixed_rows_mut::<3>(3 * k).copy_from(&old_w[old_l.0]);
         }
         for (k, &(np_, _)) in rel.point_pairs.iter().enumerate() {
             let pt = &model.points[np_.0];
             let p = kd.position_of(pt.link, &pt.p_link_m);
-            jd.view_mut((3 * (np + k), 0), (3, n_of(model)))
+            jd.view_mut((3 * (np + k), 0), (3, nd))
                 .copy_from(&kd.point_jacobian(model, pt.link, &p));
             target
                 .fixed_rows_mut::<3>(3 * (np + k))
                 .copy_from(&old_points[k].1);
         }
         // Least squares over the free columns (normal equations; the system is consistent).
-        let free: Vec<usize> = (0..n_of(model))
+        let free: Vec<usize> = (0..nd)
             .filter(|c| !rel.fixed.iter().any(|f| f.0 == *c))
             .filter(|&c| jac.column(c).amax() > 1e-12)
             .collect();
@@ -747,7 +738,7 @@ impl Walker {
             .lu()
             .solve(&rhs)
             .ok_or_else(|| num("singular relabelling velocities"))?;
-        let mut qd_new = DVector::<DualSVec64<N>>::zeros(n_of(model));
+        let mut qd_new = DVector::<DualSVec64<N>>::zeros(nd);
         for (k, &c) in free.iter().enumerate() {
             qd_new[c] = x[k];
         }
@@ -761,8 +752,4 @@ impl Walker {
             }
         }))
     }
-}
-
-fn n_of(model: &Model) -> usize {
-    model.dof()
 }
