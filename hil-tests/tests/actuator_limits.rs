@@ -10,7 +10,7 @@
 mod common;
 
 use common::{matched, walk};
-use sim::sil::{ActuatorParams, ActuatorStats, Side, SilReport};
+use sil::{ActuatorParams, ActuatorStats, Side, SilReport};
 use sim::stride::FailureKind;
 use sim::walk::Walk;
 
@@ -22,7 +22,7 @@ fn mean_period_s(w: &Walk) -> f64 {
     w.steps.iter().map(|s| s.duration_s).sum::<f64>() / w.steps.len() as f64
 }
 
-fn with_limit(max_torque_n_m: f64) -> sim::sil::SilConfig {
+fn with_limit(max_torque_n_m: f64) -> sil::SilConfig {
     let mut c = matched();
     c.actuator.max_torque_n_m = max_torque_n_m;
     c

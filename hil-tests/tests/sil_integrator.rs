@@ -1,4 +1,4 @@
-//! `sim::sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6) against DOPRI5 at 1e-12 on the same
+//! `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6) against DOPRI5 at 1e-12 on the same
 //! firmware-in-the-loop walk: 12 steps of `wisse3d` from its limit cycle with both ankle nodes'
 //! firmware, and the gait figures averaged over all 12 steps. The bounds are 3 × the measured
 //! relative differences (docs/sil.md), so the accuracy claimed in `SIL_INTEGRATOR`'s
@@ -10,8 +10,8 @@
 mod common;
 
 use common::{matched, setup};
+use sil::{FirmwareInTheLoop, SIL_INTEGRATOR};
 use sim::integrators::IntegratorChoice;
-use sim::sil::{FirmwareInTheLoop, SIL_INTEGRATOR};
 use sim::walk::Walk;
 
 const STEPS: usize = 12;

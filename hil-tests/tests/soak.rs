@@ -21,8 +21,8 @@
 mod common;
 
 use common::{matched, setup};
+use sil::FirmwareInTheLoop;
 use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
-use sim::sil::FirmwareInTheLoop;
 use sim::walk::WalkOptions;
 
 const STEPS: usize = 10_000;

@@ -9,7 +9,7 @@
 mod common;
 
 use common::{matched, setup, walk, walk_with, TICK_S};
-use sim::sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport};
+use sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport};
 
 /// Time of the stride `k`'s start on the nominal gait, plus `frac` of a stride [s].
 fn in_stride(k: usize, frac: f64) -> f64 {

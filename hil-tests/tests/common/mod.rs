@@ -4,9 +4,9 @@
 use std::sync::OnceLock;
 
 use nalgebra::DVector;
+use sil::{FirmwareInTheLoop, SilConfig, SilReport};
 use sim::limit_cycle::NewtonSettings;
 use sim::scene::Scene;
-use sim::sil::{FirmwareInTheLoop, SilConfig, SilReport};
 use sim::walk::Walk;
 use sim::walker::Walker;
 
@@ -35,7 +35,7 @@ pub fn setup() -> &'static Setup {
             .expect("gait converges");
         let (q0, qd0) = walker.unpack(&gait.fixed_point);
         // The gait with the scene's integrator; the walks with the firmware's.
-        walker.integrator = sim::sil::SIL_INTEGRATOR;
+        walker.integrator = sil::SIL_INTEGRATOR;
         Setup {
             period_s: gait.stride.duration_s,
             walker,

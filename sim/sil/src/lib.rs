@@ -1,5 +1,5 @@
 //! Firmware in the loop: the ankle nodes' firmware, on a simulated CAN bus, controlling the
-//! simulated walker's stance ankle (see `crate::control` and `docs/sil.md`).
+//! simulated walker's stance ankle (see `sim::control` and `docs/sil.md`).
 //!
 //! Two [`firmware::AnkleNode`]s (left, node 2, and right, node 3) and a host (node 1) sit on a
 //! [`canbus::Bus`]. Every control tick:
@@ -52,7 +52,7 @@ use protocol::{
     Target,
 };
 
-use crate::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
+use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
 pub use config::{HostCommand, Side, SilConfig, SwingAnkleModel};
@@ -75,8 +75,8 @@ use hal::{ActuatorLink, CanLink, Shaft, SimActuator, SimCan, SimClock, SimContac
 /// bounds 3 × these; docs/sil.md). It costs 6.4 right-hand-side evaluations per tick against
 /// 9.6 at 1e-9 and 21.4 at 1e-12. Classical RK4 at one step per tick is cheaper
 /// (4 evaluations) but its step period is 0.1 % off and its impact loss 0.7 %.
-pub const SIL_INTEGRATOR: crate::integrators::IntegratorChoice =
-    crate::integrators::IntegratorChoice::Dopri5 {
+pub const SIL_INTEGRATOR: sim::integrators::IntegratorChoice =
+    sim::integrators::IntegratorChoice::Dopri5 {
         rtol: 1e-6,
         atol: 1e-6,
         h_max_s: 0.01,

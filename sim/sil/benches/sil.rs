@@ -4,9 +4,9 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use sil::config::SilConfig;
+use sil::FirmwareInTheLoop;
 use sim::scene::Scene;
-use sim::sil::config::SilConfig;
-use sim::sil::FirmwareInTheLoop;
 
 fn bench(c: &mut Criterion) {
     let scene = Scene::load("wisse3d").unwrap();
@@ -18,7 +18,7 @@ fn bench(c: &mut Criterion) {
         )
         .unwrap();
     let (q, qd) = walker.unpack(&gait.fixed_point);
-    walker.integrator = sim::sil::SIL_INTEGRATOR;
+    walker.integrator = sil::SIL_INTEGRATOR;
     let reflex = walker.ankle.clone().unwrap();
     let mut group = c.benchmark_group("sil");
     group.sample_size(10);

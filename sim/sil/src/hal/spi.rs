@@ -20,7 +20,7 @@ use std::rc::Rc;
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use firmware::drivers::encoder::{even_parity, ANGLECOM};
 
-use crate::sil::sensors::SimEncoder;
+use crate::sensors::SimEncoder;
 
 /// Register address of the uncompensated angle (answered like [`ANGLECOM`]).
 const ANGLEUNC: u16 = 0x3FFE;
@@ -53,7 +53,7 @@ impl Shaft {
     }
 }
 
-/// A failed SPI transaction (injected by [`crate::sil::SensorFault::SpiFailure`]).
+/// A failed SPI transaction (injected by [`crate::SensorFault::SpiFailure`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SimSpiError;
 
@@ -189,8 +189,8 @@ impl SpiDevice for SimSpi {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sil::config::Side;
-    use crate::sil::sensors::SensorFault;
+    use crate::config::Side;
+    use crate::sensors::SensorFault;
     use firmware::drivers::encoder::{parse_answer, read_command, MagneticEncoder, NOP};
     use firmware::scenarios::CALIBRATION;
     use firmware::sensors::EncoderError;

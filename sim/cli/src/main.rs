@@ -9,7 +9,9 @@ use nalgebra::DVector;
 use serde_json::{json, Value};
 use sim::accuracy;
 use sim::continuation::sweep;
-use sim::figures;
+mod figures;
+mod plot;
+
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::JacobianMethod;
 use sim::limit_cycle::NewtonSettings;
@@ -511,7 +513,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 ))
                 .into());
             };
-            let mut config = sim::sil::config::SilConfig::default()
+            let mut config = sil::config::SilConfig::default()
                 .with_reflex(&reflex)
                 .map_err(|e| InputError::Other(format!("reflex parameters: {e}")))?;
             for f in &faults {
@@ -545,7 +547,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             config.candump = candump;
             config.socketcand = socketcand;
             // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
-            // the firmware uses `sim::sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
+            // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
             // per 1 ms control tick) unless an integrator is given on the command line.
             let ideal_walker = scene.build()?;
             let v0 = ideal_walker.pack(&ideal_walker.guess_q, &ideal_walker.guess_qd);
@@ -558,10 +560,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
             };
             let mut walker = walker;
             if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
-                walker.integrator = sim::sil::SIL_INTEGRATOR;
+                walker.integrator = sil::SIL_INTEGRATOR;
             }
             // Its errors are about the configuration given (fault nodes, log path, address).
-            let mut ctl = sim::sil::FirmwareInTheLoop::new(config)
+            let mut ctl = sil::FirmwareInTheLoop::new(config)
                 .map_err(|e| InputError::Other(format!("software in the loop: {e}")))?;
             if let Some(t) = estop_at {
                 ctl.emergency_stop_at(t);

@@ -17,8 +17,8 @@ use std::rc::Rc;
 use firmware::drivers::actuator::{Actuator, ActuatorError};
 use firmware::ActuatorCommand;
 
-use crate::control::ActuatorSegment;
-use crate::sil::actuator::ActuatorModel;
+use crate::actuator::ActuatorModel;
+use sim::control::ActuatorSegment;
 
 /// State shared by a [`SimActuator`] and the orchestrator.
 #[derive(Clone, Debug)]
@@ -116,7 +116,7 @@ impl Actuator for SimActuator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sil::actuator::ActuatorParams;
+    use crate::actuator::ActuatorParams;
 
     #[test]
     fn commands_move_the_servo_and_are_recorded() {

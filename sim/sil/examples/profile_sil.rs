@@ -1,12 +1,12 @@
 //! Walks the 3D walker with both ankle nodes' firmware and the simulated bus in the loop, for
 //! profilers: real-time factor and right-hand-side evaluations per control tick
 //! (`cargo run --release -p sim --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`;
-//! without an integrator, `walker sil`'s own, `sim::sil::SIL_INTEGRATOR`).
+//! without an integrator, `walker sil`'s own, `sil::SIL_INTEGRATOR`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
+use sil::config::SilConfig;
+use sil::FirmwareInTheLoop;
 use sim::integrators::IntegratorChoice;
-use sim::sil::config::SilConfig;
-use sim::sil::FirmwareInTheLoop;
 use sim::walk::WalkOptions;
 
 fn main() {
@@ -29,7 +29,7 @@ fn main() {
             atol: x.unwrap_or(1e-6),
             h_max_s: 0.01,
         },
-        _ => sim::sil::SIL_INTEGRATOR,
+        _ => sil::SIL_INTEGRATOR,
     };
     let reflex = w.ankle.clone().unwrap();
     let mut ctl =

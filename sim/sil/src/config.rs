@@ -205,7 +205,7 @@ impl SilConfig {
     /// A value outside the firmware's parameter range.
     pub fn with_reflex(
         self,
-        reflex: &crate::actuator::AnkleReflex,
+        reflex: &sim::actuator::AnkleReflex,
     ) -> Result<Self, protocol::EncodeError> {
         use protocol::ParamId;
         self.with_param(ParamId::TautAngle, reflex.engage_rad)?

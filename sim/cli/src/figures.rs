@@ -1,12 +1,12 @@
 //! The figures of the paper, from our results: eigenvalues in the complex plane (Figs. 11,
 //! 13), the floor path of the hip-axle centre (Fig. 12), and joint angles over a stride.
 
-use crate::limit_cycle::Gait;
 use crate::plot::{Plot, Series, Style, PALETTE};
-use crate::stability::modes;
-use crate::stride::StrideOptions;
-use crate::walk::Walk;
-use crate::walker::Walker;
+use sim::limit_cycle::Gait;
+use sim::stability::modes;
+use sim::stride::StrideOptions;
+use sim::walk::Walk;
+use sim::walker::Walker;
 
 /// Eigenvalues of the stride Jacobian with the unit circle; those whose eigenvector is
 /// dominated by a freedom only the 3D model has are drawn as stars.
@@ -118,8 +118,8 @@ pub fn joint_angles(walker: &Walker, gait: &Gait, title: &str) -> Plot {
 /// One log-log panel of a speed-against-error study: an error measure against CPU time per
 /// stride, one line per integrator.
 pub fn accuracy(
-    study: &crate::accuracy::AccuracyStudy,
-    error: fn(&crate::accuracy::AccuracyPoint) -> Option<f64>,
+    study: &sim::accuracy::AccuracyStudy,
+    error: fn(&sim::accuracy::AccuracyPoint) -> Option<f64>,
     what: &str,
 ) -> Plot {
     let mut families: Vec<String> = Vec::new();
