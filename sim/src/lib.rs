@@ -10,6 +10,7 @@ pub mod control;
 pub mod dynamics;
 pub mod events;
 pub mod figures;
+pub mod hybrid;
 pub mod impact;
 pub mod integrators;
 pub mod kinematics;
