@@ -46,21 +46,7 @@ pub struct AnkleProfile {
 impl AnkleProfile {
     /// Angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s`.
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
-        let span = self.to_rad - self.from_rad;
-        let d = self.duration_s;
-        let x = ((t_s - self.start_s) / d).clamp(0.0, 1.0);
-        if x <= 0.0 || x >= 1.0 {
-            return (if x >= 1.0 { self.to_rad } else { self.from_rad }, 0.0, 0.0);
-        }
-        let (x2, x3) = (x * x, x * x * x);
-        let s = x3 * (10.0 - 15.0 * x + 6.0 * x2);
-        let ds = 30.0 * x2 * (1.0 - x) * (1.0 - x);
-        let dds = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x);
-        (
-            self.from_rad + span * s,
-            span * ds / d,
-            span * dds / (d * d),
-        )
+        crate::hybrid::profile::extension(self, t_s, self.start_s)
     }
 }
 

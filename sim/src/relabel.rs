@@ -7,10 +7,11 @@
 //! joint coordinates (positions) and a least-squares solve (velocities). The residuals are
 //! checked, so an inconsistent correspondence is an error, not a silent wrong state.
 
+pub use crate::hybrid::relabel::LinkStatesOf;
+use crate::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
 use crate::kinematics::Kinematics;
-use crate::math::{orientation_error, sagittal_reflection};
 use crate::model::{CoordIndex, LinkIndex, Model, PointIndex};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector};
 
 /// Which new link takes the pose of which old link, and the symmetry used.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,45 +52,8 @@ pub enum RelabelError {
     },
 }
 
-/// Poses and velocities of every link of a model, in the floor frame.
-#[derive(Clone, Debug)]
-pub struct LinkStates {
-    /// Rotations.
-    pub r: Vec<Matrix3<f64>>,
-    /// Origins [m].
-    pub p: Vec<Vector3<f64>>,
-    /// Angular velocities [rad/s].
-    pub w: Vec<Vector3<f64>>,
-    /// Origin velocities [m/s].
-    pub v: Vec<Vector3<f64>>,
-}
-
-impl LinkStates {
-    /// Takes the link states from a kinematics workspace, dropping the first `skip` links
-    /// (the released-root links of an impact model), and moving the origin to `origin`.
-    pub fn from_kinematics(kin: &Kinematics, skip: usize, origin: &Vector3<f64>) -> Self {
-        Self {
-            r: kin.r_floor_link[skip..].to_vec(),
-            p: kin.p_floor_link_m[skip..]
-                .iter()
-                .map(|p| p - origin)
-                .collect(),
-            w: kin.omega_floor_rad_s[skip..].to_vec(),
-            v: kin.v_floor_link_m_s[skip..].to_vec(),
-        }
-    }
-
-    /// Reflects about the sagittal plane: `R → S R S`, `p → S p`, `ω → −S ω`, `v → S v`.
-    pub fn mirrored(&self) -> Self {
-        let s = sagittal_reflection();
-        Self {
-            r: self.r.iter().map(|r| s * r * s).collect(),
-            p: self.p.iter().map(|p| s * p).collect(),
-            w: self.w.iter().map(|w| -(s * w)).collect(),
-            v: self.v.iter().map(|v| s * v).collect(),
-        }
-    }
-}
+/// Poses and velocities of every link of a model, in the floor frame (`f64`).
+pub type LinkStates = LinkStatesOf<f64>;
 
 /// The relabelled state.
 #[derive(Clone, Debug, PartialEq)]
@@ -114,8 +78,7 @@ impl Relabel {
         q_guess: &DVector<f64>,
     ) -> Result<Relabelled, RelabelError> {
         let n = model.dof();
-        let rows = 3 * (self.pairs.len() + self.point_pairs.len());
-        let np = self.pairs.len();
+        let rows = row_count(self);
         let mut kin = Kinematics::new(model);
         let zero = DVector::zeros(n);
         let mut q = q_guess.clone();
@@ -125,52 +88,11 @@ impl Relabel {
         let mut jac = DMatrix::zeros(rows, n);
         let mut res = DVector::zeros(rows);
         let mut iterations = 0;
-        // Old point positions and velocities, from the old link states before any mirroring
-        // (a point's offset in its link frame is not mirrored by reflecting the frame).
-        let s = sagittal_reflection();
-        let old_points: Vec<(Vector3<f64>, Vector3<f64>)> = self
-            .point_pairs
-            .iter()
-            .map(|&(_, op)| {
-                let pt = &model.points[op.0];
-                let l = pt.link.0;
-                let p = old.p[l] + old.r[l] * pt.p_link_m;
-                let v = old.v[l] + old.w[l].cross(&(p - old.p[l]));
-                if self.mirror {
-                    (s * p, s * v)
-                } else {
-                    (p, v)
-                }
-            })
-            .collect();
-        let mirrored;
-        let old = if self.mirror {
-            mirrored = old.mirrored();
-            &mirrored
-        } else {
-            old
-        };
+        let targets = RelabelTargets::new(self, model, old);
         loop {
             kin.update(model, &q, &zero);
-            for (k, &(new, old_l)) in self.pairs.iter().enumerate() {
-                res.fixed_rows_mut::<3>(3 * k).copy_from(&orientation_error(
-                    &old.r[old_l.0],
-                    &kin.r_floor_link[new.0],
-                ));
-                jac.view_mut((3 * k, 0), (3, n))
-                    .copy_from(&kin.angular_jacobian(model, new));
-            }
-            for (k, &(np_, _)) in self.point_pairs.iter().enumerate() {
-                let pt = &model.points[np_.0];
-                let p = kin.position_of(pt.link, &pt.p_link_m);
-                res.fixed_rows_mut::<3>(3 * (np + k))
-                    .copy_from(&(old_points[k].0 - p));
-                jac.view_mut((3 * (np + k), 0), (3, n))
-                    .copy_from(&kin.point_jacobian(model, pt.link, &p));
-            }
-            for c in &self.fixed {
-                jac.column_mut(c.0).fill(0.0);
-            }
+            pose_residual(self, model, &kin, &targets, &mut res);
+            pose_jacobian(self, model, &kin, &mut jac);
             let r = res.norm();
             if r <= self.tolerance {
                 break;
@@ -193,13 +115,7 @@ impl Relabel {
             iterations += 1;
         }
         // Velocities: J q̇ = [ω of old twins; v of old points] (jac is at the solution).
-        let mut target = DVector::zeros(rows);
-        for (k, &(_, old_l)) in self.pairs.iter().enumerate() {
-            target.fixed_rows_mut::<3>(3 * k).copy_from(&old.w[old_l.0]);
-        }
-        for (k, (_, v)) in old_points.iter().enumerate() {
-            target.fixed_rows_mut::<3>(3 * (np + k)).copy_from(v);
-        }
+        let target = targets.velocity_target();
         let qd = least_squares(&jac, &target);
         let vres = (&jac * &qd - &target).norm();
         if vres > 1e-8 * (1.0 + target.norm()) {

@@ -8,9 +8,9 @@ use crate::events::{locate, Direction, EventError};
 use crate::impact::{resolve, resolve_to, ImpactError};
 use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem, StabilityLimit};
 use crate::kinematics::Kinematics;
-use crate::model::{CoordIndex, LinkIndex, Model};
+use crate::model::{CoordIndex, Model};
 use crate::relabel::LinkStates;
-use crate::walker::{ContactConstraint, Walker};
+use crate::walker::Walker;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 
@@ -251,21 +251,23 @@ impl SecondOrderSystem for Phase<'_> {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
-        match &self.prescribed {
-            None => self
-                .dynamics
-                .accelerations(self.model, q, qd, &self.active, None),
-            Some((c, p)) => {
-                let (a, ad, add) = p.eval(t);
-                let (mut q, mut qd) = (q.clone(), qd.clone());
-                q[c.0] = a;
-                qd[c.0] = ad;
-                let mut qdd_p = DVector::zeros(q.len());
-                qdd_p[c.0] = add;
-                self.dynamics
-                    .accelerations(self.model, &q, &qd, &self.active, Some(&qdd_p))
+        let drive = self.prescribed.map(|(c, p)| {
+            let (angle_rad, rate_rad_s, acceleration_rad_s2) = p.eval(t);
+            crate::hybrid::phase::DriveValues {
+                coordinate: c.0,
+                angle_rad,
+                rate_rad_s,
+                acceleration_rad_s2,
             }
-        }
+        });
+        crate::hybrid::phase::accelerations(
+            self.model,
+            &mut self.dynamics,
+            &self.active,
+            drive.as_ref(),
+            q,
+            qd,
+        )
     }
 
     fn stability_limit(
@@ -1181,38 +1183,14 @@ impl Walker {
         active: &[bool],
     ) -> Result<HeelStrikeImpact, ImpactError> {
         let hs = &self.heel_strike;
-        let nr = hs.release.len();
         let m = &self.impact_model;
-        let n = m.dof();
-        let mut q = DVector::zeros(n);
-        let mut qd = DVector::zeros(n);
-        q.rows_mut(nr, n - nr).copy_from(&at.q);
-        qd.rows_mut(nr, n - nr).copy_from(&at.qd);
-        let mut act = vec![true; nr];
-        act.extend_from_slice(active);
-        let mut kin = Kinematics::new(m);
-        kin.update(m, &q, &qd);
-        let foot = &m.points[hs.swing_foot.0];
-        let p_foot = kin.position_of(foot.link, &foot.p_link_m);
-        let jv = kin.point_jacobian(m, foot.link, &p_foot);
-        let jw = kin.angular_jacobian(m, LinkIndex(hs.swing_foot_link.0 + nr));
-        // A constraint on a direction that no coordinate can move (e.g. yaw in a 2D variant)
-        // holds trivially: its row is zero and is dropped.
-        let rows: Vec<_> = hs
-            .constraints
-            .iter()
-            .map(|c| match c {
-                ContactConstraint::X => jv.row(0),
-                ContactConstraint::Y => jv.row(1),
-                ContactConstraint::Z => jv.row(2),
-                ContactConstraint::Yaw => jw.row(1),
-            })
-            .filter(|r| r.amax() > 1e-12)
-            .collect();
-        let mut g = DMatrix::zeros(rows.len(), n);
-        for (r, row) in rows.iter().enumerate() {
-            g.row_mut(r).copy_from(row);
-        }
+        let crate::hybrid::contact_rows::HeelStrikeRows {
+            q,
+            qd,
+            active: act,
+            g,
+            p_contact_m: p_foot,
+        } = crate::hybrid::contact_rows::heel_strike_rows(m, hs, &at.q, &at.qd, active);
         let mut dynamics = Dynamics::new(m);
         let before = energy(
             &mut dynamics,

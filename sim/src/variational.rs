@@ -22,18 +22,23 @@
 //! supported (a typed error; the perturbation Jacobian is then the fallback): infinitesimal
 //! bodies (the simplest walker), controller-driven strides, the heel coming back down.
 
-use nalgebra::{Const, DMatrix, DVector, Matrix3, RealField, SVector, Vector3, U1};
+use nalgebra::{Const, DMatrix, DVector, RealField, SVector, U1};
 use num_dual::{Derivative, DualSVec64};
 
 use crate::actuator::AnkleProfile;
 use crate::dynamics::{DynamicsError, DynamicsOf};
+use crate::hybrid::contact_rows::heel_strike_rows;
+use crate::hybrid::impact::solve_finite;
+use crate::hybrid::phase::DriveValues;
+use crate::hybrid::profile::extension;
+use crate::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
+use crate::hybrid::{konst, EngineScalar};
 use crate::integrators::{Dop853, Integrator, IntegratorChoice, Sample, SecondOrderSystem};
 use crate::kinematics::KinematicsOf;
-use crate::math::{orientation_error, sagittal_reflection};
-use crate::model::{LinkIndex, Model};
-use crate::relabel::LinkStates;
+use crate::model::Model;
+use crate::relabel::{LinkStates, LinkStatesOf};
 use crate::stride::{StrideFailure, StrideOptions, StrideResult};
-use crate::walker::{ContactConstraint, Walker};
+use crate::walker::Walker;
 
 /// Directions carried by one dual number (more are done in chunks).
 pub const LANES: usize = 6;
@@ -54,10 +59,6 @@ pub enum VariationalError {
 
 fn num(e: impl std::fmt::Display) -> VariationalError {
     VariationalError::Numerical(e.to_string())
-}
-
-fn konst<T: RealField + Copy>(x: f64) -> T {
-    nalgebra::convert(x)
 }
 
 fn dual<const N: usize>(re: f64, eps: SVector<f64, N>) -> DualSVec64<N> {
@@ -97,30 +98,6 @@ fn harvest<const N: usize>(y: &DVector<DualSVec64<N>>, out: &mut DMatrix<f64>, c
     }
 }
 
-/// The ideal drive's angle, rate and acceleration at `t` for a profile started at `start`
-/// (as [`AnkleProfile::eval`], in any scalar).
-fn profile<T: RealField + Copy>(p: &AnkleProfile, t: T, start: T) -> (T, T, T) {
-    let d: T = konst(p.duration_s);
-    let span: T = konst(p.to_rad - p.from_rad);
-    let x = (t - start) / d;
-    if x <= T::zero() {
-        return (konst(p.from_rad), T::zero(), T::zero());
-    }
-    if x >= T::one() {
-        return (konst(p.to_rad), T::zero(), T::zero());
-    }
-    let one = T::one();
-    let (x2, x3) = (x * x, x * x * x);
-    let s = x3 * (konst::<T>(10.0) - konst::<T>(15.0) * x + konst::<T>(6.0) * x2);
-    let ds = konst::<T>(30.0) * x2 * (one - x) * (one - x);
-    let dds = konst::<T>(60.0) * x * (one - x) * (one - x - x);
-    (
-        konst::<T>(p.from_rad) + span * s,
-        span * ds / d,
-        span * dds / (d * d),
-    )
-}
-
 /// Which coordinates are free and which one the ideal drive moves.
 #[derive(Clone, Debug)]
 struct PhaseSpec {
@@ -128,8 +105,9 @@ struct PhaseSpec {
     drive: Option<(usize, AnkleProfile)>,
 }
 
-/// `q̈` in any scalar, the drive started at `start`.
-fn accelerations<T: RealField + Copy>(
+/// `q̈` of a phase in any scalar, the drive started at `start` [s] (the shared phase
+/// accelerations with the drive's values from the shared profile).
+fn accelerations<T: EngineScalar>(
     model: &Model,
     dy: &mut DynamicsOf<T>,
     spec: &PhaseSpec,
@@ -138,18 +116,16 @@ fn accelerations<T: RealField + Copy>(
     q: &DVector<T>,
     qd: &DVector<T>,
 ) -> Result<DVector<T>, DynamicsError> {
-    match &spec.drive {
-        None => dy.accelerations_finite(model, q, qd, &spec.active, None),
-        Some((a, p)) => {
-            let (pa, va, aa) = profile(p, t, start);
-            let (mut q, mut qd) = (q.clone(), qd.clone());
-            q[*a] = pa;
-            qd[*a] = va;
-            let mut qdd_p = DVector::zeros(q.len());
-            qdd_p[*a] = aa;
-            dy.accelerations_finite(model, &q, &qd, &spec.active, Some(&qdd_p))
+    let drive = spec.drive.as_ref().map(|(a, p)| {
+        let (angle_rad, rate_rad_s, acceleration_rad_s2) = extension(p, t, start);
+        DriveValues {
+            coordinate: *a,
+            angle_rad,
+            rate_rad_s,
+            acceleration_rad_s2,
         }
-    }
+    });
+    crate::hybrid::phase::accelerations(model, dy, &spec.active, drive.as_ref(), q, qd)
 }
 
 /// `(q, q̇)` stacked with the sensitivities: `q` part `[q; vec Φ_q]`, `q̇` part
@@ -202,53 +178,6 @@ impl<const N: usize> SecondOrderSystem for Augmented<'_, N> {
         }
         Ok(out)
     }
-}
-
-/// Impact equations (19)-(21) for finite masses in any scalar: `q̇⁺` with `G q̇⁺ = target`
-/// over the active coordinates (the others keep their rates).
-#[allow(clippy::too_many_arguments)]
-fn impact<T: RealField + Copy>(
-    model: &Model,
-    dy: &mut DynamicsOf<T>,
-    q: &DVector<T>,
-    qd: &DVector<T>,
-    active: &[bool],
-    g: &DMatrix<T>,
-    target: &DVector<T>,
-) -> Result<DVector<T>, VariationalError> {
-    dy.assemble(model, q, qd, None);
-    let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
-    let (n, k) = (idx.len(), g.nrows());
-    let mut a = DMatrix::<T>::zeros(n + k, n + k);
-    let mut b = DVector::<T>::zeros(n + k);
-    for (r, &i) in idx.iter().enumerate() {
-        let mut mv = T::zero();
-        for (c, &j) in idx.iter().enumerate() {
-            a[(r, c)] = dy.mass_matrix[(i, j)];
-            mv += dy.mass_matrix[(i, j)] * qd[j];
-        }
-        b[r] = mv;
-        for row in 0..k {
-            a[(r, n + row)] = g[(row, i)];
-            a[(n + row, r)] = g[(row, i)];
-        }
-    }
-    for row in 0..k {
-        let mut fixed = T::zero();
-        for j in (0..q.len()).filter(|&j| !active[j]) {
-            fixed += g[(row, j)] * qd[j];
-        }
-        b[n + row] = target[row] - fixed;
-    }
-    let x = a
-        .lu()
-        .solve(&b)
-        .ok_or_else(|| num("singular impact equations"))?;
-    let mut qd_plus = qd.clone();
-    for (j, &i) in idx.iter().enumerate() {
-        qd_plus[i] = x[j];
-    }
-    Ok(qd_plus)
 }
 
 /// A unit constraint row on coordinate `c`.
@@ -430,15 +359,17 @@ impl Walker {
                 &y,
                 |q, qd, dy| {
                     let target = DVector::zeros(1);
-                    let mut qd = impact(
-                        &self.model,
+                    let mut qd = solve_finite(
                         dy,
+                        &self.model,
                         q,
                         qd,
                         &impact_active,
                         &unit_row(n, c),
                         &target,
-                    )?;
+                    )
+                    .map_err(num)?
+                    .qd_plus;
                     let mut q = q.clone();
                     q[c] = konst(value);
                     qd[c] = DualSVec64::<N>::from_re(0.0);
@@ -605,103 +536,37 @@ impl Walker {
         let hs = &self.heel_strike;
         let nr = hs.release.len();
         let mi = &self.impact_model;
-        let ni = mi.dof();
-        let mut qi = DVector::<DualSVec64<N>>::zeros(ni);
-        let mut qdi = DVector::<DualSVec64<N>>::zeros(ni);
-        qi.rows_mut(nr, ni - nr).copy_from(q);
-        qdi.rows_mut(nr, ni - nr).copy_from(qd);
-        let mut act = vec![true; nr];
-        act.extend_from_slice(active);
-        let mut kin: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(mi);
-        kin.update(mi, &qi, &qdi);
-        let foot = &mi.points[hs.swing_foot.0];
-        let p_foot = kin.position_of(foot.link, &foot.p_link_m);
-        let jv = kin.point_jacobian(mi, foot.link, &p_foot);
-        let jw = kin.angular_jacobian(mi, LinkIndex(hs.swing_foot_link.0 + nr));
-        let rows: Vec<_> = hs
-            .constraints
-            .iter()
-            .map(|c| match c {
-                ContactConstraint::X => jv.row(0).into_owned(),
-                ContactConstraint::Y => jv.row(1).into_owned(),
-                ContactConstraint::Z => jv.row(2).into_owned(),
-                ContactConstraint::Yaw => jw.row(1).into_owned(),
-            })
-            .filter(|r| r.iter().any(|x| x.re.abs() > 1e-12))
-            .collect();
-        let mut g = DMatrix::<DualSVec64<N>>::zeros(rows.len(), ni);
-        for (r, row) in rows.iter().enumerate() {
-            g.row_mut(r).copy_from(row);
-        }
-        let target = &g * &qdi * konst::<DualSVec64<N>>(-hs.restitution);
+        let rows = heel_strike_rows(mi, hs, q, qd, active);
+        let target = &rows.g * &rows.qd * konst::<DualSVec64<N>>(-hs.restitution);
         let mut dy: DynamicsOf<DualSVec64<N>> = DynamicsOf::new(mi);
-        let qd_plus = impact(mi, &mut dy, &qi, &qdi, &act, &g, &target)?;
-        kin.update(mi, &qi, &qd_plus);
+        let qd_plus = solve_finite(
+            &mut dy,
+            mi,
+            &rows.q,
+            &rows.qd,
+            &rows.active,
+            &rows.g,
+            &target,
+        )
+        .map_err(num)?
+        .qd_plus;
+        let mut kin: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(mi);
+        kin.update(mi, &rows.q, &qd_plus);
         // The old links' states relative to the new contact, mirrored if the scene mirrors.
         let rel = &self.relabel;
-        let s: Matrix3<DualSVec64<N>> = sagittal_reflection().map(konst);
-        let links = mi.links.len() - nr;
-        let old_p: Vec<Vector3<DualSVec64<N>>> = (0..links)
-            .map(|l| kin.p_floor_link_m[l + nr] - p_foot)
-            .collect();
-        let old_r: Vec<Matrix3<DualSVec64<N>>> =
-            (0..links).map(|l| kin.r_floor_link[l + nr]).collect();
-        let old_w: Vec<Vector3<DualSVec64<N>>> =
-            (0..links).map(|l| kin.omega_floor_rad_s[l + nr]).collect();
-        let old_v: Vec<Vector3<DualSVec64<N>>> =
-            (0..links).map(|l| kin.v_floor_link_m_s[l + nr]).collect();
-        let old_points: Vec<(Vector3<DualSVec64<N>>, Vector3<DualSVec64<N>>)> = rel
-            .point_pairs
-            .iter()
-            .map(|&(_, op)| {
-                let pt = &self.model.points[op.0];
-                let l = pt.link.0;
-                let p = old_p[l] + old_r[l] * pt.p_link_m.map(konst::<DualSVec64<N>>);
-                let v = old_v[l] + old_w[l].cross(&(p - old_p[l]));
-                if rel.mirror {
-                    (s * p, s * v)
-                } else {
-                    (p, v)
-                }
-            })
-            .collect();
-        let (old_r, old_w): (Vec<Matrix3<DualSVec64<N>>>, Vec<Vector3<DualSVec64<N>>>) =
-            if rel.mirror {
-                (
-                    old_r.iter().map(|r| s * r * s).collect(),
-                    old_w.iter().map(|w| -(s * w)).collect(),
-                )
-            } else {
-                (old_r, old_w)
-            };
+        let model = &self.model;
+        let old = LinkStatesOf::from_kinematics(&kin, nr, &rows.p_contact_m);
+        let targets = RelabelTargets::new(rel, model, &old);
         // Positions: one Gauss-Newton step from the converged pose (implicit function
         // theorem): Δq = J⁺ r(old), with J the pose Jacobian in f64.
-        let model = &self.model;
         let nd = model.dof();
-        let np = rel.pairs.len();
-        let nrows = 3 * (np + rel.point_pairs.len());
+        let nrows = row_count(rel);
         let mut kf: KinematicsOf<f64> = KinematicsOf::new(model);
         kf.update(model, q_new, &DVector::zeros(nd));
         let mut jac = DMatrix::zeros(nrows, nd);
         let mut res = DVector::<DualSVec64<N>>::zeros(nrows);
-        for (k, &(new, old_l)) in rel.pairs.iter().enumerate() {
-            let r_new: Matrix3<DualSVec64<N>> = kf.r_floor_link[new.0].map(konst);
-            res.fixed_rows_mut::<3>(3 * k)
-                .copy_from(&orientation_error(&old_r[old_l.0], &r_new));
-            jac.view_mut((3 * k, 0), (3, nd))
-                .copy_from(&kf.angular_jacobian(model, new));
-        }
-        for (k, &(np_, _)) in rel.point_pairs.iter().enumerate() {
-            let pt = &model.points[np_.0];
-            let p = kf.position_of(pt.link, &pt.p_link_m);
-            res.fixed_rows_mut::<3>(3 * (np + k))
-                .copy_from(&(old_points[k].0 - p.map(konst::<DualSVec64<N>>)));
-            jac.view_mut((3 * (np + k), 0), (3, nd))
-                .copy_from(&kf.point_jacobian(model, pt.link, &p));
-        }
-        for c in &rel.fixed {
-            jac.column_mut(c.0).fill(0.0);
-        }
+        pose_residual(rel, model, &kf, &targets, &mut res);
+        pose_jacobian(rel, model, &kf, &mut jac);
         let svd = jac.clone().svd(true, true);
         let tol = 1e-12 * svd.singular_values.max().max(1e-300);
         let pinv = svd.pseudo_inverse(tol).map_err(num)?;
@@ -711,21 +576,8 @@ impl Walker {
         let mut kd: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(model);
         kd.update(model, &q_new_d, &DVector::zeros(nd));
         let mut jd = DMatrix::<DualSVec64<N>>::zeros(nrows, nd);
-        let mut target = DVector::<DualSVec64<N>>::zeros(nrows);
-        for (k, &(new, old_l)) in rel.pairs.iter().enumerate() {
-            jd.view_mut((3 * k, 0), (3, nd))
-                .copy_from(&kd.angular_jacobian(model, new));
-            target.fixed_rows_mut::<3>(3 * k).copy_from(&old_w[old_l.0]);
-        }
-        for (k, &(np_, _)) in rel.point_pairs.iter().enumerate() {
-            let pt = &model.points[np_.0];
-            let p = kd.position_of(pt.link, &pt.p_link_m);
-            jd.view_mut((3 * (np + k), 0), (3, nd))
-                .copy_from(&kd.point_jacobian(model, pt.link, &p));
-            target
-                .fixed_rows_mut::<3>(3 * (np + k))
-                .copy_from(&old_points[k].1);
-        }
+        pose_jacobian(rel, model, &kd, &mut jd);
+        let target = targets.velocity_target();
         // Least squares over the free columns (normal equations; the system is consistent).
         let free: Vec<usize> = (0..nd)
             .filter(|c| !rel.fixed.iter().any(|f| f.0 == *c))

@@ -5,7 +5,8 @@
 // The coefficients are written with the digits Hairer published, beyond f64's precision.
 #![allow(clippy::excessive_precision)]
 
-use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
+use super::embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
+use super::Sample;
 use nalgebra::DVector;
 
 /// Stage nodes `c_1 … c_12` (index 0 is stage 1).
@@ -130,90 +131,35 @@ const ER: [(usize, f64); 8] = [
     (11, -0.223_553_078_638_862_952_588_442_784_5e-1),
 ];
 
-/// A kept end derivative: time, positions, velocities, accelerations.
-type Fsal = (f64, DVector<f64>, DVector<f64>, DVector<f64>);
+/// The Dormand-Prince 8(5,3) pair with Hairer's step-size controller (exponent 1/8).
+#[derive(Clone, Copy, Debug)]
+pub struct Dop853Pair;
 
-/// Adaptive Dormand-Prince 8(5,3) with Hairer's step-size controller (exponent 1/8).
-#[derive(Clone, Debug)]
-pub struct Dop853 {
-    rtol: f64,
-    atol: f64,
-    h_max_s: f64,
-    h_next_s: f64,
-    evaluations: usize,
-    /// Smallest step before giving up [s].
-    pub h_min_s: f64,
-    /// The first stage (the derivative at a step's start), evaluated on demand and kept, so
-    /// that a retried step (after a rejection) and the next step from exactly the same sample
-    /// do not evaluate it again.
-    fsal: Option<Fsal>,
-}
+impl EmbeddedPair for Dop853Pair {
+    const NAME: &'static str = "dop853";
+    const C: &'static [f64] = &C;
+    const A: &'static [&'static [(usize, f64)]] = &A;
+    const B: &'static [(usize, f64)] = &B;
+    const EXPONENT: f64 = 0.125;
+    const MIN_FACTOR: f64 = 1.0 / 3.0;
+    const MAX_FACTOR: f64 = 6.0;
+    const FSAL: bool = false;
 
-impl Dop853 {
-    /// Tolerances on the local error, and the largest step [s].
-    pub fn new(rtol: f64, atol: f64, h_max_s: f64) -> Self {
-        Self {
-            rtol,
-            atol,
-            h_max_s,
-            h_next_s: 0.0,
-            evaluations: 0,
-            h_min_s: 1e-14,
-            fsal: None,
-        }
-    }
-
-    fn first_stage(
-        &mut self,
-        sys: &mut dyn SecondOrderSystem,
-        s: &Sample,
-    ) -> Result<DVector<f64>, IntegrationError> {
-        if let Some((t, q, v, a)) = &self.fsal {
-            if *t == s.t_s && *q == s.q && *v == s.qd {
-                return Ok(a.clone());
-            }
-        }
-        self.evaluations += 1;
-        let a = sys.accelerations(s.t_s, &s.q, &s.qd)?;
-        self.fsal = Some((s.t_s, s.q.clone(), s.qd.clone(), a.clone()));
-        Ok(a)
-    }
-
-    /// One step of size `h`; returns the new sample and the scaled error norm.
-    fn try_step(
-        &mut self,
-        sys: &mut dyn SecondOrderSystem,
-        s: &Sample,
+    fn error_norm(
+        tol: Tolerances,
         h: f64,
-    ) -> Result<(Sample, f64), IntegrationError> {
+        s: &Sample,
+        q_new: &DVector<f64>,
+        v_new: &DVector<f64>,
+        kq: &[DVector<f64>],
+        kv: &[DVector<f64>],
+    ) -> f64 {
         let n = s.q.len();
-        let mut kq: Vec<DVector<f64>> = Vec::with_capacity(12);
-        let mut kv: Vec<DVector<f64>> = Vec::with_capacity(12);
-        kq.push(s.qd.clone());
-        kv.push(self.first_stage(sys, s)?);
-        for (i, row) in A.iter().enumerate().skip(1) {
-            let mut q = s.q.clone();
-            let mut v = s.qd.clone();
-            for &(j, a) in row.iter() {
-                q.axpy(h * a, &kq[j], 1.0);
-                v.axpy(h * a, &kv[j], 1.0);
-            }
-            self.evaluations += 1;
-            let acc = sys.accelerations(s.t_s + C[i] * h, &q, &v)?;
-            kq.push(v);
-            kv.push(acc);
-        }
-        let mut q_new = s.q.clone();
-        let mut v_new = s.qd.clone();
-        for &(j, b) in &B {
-            q_new.axpy(h * b, &kq[j], 1.0);
-            v_new.axpy(h * b, &kv[j], 1.0);
-        }
         // Hairer's combined estimate: the fifth-order difference, damped where the
         // third-order one is much larger.
         let (mut err5, mut err3) = (0.0, 0.0);
         let mut add = |k: &[DVector<f64>], y0: &DVector<f64>, y1: &DVector<f64>, i: usize| {
-            let sk = self.atol + self.rtol * y0[i].abs().max(y1[i].abs());
+            let sk = tol.atol + tol.rtol * y0[i].abs().max(y1[i].abs());
             let mut e5 = 0.0;
             let mut e3 = 0.0;
             for &(j, b) in &B {
@@ -229,79 +175,25 @@ impl Dop853 {
             err3 += (e3 / sk).powi(2);
         };
         for i in 0..n {
-            add(&kq, &s.q, &q_new, i);
-            add(&kv, &s.qd, &v_new, i);
+            add(kq, &s.q, q_new, i);
+            add(kv, &s.qd, v_new, i);
         }
         let mut deno = err5 + 0.01 * err3;
         if deno <= 0.0 {
             deno = 1.0;
         }
-        let err = h.abs() * err5 * (1.0 / ((2 * n).max(1) as f64 * deno)).sqrt();
-        Ok((
-            Sample {
-                t_s: s.t_s + h,
-                q: q_new,
-                qd: v_new,
-            },
-            err,
-        ))
+        h.abs() * err5 * (1.0 / ((2 * n).max(1) as f64 * deno)).sqrt()
     }
 }
 
-impl Integrator for Dop853 {
-    fn name(&self) -> &'static str {
-        "dop853"
-    }
-    fn reset(&mut self) {
-        self.evaluations = 0;
-        self.h_next_s = 0.0;
-        self.fsal = None;
-    }
-    fn system_changed(&mut self) {
-        self.fsal = None;
-    }
-    fn proposed_step_s(&self) -> f64 {
-        if self.h_next_s > 0.0 {
-            self.h_next_s
-        } else {
-            (self.h_max_s * self.rtol.powf(0.125)).min(self.h_max_s)
-        }
-    }
-    fn advance(
-        &mut self,
-        sys: &mut dyn SecondOrderSystem,
-        from: &Sample,
-        h_limit_s: f64,
-    ) -> Result<Sample, IntegrationError> {
-        let h = self.proposed_step_s().min(h_limit_s).min(self.h_max_s);
-        let limits = StepLimits {
-            exponent: 0.125,
-            min_factor: 1.0 / 3.0,
-            max_factor: 6.0,
-            h_max_s: self.h_max_s,
-            h_min_s: self.h_min_s,
-        };
-        let (next, h_next) = adaptive_step(h, limits, from.t_s, |h| self.try_step(sys, from, h))?;
-        self.h_next_s = h_next;
-        Ok(next)
-    }
-    fn step_exact(
-        &mut self,
-        sys: &mut dyn SecondOrderSystem,
-        from: &Sample,
-        h_s: f64,
-    ) -> Result<Sample, IntegrationError> {
-        Ok(self.try_step(sys, from, h_s)?.0)
-    }
-    fn evaluations(&self) -> usize {
-        self.evaluations
-    }
-}
+/// Adaptive Dormand-Prince 8(5,3) with Hairer's step-size controller (exponent 1/8).
+pub type Dop853 = EmbeddedRk<Dop853Pair>;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::dynamics::DynamicsError;
+    use crate::integrators::{Integrator, SecondOrderSystem};
 
     #[test]
     fn coefficients_satisfy_the_order_conditions() {

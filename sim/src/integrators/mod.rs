@@ -5,11 +5,13 @@
 
 mod dop853;
 mod dopri5;
+mod embedded;
 mod meijaard;
 mod rk4;
 
-pub use dop853::Dop853;
-pub use dopri5::Dopri5;
+pub use dop853::{Dop853, Dop853Pair};
+pub use dopri5::{Dopri5, Dopri5Pair};
+pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
 pub use meijaard::{Meijaard, StabilityLimit};
 pub use rk4::Rk4;
 

@@ -1,0 +1,27 @@
+//! The hybrid core written once over the scalar: the pieces of the stride that both the `f64`
+//! engine ([`crate::stride`], [`crate::impact`], [`crate::relabel`]) and the variational
+//! Jacobian ([`crate::variational`], on dual numbers) evaluate.
+//!
+//! - [`profile`]: the ideal ankle drive's smooth extension (angle, rate, acceleration);
+//! - [`phase`]: the accelerations of a smooth phase with an optional driven coordinate;
+//! - [`impact`]: the impact equations (19)-(21) for finite masses;
+//! - [`contact_rows`]: the heel-strike constraint rows on the released impact model;
+//! - [`relabel`]: the relabelling's geometry (old link states at the new contact, the
+//!   sagittal mirroring, the matched rows and their Jacobian).
+//!
+//! Everything here is generic over `T: RealField + Copy` (`f64`, or `num_dual` dual numbers
+//! that carry derivatives); the only scalar-specific step, the acceleration solve (the `f64`
+//! engine also solves the vanishing-mass limit), is the [`EngineScalar`] trait.
+
+pub mod contact_rows;
+pub mod impact;
+pub mod phase;
+pub mod profile;
+pub mod relabel;
+
+pub use phase::EngineScalar;
+
+/// A model constant (an `f64`) in the scalar `T`.
+pub(crate) fn konst<T: nalgebra::RealField + Copy>(x: f64) -> T {
+    nalgebra::convert(x)
+}
