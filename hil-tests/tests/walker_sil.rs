@@ -140,7 +140,7 @@ fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
     assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
     // Without the left ankle's push-off the walker does not keep going.
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > safe, "{f:?}");
+    assert!(f.t_walk_s > safe, "{f:?}");
 }
 
 #[test]
@@ -167,7 +167,7 @@ fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() 
         "{left}"
     );
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > right, "{f:?}");
+    assert!(f.t_walk_s > right, "{f:?}");
 }
 
 #[test]

@@ -9,6 +9,7 @@ pub mod continuation;
 pub mod control;
 pub mod dynamics;
 pub mod events;
+pub mod hermite;
 pub mod impact;
 pub mod integrators;
 pub mod kinematics;
