@@ -138,15 +138,15 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     // Per window: sum, min and max of the step durations.
     let mut windows: Vec<(f64, f64, f64)> = Vec::new();
     let mut on_step = |step: &sim::walk::StepSummary| {
-            let w = step.step / EVERY;
-            if windows.len() <= w {
-                windows.push((0.0, f64::INFINITY, 0.0));
-            }
-            if let Some(x) = windows.get_mut(w) {
-                x.0 += step.duration_s;
-                x.1 = x.1.min(step.duration_s);
-                x.2 = x.2.max(step.duration_s);
-            }
+        let w = step.step / EVERY;
+        if windows.len() <= w {
+            windows.push((0.0, f64::INFINITY, 0.0));
+        }
+        if let Some(x) = windows.get_mut(w) {
+            x.0 += step.duration_s;
+            x.1 = x.1.min(step.duration_s);
+            x.2 = x.2.max(step.duration_s);
+        }
     };
     let request = WalkRequest::new(&s.settings, STEPS)
         .options(WalkOptions {

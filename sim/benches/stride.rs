@@ -69,9 +69,7 @@ fn benches(c: &mut Criterion) {
         group.finish();
         let mut group = c.benchmark_group("gait");
         group.sample_size(10);
-        group.bench_function(name, |b| {
-            b.iter(|| search.find(black_box(&v0)))
-        });
+        group.bench_function(name, |b| b.iter(|| search.find(black_box(&v0))));
         group.finish();
     }
 }

@@ -63,8 +63,8 @@ pub fn scalar(a: Knot, b: Knot, h_s: f64, x: f64) -> (f64, f64, f64) {
     } = HermiteBasis::at(x);
     let p = w[0] * a.value + w[1] * h_s * a.rate + w[2] * b.value + w[3] * h_s * b.rate;
     let v = (d[0] * a.value + d[2] * b.value) / h_s + d[1] * a.rate + d[3] * b.rate;
-    let acc = (dd[0] * a.value + dd[2] * b.value) / (h_s * h_s)
-        + (dd[1] * a.rate + dd[3] * b.rate) / h_s;
+    let acc =
+        (dd[0] * a.value + dd[2] * b.value) / (h_s * h_s) + (dd[1] * a.rate + dd[3] * b.rate) / h_s;
     (p, v, acc)
 }
 
@@ -104,7 +104,12 @@ mod tests {
         assert!((v - df(t)).abs() < 1e-13);
         assert!((a - ddf(t)).abs() < 1e-12);
         let one = |x: f64| DVector::from_element(1, x);
-        let (q, qd) = vector((&one(f(t0)), &one(df(t0))), (&one(f(t1)), &one(df(t1))), h, x);
+        let (q, qd) = vector(
+            (&one(f(t0)), &one(df(t0))),
+            (&one(f(t1)), &one(df(t1))),
+            h,
+            x,
+        );
         assert!((q[0] - f(t)).abs() < 1e-14);
         assert!((qd[0] - df(t)).abs() < 1e-13);
     }

@@ -5,7 +5,9 @@
 //! settings, with the stride map, its Jacobian and the fixed-point iteration as methods. A
 //! search usually starts from the scene's [`GaitGuess`] ([`GaitSearch::find_from_guess`]).
 
-use crate::stride::{Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings};
+use crate::stride::{
+    Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings,
+};
 use crate::variational::VariationalError;
 use crate::walker::Walker;
 use nalgebra::{Complex, DMatrix, DVector};
@@ -144,7 +146,11 @@ pub struct GaitSearch<'a> {
 
 impl<'a> GaitSearch<'a> {
     /// A search for `walker`'s gait with these settings.
-    pub fn new(walker: &'a Walker, settings: &'a StrideSettings, newton: &'a NewtonSettings) -> Self {
+    pub fn new(
+        walker: &'a Walker,
+        settings: &'a StrideSettings,
+        newton: &'a NewtonSettings,
+    ) -> Self {
         Self {
             walker,
             settings,
@@ -209,7 +215,8 @@ impl<'a> GaitSearch<'a> {
         let mut schedule = StepSchedule::default();
         let nominal = if settings.frozen_steps {
             let (q, qd) = w.unpack(v);
-            let request = StrideRequest::new(self.settings).schedule(Schedule::Record(&mut schedule));
+            let request =
+                StrideRequest::new(self.settings).schedule(Schedule::Record(&mut schedule));
             let r = w.stride(&q, &qd, request)?;
             Some(w.pack(&r.q_next, &r.qd_next))
         } else {
@@ -219,7 +226,8 @@ impl<'a> GaitSearch<'a> {
         let map = |x: &DVector<f64>| -> Result<DVector<f64>, StrideFailure> {
             if settings.frozen_steps {
                 let (q, qd) = w.unpack(x);
-                let request = StrideRequest::new(self.settings).schedule(Schedule::Replay(&schedule));
+                let request =
+                    StrideRequest::new(self.settings).schedule(Schedule::Replay(&schedule));
                 let r = w.stride(&q, &qd, request)?;
                 Ok(w.pack(&r.q_next, &r.qd_next))
             } else {
@@ -271,8 +279,7 @@ impl<'a> GaitSearch<'a> {
             };
             let r = &s - &v;
             if last_step < settings.tolerance {
-                let (j, jacobian_method) =
-                    self.stride_jacobian_by(&v, &s).map_err(fail)?;
+                let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
                 let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
                 return Ok(Gait {
                     jacobian_method,

@@ -29,7 +29,10 @@ pub fn start_state(w: &Setup, g: &Gait) -> (DVector<f64>, DVector<f64>) {
 }
 
 /// The stride map `S(v)` with the setup's settings.
-pub fn stride_map(w: &Setup, v: &DVector<f64>) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+pub fn stride_map(
+    w: &Setup,
+    v: &DVector<f64>,
+) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
     GaitSearch::new(&w.walker, &w.settings, &NewtonSettings::default()).stride_map(v)
 }
 
@@ -44,5 +47,10 @@ pub fn stride(
 
 /// A walk of up to `steps` strides with the setup's settings.
 pub fn walk(w: &Setup, q: &DVector<f64>, qd: &DVector<f64>, steps: usize, record: bool) -> Walk {
-    sim::walk::walk(&w.walker, q, qd, WalkRequest::new(&w.settings, steps).recording(record))
+    sim::walk::walk(
+        &w.walker,
+        q,
+        qd,
+        WalkRequest::new(&w.settings, steps).recording(record),
+    )
 }

@@ -17,7 +17,9 @@ fn perturbed(w: &Setup, name: &str, delta: f64) -> FailureKind {
     let i = w.walker.map_names().iter().position(|n| n == name).unwrap();
     let mut v = g.fixed_point.clone();
     v[i] += delta;
-    common::stride_map(w, &v).expect_err("stride must fail").kind
+    common::stride_map(w, &v)
+        .expect_err("stride must fail")
+        .kind
 }
 
 #[test]
@@ -63,8 +65,7 @@ fn a_swing_leg_thrown_forward_keeps_the_old_stance_foot_down() {
 fn no_heel_strike_within_the_time_budget() {
     let (_, mut w) = common::walker("compass");
     w.settings.max_stride_time_s = 0.1;
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NoImpactWithinTime);
 }
 
@@ -73,8 +74,7 @@ fn a_non_finite_state_is_caught() {
     let (_, w) = common::walker("compass");
     let mut q = w.guess.q.clone();
     q[0] = f64::NAN;
-    let e = common::stride(&w, &q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
 
@@ -85,8 +85,7 @@ fn a_meijaard_step_beyond_the_stability_limit_is_reported() {
         h_s: 1.0,
         check_every: 1,
     };
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
     // The same step without the check produces a stride anyway (garbage or failure) - the
     // check is what turns it into a typed error; a small step passes the check.
@@ -94,8 +93,7 @@ fn a_meijaard_step_beyond_the_stability_limit_is_reported() {
         h_s: 1e-3,
         check_every: 1,
     };
-    common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap();
+    common::stride(&w, &w.guess.q, &w.guess.qd).unwrap();
 }
 
 #[test]
@@ -106,8 +104,7 @@ fn an_unreachable_tolerance_underflows_the_adaptive_step() {
         atol: 1e-30,
         h_max_s: 0.05,
     };
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepUnderflow);
 }
 
@@ -118,8 +115,7 @@ fn an_event_without_refinement_budget_is_not_located() {
         max_iterations: 0,
         ..Default::default()
     };
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::EventNotLocated);
 }
 
@@ -131,8 +127,7 @@ fn redundant_contact_constraints_make_the_impact_singular() {
         ContactConstraint::Y,
         ContactConstraint::X,
     ];
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::ImpactSingular);
 }
 
@@ -141,8 +136,7 @@ fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
     let (_, mut w) = common::walker("compass");
     let (a, b) = (w.walker.relabel.pairs[0].0, w.walker.relabel.pairs[1].0);
     w.walker.relabel.pairs = vec![(a, a), (b, b)];
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::RelabelFailed);
 }
 
@@ -173,8 +167,7 @@ fn a_drive_that_retracts_lets_the_heel_back_down() {
     let g = common::gait(&w);
     scene.set_text("ankle_final_rad=-0.2").unwrap();
     let retracting = scene.setup().unwrap();
-    let e = common::stride_map(&retracting, &g.fixed_point)
-        .expect_err("must fail");
+    let e = common::stride_map(&retracting, &g.fixed_point).expect_err("must fail");
     assert_eq!(e.kind, FailureKind::HeelReturnedToFloor, "{e}");
     // The same start with the scene's own drive walks on.
     assert!(common::stride_map(&w, &g.fixed_point).is_ok());

@@ -28,7 +28,9 @@ fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
         .unwrap();
     let clearance = c0.contact.mid_swing_clearance_m.unwrap();
     assert!(clearance < -1e-3, "{clearance}");
-    w.walker.model.points[w.walker.heel_strike.swing_foot.0].p_link_m.y += -clearance - 5e-4;
+    w.walker.model.points[w.walker.heel_strike.swing_foot.0]
+        .p_link_m
+        .y += -clearance - 5e-4;
     w.walker.heel_strike.ignore_scuffing = false;
     w.walker.heel_strike.min_ahead_m = 0.05;
     let scuffs = |w: &sim::scene::Setup| matches!(common::stride(w, &q, &qd), Err(e) if e.kind == FailureKind::Scuffed);
@@ -54,8 +56,7 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
         h_s: 1e-3,
         check_every: 1,
     };
-    let e = common::stride(&w, &w.guess.q, &w.guess.qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
     // For a very stiff spring the fastest mode is the pelvis's yaw against the rest of the
     // walker: λ² ≈ k (M̄⁻¹)_yaw,yaw, with the reduced mass matrix over the free coordinates.
@@ -186,8 +187,7 @@ fn a_non_finite_velocity_is_a_typed_failure() {
     let (_, w) = common::walker("wisse3d");
     let mut qd = w.guess.qd.clone();
     qd[2] = f64::INFINITY;
-    let e = common::stride(&w, &w.guess.q, &qd)
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
 
@@ -300,9 +300,7 @@ fn event_location_error_is_far_below_the_integration_error() {
         atol: 1e-13,
         h_max_s: 0.01,
     };
-    let t_ref = common::stride(&reference, &q, &qd)
-        .unwrap()
-        .duration_s;
+    let t_ref = common::stride(&reference, &q, &qd).unwrap().duration_s;
     let period = g.stride.duration_s;
     for integrator in [
         IntegratorChoice::Rk4 { h_s: period / 50.0 },
@@ -322,15 +320,11 @@ fn event_location_error_is_far_below_the_integration_error() {
     ] {
         let mut a = w.clone();
         a.settings.integrator = integrator.clone();
-        let t_default = common::stride(&a, &q, &qd)
-            .unwrap()
-            .duration_s;
+        let t_default = common::stride(&a, &q, &qd).unwrap().duration_s;
         a.settings.event_tolerance.time_s = 1e-16;
         a.settings.event_tolerance.witness = 0.0;
         a.settings.event_tolerance.max_iterations = 200;
-        let t_tight = common::stride(&a, &q, &qd)
-            .unwrap()
-            .duration_s;
+        let t_tight = common::stride(&a, &q, &qd).unwrap().duration_s;
         let location = (t_default - t_tight).abs();
         let integration = (t_tight - t_ref).abs();
         assert!(

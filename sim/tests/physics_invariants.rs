@@ -8,11 +8,11 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use proptest::prelude::*;
 use sim::dynamics::Dynamics;
 use sim::integrators::{IntegratorChoice, Sample, SecondOrderSystem};
+use sim::limit_cycle::GaitSearch;
 use sim::model::{BodyInertia, JointForce, JointKind, Model};
 use sim::relabel::LinkStates;
-use sim::limit_cycle::GaitSearch;
-use sim::stride::Phase;
 use sim::scene::Setup;
+use sim::stride::Phase;
 
 /// Integrates `sys` over `[0, t_end]` in `n` equal steps.
 fn integrate(
@@ -200,7 +200,10 @@ fn angular_momentum_about_the_new_contact_is_conserved_across_heel_strike() {
         let active: Vec<bool> = (0..w.walker.model.dof())
             .map(|i| !w.walker.knees.iter().any(|k| k.coordinate.0 == i))
             .collect();
-        let imp = w.walker.heel_strike_impact(&g.stride.pre_impact, &active).unwrap();
+        let imp = w
+            .walker
+            .heel_strike_impact(&g.stride.pre_impact, &active)
+            .unwrap();
         let mut d = Dynamics::new(&w.walker.impact_model);
         d.assemble(&w.walker.impact_model, &imp.q, &imp.qd_minus, None);
         let before = d.angular_momentum_about(&w.walker.impact_model, &imp.p_contact_m);
@@ -345,7 +348,11 @@ fn relabelling_twice_returns_the_configuration() {
             kin.update(&w.walker.model, q, &zero);
             let foot = kin.point_position(&w.walker.model, w.walker.heel_strike.swing_foot);
             let states = LinkStates::from_kinematics(&kin, 0, &foot);
-            w.walker.relabel.solve(&w.walker.model, &states, q).unwrap().q
+            w.walker
+                .relabel
+                .solve(&w.walker.model, &states, q)
+                .unwrap()
+                .q
         };
         let once = relabel_once(&q0);
         assert!(
@@ -371,7 +378,9 @@ fn stride_jacobian_eigenvalues_converge_as_the_perturbation_shrinks() {
                 perturbation: d,
                 ..Default::default()
             };
-            let j = GaitSearch::new(&w.walker, &w.settings, &set).stride_jacobian(&g.fixed_point, &s).unwrap();
+            let j = GaitSearch::new(&w.walker, &w.settings, &set)
+                .stride_jacobian(&g.fixed_point, &s)
+                .unwrap();
             j.complex_eigenvalues()
                 .iter()
                 .map(|z| z.norm())

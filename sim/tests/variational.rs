@@ -14,9 +14,13 @@ fn the_variational_jacobian_matches_central_differences_on_every_event_kind() {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
         let s = common::stride_map(&w, &g.fixed_point).unwrap().0;
-        let fd = GaitSearch::new(&w.walker, &w.settings, &NewtonSettings::default()).stride_jacobian(&g.fixed_point, &s)
+        let fd = GaitSearch::new(&w.walker, &w.settings, &NewtonSettings::default())
+            .stride_jacobian(&g.fixed_point, &s)
             .unwrap();
-        let (var, _) = w.walker.stride_jacobian_variational(&g.fixed_point, &w.settings).unwrap();
+        let (var, _) = w
+            .walker
+            .stride_jacobian_variational(&g.fixed_point, &w.settings)
+            .unwrap();
         let d = (&var - &fd).amax();
         assert!(d < bound * fd.amax(), "{name}: |J_var - J_fd| = {d:e}");
     }
@@ -29,7 +33,10 @@ fn the_variational_jacobian_has_the_exact_zero_eigenvalues() {
     // there; the variational Jacobian gives zero to rounding.
     let (_, w) = common::walker("kneed2d");
     let g = common::gait(&w);
-    let (var, _) = w.walker.stride_jacobian_variational(&g.fixed_point, &w.settings).unwrap();
+    let (var, _) = w
+        .walker
+        .stride_jacobian_variational(&g.fixed_point, &w.settings)
+        .unwrap();
     let mut moduli: Vec<f64> = var.complex_eigenvalues().iter().map(|z| z.norm()).collect();
     moduli.sort_by(f64::total_cmp);
     assert!(moduli[0] < 1e-13, "{moduli:?}");
@@ -42,15 +49,11 @@ fn a_gait_says_which_jacobian_it_used() {
         ..Default::default()
     };
     let (_, w) = common::walker("kneed2d");
-    let g = w
-        .find_gait(&settings)
-        .unwrap();
+    let g = w.find_gait(&settings).unwrap();
     assert_eq!(g.jacobian_method, JacobianMethod::Variational);
     // The simplest walker's infinitesimal masses are outside the method: central differences,
     // and the gait says so.
     let (_, w) = common::walker("simplest");
-    let g = w
-        .find_gait(&settings)
-        .unwrap();
+    let g = w.find_gait(&settings).unwrap();
     assert_eq!(g.jacobian_method, JacobianMethod::CentralDifferences);
 }

@@ -75,7 +75,9 @@ fn the_uncompensated_walker_zigzags_with_growing_yaw_and_fails_within_30_steps()
     let (_, w) = common::walker("wisse3d-uncompensated");
     // It has no gait of its own: its Newton search fails.
     let v0 = w.walker.pack(&w.guess.q, &w.guess.qd);
-    assert!(GaitSearch::new(&w.walker, &w.settings, &Default::default()).find(&v0).is_err());
+    assert!(GaitSearch::new(&w.walker, &w.settings, &Default::default())
+        .find(&v0)
+        .is_err());
     // Start from its yaw-locked gait, as `walker walk` does.
     let (_, w2) = common::walker("wisse2d-uncompensated");
     let g2 = common::gait(&w2);
@@ -152,9 +154,9 @@ fn roll_freedom_of_the_pelvis_shrinks_the_lateral_centre_of_pressure() {
                     contact: true,
                 }),
             )
-        .unwrap()
-        .contact
-        .max_lateral_cop_m
+            .unwrap()
+            .contact
+            .max_lateral_cop_m
     };
     let (c2, c3) = (cop("wisse2d"), cop("wisse3d"));
     assert!(c3 < c2, "3D {c3} vs 2D {c2}");

@@ -78,12 +78,7 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
 }
 
 /// Every joint coordinate over one stride from the gait's fixed point.
-pub fn joint_angles(
-    walker: &Walker,
-    settings: &StrideSettings,
-    gait: &Gait,
-    title: &str,
-) -> Plot {
+pub fn joint_angles(walker: &Walker, settings: &StrideSettings, gait: &Gait, title: &str) -> Plot {
     let (q, qd) = walker.unpack(&gait.fixed_point);
     let samples = walker
         .stride(

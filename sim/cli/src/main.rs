@@ -238,14 +238,18 @@ impl Common {
         }
         if let Some(kind) = &self.integrator {
             w.settings.integrator =
-                IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None)
-                .ok_or_else(|| {
-                    InputError::Other(format!(
-                        "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
-                    ))
-                })?;
+                IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None).ok_or_else(
+                    || {
+                        InputError::Other(format!(
+                            "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
+                        ))
+                    },
+                )?;
         } else {
-            w.settings.integrator = w.settings.integrator.with_tolerance_or_step(self.rtol, self.step_s);
+            w.settings.integrator = w
+                .settings
+                .integrator
+                .with_tolerance_or_step(self.rtol, self.step_s);
         }
         Ok(w)
     }
@@ -389,7 +393,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 v[i] += d;
             }
             let (q, qd) = walker.unpack(&v);
-            let request = WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
+            let request =
+                WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
             let walk = sim::walk::walk(walker, &q, &qd, request);
             if let Some(dir) = &plot {
                 std::fs::create_dir_all(dir)?;
@@ -406,7 +411,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
                         .unwrap_or(v0);
                     let (oq, oqd) = ow.unpack(&start);
                     let request = WalkRequest::new(&oset.settings, steps).recording(true);
-                    walks.push((os.name().to_string(), sim::walk::walk(ow, &oq, &oqd, request)));
+                    walks.push((
+                        os.name().to_string(),
+                        sim::walk::walk(ow, &oq, &oqd, request),
+                    ));
                 }
                 let refs: Vec<(&str, &sim::walk::Walk)> =
                     walks.iter().map(|(n, w)| (n.as_str(), w)).collect();

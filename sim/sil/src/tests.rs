@@ -368,7 +368,12 @@ fn bad_configurations_and_times_are_refused() {
         string_torque_n_m: 0.0,
     };
     assert!(c.tick(&s).is_err());
-    assert!(c.tick(&AnkleSensing { t_walk_s: f64::NAN, ..s }).is_err());
+    assert!(c
+        .tick(&AnkleSensing {
+            t_walk_s: f64::NAN,
+            ..s
+        })
+        .is_err());
 }
 
 #[test]

@@ -6,10 +6,10 @@
 //! [`crate::impact`]; each reports the mechanical energy it dissipates and the work a drive
 //! holding the ankle does through it.
 
+use super::contact_figures::ContactSummary;
 use super::energy::energy;
 use super::phase::{Drive, Phase};
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
-use super::contact_figures::ContactSummary;
 use crate::actuator::AnkleReflex;
 use crate::dynamics::Dynamics;
 use crate::impact::{resolve, resolve_to, ImpactError};

@@ -18,11 +18,11 @@ pub enum Drive {
 }
 
 impl Drive {
-    /// Angle [rad], rate [rad/s], acceleration [rad/s²] at `t_s`.
-    pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
+    /// Angle [rad], rate [rad/s], acceleration [rad/s²] at stride time `t_stride_s` [s].
+    pub fn eval(&self, t_stride_s: f64) -> (f64, f64, f64) {
         match self {
-            Drive::Profile(p) => p.eval(t_s),
-            Drive::Segment(s) => s.eval(t_s),
+            Drive::Profile(p) => p.eval(t_stride_s),
+            Drive::Segment(s) => s.eval(t_stride_s),
         }
     }
 }
@@ -160,4 +160,3 @@ pub fn linearised_limit(
         beta,
     })
 }
-

@@ -177,19 +177,19 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 return Err(StrideFailure::new(
                     FailureKind::NoImpactWithinTime,
                     self.cur.t_s,
-                    format!("no heel strike within {} s", self.settings.max_stride_time_s),
+                    format!(
+                        "no heel strike within {} s",
+                        self.settings.max_stride_time_s
+                    ),
                 ));
             }
             let drive_end_s = self.drive_end_s();
             let next = self.step(drive_end_s)?;
             let (next, w_cur, w_next) = self.grazing_check(next)?;
             let limit = self.string_limit();
-            let triggered = self.wit.triggered(
-                &self.phase,
-                limit,
-                (&self.cur, &w_cur),
-                (&next, &w_next),
-            );
+            let triggered =
+                self.wit
+                    .triggered(&self.phase, limit, (&self.cur, &w_cur), (&next, &w_next));
             if triggered.is_empty() {
                 self.accept(next, drive_end_s)?;
                 continue;
