@@ -290,7 +290,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 std::fs::create_dir_all(dir)?;
                 let name = scene.name();
                 let eig = figures::eigenvalues(
-                    &walker,
+                    walker,
                     g,
                     &format!("{name}: eigenvalues of the stride Jacobian"),
                 );
