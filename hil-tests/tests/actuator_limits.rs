@@ -62,12 +62,12 @@ fn a_servo_weaker_than_the_push_stalls_and_the_gait_changes() {
     assert!(nominal.failure.is_none() && weak.failure.is_none());
     let engaged = |w: &Walk, k: usize| {
         let s = &w.steps[k];
-        s.start_time_s
+        s.start_t_walk_s
             + s.events
                 .iter()
                 .find(|e| e.name == "string_engaged")
                 .unwrap()
-                .time_s
+                .t_stride_s
     };
     for side in Side::BOTH {
         let (a, n) = (stats(&rw, side), stats(&rn, side));

@@ -28,13 +28,14 @@ struct Figures {
 
 fn walk_with(integrator: IntegratorChoice) -> (Walk, Figures) {
     let s = setup();
-    let mut walker = s.walker.clone();
-    walker.integrator = integrator;
+    let walker = &s.walker;
+    let settings = s.settings.with_integrator(integrator);
     let mut ctl = FirmwareInTheLoop::new(matched()).unwrap();
-    let walk = walker.walk_controlled(&s.q0, &s.qd0, STEPS, false, &mut ctl);
+    let request = sim::walk::WalkRequest::new(&settings, STEPS).controlled(&mut ctl);
+    let walk = sim::walk::walk(walker, &s.q0, &s.qd0, request);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), STEPS);
-    let g = sim::report::walk_gait_json(&walker, &walk, STEPS);
+    let g = sim::report::walk_gait_json(walker, &walk, STEPS);
     let f = |k: &str| g[k].as_f64().unwrap();
     let mean = |x: &dyn Fn(&sim::walk::StepSummary) -> f64| {
         walk.steps.iter().map(x).sum::<f64>() / STEPS as f64

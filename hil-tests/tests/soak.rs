@@ -23,7 +23,7 @@ mod common;
 use common::{matched, setup};
 use sil::FirmwareInTheLoop;
 use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
-use sim::walk::WalkOptions;
+use sim::walk::{WalkOptions, WalkRequest};
 
 const STEPS: usize = 10_000;
 const EVERY: usize = 1_000;
@@ -137,27 +137,25 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     sampler.sample(0.0);
     // Per window: sum, min and max of the step durations.
     let mut windows: Vec<(f64, f64, f64)> = Vec::new();
-    let walk = s.walker.walk_streaming(
-        &s.q0,
-        &s.qd0,
-        STEPS,
-        WalkOptions {
+    let mut on_step = |step: &sim::walk::StepSummary| {
+        let w = step.step / EVERY;
+        if windows.len() <= w {
+            windows.push((0.0, f64::INFINITY, 0.0));
+        }
+        if let Some(x) = windows.get_mut(w) {
+            x.0 += step.duration_s;
+            x.1 = x.1.min(step.duration_s);
+            x.2 = x.2.max(step.duration_s);
+        }
+    };
+    let request = WalkRequest::new(&s.settings, STEPS)
+        .options(WalkOptions {
             record: false,
             keep_steps: Some(KEEP_STEPS),
-        },
-        Some(&mut sampler),
-        &mut |step| {
-            let w = step.step / EVERY;
-            if windows.len() <= w {
-                windows.push((0.0, f64::INFINITY, 0.0));
-            }
-            if let Some(x) = windows.get_mut(w) {
-                x.0 += step.duration_s;
-                x.1 = x.1.min(step.duration_s);
-                x.2 = x.2.max(step.duration_s);
-            }
-        },
-    );
+        })
+        .controlled(&mut sampler)
+        .on_step(&mut on_step);
+    let walk = sim::walk::walk(&s.walker, &s.q0, &s.qd0, request);
     let samples = std::mem::take(&mut sampler.samples);
     drop(sampler);
     let r = ctl.finish().unwrap();

@@ -140,7 +140,7 @@ fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
     assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
     // Without the left ankle's push-off the walker does not keep going.
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > safe, "{f:?}");
+    assert!(f.t_walk_s > safe, "{f:?}");
 }
 
 #[test]
@@ -167,7 +167,7 @@ fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() 
         "{left}"
     );
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > right, "{f:?}");
+    assert!(f.t_walk_s > right, "{f:?}");
 }
 
 #[test]
@@ -216,7 +216,7 @@ fn a_high_priority_babbler_starves_the_nodes_into_the_safe_state() {
         assert!(r.node(side).unwrap().frames_refused_queue_full > 0);
     }
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > from_s);
+    assert!(f.t_walk_s > from_s);
     // Busy all the time from the babble's start.
     let share = (r.t_end_s - from_s) / r.t_end_s;
     assert!(r.bus.load > 0.9 * share, "{} vs {share}", r.bus.load);
@@ -242,7 +242,7 @@ fn an_encoder_glitch_raises_a_rate_fault_and_the_node_goes_safe() {
     assert_eq!(r.node(Side::Left).unwrap().state, "Safe");
     assert!(r.node(Side::Left).unwrap().active_faults.is_empty());
     let f = walk.failure.expect("typed failure");
-    assert!(f.time_s > raised);
+    assert!(f.t_walk_s > raised);
 }
 
 /// Time of the string's engagement in stride `k` of the nominal walk [s].
@@ -254,7 +254,7 @@ fn engagement_in_stride(k: usize) -> f64 {
         .iter()
         .find(|e| e.name == "string_engaged")
         .unwrap();
-    s.start_time_s + e.time_s
+    s.start_t_walk_s + e.t_stride_s
 }
 
 #[test]
@@ -296,7 +296,7 @@ fn released_in(walk: &sim::walk::Walk, k: usize) -> Option<f64> {
     s.events
         .iter()
         .find(|e| e.name == "string_released")
-        .map(|e| s.start_time_s + e.time_s)
+        .map(|e| s.start_t_walk_s + e.t_stride_s)
 }
 
 #[test]
@@ -323,7 +323,7 @@ fn an_encoder_stuck_before_the_push_is_not_detected_and_the_robot_falls() {
         "strides 0, 2, .., 8"
     );
     let f = walk.failure.expect("typed failure");
-    assert!(f.step <= 11 && f.time_s > from_s, "{f:?}");
+    assert!(f.step <= 11 && f.t_walk_s > from_s, "{f:?}");
 }
 
 #[test]

@@ -5,26 +5,29 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::NewtonSettings;
+use sim::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::scene::Scene;
-use sim::stride::StrideOptions;
+use sim::stride::StrideRequest;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
 
 fn benches(c: &mut Criterion) {
     for name in SCENES {
-        let Ok(walker) = Scene::load(name).and_then(|s| s.build()) else {
+        let Ok(setup) = Scene::load(name).and_then(|s| s.setup()) else {
             continue;
         };
-        let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-        let Ok(gait) = walker.find_gait(&v0, &NewtonSettings::default()) else {
+        let walker = &setup.walker;
+        let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
+        let newton = NewtonSettings::default();
+        let search = GaitSearch::new(walker, &setup.settings, &newton);
+        let Ok(gait) = search.find(&v0) else {
             continue;
         };
         let (q, qd) = walker.unpack(&gait.fixed_point);
         let period = gait.stride.duration_s;
         let mut group = c.benchmark_group(format!("stride/{name}"));
         for (label, integrator) in [
-            ("default", walker.integrator.clone()),
+            ("default", setup.settings.integrator.clone()),
             (
                 "meijaard_h_T/400",
                 IntegratorChoice::Meijaard {
@@ -55,18 +58,18 @@ fn benches(c: &mut Criterion) {
                 },
             ),
         ] {
-            let mut w = walker.clone();
-            w.integrator = integrator;
+            let settings = setup.settings.with_integrator(integrator);
             group.bench_function(label, |b| {
-                b.iter(|| w.stride(black_box(&q), black_box(&qd), StrideOptions::default()))
+                b.iter(|| {
+                    let request = StrideRequest::new(&settings);
+                    walker.stride(black_box(&q), black_box(&qd), request)
+                })
             });
         }
         group.finish();
         let mut group = c.benchmark_group("gait");
         group.sample_size(10);
-        group.bench_function(name, |b| {
-            b.iter(|| walker.find_gait(black_box(&v0), &NewtonSettings::default()))
-        });
+        group.bench_function(name, |b| b.iter(|| search.find(black_box(&v0))));
         group.finish();
     }
 }

@@ -7,7 +7,9 @@
 
 use nalgebra::DMatrix;
 use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::NewtonSettings;
+use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::stride::{Schedule, StepSchedule, StrideRequest, StrideSettings};
+use sim::walker::Walker;
 
 fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
     let mut m: Vec<f64> = j
@@ -24,30 +26,31 @@ fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
 fn main() {
     let name = std::env::args().nth(1).unwrap_or_else(|| "wisse3d".into());
     let scene = sim::scene::Scene::load(&name).expect("scene");
-    let mut w = scene.build().expect("build");
-    let g = w
-        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &NewtonSettings::default())
-        .expect("gait");
-    replay_check(&w, &g.fixed_point);
-    smoothness(&w, &g.fixed_point);
+    let setup = scene.setup().expect("build");
+    let g = setup.find_gait(&NewtonSettings::default()).expect("gait");
+    let w = &setup.walker;
+    replay_check(w, &setup.settings, &g.fixed_point);
+    smoothness(w, &setup.settings, &g.fixed_point);
     for tol in [1e-12, 1e-13] {
-        w.integrator = IntegratorChoice::Dop853 {
+        let settings = setup.settings.with_integrator(IntegratorChoice::Dop853 {
             rtol: tol,
             atol: tol,
             h_max_s: 0.01,
-        };
-        let s = w.stride_map(&g.fixed_point).unwrap().0;
+        });
+        let newton = NewtonSettings::default();
+        let s = GaitSearch::new(w, &settings, &newton)
+            .stride_map(&g.fixed_point)
+            .unwrap()
+            .0;
         for d in [1e-6, 1e-5, 1e-4, 4e-4] {
             let c = |d: f64| {
-                w.stride_jacobian(
-                    &g.fixed_point,
-                    &s,
-                    &NewtonSettings {
-                        perturbation: d,
-                        ..Default::default()
-                    },
-                )
-                .unwrap()
+                let newton = NewtonSettings {
+                    perturbation: d,
+                    ..Default::default()
+                };
+                GaitSearch::new(w, &settings, &newton)
+                    .stride_jacobian(&g.fixed_point, &s)
+                    .unwrap()
             };
             let (j1, j2) = (c(d), c(d / 2.0));
             let rich = (&j2 * 4.0 - &j1) / 3.0;
@@ -63,58 +66,44 @@ fn main() {
     }
 }
 
-fn replay_check(w: &sim::walker::Walker, v: &nalgebra::DVector<f64>) {
-    use sim::stride::{Schedule, StepSchedule, StrideOptions};
+fn replay_check(w: &Walker, settings: &StrideSettings, v: &nalgebra::DVector<f64>) {
     let mut sch = StepSchedule::default();
     let (q, qd) = w.unpack(v);
-    let a = w
-        .stride_scheduled(
-            &q,
-            &qd,
-            StrideOptions::default(),
-            Schedule::Record(&mut sch),
-        )
-        .unwrap();
-    let b = w
-        .stride_scheduled(&q, &qd, StrideOptions::default(), Schedule::Replay(&sch))
-        .unwrap();
+    let request = StrideRequest::new(settings).schedule(Schedule::Record(&mut sch));
+    let a = w.stride(&q, &qd, request).unwrap();
+    let request = StrideRequest::new(settings).schedule(Schedule::Replay(&sch));
+    let b = w.stride(&q, &qd, request).unwrap();
     println!(
         "replay of the nominal: |Δq| = {:e}, phases {:?}, events a {:?} b {:?}",
         (&a.q_next - &b.q_next).amax(),
         sch.phases.iter().map(|p| p.len()).collect::<Vec<_>>(),
         a.events
             .iter()
-            .map(|e| (e.name.clone(), e.time_s))
+            .map(|e| (e.name.clone(), e.t_stride_s))
             .collect::<Vec<_>>(),
         b.events
             .iter()
-            .map(|e| (e.name.clone(), e.time_s))
+            .map(|e| (e.name.clone(), e.t_stride_s))
             .collect::<Vec<_>>()
     );
 }
 
-fn smoothness(w: &sim::walker::Walker, v: &nalgebra::DVector<f64>) {
-    use sim::stride::{Schedule, StepSchedule, StrideOptions};
+fn smoothness(w: &Walker, settings: &StrideSettings, v: &nalgebra::DVector<f64>) {
     let mut sch = StepSchedule::default();
     let (q, qd) = w.unpack(v);
-    w.stride_scheduled(
-        &q,
-        &qd,
-        StrideOptions::default(),
-        Schedule::Record(&mut sch),
-    )
-    .unwrap();
+    let request = StrideRequest::new(settings).schedule(Schedule::Record(&mut sch));
+    w.stride(&q, &qd, request).unwrap();
     let f = |x: &nalgebra::DVector<f64>, replay: bool| {
         let (q, qd) = w.unpack(x);
-        let r = if replay {
-            w.stride_scheduled(&q, &qd, StrideOptions::default(), Schedule::Replay(&sch))
+        let request = if replay {
+            StrideRequest::new(settings).schedule(Schedule::Replay(&sch))
         } else {
-            w.stride(&q, &qd, StrideOptions::default())
-        }
-        .unwrap();
+            StrideRequest::new(settings)
+        };
+        let r = w.stride(&q, &qd, request).unwrap();
         (
             w.pack(&r.q_next, &r.qd_next),
-            r.events.iter().map(|e| e.time_s).collect::<Vec<_>>(),
+            r.events.iter().map(|e| e.t_stride_s).collect::<Vec<_>>(),
         )
     };
     let names = w.map_names();

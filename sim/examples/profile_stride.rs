@@ -7,15 +7,15 @@ fn main() {
     let name = args.next().unwrap_or_else(|| "compass".into());
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100);
     let scene = sim::scene::Scene::load(&name).expect("scene");
-    let w = scene.build().expect("build");
-    let g = w
-        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &Default::default())
-        .expect("gait");
+    let setup = scene.setup().expect("build");
+    let g = setup.find_gait(&Default::default()).expect("gait");
+    let w = &setup.walker;
     let (q, qd) = w.unpack(&g.fixed_point);
     let mut evals = 0;
     let start = std::time::Instant::now();
     for _ in 0..n {
-        let r = w.stride(&q, &qd, Default::default()).expect("stride");
+        let request = sim::stride::StrideRequest::new(&setup.settings);
+        let r = w.stride(&q, &qd, request).expect("stride");
         evals = r.evaluations;
         std::hint::black_box(r);
     }

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nalgebra::DMatrix;
-use sim::limit_cycle::NewtonSettings;
+use sim::limit_cycle::{GaitSearch, NewtonSettings};
 
 fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
     let mut m: Vec<f64> = j
@@ -19,18 +19,18 @@ fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
 
 fn main() {
     for name in std::env::args().skip(1) {
-        let w = sim::scene::Scene::load(&name).unwrap().build().unwrap();
-        let g = w
-            .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &NewtonSettings::default())
-            .unwrap();
-        let s = w.stride_map(&g.fixed_point).unwrap().0;
+        let setup = sim::scene::Scene::load(&name).unwrap().setup().unwrap();
+        let newton = NewtonSettings::default();
+        let search = GaitSearch::new(&setup.walker, &setup.settings, &newton);
+        let g = search.find_from_guess(&setup.guess).unwrap();
+        let s = search.stride_map(&g.fixed_point).unwrap().0;
         let t0 = std::time::Instant::now();
-        let fd = w
-            .stride_jacobian(&g.fixed_point, &s, &NewtonSettings::default())
-            .unwrap();
+        let fd = search.stride_jacobian(&g.fixed_point, &s).unwrap();
         let t_fd = t0.elapsed().as_secs_f64();
         let t0 = std::time::Instant::now();
-        let var = w.stride_jacobian_variational(&g.fixed_point);
+        let var = setup
+            .walker
+            .stride_jacobian_variational(&g.fixed_point, &setup.settings);
         let t_var = t0.elapsed().as_secs_f64();
         match var {
             Ok((jv, _)) => {

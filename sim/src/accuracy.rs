@@ -3,9 +3,9 @@
 //! beside the CPU time of one stride.
 
 use crate::integrators::IntegratorChoice;
-use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
-use crate::stride::StrideOptions;
-use crate::walker::Walker;
+use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
+use crate::scene::Setup;
+use crate::stride::StrideRequest;
 use nalgebra::Complex;
 use serde::Serialize;
 use std::time::Instant;
@@ -118,34 +118,35 @@ fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
 }
 
 /// Runs the study: the reference gait with `reference`, then every setting, each gait search
-/// starting from the reference fixed point.
+/// starting from the reference fixed point. The other stride settings (event tolerances, time
+/// budget) are the setup's.
 pub fn study(
-    walker: &Walker,
+    setup: &Setup,
     reference: IntegratorChoice,
     settings: &[(String, f64, IntegratorChoice)],
     newton: &NewtonSettings,
 ) -> Result<AccuracyStudy, NewtonError> {
-    let mut w = walker.clone();
-    w.integrator = reference.clone();
-    let v0 = w.pack(&w.guess_q, &w.guess_qd);
+    let w = &setup.walker;
+    let mut stride_settings = setup.settings.with_integrator(reference.clone());
     let study_newton = NewtonSettings {
         perturbation: STUDY_PERTURBATION,
         ..*newton
     };
-    let reference_gait: Gait = w.find_gait(&v0, &study_newton)?;
+    let reference_gait: Gait =
+        GaitSearch::new(w, &stride_settings, &study_newton).find_from_guess(&setup.guess)?;
     let x_ref = reference_gait.fixed_point.clone();
     let t_ref = reference_gait.stride.duration_s;
     let (q_ref, qd_ref) = w.unpack(&x_ref);
     let mut points = Vec::new();
     for (family, value, setting) in settings {
-        w.integrator = setting.clone();
+        stride_settings = setup.settings.with_integrator(setting.clone());
         // CPU time per stride: median of a few repeats of the stride from the reference point.
         let mut times = Vec::new();
         let mut evaluations = 0;
         let mut t_hs = None;
         for _ in 0..5 {
             let start = Instant::now();
-            let r = w.stride(&q_ref, &qd_ref, StrideOptions::default());
+            let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(&stride_settings));
             times.push(start.elapsed().as_secs_f64() * 1e6);
             if let Ok(r) = r {
                 evaluations = r.evaluations;
@@ -153,7 +154,7 @@ pub fn study(
             }
         }
         times.sort_by(f64::total_cmp);
-        let gait = w.find_gait(&x_ref, &study_newton);
+        let gait = GaitSearch::new(w, &stride_settings, &study_newton).find(&x_ref);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (
                 Some((&g.fixed_point - &x_ref).amax()),
@@ -175,7 +176,7 @@ pub fn study(
         });
     }
     Ok(AccuracyStudy {
-        scene: walker.name.clone(),
+        scene: w.name.clone(),
         reference,
         reference_step_period_s: t_ref,
         points,

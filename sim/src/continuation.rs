@@ -1,7 +1,7 @@
 //! Natural-parameter continuation: follow a gait while one scene parameter changes, and report
 //! where the largest |eigenvalue| crosses 1.
 
-use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
+use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 
@@ -57,17 +57,19 @@ pub fn sweep(
     for i in 0..points {
         let value = from + (to - from) * i as f64 / (points - 1) as f64;
         scene.set(param, value)?;
-        let walker = scene.build()?;
+        let setup = scene.setup()?;
+        let search = GaitSearch::new(&setup.walker, &setup.settings, settings);
+        let from_guess = || setup.walker.pack(&setup.guess.q, &setup.guess.qd);
         let guess = match history.as_slice() {
-            [] => walker.pack(&walker.guess_q, &walker.guess_qd),
+            [] => from_guess(),
             [.., (_, v)] if history.len() == 1 => v.clone(),
             [.., (p0, v0), (p1, v1)] => v1 + (v1 - v0) * ((value - p1) / (p1 - p0)),
-            _ => walker.pack(&walker.guess_q, &walker.guess_qd),
+            _ => from_guess(),
         };
-        let mut gait = walker.find_gait(&guess, settings);
+        let mut gait = search.find(&guess);
         if gait.is_err() && !history.is_empty() {
             if let Some((_, last)) = history.last() {
-                gait = walker.find_gait(last, settings);
+                gait = search.find(last);
             }
         }
         if let Ok(g) = &gait {

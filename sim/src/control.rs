@@ -8,14 +8,16 @@
 //! follows the limit. A limit that is released (string slack) never engages; released during
 //! push-off, the heel comes back down, which ends the stride as `heel_returned_to_floor`.
 
+use crate::hermite::{self, Knot};
 use serde::Serialize;
 
 /// What the stance ankle's sensors see at a tick (true physical values; a controller quantises
 /// and filters them as its hardware would).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct AnkleSensing {
-    /// Time since the start of the walk [s].
-    pub t_s: f64,
+    /// Time since the start of the walk [s] (walk time; serialised as `t_s`).
+    #[serde(rename = "t_s")]
+    pub t_walk_s: f64,
     /// Stance ankle angle [rad] (negative with the hip ahead of the ankle).
     pub stance_ankle_rad: f64,
     /// Stance ankle rate [rad/s].
@@ -36,9 +38,10 @@ pub struct AnkleSensing {
 /// `(p1, v1)` at `t1` (continuous position and rate across ticks), or released.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ActuatorSegment {
-    /// Start of the tick [s].
+    /// Start of the tick [s] (walk time as a controller returns it; a stride shifts its
+    /// segments to stride time).
     pub t0_s: f64,
-    /// End of the tick [s].
+    /// End of the tick [s] (same clock as [`Self::t0_s`]).
     pub t1_s: f64,
     /// Limit angle at the start [rad].
     pub p0_rad: f64,
@@ -66,24 +69,21 @@ impl ActuatorSegment {
         }
     }
 
-    /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (clamped to the tick).
+    /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (the clock of
+    /// [`Self::t0_s`]; clamped to the tick).
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
         let h = self.t1_s - self.t0_s;
         if h <= 0.0 {
             return (self.p1_rad, self.v1_rad_s, 0.0);
         }
         let x = ((t_s - self.t0_s) / h).clamp(0.0, 1.0);
-        let (x2, x3) = (x * x, x * x * x);
-        let p = (1.0 - 3.0 * x2 + 2.0 * x3) * self.p0_rad
-            + (x - 2.0 * x2 + x3) * h * self.v0_rad_s
-            + (3.0 * x2 - 2.0 * x3) * self.p1_rad
-            + (-x2 + x3) * h * self.v1_rad_s;
-        let v = ((-6.0 * x + 6.0 * x2) * self.p0_rad + (6.0 * x - 6.0 * x2) * self.p1_rad) / h
-            + (1.0 - 4.0 * x + 3.0 * x2) * self.v0_rad_s
-            + (-2.0 * x + 3.0 * x2) * self.v1_rad_s;
-        let a = ((-6.0 + 12.0 * x) * self.p0_rad + (6.0 - 12.0 * x) * self.p1_rad) / (h * h)
-            + ((-4.0 + 6.0 * x) * self.v0_rad_s + (-2.0 + 6.0 * x) * self.v1_rad_s) / h;
-        (p, v, a)
+        let knot = |value, rate| Knot { value, rate };
+        hermite::scalar(
+            knot(self.p0_rad, self.v0_rad_s),
+            knot(self.p1_rad, self.v1_rad_s),
+            h,
+            x,
+        )
     }
 }
 
@@ -96,10 +96,11 @@ pub struct ControlError(pub String);
 pub trait AnkleController {
     /// Control period [s].
     fn period_s(&self) -> f64;
-    /// One tick at `sensing.t_s`: returns the string's limit until the next tick.
+    /// One tick at `sensing.t_walk_s`: returns the string's limit until the next tick.
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError>;
-    /// Heel strike at `t_s`: the swing leg becomes the stance leg (the legs swap roles).
-    fn heel_strike(&mut self, t_s: f64);
+    /// Heel strike at walk time `t_walk_s`: the swing leg becomes the stance leg (the legs
+    /// swap roles).
+    fn heel_strike(&mut self, t_walk_s: f64);
 }
 
 /// Wraps a controller so that walk time keeps pace with wall-clock time (times `factor`): each
@@ -126,15 +127,15 @@ impl AnkleController for Paced<'_> {
         self.inner.period_s()
     }
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
-        let due = std::time::Duration::from_secs_f64((sensing.t_s / self.factor).max(0.0));
+        let due = std::time::Duration::from_secs_f64((sensing.t_walk_s / self.factor).max(0.0));
         let elapsed = self.start.elapsed();
         if due > elapsed {
             std::thread::sleep(due - elapsed);
         }
         self.inner.tick(sensing)
     }
-    fn heel_strike(&mut self, t_s: f64) {
-        self.inner.heel_strike(t_s);
+    fn heel_strike(&mut self, t_walk_s: f64) {
+        self.inner.heel_strike(t_walk_s);
     }
 }
 
@@ -173,7 +174,7 @@ impl AnkleController for SampledReflex {
         self.period_s
     }
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
-        let t = sensing.t_s;
+        let t = sensing.t_walk_s;
         if self.started_at_s.is_none() && sensing.string_engaged {
             self.started_at_s = Some(t);
         }

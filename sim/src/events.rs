@@ -51,23 +51,11 @@ impl Default for EventTolerance {
     }
 }
 
-/// Cubic Hermite interpolation of `q` (and its derivative) between two samples, eq. (14).
+/// Cubic Hermite interpolation of `q` (and its derivative) between two samples, eq. (14)
+/// ([`crate::hermite::vector`] at the normalised time of `t_s`).
 pub fn hermite(a: &Sample, b: &Sample, t_s: f64) -> (DVector<f64>, DVector<f64>) {
     let h = b.t_s - a.t_s;
-    let x = (t_s - a.t_s) / h;
-    let (x2, x3) = (x * x, x * x * x);
-    let h00 = 1.0 - 3.0 * x2 + 2.0 * x3;
-    let h10 = (x - 2.0 * x2 + x3) * h;
-    let h01 = 3.0 * x2 - 2.0 * x3;
-    let h11 = (-x2 + x3) * h;
-    let q = &a.q * h00 + &a.qd * h10 + &b.q * h01 + &b.qd * h11;
-    // Derivatives of the basis with respect to t.
-    let d00 = (-6.0 * x + 6.0 * x2) / h;
-    let d10 = 1.0 - 4.0 * x + 3.0 * x2;
-    let d01 = (6.0 * x - 6.0 * x2) / h;
-    let d11 = -2.0 * x + 3.0 * x2;
-    let qd = &a.q * d00 + &a.qd * d10 + &b.q * d01 + &b.qd * d11;
-    (q, qd)
+    crate::hermite::vector((&a.q, &a.qd), (&b.q, &b.qd), h, (t_s - a.t_s) / h)
 }
 
 /// Why an event could not be located.

@@ -9,6 +9,7 @@ pub mod continuation;
 pub mod control;
 pub mod dynamics;
 pub mod events;
+pub mod hermite;
 pub mod hybrid;
 pub mod impact;
 pub mod integrators;

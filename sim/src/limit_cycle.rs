@@ -1,7 +1,13 @@
 //! Periodic gaits: the Newton-Raphson fixed point of the stride function, eq. (24)-(26), and
 //! the stride Jacobian by perturbation, whose eigenvalues decide stability, eq. (27).
+//!
+//! The search is its own type, [`GaitSearch`]: a walker, its stride settings and the Newton
+//! settings, with the stride map, its Jacobian and the fixed-point iteration as methods. A
+//! search usually starts from the scene's [`GaitGuess`] ([`GaitSearch::find_from_guess`]).
 
-use crate::stride::{Schedule, StepSchedule, StrideFailure, StrideOptions, StrideResult};
+use crate::stride::{
+    Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings,
+};
 use crate::variational::VariationalError;
 use crate::walker::Walker;
 use nalgebra::{Complex, DMatrix, DVector};
@@ -116,18 +122,62 @@ impl Gait {
     }
 }
 
-impl Walker {
+/// A starting guess for a gait: the state just after heel strike (stance labelling), as a
+/// scene file's `guess` section gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaitGuess {
+    /// Coordinates [rad or m, by coordinate].
+    pub q: DVector<f64>,
+    /// Velocities [rad/s or m/s, by coordinate].
+    pub qd: DVector<f64>,
+}
+
+/// A gait search: the stride map of `walker` with `settings`, and Newton's method with
+/// `newton` on it.
+#[derive(Clone, Copy, Debug)]
+pub struct GaitSearch<'a> {
+    /// The walker.
+    pub walker: &'a Walker,
+    /// How each stride is integrated.
+    pub settings: &'a StrideSettings,
+    /// The fixed-point search and the Jacobian.
+    pub newton: &'a NewtonSettings,
+}
+
+impl<'a> GaitSearch<'a> {
+    /// A search for `walker`'s gait with these settings.
+    pub fn new(
+        walker: &'a Walker,
+        settings: &'a StrideSettings,
+        newton: &'a NewtonSettings,
+    ) -> Self {
+        Self {
+            walker,
+            settings,
+            newton,
+        }
+    }
+
+    /// Finds the gait from `guess` (packed into a stride-map vector).
+    ///
+    /// # Errors
+    /// As [`Self::find`].
+    pub fn find_from_guess(&self, guess: &GaitGuess) -> Result<Gait, NewtonError> {
+        self.find(&self.walker.pack(&guess.q, &guess.qd))
+    }
+
     /// The stride function `S(v)` on packed stride-map vectors.
     pub fn stride_map(
         &self,
         v: &DVector<f64>,
     ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
-        let (q, qd) = self.unpack(v);
-        let r = self.stride(&q, &qd, StrideOptions::default())?;
-        Ok((self.pack(&r.q_next, &r.qd_next), r))
+        let w = self.walker;
+        let (q, qd) = w.unpack(v);
+        let r = w.stride(&q, &qd, StrideRequest::new(self.settings))?;
+        Ok((w.pack(&r.q_next, &r.qd_next), r))
     }
 
-    /// The stride Jacobian at `v` by `settings.jacobian`, with the method actually used (the
+    /// The stride Jacobian at `v` by `newton.jacobian`, with the method actually used (the
     /// variational equations fall back to central differences where they do not apply).
     ///
     /// # Errors
@@ -136,54 +186,50 @@ impl Walker {
         &self,
         v: &DVector<f64>,
         s_v: &DVector<f64>,
-        settings: &NewtonSettings,
     ) -> Result<(DMatrix<f64>, JacobianMethod), StrideFailure> {
-        if settings.jacobian == JacobianMethod::Variational {
-            match self.stride_jacobian_variational(v) {
+        if self.newton.jacobian == JacobianMethod::Variational {
+            match self.walker.stride_jacobian_variational(v, self.settings) {
                 Ok((j, _)) => return Ok((j, JacobianMethod::Variational)),
                 Err(VariationalError::Stride(f)) => return Err(f),
                 Err(_) => {}
             }
         }
         Ok((
-            self.stride_jacobian(v, s_v, settings)?,
+            self.stride_jacobian(v, s_v)?,
             JacobianMethod::CentralDifferences,
         ))
     }
 
     /// The stride Jacobian at `v` by perturbation.
+    ///
+    /// # Errors
+    /// A stride that fails.
     pub fn stride_jacobian(
         &self,
         v: &DVector<f64>,
         s_v: &DVector<f64>,
-        settings: &NewtonSettings,
     ) -> Result<DMatrix<f64>, StrideFailure> {
+        let (w, settings) = (self.walker, self.newton);
         let n = v.len();
         let d = settings.perturbation;
         let mut schedule = StepSchedule::default();
         let nominal = if settings.frozen_steps {
-            let (q, qd) = self.unpack(v);
-            let r = self.stride_scheduled(
-                &q,
-                &qd,
-                StrideOptions::default(),
-                Schedule::Record(&mut schedule),
-            )?;
-            Some(self.pack(&r.q_next, &r.qd_next))
+            let (q, qd) = w.unpack(v);
+            let request =
+                StrideRequest::new(self.settings).schedule(Schedule::Record(&mut schedule));
+            let r = w.stride(&q, &qd, request)?;
+            Some(w.pack(&r.q_next, &r.qd_next))
         } else {
             None
         };
         let s_v = nominal.as_ref().unwrap_or(s_v);
         let map = |x: &DVector<f64>| -> Result<DVector<f64>, StrideFailure> {
             if settings.frozen_steps {
-                let (q, qd) = self.unpack(x);
-                let r = self.stride_scheduled(
-                    &q,
-                    &qd,
-                    StrideOptions::default(),
-                    Schedule::Replay(&schedule),
-                )?;
-                Ok(self.pack(&r.q_next, &r.qd_next))
+                let (q, qd) = w.unpack(x);
+                let request =
+                    StrideRequest::new(self.settings).schedule(Schedule::Replay(&schedule));
+                let r = w.stride(&q, &qd, request)?;
+                Ok(w.pack(&r.q_next, &r.qd_next))
             } else {
                 Ok(self.stride_map(x)?.0)
             }
@@ -207,11 +253,11 @@ impl Walker {
     }
 
     /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
-    pub fn find_gait(
-        &self,
-        v0: &DVector<f64>,
-        settings: &NewtonSettings,
-    ) -> Result<Gait, NewtonError> {
+    ///
+    /// # Errors
+    /// [`NewtonError`]: a stride fails, the budget runs out, or `I − J` is singular.
+    pub fn find(&self, v0: &DVector<f64>) -> Result<Gait, NewtonError> {
+        let settings = self.newton;
         let mut v = v0.clone();
         let n = v.len();
         let mut last_step = f64::INFINITY;
@@ -233,8 +279,7 @@ impl Walker {
             };
             let r = &s - &v;
             if last_step < settings.tolerance {
-                let (j, jacobian_method) =
-                    self.stride_jacobian_by(&v, &s, settings).map_err(fail)?;
+                let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
                 let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
                 return Ok(Gait {
                     jacobian_method,
@@ -252,7 +297,7 @@ impl Walker {
             let r_norm_now = r.amax();
             let j = match kept.take() {
                 Some(j) if r_norm_now <= 0.25 * last_residual => j,
-                _ => self.stride_jacobian_by(&v, &s, settings).map_err(fail)?.0,
+                _ => self.stride_jacobian_by(&v, &s).map_err(fail)?.0,
             };
             last_residual = r_norm_now;
             let a = DMatrix::identity(n, n) - &j;

@@ -4,7 +4,7 @@ use crate::continuation::{StabilityBoundary, SweepPoint};
 use crate::limit_cycle::{Gait, NewtonError};
 use crate::scene::Scene;
 use crate::stability::modes;
-use crate::stride::StrideOptions;
+use crate::stride::{StrideOptions, StrideRequest, StrideSettings};
 use crate::walk::Walk;
 use crate::walker::Walker;
 use serde_json::{json, Map, Value};
@@ -65,12 +65,17 @@ pub fn forward_progress_m(walker: &Walker, gait: &Gait) -> f64 {
 }
 
 /// The `walker gait --json` object.
-pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonError>) -> Value {
+pub fn gait_json(
+    scene: &Scene,
+    walker: &Walker,
+    settings: &StrideSettings,
+    result: &Result<Gait, NewtonError>,
+) -> Value {
     let mut map = Map::new();
     let o = &mut map;
     o.insert("scene".into(), json!(scene.name()));
     o.insert("parameters".into(), json!(scene.values));
-    o.insert("integrator".into(), json!(walker.integrator));
+    o.insert("integrator".into(), json!(settings.integrator));
     match result {
         Err(e) => {
             o.insert("converged".into(), json!(false));
@@ -167,10 +172,10 @@ pub fn gait_json(scene: &Scene, walker: &Walker, result: &Result<Gait, NewtonErr
             if let Ok(c) = walker.stride(
                 &q,
                 &qd,
-                StrideOptions {
+                StrideRequest::new(settings).options(StrideOptions {
                     record: false,
                     contact: true,
-                },
+                }),
             ) {
                 o.insert(
                     "max_lateral_cop_m".into(),

@@ -3,7 +3,7 @@
 //! from the best fixed point found so far (the paper notes such searches are slow; they are
 //! fine at these sizes).
 
-use crate::limit_cycle::NewtonSettings;
+use crate::limit_cycle::{GaitSearch, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 use serde::Serialize;
@@ -72,11 +72,12 @@ pub fn tune(
         for (v, p) in clamped.iter().zip(params) {
             scene.set(&p.name, *v)?;
         }
-        let walker = scene.build()?;
-        let guess = warm
-            .clone()
-            .unwrap_or_else(|| walker.pack(&walker.guess_q, &walker.guess_qd));
-        let gait = walker.find_gait(&guess, settings);
+        let setup = scene.setup()?;
+        let search = GaitSearch::new(&setup.walker, &setup.settings, settings);
+        let gait = match &warm {
+            Some(v) => search.find(v),
+            None => search.find_from_guess(&setup.guess),
+        };
         let value = match &gait {
             Ok(g) => {
                 warm = Some(g.fixed_point.clone());

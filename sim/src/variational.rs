@@ -37,7 +37,7 @@ use crate::integrators::{Dop853, Integrator, IntegratorChoice, Sample, SecondOrd
 use crate::kinematics::KinematicsOf;
 use crate::model::Model;
 use crate::relabel::{LinkStates, LinkStatesOf};
-use crate::stride::{StrideFailure, StrideOptions, StrideResult};
+use crate::stride::{StrideFailure, StrideRequest, StrideResult, StrideSettings};
 use crate::walker::Walker;
 
 /// Directions carried by one dual number (more are done in chunks).
@@ -203,21 +203,23 @@ impl Walker {
     pub fn stride_jacobian_variational(
         &self,
         v: &DVector<f64>,
+        settings: &StrideSettings,
     ) -> Result<(DMatrix<f64>, StrideResult), VariationalError> {
         // As many directions per dual number as the map has entries (fewer chunks, no
         // wasted lanes), up to LANES.
         // Six directions per dual number measured fastest on wisse3d (12 entries: 84 ms,
         // against 110 ms with 4, 155 ms with 8 and 165 ms with 12).
         if v.len() <= 4 {
-            self.variational::<4>(v)
+            self.variational::<4>(v, settings)
         } else {
-            self.variational::<LANES>(v)
+            self.variational::<LANES>(v, settings)
         }
     }
 
     fn variational<const N: usize>(
         &self,
         v: &DVector<f64>,
+        settings: &StrideSettings,
     ) -> Result<(DMatrix<f64>, StrideResult), VariationalError> {
         if self.model.has_infinitesimal_bodies() || self.impact_model.has_infinitesimal_bodies() {
             return Err(VariationalError::Unsupported(
@@ -225,7 +227,7 @@ impl Walker {
             ));
         }
         let (q0, qd0) = self.unpack(v);
-        let nominal = self.stride(&q0, &qd0, StrideOptions::default())?;
+        let nominal = self.stride(&q0, &qd0, StrideRequest::new(settings))?;
         let n = self.model.dof();
         let m = v.len();
         let coords = self.map_coordinates();
@@ -249,7 +251,7 @@ impl Walker {
             q: q0.clone(),
             qd: qd0.clone(),
         };
-        let (rtol, h_max) = match self.integrator {
+        let (rtol, h_max) = match settings.integrator {
             IntegratorChoice::Dop853 { rtol, h_max_s, .. }
             | IntegratorChoice::Dopri5 { rtol, h_max_s, .. } => (rtol, h_max_s),
             _ => (1e-12, 0.05),
@@ -501,7 +503,7 @@ impl Walker {
         let states = LinkStates::from_kinematics(&kin, nr, &hs.p_contact_m);
         let solved = self
             .relabel
-            .solve(&self.model, &states, &self.guess_q)
+            .solve(&self.model, &states, &self.relabel_reference_q)
             .or_else(|_| self.relabel.solve(&self.model, &states, &before.q))
             .map_err(num)?;
         let mut q_new = solved.q.clone();

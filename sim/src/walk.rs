@@ -3,12 +3,16 @@
 //! Every stride is computed in its own stance frame (origin at the stance contact, and for 3D
 //! walkers reflected at every step). [`FloorFrame`] composes those frames so that paths are
 //! reported in one fixed floor frame.
+//!
+//! The one entry point is the free function [`walk`] with a [`WalkRequest`] (stride settings,
+//! step count, recording, bounded step summaries, controller, per-step callback). Times here
+//! are walk time (from the start of the walk); a stride's own times are stride time.
 
 use crate::control::AnkleController;
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
 use crate::math::{rotation_about, sagittal_reflection};
-use crate::stride::{FailureKind, StrideEvent, StrideOptions};
+use crate::stride::{FailureKind, StrideEvent, StrideOptions, StrideRequest, StrideSettings};
 use crate::walker::Walker;
 use nalgebra::{DVector, Matrix3, Vector3};
 use serde::Serialize;
@@ -59,8 +63,9 @@ impl FloorFrame {
 pub struct StepSummary {
     /// 0-based step number.
     pub step: usize,
-    /// Time at the start of the step [s].
-    pub start_time_s: f64,
+    /// Walk time at the start of the step [s] (serialised as `start_time_s`).
+    #[serde(rename = "start_time_s")]
+    pub start_t_walk_s: f64,
     /// Duration [s].
     pub duration_s: f64,
     /// Distance between the contacts [m].
@@ -92,8 +97,9 @@ pub struct WalkFailure {
     pub kind: FailureKind,
     /// 0-based step in which it happened.
     pub step: usize,
-    /// Time from the start of the walk [s].
-    pub time_s: f64,
+    /// Time from the start of the walk [s] (walk time; serialised as `time_s`).
+    #[serde(rename = "time_s")]
+    pub t_walk_s: f64,
     /// Details.
     pub detail: String,
 }
@@ -103,8 +109,8 @@ pub struct WalkFailure {
 pub struct PathSample {
     /// Step number.
     pub step: usize,
-    /// Time from the start of the walk [s].
-    pub time_s: f64,
+    /// Time from the start of the walk [s] (walk time).
+    pub t_walk_s: f64,
     /// Coordinates (stance labelling of that step).
     pub q: DVector<f64>,
     /// Velocities.
@@ -120,7 +126,7 @@ pub struct WalkOptions {
     pub record: bool,
     /// Keep only the summaries of the last this many steps in [`Walk::steps`] (`None`: all).
     /// A long walk (a soak) then runs in bounded memory; [`Walk::steps_completed`] still
-    /// counts every step and the per-step callback of [`Walker::walk_streaming`] sees each.
+    /// counts every step and the per-step callback of [`WalkRequest::on_step`] sees each.
     pub keep_steps: Option<usize>,
 }
 
@@ -137,142 +143,182 @@ pub struct Walk {
     pub path: Vec<PathSample>,
 }
 
-impl Walker {
-    /// Walks up to `steps` strides from `q0`, `qd0`; records the path when `record`.
-    pub fn walk(&self, q0: &DVector<f64>, qd0: &DVector<f64>, steps: usize, record: bool) -> Walk {
-        let options = WalkOptions {
-            record,
-            keep_steps: None,
-        };
-        self.walk_streaming(q0, qd0, steps, options, None, &mut |_| {})
+/// Everything a walk is asked to do.
+pub struct WalkRequest<'a> {
+    /// How each stride is integrated.
+    pub settings: &'a StrideSettings,
+    /// Strides to walk at most.
+    pub steps: usize,
+    /// What the walk keeps (path, bounded step summaries).
+    pub options: WalkOptions,
+    /// The stance ankle's string moved by this controller at its control ticks (see
+    /// [`crate::control`]); it is told of every heel strike. `None`: the scene's ideal reflex.
+    pub controller: Option<&'a mut dyn AnkleController>,
+    /// Called with each step's summary as it completes.
+    pub on_step: Option<&'a mut dyn FnMut(&StepSummary)>,
+}
+
+impl<'a> WalkRequest<'a> {
+    /// Up to `steps` strides with `settings`, keeping every step summary and no path.
+    pub fn new(settings: &'a StrideSettings, steps: usize) -> Self {
+        Self {
+            settings,
+            steps,
+            options: WalkOptions::default(),
+            controller: None,
+            on_step: None,
+        }
     }
 
-    /// As [`Self::walk`], with the stance ankle's string moved by `controller` at its control
-    /// ticks (see [`crate::control`]); the controller is told of every heel strike.
-    pub fn walk_controlled(
-        &self,
-        q0: &DVector<f64>,
-        qd0: &DVector<f64>,
-        steps: usize,
-        record: bool,
-        controller: &mut dyn AnkleController,
-    ) -> Walk {
+    /// Recording the path (every integration sample) when `record`.
+    pub fn recording(self, record: bool) -> Self {
         let options = WalkOptions {
             record,
-            keep_steps: None,
+            ..self.options
         };
-        self.walk_streaming(q0, qd0, steps, options, Some(controller), &mut |_| {})
+        Self { options, ..self }
     }
 
-    /// Walks up to `steps` strides, handing each step's summary to `on_step` as it completes;
-    /// with a controller the stance ankle's string is moved by it (as
-    /// [`Self::walk_controlled`]). With [`WalkOptions::keep_steps`] and no recording the
-    /// memory stays bounded however long the walk.
-    pub fn walk_streaming(
-        &self,
-        q0: &DVector<f64>,
-        qd0: &DVector<f64>,
-        steps: usize,
-        options: WalkOptions,
-        mut controller: Option<&mut dyn AnkleController>,
-        on_step: &mut dyn FnMut(&StepSummary),
-    ) -> Walk {
-        let (record, keep_steps) = (options.record, options.keep_steps);
-        let mut frame = FloorFrame::default();
-        let (mut q, mut qd) = (q0.clone(), qd0.clone());
-        let v0 = self.pack(q0, qd0);
-        let names = self.map_names();
-        let mut kin = Kinematics::new(&self.model);
-        let mut out = Walk {
-            steps_completed: 0,
-            steps: Vec::new(),
-            failure: None,
-            path: Vec::new(),
+    /// With these options.
+    pub fn options(self, options: WalkOptions) -> Self {
+        Self { options, ..self }
+    }
+
+    /// With the stance ankle's string moved by `controller`.
+    pub fn controlled(self, controller: &'a mut dyn AnkleController) -> Self {
+        Self {
+            controller: Some(controller),
+            ..self
+        }
+    }
+
+    /// With `on_step` called with each step's summary.
+    pub fn on_step(self, on_step: &'a mut dyn FnMut(&StepSummary)) -> Self {
+        Self {
+            on_step: Some(on_step),
+            ..self
+        }
+    }
+}
+
+/// Walks up to `request.steps` strides of `walker` from `q0`, `qd0` (just after heel strike),
+/// as `request` asks. With [`WalkOptions::keep_steps`] and no recording the memory stays
+/// bounded however long the walk.
+pub fn walk(
+    walker: &Walker,
+    q0: &DVector<f64>,
+    qd0: &DVector<f64>,
+    request: WalkRequest<'_>,
+) -> Walk {
+    let WalkRequest {
+        settings,
+        steps,
+        options,
+        mut controller,
+        mut on_step,
+    } = request;
+    let (record, keep_steps) = (options.record, options.keep_steps);
+    let mut frame = FloorFrame::default();
+    let (mut q, mut qd) = (q0.clone(), qd0.clone());
+    let v0 = walker.pack(q0, qd0);
+    let names = walker.map_names();
+    let mut kin = Kinematics::new(&walker.model);
+    let mut out = Walk {
+        steps_completed: 0,
+        steps: Vec::new(),
+        failure: None,
+        path: Vec::new(),
+    };
+    let mut t0 = 0.0;
+    let hip = &walker.model.points[walker.fall.hip.0];
+    let mut samples = Vec::new();
+    for step in 0..steps {
+        samples.clear();
+        let options = StrideOptions {
+            record,
+            contact: false,
         };
-        let mut t0 = 0.0;
-        let hip = &self.model.points[self.fall.hip.0];
-        let mut samples = Vec::new();
-        for step in 0..steps {
-            samples.clear();
-            let options = StrideOptions {
-                record,
-                contact: false,
-            };
-            let result = match controller.as_deref_mut() {
-                Some(c) => self.stride_controlled(&q, &qd, options, &mut samples, c, t0),
-                None => self.stride_recording(&q, &qd, options, &mut samples),
-            };
-            for s in &samples {
-                out.path
-                    .push(self.path_sample(&mut kin, &frame, step, t0, s));
+        let mut request = StrideRequest::new(settings)
+            .options(options)
+            .sink(&mut samples);
+        if let Some(c) = controller.as_deref_mut() {
+            request = request.controlled(c, t0);
+        }
+        let result = walker.stride(&q, &qd, request);
+        for s in &samples {
+            out.path
+                .push(path_sample(walker, &mut kin, &frame, step, t0, s));
+        }
+        match result {
+            Err(f) => {
+                out.failure = Some(WalkFailure {
+                    kind: f.kind,
+                    step,
+                    t_walk_s: t0 + f.t_stride_s,
+                    detail: f.detail,
+                });
+                break;
             }
-            match result {
-                Err(f) => {
-                    out.failure = Some(WalkFailure {
-                        kind: f.kind,
-                        step,
-                        time_s: t0 + f.time_s,
-                        detail: f.detail,
-                    });
-                    break;
+            Ok(r) => {
+                kin.update(&walker.model, &r.pre_impact.q, &r.pre_impact.qd);
+                let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
+                let v = walker.pack(&r.q_next, &r.qd_next);
+                let summary = StepSummary {
+                    step,
+                    start_t_walk_s: t0,
+                    duration_s: r.duration_s,
+                    step_length_m: r.step_m.norm(),
+                    heading_change_rad: r.heading_change_rad,
+                    hip_floor_m: [p_hip.x, p_hip.y, p_hip.z],
+                    state_deviation: (&v - &v0).amax(),
+                    impact_energy_loss_j: r.impact_energy_loss_j,
+                    actuator_work_j: r.actuator_work_j,
+                    evaluations: r.evaluations,
+                    events: r.events.clone(),
+                    state: names.iter().cloned().zip(v.iter().copied()).collect(),
+                };
+                if let Some(f) = on_step.as_deref_mut() {
+                    f(&summary);
                 }
-                Ok(r) => {
-                    kin.update(&self.model, &r.pre_impact.q, &r.pre_impact.qd);
-                    let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
-                    let v = self.pack(&r.q_next, &r.qd_next);
-                    let summary = StepSummary {
-                        step,
-                        start_time_s: t0,
-                        duration_s: r.duration_s,
-                        step_length_m: r.step_m.norm(),
-                        heading_change_rad: r.heading_change_rad,
-                        hip_floor_m: [p_hip.x, p_hip.y, p_hip.z],
-                        state_deviation: (&v - &v0).amax(),
-                        impact_energy_loss_j: r.impact_energy_loss_j,
-                        actuator_work_j: r.actuator_work_j,
-                        evaluations: r.evaluations,
-                        events: r.events.clone(),
-                        state: names.iter().cloned().zip(v.iter().copied()).collect(),
-                    };
-                    on_step(&summary);
-                    out.steps_completed += 1;
-                    out.steps.push(summary);
-                    // Bounded: drop the oldest half once twice the kept number accumulate.
-                    if let Some(keep) = keep_steps {
-                        if out.steps.len() >= 2 * keep.max(1) {
-                            out.steps.drain(..out.steps.len() - keep);
-                        }
+                out.steps_completed += 1;
+                out.steps.push(summary);
+                // Bounded: drop the oldest half once twice the kept number accumulate.
+                if let Some(keep) = keep_steps {
+                    if out.steps.len() >= 2 * keep.max(1) {
+                        out.steps.drain(..out.steps.len() - keep);
                     }
-                    frame = frame.next(&r.step_m, r.heading_change_rad, self.relabel.mirror);
-                    t0 += r.duration_s;
-                    q = r.q_next;
-                    qd = r.qd_next;
                 }
+                frame = frame.next(&r.step_m, r.heading_change_rad, walker.relabel.mirror);
+                t0 += r.duration_s;
+                q = r.q_next;
+                qd = r.qd_next;
             }
         }
-        if let Some(keep) = keep_steps {
-            let excess = out.steps.len().saturating_sub(keep);
-            out.steps.drain(..excess);
-        }
-        out
     }
+    if let Some(keep) = keep_steps {
+        let excess = out.steps.len().saturating_sub(keep);
+        out.steps.drain(..excess);
+    }
+    out
+}
 
-    fn path_sample(
-        &self,
-        kin: &mut Kinematics,
-        frame: &FloorFrame,
-        step: usize,
-        t0: f64,
-        s: &Sample,
-    ) -> PathSample {
-        kin.update(&self.model, &s.q, &s.qd);
-        let hip = &self.model.points[self.fall.hip.0];
-        PathSample {
-            step,
-            time_s: t0 + s.t_s,
-            q: s.q.clone(),
-            qd: s.qd.clone(),
-            hip_floor_m: frame.apply(&kin.position_of(hip.link, &hip.p_link_m)),
-        }
+/// A stride's sample `s` (stride time) of step `step`, which started at walk time `t0` [s],
+/// in the floor frame.
+fn path_sample(
+    walker: &Walker,
+    kin: &mut Kinematics,
+    frame: &FloorFrame,
+    step: usize,
+    t0: f64,
+    s: &Sample,
+) -> PathSample {
+    kin.update(&walker.model, &s.q, &s.qd);
+    let hip = &walker.model.points[walker.fall.hip.0];
+    PathSample {
+        step,
+        t_walk_s: t0 + s.t_s,
+        q: s.q.clone(),
+        qd: s.qd.clone(),
+        hip_floor_m: frame.apply(&kin.position_of(hip.link, &hip.p_link_m)),
     }
 }

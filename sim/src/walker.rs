@@ -1,7 +1,6 @@
 //! A hybrid walker: a model plus its contact, impact, event and relabelling rules.
 
-use crate::events::{Direction, EventTolerance};
-use crate::integrators::IntegratorChoice;
+use crate::events::Direction;
 use crate::model::{CoordIndex, JointKind, LinkIndex, Model, PointIndex};
 use crate::relabel::Relabel;
 use nalgebra::DVector;
@@ -79,12 +78,6 @@ pub struct Walker {
     pub fall: FallRule,
     /// Relabelling after heel strike.
     pub relabel: Relabel,
-    /// Integrator.
-    pub integrator: IntegratorChoice,
-    /// Event tolerances.
-    pub event_tolerance: EventTolerance,
-    /// A stride longer than this fails [s].
-    pub max_stride_time_s: f64,
     /// The stance ankle's stretch reflex, if the walker has one.
     pub ankle: Option<crate::actuator::AnkleReflex>,
     /// Coordinates locked (at zero) at the start of every stride, e.g. the toe pitch of a flat
@@ -92,10 +85,12 @@ pub struct Walker {
     pub initially_locked: Vec<CoordIndex>,
     /// Coordinates only the 3D model has (for eigenvalue reports).
     pub three_d_freedoms: Vec<String>,
-    /// A starting guess for the gait (just after heel strike).
-    pub guess_q: DVector<f64>,
-    /// A starting guess for the gait velocities.
-    pub guess_qd: DVector<f64>,
+    /// The relabelling's reference pose: the Newton solve that finds the new stance
+    /// coordinates after heel strike starts from it (and, failing that, from the pre-impact
+    /// pose). Any pose near the walker's stance just after heel strike will do; the scene sets
+    /// it to the coordinates of its gait guess. It does not change the solution, only whether
+    /// and how fast the solve finds it.
+    pub relabel_reference_q: DVector<f64>,
 }
 
 impl Walker {

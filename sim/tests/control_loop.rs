@@ -4,15 +4,17 @@
 mod common;
 
 use sim::control::SampledReflex;
+use sim::walk::WalkRequest;
 
 #[test]
 fn a_sampled_reflex_at_1_khz_walks_like_the_ideal_actuator() {
     let (_, w) = common::walker("wisse3d");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    let reflex = w.ankle.clone().unwrap();
+    let reflex = w.walker.ankle.clone().unwrap();
     let mut ctl = SampledReflex::new(1e-3, &reflex);
-    let walk = w.walk_controlled(&q, &qd, 20, false, &mut ctl);
+    let request = WalkRequest::new(&w.settings, 20).controlled(&mut ctl);
+    let walk = sim::walk::walk(&w.walker, &q, &qd, request);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     let ideal = g.stride.duration_s;
     for s in &walk.steps {

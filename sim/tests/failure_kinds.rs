@@ -6,17 +6,20 @@ mod common;
 use nalgebra::DVector;
 use sim::events::EventTolerance;
 use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{NewtonError, NewtonSettings};
-use sim::stride::{FailureKind, StrideOptions};
-use sim::walker::{ContactConstraint, Walker};
+use sim::limit_cycle::{GaitSearch, NewtonError, NewtonSettings};
+use sim::scene::Setup;
+use sim::stride::FailureKind;
+use sim::walker::ContactConstraint;
 
 /// The failure of one stride from the gait's start with `name += delta`.
-fn perturbed(w: &Walker, name: &str, delta: f64) -> FailureKind {
+fn perturbed(w: &Setup, name: &str, delta: f64) -> FailureKind {
     let g = common::gait(w);
-    let i = w.map_names().iter().position(|n| n == name).unwrap();
+    let i = w.walker.map_names().iter().position(|n| n == name).unwrap();
     let mut v = g.fixed_point.clone();
     v[i] += delta;
-    w.stride_map(&v).expect_err("stride must fail").kind
+    common::stride_map(w, &v)
+        .expect_err("stride must fail")
+        .kind
 }
 
 #[test]
@@ -61,112 +64,97 @@ fn a_swing_leg_thrown_forward_keeps_the_old_stance_foot_down() {
 #[test]
 fn no_heel_strike_within_the_time_budget() {
     let (_, mut w) = common::walker("compass");
-    w.max_stride_time_s = 0.1;
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    w.settings.max_stride_time_s = 0.1;
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NoImpactWithinTime);
 }
 
 #[test]
 fn a_non_finite_state_is_caught() {
     let (_, w) = common::walker("compass");
-    let mut q = w.guess_q.clone();
+    let mut q = w.guess.q.clone();
     q[0] = f64::NAN;
-    let e = w
-        .stride(&q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
 
 #[test]
 fn a_meijaard_step_beyond_the_stability_limit_is_reported() {
     let (_, mut w) = common::walker("compass");
-    w.integrator = IntegratorChoice::Meijaard {
+    w.settings.integrator = IntegratorChoice::Meijaard {
         h_s: 1.0,
         check_every: 1,
     };
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
     // The same step without the check produces a stride anyway (garbage or failure) - the
     // check is what turns it into a typed error; a small step passes the check.
-    w.integrator = IntegratorChoice::Meijaard {
+    w.settings.integrator = IntegratorChoice::Meijaard {
         h_s: 1e-3,
         check_every: 1,
     };
-    w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap();
+    common::stride(&w, &w.guess.q, &w.guess.qd).unwrap();
 }
 
 #[test]
 fn an_unreachable_tolerance_underflows_the_adaptive_step() {
     let (_, mut w) = common::walker("compass");
-    w.integrator = IntegratorChoice::Dopri5 {
+    w.settings.integrator = IntegratorChoice::Dopri5 {
         rtol: 1e-30,
         atol: 1e-30,
         h_max_s: 0.05,
     };
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepUnderflow);
 }
 
 #[test]
 fn an_event_without_refinement_budget_is_not_located() {
     let (_, mut w) = common::walker("compass");
-    w.event_tolerance = EventTolerance {
+    w.settings.event_tolerance = EventTolerance {
         max_iterations: 0,
         ..Default::default()
     };
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::EventNotLocated);
 }
 
 #[test]
 fn redundant_contact_constraints_make_the_impact_singular() {
     let (_, mut w) = common::walker("compass");
-    w.heel_strike.constraints = vec![
+    w.walker.heel_strike.constraints = vec![
         ContactConstraint::X,
         ContactConstraint::Y,
         ContactConstraint::X,
     ];
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::ImpactSingular);
 }
 
 #[test]
 fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
     let (_, mut w) = common::walker("compass");
-    let (a, b) = (w.relabel.pairs[0].0, w.relabel.pairs[1].0);
-    w.relabel.pairs = vec![(a, a), (b, b)];
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let (a, b) = (w.walker.relabel.pairs[0].0, w.walker.relabel.pairs[1].0);
+    w.walker.relabel.pairs = vec![(a, a), (b, b)];
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::RelabelFailed);
 }
 
 #[test]
 fn newton_reports_its_spent_budget_and_failed_strides() {
     let (_, w) = common::walker("compass");
-    let v0 = w.pack(&w.guess_q, &w.guess_qd);
+    let v0 = w.walker.pack(&w.guess.q, &w.guess.qd);
     let tight = NewtonSettings {
         max_iterations: 1,
         ..Default::default()
     };
     assert!(matches!(
-        w.find_gait(&v0, &tight),
+        GaitSearch::new(&w.walker, &w.settings, &tight).find(&v0),
         Err(NewtonError::NotConverged { iterations: 1, .. })
     ));
     let bad = DVector::from_vec(vec![0.27, -0.54, -3.0, 0.7]);
     assert!(matches!(
-        w.find_gait(&bad, &NewtonSettings::default()),
+        GaitSearch::new(&w.walker, &w.settings, &NewtonSettings::default()).find(&bad),
         Err(NewtonError::StrideFailed { iteration: 0, .. })
     ));
 }
@@ -178,11 +166,9 @@ fn a_drive_that_retracts_lets_the_heel_back_down() {
     let (mut scene, w) = common::walker("wisse3d");
     let g = common::gait(&w);
     scene.set_text("ankle_final_rad=-0.2").unwrap();
-    let retracting = scene.build().unwrap();
-    let e = retracting
-        .stride_map(&g.fixed_point)
-        .expect_err("must fail");
+    let retracting = scene.setup().unwrap();
+    let e = common::stride_map(&retracting, &g.fixed_point).expect_err("must fail");
     assert_eq!(e.kind, FailureKind::HeelReturnedToFloor, "{e}");
     // The same start with the scene's own drive walks on.
-    assert!(w.stride_map(&g.fixed_point).is_ok());
+    assert!(common::stride_map(&w, &g.fixed_point).is_ok());
 }

@@ -4,8 +4,8 @@
 mod common;
 
 use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::NewtonSettings;
-use sim::stride::{FailureKind, StrideOptions};
+use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::stride::{FailureKind, StrideOptions, StrideRequest};
 
 #[test]
 fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
@@ -16,26 +16,29 @@ fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
     let c0 = w
+        .walker
         .stride(
             &q,
             &qd,
-            StrideOptions {
+            StrideRequest::new(&w.settings).options(StrideOptions {
                 record: false,
                 contact: true,
-            },
+            }),
         )
         .unwrap();
     let clearance = c0.contact.mid_swing_clearance_m.unwrap();
     assert!(clearance < -1e-3, "{clearance}");
-    w.model.points[w.heel_strike.swing_foot.0].p_link_m.y += -clearance - 5e-4;
-    w.heel_strike.ignore_scuffing = false;
-    w.heel_strike.min_ahead_m = 0.05;
-    let scuffs = |w: &sim::walker::Walker| matches!(w.stride(&q, &qd, StrideOptions::default()), Err(e) if e.kind == FailureKind::Scuffed);
+    w.walker.model.points[w.walker.heel_strike.swing_foot.0]
+        .p_link_m
+        .y += -clearance - 5e-4;
+    w.walker.heel_strike.ignore_scuffing = false;
+    w.walker.heel_strike.min_ahead_m = 0.05;
+    let scuffs = |w: &sim::scene::Setup| matches!(common::stride(w, &q, &qd), Err(e) if e.kind == FailureKind::Scuffed);
     assert!(scuffs(&w), "the accurate integrator must see the graze");
     // Long fixed steps: the whole dip lies inside one step.
-    w.integrator = IntegratorChoice::Rk4 { h_s: 0.1 };
+    w.settings.integrator = IntegratorChoice::Rk4 { h_s: 0.1 };
     assert!(scuffs(&w), "the interior check must catch the graze");
-    w.event_tolerance.grazing_samples = 0;
+    w.settings.event_tolerance.grazing_samples = 0;
     assert!(
         !scuffs(&w),
         "without the interior check the graze is missed"
@@ -48,14 +51,12 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
     scene
         .set("pelvis_yaw_stiffness_n_m_per_rad", 1.0e7)
         .unwrap();
-    let mut w = scene.build().unwrap();
-    w.integrator = IntegratorChoice::Meijaard {
+    let mut w = scene.setup().unwrap();
+    w.settings.integrator = IntegratorChoice::Meijaard {
         h_s: 1e-3,
         check_every: 1,
     };
-    let e = w
-        .stride(&w.guess_q, &w.guess_qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepTooLarge, "{e}");
     // For a very stiff spring the fastest mode is the pelvis's yaw against the rest of the
     // walker: λ² ≈ k (M̄⁻¹)_yaw,yaw, with the reduced mass matrix over the free coordinates.
@@ -70,15 +71,15 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
         .unwrap()
         .parse()
         .unwrap();
-    let mut d = sim::dynamics::Dynamics::new(&w.model);
-    d.assemble(&w.model, &w.guess_q, &w.guess_qd, None);
-    let free: Vec<usize> = (0..w.model.dof())
-        .filter(|i| !w.initially_locked.iter().any(|c| c.0 == *i))
+    let mut d = sim::dynamics::Dynamics::new(&w.walker.model);
+    d.assemble(&w.walker.model, &w.guess.q, &w.guess.qd, None);
+    let free: Vec<usize> = (0..w.walker.model.dof())
+        .filter(|i| !w.walker.initially_locked.iter().any(|c| c.0 == *i))
         .collect();
     let m = d.mass_matrix.select_rows(&free).select_columns(&free);
     let yaw = free
         .iter()
-        .position(|&i| i == w.model.coord_index("pelvis_yaw").unwrap().0)
+        .position(|&i| i == w.walker.model.coord_index("pelvis_yaw").unwrap().0)
         .unwrap();
     let expected = (1.0e7 * m.try_inverse().unwrap()[(yaw, yaw)]).sqrt();
     assert!(
@@ -87,11 +88,11 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
     );
     assert!(lambda > 2.0 / 1e-3, "the step must really exceed the limit");
     // A step inside the limit passes the check.
-    w.integrator = IntegratorChoice::Meijaard {
+    w.settings.integrator = IntegratorChoice::Meijaard {
         h_s: 1e-4,
         check_every: 1,
     };
-    let r = w.stride(&w.guess_q, &w.guess_qd, StrideOptions::default());
+    let r = common::stride(&w, &w.guess.q, &w.guess.qd);
     assert!(
         !matches!(r, Err(ref e) if e.kind == FailureKind::StepTooLarge),
         "{r:?}"
@@ -114,11 +115,11 @@ fn just_past_the_period_doubling_slope_the_walker_settles_into_two_alternating_s
     let g = last.gait.as_ref().unwrap();
     assert!(!g.stable());
     scene.set("slope", last.value).unwrap();
-    let w = scene.build().unwrap();
+    let w = scene.setup().unwrap();
     let mut v = g.fixed_point.clone();
     v[0] += 1e-4;
-    let (q, qd) = w.unpack(&v);
-    let walk = w.walk(&q, &qd, 400, false);
+    let (q, qd) = w.walker.unpack(&v);
+    let walk = common::walk(&w, &q, &qd, 400, false);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     let d: Vec<f64> = walk
         .steps
@@ -163,7 +164,7 @@ fn ten_thousand_strides_from_the_fixed_point_do_not_drift() {
     let (_, w) = common::walker("compass");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    let walk = w.walk(&q, &qd, 10_000, false);
+    let walk = common::walk(&w, &q, &qd, 10_000, false);
     assert!(walk.failure.is_none());
     let worst = walk
         .steps
@@ -184,11 +185,9 @@ fn ten_thousand_strides_from_the_fixed_point_do_not_drift() {
 #[test]
 fn a_non_finite_velocity_is_a_typed_failure() {
     let (_, w) = common::walker("wisse3d");
-    let mut qd = w.guess_qd.clone();
+    let mut qd = w.guess.qd.clone();
     qd[2] = f64::INFINITY;
-    let e = w
-        .stride(&w.guess_q, &qd, StrideOptions::default())
-        .unwrap_err();
+    let e = common::stride(&w, &w.guess.q, &qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState);
 }
 
@@ -200,8 +199,8 @@ fn equations_of_motion_that_overflow_are_a_typed_failure() {
     let (_, mut w) = common::walker("compass");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    w.model.gravity_floor_m_s2 *= 1e308;
-    let e = w.stride(&q, &qd, StrideOptions::default()).unwrap_err();
+    w.walker.model.gravity_floor_m_s2 *= 1e308;
+    let e = common::stride(&w, &q, &qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState, "{e}");
     assert!(!e.detail.contains("initial state"), "{e}");
 }
@@ -216,6 +215,7 @@ fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay
     let (_, w) = common::walker("kneed2d");
     let g = common::gait(&w);
     let i = w
+        .walker
         .map_names()
         .iter()
         .position(|n| n == "stance_leg")
@@ -223,8 +223,8 @@ fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay
     let outcome = |d: f64| {
         let mut v = g.fixed_point.clone();
         v[i] += d;
-        let (q, qd) = w.unpack(&v);
-        w.stride(&q, &qd, StrideOptions::default())
+        let (q, qd) = w.walker.unpack(&v);
+        common::stride(&w, &q, &qd)
     };
     let (mut ok, mut bad) = (0.0, -0.5);
     for _ in 0..40 {
@@ -246,7 +246,7 @@ fn near_the_boundary_between_knee_lock_first_and_heel_strike_first_outcomes_stay
     assert!((ok - bad).abs() < 1e-12);
     let (t_ok, t_bad) = (
         outcome(ok).unwrap().duration_s,
-        outcome(bad).unwrap_err().time_s,
+        outcome(bad).unwrap_err().t_stride_s,
     );
     assert!(
         t_bad < t_ok,
@@ -262,18 +262,18 @@ fn the_3d_walkers_stride_map_is_smooth_across_its_drives_end() {
     // integration both perturbations give the same spectrum.
     let (_, w) = common::walker("wisse3d");
     let g = common::gait(&w);
-    let s = w.stride_map(&g.fixed_point).unwrap().0;
+    let s = common::stride_map(&w, &g.fixed_point).unwrap().0;
     let moduli = |d: f64| {
-        let j = w
-            .stride_jacobian(
-                &g.fixed_point,
-                &s,
-                &NewtonSettings {
-                    perturbation: d,
-                    ..Default::default()
-                },
-            )
-            .unwrap();
+        let j = GaitSearch::new(
+            &w.walker,
+            &w.settings,
+            &NewtonSettings {
+                perturbation: d,
+                ..Default::default()
+            },
+        )
+        .stride_jacobian(&g.fixed_point, &s)
+        .unwrap();
         let mut m: Vec<f64> = j.complex_eigenvalues().iter().map(|z| z.norm()).collect();
         m.sort_by(|a, b| b.total_cmp(a));
         m
@@ -295,15 +295,12 @@ fn event_location_error_is_far_below_the_integration_error() {
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
     let mut reference = w.clone();
-    reference.integrator = IntegratorChoice::Dopri5 {
+    reference.settings.integrator = IntegratorChoice::Dopri5 {
         rtol: 1e-13,
         atol: 1e-13,
         h_max_s: 0.01,
     };
-    let t_ref = reference
-        .stride(&q, &qd, StrideOptions::default())
-        .unwrap()
-        .duration_s;
+    let t_ref = common::stride(&reference, &q, &qd).unwrap().duration_s;
     let period = g.stride.duration_s;
     for integrator in [
         IntegratorChoice::Rk4 { h_s: period / 50.0 },
@@ -322,18 +319,12 @@ fn event_location_error_is_far_below_the_integration_error() {
         },
     ] {
         let mut a = w.clone();
-        a.integrator = integrator.clone();
-        let t_default = a
-            .stride(&q, &qd, StrideOptions::default())
-            .unwrap()
-            .duration_s;
-        a.event_tolerance.time_s = 1e-16;
-        a.event_tolerance.witness = 0.0;
-        a.event_tolerance.max_iterations = 200;
-        let t_tight = a
-            .stride(&q, &qd, StrideOptions::default())
-            .unwrap()
-            .duration_s;
+        a.settings.integrator = integrator.clone();
+        let t_default = common::stride(&a, &q, &qd).unwrap().duration_s;
+        a.settings.event_tolerance.time_s = 1e-16;
+        a.settings.event_tolerance.witness = 0.0;
+        a.settings.event_tolerance.max_iterations = 200;
+        let t_tight = common::stride(&a, &q, &qd).unwrap().duration_s;
         let location = (t_default - t_tight).abs();
         let integration = (t_tight - t_ref).abs();
         assert!(

@@ -137,7 +137,7 @@ fn compass_gait_is_stable_with_goswami_leg_angles() {
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
     let out: std::collections::BTreeMap<_, _> = scene
-        .convention_outputs(&w, &q, &qd)
+        .convention_outputs(&w.walker, &q, &qd)
         .unwrap()
         .into_iter()
         .collect();

@@ -4,7 +4,7 @@
 
 mod common;
 
-use sim::limit_cycle::{JacobianMethod, NewtonSettings};
+use sim::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
 
 #[test]
 fn the_variational_jacobian_matches_central_differences_on_every_event_kind() {
@@ -13,11 +13,14 @@ fn the_variational_jacobian_matches_central_differences_on_every_event_kind() {
     for (name, bound) in [("compass", 1e-8), ("kneed2d", 3e-8), ("wisse3d", 3e-8)] {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
-        let s = w.stride_map(&g.fixed_point).unwrap().0;
-        let fd = w
-            .stride_jacobian(&g.fixed_point, &s, &NewtonSettings::default())
+        let s = common::stride_map(&w, &g.fixed_point).unwrap().0;
+        let fd = GaitSearch::new(&w.walker, &w.settings, &NewtonSettings::default())
+            .stride_jacobian(&g.fixed_point, &s)
             .unwrap();
-        let (var, _) = w.stride_jacobian_variational(&g.fixed_point).unwrap();
+        let (var, _) = w
+            .walker
+            .stride_jacobian_variational(&g.fixed_point, &w.settings)
+            .unwrap();
         let d = (&var - &fd).amax();
         assert!(d < bound * fd.amax(), "{name}: |J_var - J_fd| = {d:e}");
     }
@@ -30,7 +33,10 @@ fn the_variational_jacobian_has_the_exact_zero_eigenvalues() {
     // there; the variational Jacobian gives zero to rounding.
     let (_, w) = common::walker("kneed2d");
     let g = common::gait(&w);
-    let (var, _) = w.stride_jacobian_variational(&g.fixed_point).unwrap();
+    let (var, _) = w
+        .walker
+        .stride_jacobian_variational(&g.fixed_point, &w.settings)
+        .unwrap();
     let mut moduli: Vec<f64> = var.complex_eigenvalues().iter().map(|z| z.norm()).collect();
     moduli.sort_by(f64::total_cmp);
     assert!(moduli[0] < 1e-13, "{moduli:?}");
@@ -43,15 +49,11 @@ fn a_gait_says_which_jacobian_it_used() {
         ..Default::default()
     };
     let (_, w) = common::walker("kneed2d");
-    let g = w
-        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &settings)
-        .unwrap();
+    let g = w.find_gait(&settings).unwrap();
     assert_eq!(g.jacobian_method, JacobianMethod::Variational);
     // The simplest walker's infinitesimal masses are outside the method: central differences,
     // and the gait says so.
     let (_, w) = common::walker("simplest");
-    let g = w
-        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &settings)
-        .unwrap();
+    let g = w.find_gait(&settings).unwrap();
     assert_eq!(g.jacobian_method, JacobianMethod::CentralDifferences);
 }

@@ -8,7 +8,8 @@
 mod common;
 
 use serde_json::{json, Value};
-use sim::stride::{FailureKind, StrideOptions};
+use sim::limit_cycle::GaitSearch;
+use sim::stride::{FailureKind, StrideOptions, StrideRequest};
 
 #[test]
 fn the_2d_and_3d_walkers_have_stable_gaits() {
@@ -28,8 +29,8 @@ fn table_one_exactly_gives_a_gait_that_is_unstable_in_a_3d_mode() {
     let m = sim::stability::modes(
         &g.jacobian,
         &g.eigenvalues,
-        &w.map_names(),
-        &w.three_d_freedoms,
+        &w.walker.map_names(),
+        &w.walker.three_d_freedoms,
     );
     let worst = m.iter().max_by(|a, b| a.abs.total_cmp(&b.abs)).unwrap();
     assert!(worst.three_d, "{worst:?}");
@@ -40,7 +41,7 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
     let (_, w) = common::walker("wisse3d");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    let walk = w.walk(&q, &qd, 200, false);
+    let walk = common::walk(&w, &q, &qd, 200, false);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), 200);
     // Straight: the hip positions at the ends of steps lie on a line (alternating sides by
@@ -73,13 +74,15 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
 fn the_uncompensated_walker_zigzags_with_growing_yaw_and_fails_within_30_steps() {
     let (_, w) = common::walker("wisse3d-uncompensated");
     // It has no gait of its own: its Newton search fails.
-    let v0 = w.pack(&w.guess_q, &w.guess_qd);
-    assert!(w.find_gait(&v0, &Default::default()).is_err());
+    let v0 = w.walker.pack(&w.guess.q, &w.guess.qd);
+    assert!(GaitSearch::new(&w.walker, &w.settings, &Default::default())
+        .find(&v0)
+        .is_err());
     // Start from its yaw-locked gait, as `walker walk` does.
     let (_, w2) = common::walker("wisse2d-uncompensated");
     let g2 = common::gait(&w2);
-    let names = w.map_names();
-    let names2 = w2.map_names();
+    let names = w.walker.map_names();
+    let names2 = w2.walker.map_names();
     let v = nalgebra::DVector::from_iterator(
         names.len(),
         names.iter().map(|n| {
@@ -89,8 +92,8 @@ fn the_uncompensated_walker_zigzags_with_growing_yaw_and_fails_within_30_steps()
                 .map_or(0.0, |j| g2.fixed_point[j])
         }),
     );
-    let (q, qd) = w.unpack(&v);
-    let walk = w.walk(&q, &qd, 30, false);
+    let (q, qd) = w.walker.unpack(&v);
+    let walk = common::walk(&w, &q, &qd, 30, false);
     let failure = walk.failure.expect("must fail within 30 steps");
     assert!(
         matches!(
@@ -117,13 +120,13 @@ fn speed_and_cost_of_transport_are_near_the_paper_and_energy_balances() {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
         let s = &g.stride;
-        let length = sim::report::forward_progress_m(&w, &g);
+        let length = sim::report::forward_progress_m(&w.walker, &g);
         assert!(
             length < s.step_m.norm(),
             "progress leaves out the sideways zigzag"
         );
         let speed = length / s.duration_s;
-        let cot = s.actuator_work_j / (w.model.total_mass_kg() * length);
+        let cot = s.actuator_work_j / (w.walker.model.total_mass_kg() * length);
         assert!((0.4..0.7).contains(&speed), "{name}: speed {speed}");
         assert!((0.1..0.2).contains(&cot), "{name}: cost of transport {cot}");
         // Over a periodic stride on level ground the actuator's work is what impacts and the
@@ -142,17 +145,18 @@ fn roll_freedom_of_the_pelvis_shrinks_the_lateral_centre_of_pressure() {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
         let (q, qd) = common::start_state(&w, &g);
-        w.stride(
-            &q,
-            &qd,
-            StrideOptions {
-                record: false,
-                contact: true,
-            },
-        )
-        .unwrap()
-        .contact
-        .max_lateral_cop_m
+        w.walker
+            .stride(
+                &q,
+                &qd,
+                StrideRequest::new(&w.settings).options(StrideOptions {
+                    record: false,
+                    contact: true,
+                }),
+            )
+            .unwrap()
+            .contact
+            .max_lateral_cop_m
     };
     let (c2, c3) = (cop("wisse2d"), cop("wisse3d"));
     assert!(c3 < c2, "3D {c3} vs 2D {c2}");
@@ -162,6 +166,7 @@ fn gait_record(name: &str) -> Value {
     let (_, w) = common::walker(name);
     let g = common::gait(&w);
     let fixed_point: serde_json::Map<String, Value> = w
+        .walker
         .map_names()
         .iter()
         .zip(g.fixed_point.iter())

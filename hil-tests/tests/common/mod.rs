@@ -7,7 +7,8 @@ use nalgebra::DVector;
 use sil::{FirmwareInTheLoop, SilConfig, SilReport};
 use sim::limit_cycle::NewtonSettings;
 use sim::scene::Scene;
-use sim::walk::Walk;
+use sim::stride::StrideSettings;
+use sim::walk::{Walk, WalkRequest};
 use sim::walker::Walker;
 
 /// The scene every test walks.
@@ -17,6 +18,8 @@ pub const TICK_S: f64 = 1e-3;
 
 pub struct Setup {
     pub walker: Walker,
+    /// The firmware walks' stride settings (the scene's, with `sil::SIL_INTEGRATOR`).
+    pub settings: StrideSettings,
     pub q0: DVector<f64>,
     pub qd0: DVector<f64>,
     /// Stride period of the ideal reflex's limit cycle [s].
@@ -28,17 +31,17 @@ pub fn setup() -> &'static Setup {
     static S: OnceLock<Setup> = OnceLock::new();
     S.get_or_init(|| {
         let scene = Scene::load(SCENE).expect("scene loads");
-        let mut walker = scene.build().expect("scene builds");
-        let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-        let gait = walker
-            .find_gait(&v0, &NewtonSettings::default())
+        let setup = scene.setup().expect("scene builds");
+        let gait = setup
+            .find_gait(&NewtonSettings::default())
             .expect("gait converges");
-        let (q0, qd0) = walker.unpack(&gait.fixed_point);
+        let (q0, qd0) = setup.walker.unpack(&gait.fixed_point);
         // The gait with the scene's integrator; the walks with the firmware's.
-        walker.integrator = sil::SIL_INTEGRATOR;
+        let settings = setup.settings.with_integrator(sil::SIL_INTEGRATOR);
         Setup {
             period_s: gait.stride.duration_s,
-            walker,
+            walker: setup.walker,
+            settings,
             q0,
             qd0,
         }
@@ -65,9 +68,8 @@ pub fn walk(config: SilConfig, steps: usize) -> (Walk, SilReport) {
 /// Walk with a prepared controller.
 pub fn walk_with(mut ctl: FirmwareInTheLoop, steps: usize) -> (Walk, SilReport) {
     let s = setup();
-    let walk = s
-        .walker
-        .walk_controlled(&s.q0, &s.qd0, steps, false, &mut ctl);
+    let request = WalkRequest::new(&s.settings, steps).controlled(&mut ctl);
+    let walk = sim::walk::walk(&s.walker, &s.q0, &s.qd0, request);
     let report = ctl.finish().expect("report");
     eprintln!("{}", summary(&walk, &report));
     (walk, report)
@@ -98,7 +100,7 @@ pub fn summary(walk: &Walk, r: &SilReport) -> String {
     format!(
         "steps {} failure {:?}\n  t_end {:.3} s, heel strikes {}, frames {}, bus load {:.2} %, error frames {}, bus-off {:?}\n  {}\n  states {:?}",
         walk.steps_completed,
-        walk.failure.as_ref().map(|f| (f.kind, f.step, f.time_s)),
+        walk.failure.as_ref().map(|f| (f.kind, f.step, f.t_walk_s)),
         r.t_end_s,
         r.heel_strikes,
         r.frames_delivered,

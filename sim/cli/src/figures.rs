@@ -4,7 +4,7 @@
 use crate::plot::{Plot, Series, Style, PALETTE};
 use sim::limit_cycle::Gait;
 use sim::stability::modes;
-use sim::stride::StrideOptions;
+use sim::stride::{StrideOptions, StrideRequest, StrideSettings};
 use sim::walk::Walk;
 use sim::walker::Walker;
 
@@ -78,16 +78,16 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
 }
 
 /// Every joint coordinate over one stride from the gait's fixed point.
-pub fn joint_angles(walker: &Walker, gait: &Gait, title: &str) -> Plot {
+pub fn joint_angles(walker: &Walker, settings: &StrideSettings, gait: &Gait, title: &str) -> Plot {
     let (q, qd) = walker.unpack(&gait.fixed_point);
     let samples = walker
         .stride(
             &q,
             &qd,
-            StrideOptions {
+            StrideRequest::new(settings).options(StrideOptions {
                 record: true,
                 contact: false,
-            },
+            }),
         )
         .map(|r| r.trajectory)
         .unwrap_or_default();

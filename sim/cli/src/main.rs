@@ -16,8 +16,9 @@ use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::JacobianMethod;
 use sim::limit_cycle::NewtonSettings;
 use sim::report::{gait_json, sweep_json, walk_json};
-use sim::scene::{Scene, SceneError, BUILTIN};
+use sim::scene::{Scene, SceneError, Setup, BUILTIN};
 use sim::tune::{tune, TunedParameter};
+use sim::walk::WalkRequest;
 use sim::walker::Walker;
 use std::io::Write;
 use std::process::ExitCode;
@@ -217,8 +218,8 @@ impl Common {
         Ok(scene)
     }
 
-    fn walker(&self, scene: &Scene) -> Result<Walker, InputError> {
-        let mut w = scene.build()?;
+    fn walker(&self, scene: &Scene) -> Result<Setup, InputError> {
+        let mut w = scene.setup()?;
         let positive = |name: &str, v: Option<f64>| match v {
             Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
                 "--{name} must be a positive number, got {x}"
@@ -236,14 +237,19 @@ impl Common {
             )));
         }
         if let Some(kind) = &self.integrator {
-            w.integrator = IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None)
-                .ok_or_else(|| {
-                    InputError::Other(format!(
-                        "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
-                    ))
-                })?;
+            w.settings.integrator =
+                IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None).ok_or_else(
+                    || {
+                        InputError::Other(format!(
+                            "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
+                        ))
+                    },
+                )?;
         } else {
-            w.integrator = w.integrator.with_tolerance_or_step(self.rtol, self.step_s);
+            w.settings.integrator = w
+                .settings
+                .integrator
+                .with_tolerance_or_step(self.rtol, self.step_s);
         }
         Ok(w)
     }
@@ -276,21 +282,22 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Scenes { json } => scenes(json),
         Command::Gait { common, plot } => {
             let scene = common.scene()?;
-            let walker = common.walker(&scene)?;
-            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-            let result = walker.find_gait(&v0, &common.newton());
-            let report = gait_json(&scene, &walker, &result);
+            let setup = common.walker(&scene)?;
+            let walker = &setup.walker;
+            let result = setup.find_gait(&common.newton());
+            let report = gait_json(&scene, walker, &setup.settings, &result);
             if let (Some(dir), Ok(g)) = (&plot, &result) {
                 std::fs::create_dir_all(dir)?;
                 let name = scene.name();
                 let eig = figures::eigenvalues(
-                    &walker,
+                    walker,
                     g,
                     &format!("{name}: eigenvalues of the stride Jacobian"),
                 );
                 std::fs::write(dir.join("eigenvalues.svg"), eig.to_svg(640.0, 600.0))?;
                 let ang = figures::joint_angles(
-                    &walker,
+                    walker,
+                    &setup.settings,
                     g,
                     &format!("{name}: joint angles over one step"),
                 );
@@ -319,11 +326,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             plot_with,
         } => {
             let scene = common.scene()?;
-            let walker = common.walker(&scene)?;
-            let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
+            let setup = common.walker(&scene)?;
+            let walker = &setup.walker;
+            let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
             let start_from_scene = match (start_from_scene, start.as_str()) {
                 (None, "gait") => match &scene.file.walk_start_scene {
-                    Some(other) if walker.find_gait(&v0, &common.newton()).is_err() => {
+                    Some(other) if setup.find_gait(&common.newton()).is_err() => {
                         eprintln!(
                             "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
                             scene.name()
@@ -335,12 +343,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 (s, _) => s,
             };
             let mut v = match (start_from_scene, start.as_str()) {
-                (Some(other), _) => match start_from_other(&other, &scene, &walker, &common)? {
+                (Some(other), _) => match start_from_other(&other, &scene, walker, &common)? {
                     Some(v) => v,
                     None => return Ok(ExitCode::from(1)),
                 },
                 (None, "guess") => v0,
-                (None, "gait") => match walker.find_gait(&v0, &common.newton()) {
+                (None, "gait") => match setup.find_gait(&common.newton()) {
                     Ok(g) => g.fixed_point,
                     Err(e) => {
                         eprintln!("error: no gait to start from: {e} (use --start guess)");
@@ -385,21 +393,28 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 v[i] += d;
             }
             let (q, qd) = walker.unpack(&v);
-            let walk = walker.walk(&q, &qd, steps, out.is_some() || plot.is_some());
+            let request =
+                WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
+            let walk = sim::walk::walk(walker, &q, &qd, request);
             if let Some(dir) = &plot {
                 std::fs::create_dir_all(dir)?;
                 let mut walks = vec![(scene.name().to_string(), walk.clone())];
                 if let Some(other) = &plot_with {
                     // The other scene walks with its own defaults, from its own gait.
                     let os = Scene::load(other)?;
-                    let ow = os.build()?;
-                    let v0 = ow.pack(&ow.guess_q, &ow.guess_qd);
-                    let start = ow
-                        .find_gait(&v0, &common.newton())
+                    let oset = os.setup()?;
+                    let ow = &oset.walker;
+                    let v0 = ow.pack(&oset.guess.q, &oset.guess.qd);
+                    let start = oset
+                        .find_gait(&common.newton())
                         .map(|g| g.fixed_point)
                         .unwrap_or(v0);
                     let (oq, oqd) = ow.unpack(&start);
-                    walks.push((os.name().to_string(), ow.walk(&oq, &oqd, steps, true)));
+                    let request = WalkRequest::new(&oset.settings, steps).recording(true);
+                    walks.push((
+                        os.name().to_string(),
+                        sim::walk::walk(ow, &oq, &oqd, request),
+                    ));
                 }
                 let refs: Vec<(&str, &sim::walk::Walk)> =
                     walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
@@ -407,7 +422,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 std::fs::write(dir.join("floor_path.svg"), fig.to_svg(820.0, 420.0))?;
             }
             if let Some(path) = out {
-                write_csv(&path, &walker, &walk)?;
+                write_csv(&path, walker, &walk)?;
             }
             let report = walk_json(&scene, &walk);
             if common.json {
@@ -425,14 +440,14 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 for s in &walk.steps {
                     println!(
                         "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
-                        s.step, s.start_time_s, s.duration_s, s.step_length_m, s.state_deviation
+                        s.step, s.start_t_walk_s, s.duration_s, s.step_length_m, s.state_deviation
                     );
                 }
                 match &walk.failure {
                     None => println!("no failure"),
                     Some(f) => println!(
                         "failure: {:?} in step {} at t = {:.4} s: {}",
-                        f.kind, f.step, f.time_s, f.detail
+                        f.kind, f.step, f.t_walk_s, f.detail
                     ),
                 }
             }
@@ -440,15 +455,14 @@ fn run(cli: Cli) -> Result<ExitCode> {
         }
         Command::Accuracy { common, out } => {
             let scene = common.scene()?;
-            let walker = common.walker(&scene)?;
+            let setup = common.walker(&scene)?;
             let reference = IntegratorChoice::Dopri5 {
                 rtol: 1e-13,
                 atol: 1e-13,
                 h_max_s: 0.01,
             };
             let period = {
-                let v0 = walker.pack(&walker.guess_q, &walker.guess_qd);
-                match walker.find_gait(&v0, &common.newton()) {
+                match setup.find_gait(&common.newton()) {
                     Ok(g) => g.stride.duration_s,
                     Err(e) => {
                         eprintln!("error: no gait: {e}");
@@ -457,7 +471,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 }
             };
             let settings = accuracy::default_settings(period);
-            let study = match accuracy::study(&walker, reference, &settings, &common.newton()) {
+            let study = match accuracy::study(&setup, reference, &settings, &common.newton()) {
                 Ok(s) => s,
                 Err(e) => {
                     eprintln!("error: no reference gait: {e}");
@@ -505,7 +519,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
             keep_steps,
         } => {
             let scene = common.scene()?;
-            let walker = common.walker(&scene)?;
+            let Setup {
+                walker,
+                settings: mut stride_settings,
+                ..
+            } = common.walker(&scene)?;
             let Some(reflex) = walker.ankle.clone() else {
                 return Err(InputError::Other(format!(
                     "scene `{}` has no actuated ankles (ankle_reflex)",
@@ -549,18 +567,17 @@ fn run(cli: Cli) -> Result<ExitCode> {
             // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
             // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
             // per 1 ms control tick) unless an integrator is given on the command line.
-            let ideal_walker = scene.build()?;
-            let v0 = ideal_walker.pack(&ideal_walker.guess_q, &ideal_walker.guess_qd);
-            let ideal = match ideal_walker.find_gait(&v0, &common.newton()) {
+            let ideal_setup = scene.setup()?;
+            let ideal_walker = &ideal_setup.walker;
+            let ideal = match ideal_setup.find_gait(&common.newton()) {
                 Ok(g) => g,
                 Err(e) => {
                     eprintln!("error: no ideal-actuator gait to start from: {e}");
                     return Ok(ExitCode::from(1));
                 }
             };
-            let mut walker = walker;
             if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
-                walker.integrator = sil::SIL_INTEGRATOR;
+                stride_settings.integrator = sil::SIL_INTEGRATOR;
             }
             // Its errors are about the configuration given (fault nodes, log path, address).
             let mut ctl = sil::FirmwareInTheLoop::new(config)
@@ -578,12 +595,26 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 keep_steps: keep_steps.map(|n| n.max(10)),
             };
             let walk = match realtime {
-                None => walker.walk_streaming(&q, &qd, steps, options, Some(&mut ctl), &mut |_| {}),
+                None => sim::walk::walk(
+                    &walker,
+                    &q,
+                    &qd,
+                    WalkRequest::new(&stride_settings, steps)
+                        .options(options)
+                        .controlled(&mut ctl),
+                ),
                 Some(factor) => {
                     // Step by step, sleeping so that walk time keeps pace with wall time.
                     let start = std::time::Instant::now();
                     let mut paced = sim::control::Paced::new(&mut ctl, factor, start);
-                    walker.walk_streaming(&q, &qd, steps, options, Some(&mut paced), &mut |_| {})
+                    sim::walk::walk(
+                        &walker,
+                        &q,
+                        &qd,
+                        WalkRequest::new(&stride_settings, steps)
+                            .options(options)
+                            .controlled(&mut paced),
+                    )
                 }
             };
             let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
@@ -592,10 +623,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 .finish()
                 .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
             let sil_gait = sim::report::walk_gait_json(&walker, &walk, 10);
-            let ideal_gait = sim::report::ideal_gait_json(&ideal_walker, &ideal);
+            let ideal_gait = sim::report::ideal_gait_json(ideal_walker, &ideal);
             let out = json!({
                 "scene": scene.name(),
-                "integrator": walker.integrator,
+                "integrator": stride_settings.integrator,
                 "steps_completed": walk.steps_completed,
                 "failure": walk.failure,
                 "gait": sil_gait,
@@ -618,7 +649,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 if let Some(f) = &walk.failure {
                     println!(
                         "failure: {:?} in step {} at t = {:.4} s: {}",
-                        f.kind, f.step, f.time_s, f.detail
+                        f.kind, f.step, f.t_walk_s, f.detail
                     );
                 }
                 for (label, g) in [("firmware", &out["gait"]), ("ideal", &out["ideal_gait"])] {
@@ -791,8 +822,9 @@ fn start_from_other(
             other_scene.set(k, *val)?;
         }
     }
-    let ow = other_scene.build()?;
-    let og = match ow.find_gait(&ow.pack(&ow.guess_q, &ow.guess_qd), &common.newton()) {
+    let oset = other_scene.setup()?;
+    let ow = &oset.walker;
+    let og = match oset.find_gait(&common.newton()) {
         Ok(g) => g,
         Err(e) => {
             eprintln!("error: scene `{other}` has no gait to start from: {e}");
@@ -930,7 +962,7 @@ fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) ->
     }
     writeln!(f, ",hip_x_m,hip_y_m,hip_z_m")?;
     for s in &walk.path {
-        write!(f, "{},{}", s.step, s.time_s)?;
+        write!(f, "{},{}", s.step, s.t_walk_s)?;
         for v in s.q.iter().chain(s.qd.iter()) {
             write!(f, ",{v}")?;
         }

@@ -7,18 +7,15 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use sil::config::SilConfig;
 use sil::FirmwareInTheLoop;
 use sim::scene::Scene;
+use sim::walk::WalkRequest;
 
 fn bench(c: &mut Criterion) {
     let scene = Scene::load("wisse3d").unwrap();
-    let mut walker = scene.build().unwrap();
-    let gait = walker
-        .find_gait(
-            &walker.pack(&walker.guess_q, &walker.guess_qd),
-            &Default::default(),
-        )
-        .unwrap();
+    let setup = scene.setup().unwrap();
+    let gait = setup.find_gait(&Default::default()).unwrap();
+    let walker = &setup.walker;
     let (q, qd) = walker.unpack(&gait.fixed_point);
-    walker.integrator = sil::SIL_INTEGRATOR;
+    let settings = setup.settings.with_integrator(sil::SIL_INTEGRATOR);
     let reflex = walker.ankle.clone().unwrap();
     let mut group = c.benchmark_group("sil");
     group.sample_size(10);
@@ -26,7 +23,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let mut ctl =
                 FirmwareInTheLoop::new(SilConfig::default().with_reflex(&reflex).unwrap()).unwrap();
-            let walk = walker.walk_controlled(&q, &qd, 5, false, &mut ctl);
+            let request = WalkRequest::new(&settings, 5).controlled(&mut ctl);
+            let walk = sim::walk::walk(walker, &q, &qd, request);
             assert!(walk.failure.is_none());
             walk.steps.len()
         })

@@ -7,7 +7,7 @@
 use sil::config::SilConfig;
 use sil::FirmwareInTheLoop;
 use sim::integrators::IntegratorChoice;
-use sim::walk::WalkOptions;
+use sim::walk::WalkRequest;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -15,12 +15,11 @@ fn main() {
     let kind = args.next().unwrap_or_else(|| "sil".into());
     let x: Option<f64> = args.next().and_then(|s| s.parse().ok());
     let scene = sim::scene::Scene::load("wisse3d").expect("scene");
-    let mut w = scene.build().expect("build");
-    let g = w
-        .find_gait(&w.pack(&w.guess_q, &w.guess_qd), &Default::default())
-        .expect("gait");
+    let setup = scene.setup().expect("build");
+    let g = setup.find_gait(&Default::default()).expect("gait");
+    let w = &setup.walker;
     let (q, qd) = w.unpack(&g.fixed_point);
-    w.integrator = match kind.as_str() {
+    let integrator = match kind.as_str() {
         "rk4" => IntegratorChoice::Rk4 {
             h_s: x.unwrap_or(1e-3),
         },
@@ -31,19 +30,17 @@ fn main() {
         },
         _ => sil::SIL_INTEGRATOR,
     };
+    let settings = setup.settings.with_integrator(integrator);
     let reflex = w.ankle.clone().unwrap();
     let mut ctl =
         FirmwareInTheLoop::new(SilConfig::default().with_reflex(&reflex).unwrap()).unwrap();
     let mut evals = 0usize;
     let start = std::time::Instant::now();
-    let walk = w.walk_streaming(
-        &q,
-        &qd,
-        steps,
-        WalkOptions::default(),
-        Some(&mut ctl),
-        &mut |s| evals += s.evaluations,
-    );
+    let mut count = |s: &sim::walk::StepSummary| evals += s.evaluations;
+    let request = WalkRequest::new(&settings, steps)
+        .controlled(&mut ctl)
+        .on_step(&mut count);
+    let walk = sim::walk::walk(w, &q, &qd, request);
     let wall = start.elapsed().as_secs_f64();
     let report = ctl.finish().unwrap();
     let walked: f64 = walk.steps.iter().map(|s| s.duration_s).sum();

@@ -557,7 +557,7 @@ impl FirmwareInTheLoop {
         t_ns: u64,
         sensing: &AnkleSensing,
     ) -> Result<ActuatorSegment, ControlError> {
-        let t_s = sensing.t_s;
+        let t_s = sensing.t_walk_s;
         let stance = side == self.stance;
         let landing = self.landing_rad[side.index()]
             .or(self.landing_rad[side.other().index()])
@@ -715,7 +715,7 @@ impl AnkleController for FirmwareInTheLoop {
     }
 
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
-        let t_s = sensing.t_s;
+        let t_s = sensing.t_walk_s;
         if !(t_s.is_finite() && t_s >= 0.0) {
             return Err(ctl(format!("tick at t = {t_s} s")));
         }

@@ -38,7 +38,7 @@ fn run(sil: &mut FirmwareInTheLoop, until_s: f64, strikes_s: &[f64]) -> Vec<Tick
             _ => free,
         };
         let sensing = AnkleSensing {
-            t_s,
+            t_walk_s: t_s,
             stance_ankle_rad: angle,
             stance_ankle_rate_rad_s: RAMP_RATE_RAD_S,
             stance_foot_on_floor: true,
@@ -359,7 +359,7 @@ fn bad_configurations_and_times_are_refused() {
     let mut c = sil(SilConfig::default());
     run(&mut c, 0.01, &[]);
     let s = AnkleSensing {
-        t_s: 0.005,
+        t_walk_s: 0.005,
         stance_ankle_rad: 0.0,
         stance_ankle_rate_rad_s: 0.0,
         stance_foot_on_floor: true,
@@ -368,7 +368,12 @@ fn bad_configurations_and_times_are_refused() {
         string_torque_n_m: 0.0,
     };
     assert!(c.tick(&s).is_err());
-    assert!(c.tick(&AnkleSensing { t_s: f64::NAN, ..s }).is_err());
+    assert!(c
+        .tick(&AnkleSensing {
+            t_walk_s: f64::NAN,
+            ..s
+        })
+        .is_err());
 }
 
 #[test]
@@ -464,7 +469,7 @@ fn a_socketcand_client_sees_the_frames_and_its_emergency_stop_reaches_the_nodes(
     let mut t_ms = 0u64;
     let tick = |c: &mut FirmwareInTheLoop, t_ms: &mut u64| {
         let s = AnkleSensing {
-            t_s: *t_ms as f64 * DT_S,
+            t_walk_s: *t_ms as f64 * DT_S,
             stance_ankle_rad: 0.05,
             stance_ankle_rate_rad_s: 0.0,
             stance_foot_on_floor: true,

@@ -10,8 +10,10 @@ pub mod variant;
 use crate::actuator::AnkleReflex;
 use crate::events::{Direction, EventTolerance};
 use crate::integrators::IntegratorChoice;
+use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
 use crate::relabel::Relabel;
+use crate::stride::StrideSettings;
 use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker};
 use file::{Num, SceneFile};
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -106,6 +108,28 @@ pub enum SceneError {
     /// A reference to something undefined, or a bad keyword.
     #[error("{0}")]
     Invalid(String),
+}
+
+/// Everything a scene file sets up: the walker's physics, the solver settings of its strides,
+/// and a starting guess for its gait.
+#[derive(Clone, Debug)]
+pub struct Setup {
+    /// The walker (model, contact, impact, event and relabelling rules).
+    pub walker: Walker,
+    /// How its strides are integrated (the scene's `integrator` section).
+    pub settings: StrideSettings,
+    /// A starting guess for its gait (the scene's `guess` section).
+    pub guess: GaitGuess,
+}
+
+impl Setup {
+    /// Finds the gait from the scene's guess with `newton`.
+    ///
+    /// # Errors
+    /// As [`GaitSearch::find`].
+    pub fn find_gait(&self, newton: &NewtonSettings) -> Result<Gait, NewtonError> {
+        GaitSearch::new(&self.walker, &self.settings, newton).find_from_guess(&self.guess)
+    }
 }
 
 /// A scene file with its parameter values.
@@ -298,8 +322,14 @@ impl Scene {
         n.as_ref().map_or(Ok(0.0), |n| self.num(n, what))
     }
 
-    /// Builds the walker.
+    /// Builds the walker (the physics only; [`Self::setup`] for its settings and gait guess).
     pub fn build(&self) -> Result<Walker, SceneError> {
+        Ok(self.setup()?.walker)
+    }
+
+    /// Builds everything the scene file sets up: the walker, its stride settings (the
+    /// `integrator` section) and its gait guess (the `guess` section).
+    pub fn setup(&self) -> Result<Setup, SceneError> {
         let f = &self.file;
         let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
         let slope = self.num(&f.world.slope_rad, "world.slope_rad")?;
@@ -472,7 +502,7 @@ impl Scene {
                 })?;
         let max_stride_time_s = match &it.max_stride_time_s {
             Some(n) => self.num(n, "integrator.max_stride_time_s")?,
-            None => 10.0,
+            None => StrideSettings::default().max_stride_time_s,
         };
         let mut guess_q = DVector::zeros(model.dof());
         let mut guess_qd = DVector::zeros(model.dof());
@@ -505,7 +535,7 @@ impl Scene {
         let mut relabel = relabel;
         relabel.fixed = initially_locked.clone();
         let impact_model = model.with_released_root(&release);
-        Ok(Walker {
+        let walker = Walker {
             name: self.name().to_string(),
             model,
             impact_model,
@@ -513,14 +543,22 @@ impl Scene {
             knees,
             fall,
             relabel,
-            integrator,
-            event_tolerance: EventTolerance::default(),
-            max_stride_time_s,
-            guess_q,
-            guess_qd,
+            relabel_reference_q: guess_q.clone(),
             ankle,
             initially_locked,
             three_d_freedoms: f.three_d_freedoms.clone(),
+        };
+        Ok(Setup {
+            walker,
+            settings: StrideSettings {
+                integrator,
+                event_tolerance: EventTolerance::default(),
+                max_stride_time_s,
+            },
+            guess: GaitGuess {
+                q: guess_q,
+                qd: guess_qd,
+            },
         })
     }
 

@@ -1,0 +1,44 @@
+//! One stride: integrate single stance from just after one heel strike to just after the next,
+//! with knee locks and the ankle string's engagement on the way, then relabel (the stride
+//! function of eq. 22). The one entry point is [`Walker::stride`] with a [`StrideRequest`].
+//!
+//! The folder, by concept:
+//! - `settings`: [`StrideSettings`], the solver settings (integrator, event tolerances, time
+//!   budget), apart from the walker's physics;
+//! - `request`: [`StrideRequest`], what one stride is asked to do (settings, recording, step
+//!   schedule, controller, sample sink);
+//! - `phase`: the smooth dynamics of a phase ([`Phase`], [`Drive`], [`linearised_limit`]);
+//! - `witnesses`: the event witnesses and which of them a step triggers;
+//! - `schedule`: step schedules recorded and replayed ([`StepSchedule`], [`Schedule`]);
+//! - `impacts`: every impact (coordinate locking, string engagement, heel strike) and the
+//!   stride's end ([`Walker::heel_strike_impact`]);
+//! - `energy`: actuator work and damper dissipation;
+//! - `contact_figures`: [`ContactSummary`];
+//! - `run`: the loop ([`Walker::stride`]);
+//! - `result`: [`StrideResult`], [`StrideFailure`], [`FailureKind`], [`StrideEvent`].
+//!
+//! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
+//! model-level methods; walks are [`crate::walk::walk`], gait searches
+//! [`crate::limit_cycle::GaitSearch`]. Times in a stride are stride time (from its start).
+//!
+//! [`Walker::stride`]: crate::walker::Walker::stride
+//! [`Walker::heel_strike_impact`]: crate::walker::Walker::heel_strike_impact
+
+mod contact_figures;
+mod energy;
+mod impacts;
+mod phase;
+mod request;
+mod result;
+mod run;
+mod schedule;
+mod settings;
+mod witnesses;
+
+pub use contact_figures::ContactSummary;
+pub use impacts::HeelStrikeImpact;
+pub use phase::{linearised_limit, Drive, Phase};
+pub use request::{StrideControl, StrideOptions, StrideRequest};
+pub use result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+pub use schedule::{Schedule, StepSchedule};
+pub use settings::StrideSettings;

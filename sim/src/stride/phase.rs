@@ -1,0 +1,165 @@
+//! The smooth dynamics of one phase of a stride: which coordinates are free, which one is
+//! driven and how ([`Drive`]), and the stability limit of eq. (12) for fixed-step integrators.
+
+use crate::actuator::AnkleProfile;
+use crate::control::ActuatorSegment;
+use crate::dynamics::{Dynamics, DynamicsError};
+use crate::hybrid::phase::DriveValues;
+use crate::integrators::{Sample, SecondOrderSystem, StabilityLimit};
+use crate::model::{CoordIndex, Model};
+use nalgebra::{DMatrix, DVector};
+
+/// How a driven coordinate moves (times are from the start of the stride).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drive {
+    /// The ideal actuator's smooth extension.
+    Profile(AnkleProfile),
+    /// A controller's actuator over the current control tick.
+    Segment(ActuatorSegment),
+}
+
+impl Drive {
+    /// Angle [rad], rate [rad/s], acceleration [rad/s²] at stride time `t_stride_s` [s].
+    pub fn eval(&self, t_stride_s: f64) -> (f64, f64, f64) {
+        match self {
+            Drive::Profile(p) => p.eval(t_stride_s),
+            Drive::Segment(s) => s.eval(t_stride_s),
+        }
+    }
+}
+
+/// The smooth dynamics of one phase (which coordinates are free).
+pub struct Phase<'a> {
+    model: &'a Model,
+    dynamics: Dynamics,
+    /// Which coordinates are free to move.
+    pub active: Vec<bool>,
+    /// A coordinate driven along a profile (not free, not locked).
+    pub prescribed: Option<(CoordIndex, Drive)>,
+}
+
+impl<'a> Phase<'a> {
+    /// All coordinates active.
+    pub fn new(model: &'a Model) -> Self {
+        Self {
+            model,
+            dynamics: Dynamics::new(model),
+            active: vec![true; model.dof()],
+            prescribed: None,
+        }
+    }
+
+    /// Puts the prescribed coordinate of `s` exactly on its profile.
+    pub fn snap(&self, s: &mut Sample) {
+        if let Some((c, p)) = &self.prescribed {
+            let (a, ad, _) = p.eval(s.t_s);
+            s.q[c.0] = a;
+            s.qd[c.0] = ad;
+        }
+    }
+
+    /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
+    /// coordinate's rate: their product is the actuator power.
+    pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
+        let Some((c, _)) = self.prescribed else {
+            return Ok((0.0, 0.0));
+        };
+        let qdd = self.accelerations(s.t_s, &s.q, &s.qd)?;
+        let m = &self.dynamics.mass_matrix;
+        let tau = (m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0];
+        Ok((tau, s.qd[c.0]))
+    }
+}
+
+impl SecondOrderSystem for Phase<'_> {
+    fn accelerations(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        let drive = self.prescribed.map(|(c, p)| {
+            let (angle_rad, rate_rad_s, acceleration_rad_s2) = p.eval(t);
+            DriveValues {
+                coordinate: c.0,
+                angle_rad,
+                rate_rad_s,
+                acceleration_rad_s2,
+            }
+        });
+        crate::hybrid::phase::accelerations(
+            self.model,
+            &mut self.dynamics,
+            &self.active,
+            drive.as_ref(),
+            q,
+            qd,
+        )
+    }
+
+    fn stability_limit(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Option<StabilityLimit> {
+        linearised_limit(self.model, &mut self.dynamics, q, qd, &self.active)
+    }
+}
+
+/// `λ_max` and `β` of eq. (12) from the linearisation `M̄ δq̈ + C δq̇ + K δq = 0`, with
+/// `K = −∂f̄/∂q` and `C = −∂f̄/∂q̇` by central differences. `β` is estimated conservatively as
+/// `ρ(M̄⁻¹C) / (2 λ_max)`.
+pub fn linearised_limit(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    active: &[bool],
+) -> Option<StabilityLimit> {
+    let idx: Vec<usize> = (0..q.len()).filter(|&i| active[i]).collect();
+    let n = idx.len();
+    if n == 0 || model.has_infinitesimal_bodies() {
+        return None;
+    }
+    dynamics.assemble(model, q, qd, None);
+    let m = dynamics.mass_matrix.select_rows(&idx).select_columns(&idx);
+    let mut k = DMatrix::zeros(n, n);
+    let mut c = DMatrix::zeros(n, n);
+    let d = 1e-6;
+    for (col, &i) in idx.iter().enumerate() {
+        for (target, is_q) in [(&mut k, true), (&mut c, false)] {
+            let (mut qp, mut qm, mut vp, mut vm) = (q.clone(), q.clone(), qd.clone(), qd.clone());
+            if is_q {
+                qp[i] += d;
+                qm[i] -= d;
+            } else {
+                vp[i] += d;
+                vm[i] -= d;
+            }
+            dynamics.assemble(model, &qp, &vp, None);
+            let fp = dynamics.force.select_rows(&idx);
+            dynamics.assemble(model, &qm, &vm, None);
+            let fm = dynamics.force.select_rows(&idx);
+            target.set_column(col, &((fm - fp) / (2.0 * d)));
+        }
+    }
+    let minv = m.try_inverse()?;
+    let mk = (&minv * k).complex_eigenvalues();
+    let lambda2 = mk.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
+    let damping = (&minv * c)
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max);
+    let lambda = lambda2.sqrt();
+    let beta = if lambda > 0.0 {
+        (damping / (2.0 * lambda)).min(1.0)
+    } else {
+        0.0
+    };
+    Some(StabilityLimit {
+        lambda_max_rad_s: lambda,
+        beta,
+    })
+}

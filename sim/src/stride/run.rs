@@ -1,0 +1,581 @@
+//! The stride loop ([`Walker::stride`]): from just after one heel strike, step the smooth
+//! dynamics of the current phase; at each step run the control tick, the grazing check and
+//! the witnesses; locate the earliest triggered event and apply it (an impact, which starts
+//! a new phase; a failure; or heel strike, which ends the stride).
+//!
+//! Times inside a stride are stride time (from its start); a controller's ticks are on its own
+//! grid of walk time, shifted by the walk time at the start of the stride.
+
+use super::contact_figures::ContactSummary;
+use super::energy::Power;
+use super::phase::{Drive, Phase};
+use super::request::{StrideControl, StrideOptions, StrideRequest};
+use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+use super::schedule::ScheduleCursor;
+use super::settings::StrideSettings;
+use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
+use crate::actuator::AnkleProfile;
+use crate::control::{ActuatorSegment, AnkleSensing};
+use crate::events::locate;
+use crate::hermite::{self, Knot};
+use crate::integrators::{Integrator, Sample};
+use crate::walker::Walker;
+use nalgebra::DVector;
+
+impl Walker {
+    /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
+    /// `request` asks: its settings, what it records, its step schedule, its controller.
+    ///
+    /// # Errors
+    /// A [`StrideFailure`] saying how and when (stride time) the stride failed; samples
+    /// recorded into the request's sink up to the failure are kept there.
+    pub fn stride(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        request: StrideRequest<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let StrideRequest {
+            settings,
+            options,
+            schedule,
+            control,
+            sink,
+        } = request;
+        if control.is_some() && self.ankle.is_none() {
+            return Err(StrideFailure::new(
+                FailureKind::NonFiniteState,
+                0.0,
+                "a controlled stride needs a scene with an ankle_reflex section",
+            ));
+        }
+        let mut own = Vec::new();
+        let keep_in_result = sink.is_none();
+        let trajectory = match sink {
+            Some(s) => s,
+            None => &mut own,
+        };
+        let cur = Sample {
+            t_s: 0.0,
+            q: q0.clone(),
+            qd: qd0.clone(),
+        };
+        let run = Run::new(self, settings, options, schedule, control, trajectory, cur);
+        let mut r = run?.run()?;
+        if keep_in_result {
+            r.trajectory = own;
+        }
+        Ok(r)
+    }
+}
+
+/// What a located event did to the stride.
+enum Applied {
+    /// An impact named so: a new smooth phase starts from the state after it.
+    Impact(String),
+    /// A mid-swing scuff the scene ignores: the step is accepted as it was.
+    Ignored,
+    /// Nothing: the event does not apply to this walker.
+    Skipped,
+    /// Heel strike: the stride is complete.
+    Done(Box<StrideResult>),
+}
+
+/// One stride in progress.
+struct Run<'w, 'r, 't> {
+    walker: &'w Walker,
+    settings: &'r StrideSettings,
+    options: StrideOptions,
+    integrator: Box<dyn Integrator>,
+    schedule: ScheduleCursor<'r>,
+    /// Evaluations of earlier phases (the integrator restarts after each impact).
+    evaluations: usize,
+    phase: Phase<'w>,
+    power: Power,
+    contact: ContactSummary,
+    wit: Witnesses<'w>,
+    /// Witness values at `cur`, carried over from the previous step.
+    w_cached: Option<WitnessValues>,
+    /// The last accepted sample.
+    cur: Sample,
+    events: Vec<StrideEvent>,
+    event_states: Vec<(Sample, Sample)>,
+    energy_loss_j: f64,
+    trajectory: &'t mut Vec<Sample>,
+    control: Option<StrideControl<'r>>,
+    /// Control ticks: on the walk-time grid `k · period`, here in stride time [s].
+    period_s: f64,
+    next_tick_s: f64,
+    /// The stance string's limit over the current tick (stride time), from the controller.
+    segment: Option<ActuatorSegment>,
+}
+
+impl<'w, 'r, 't> Run<'w, 'r, 't> {
+    fn new(
+        walker: &'w Walker,
+        settings: &'r StrideSettings,
+        options: StrideOptions,
+        schedule: super::Schedule<'r>,
+        control: Option<StrideControl<'r>>,
+        trajectory: &'t mut Vec<Sample>,
+        cur: Sample,
+    ) -> Result<Self, StrideFailure> {
+        let mut integrator = settings.integrator.build();
+        integrator.reset();
+        let mut phase = Phase::new(&walker.model);
+        for c in &walker.initially_locked {
+            phase.active[c.0] = false;
+        }
+        if cur.q.iter().chain(cur.qd.iter()).any(|v| !v.is_finite()) {
+            return Err(StrideFailure::new(
+                FailureKind::NonFiniteState,
+                0.0,
+                "initial state",
+            ));
+        }
+        if options.record {
+            trajectory.push(cur.clone());
+        }
+        let (period_s, t_walk0) = match &control {
+            Some(c) => (c.controller.period_s(), c.t_walk_start_s),
+            None => (f64::INFINITY, 0.0),
+        };
+        let next_tick_s = if period_s.is_finite() {
+            (t_walk0 / period_s - 1e-9).ceil() * period_s - t_walk0
+        } else {
+            f64::INFINITY
+        };
+        Ok(Self {
+            walker,
+            settings,
+            options,
+            integrator,
+            schedule: ScheduleCursor::new(schedule),
+            evaluations: 0,
+            phase,
+            power: Power::new(&walker.model),
+            contact: ContactSummary::default(),
+            wit: Witnesses::new(walker),
+            w_cached: None,
+            cur,
+            events: Vec::new(),
+            event_states: Vec::new(),
+            energy_loss_j: 0.0,
+            trajectory,
+            control,
+            period_s,
+            next_tick_s,
+            segment: None,
+        })
+    }
+
+    /// The loop: step, check, locate, apply, until heel strike or a failure.
+    fn run(mut self) -> Result<StrideResult, StrideFailure> {
+        loop {
+            self.control_tick()?;
+            if self.cur.t_s > self.settings.max_stride_time_s {
+                return Err(StrideFailure::new(
+                    FailureKind::NoImpactWithinTime,
+                    self.cur.t_s,
+                    format!(
+                        "no heel strike within {} s",
+                        self.settings.max_stride_time_s
+                    ),
+                ));
+            }
+            let drive_end_s = self.drive_end_s();
+            let next = self.step(drive_end_s)?;
+            let (next, w_cur, w_next) = self.grazing_check(next)?;
+            let limit = self.string_limit();
+            let triggered =
+                self.wit
+                    .triggered(&self.phase, limit, (&self.cur, &w_cur), (&next, &w_next));
+            if triggered.is_empty() {
+                self.accept(next, drive_end_s)?;
+                continue;
+            }
+            let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
+                continue;
+            };
+            self.phase.snap(&mut at);
+            self.power.accumulate(&self.cur, &at);
+            match self.apply(watch, &at)? {
+                Applied::Done(result) => return Ok(*result),
+                Applied::Ignored => self.accept_ignored(&at, next),
+                Applied::Skipped => {}
+                Applied::Impact(name) => self.after_impact(name, at),
+            }
+        }
+    }
+
+    /// A control tick, when one is due: the controller sees the stance ankle and sets the
+    /// string's limit until the next tick.
+    fn control_tick(&mut self) -> Result<(), StrideFailure> {
+        let Some(control) = self.control.as_mut() else {
+            return Ok(());
+        };
+        if self.cur.t_s < self.next_tick_s - 1e-12 {
+            return Ok(());
+        }
+        let (cur, phase) = (&mut self.cur, &mut self.phase);
+        let fail = |t: f64| move |e: String| StrideFailure::new(FailureKind::NonFiniteState, t, e);
+        let t0 = control.t_walk_start_s;
+        let w = self.wit.eval(cur);
+        let (a, engaged) = match &self.walker.ankle {
+            Some(r) => (r.ankle.0, phase.prescribed.is_some()),
+            None => (0, false),
+        };
+        let sensing = AnkleSensing {
+            t_walk_s: t0 + cur.t_s,
+            stance_ankle_rad: cur.q[a],
+            stance_ankle_rate_rad_s: cur.qd[a],
+            stance_foot_on_floor: true,
+            swing_foot_on_floor: w.foot_height_m <= 1e-9,
+            string_engaged: engaged,
+            string_torque_n_m: if engaged {
+                phase
+                    .actuator_torque(cur)
+                    .map_err(|e| fail(cur.t_s)(e.to_string()))?
+                    .0
+            } else {
+                0.0
+            },
+        };
+        let mut seg = control
+            .controller
+            .tick(&sensing)
+            .map_err(|e| fail(cur.t_s)(e.to_string()))?;
+        seg.t0_s -= t0;
+        seg.t1_s -= t0;
+        if let Some((coord, Drive::Segment(_))) = phase.prescribed {
+            if seg.released {
+                // The string goes slack during the push (an emergency stop, a fault): no
+                // impulse, the ankle is free again, and the foot keeps pivoting about its toe
+                // until the heel comes back down or the stride ends.
+                self.power.close(&self.walker.model, cur);
+                phase.prescribed = None;
+                phase.active[coord.0] = true;
+                self.integrator.system_changed();
+                self.events.push(StrideEvent {
+                    name: "string_released".into(),
+                    t_stride_s: cur.t_s,
+                });
+                self.event_states.push((cur.clone(), cur.clone()));
+            } else {
+                phase.prescribed = Some((coord, Drive::Segment(seg)));
+                phase.snap(cur);
+            }
+        }
+        // Only an engaged string's new segment changes the vector field; while the ankle is
+        // free the tick only moves the engagement witness, and the integrator keeps its last
+        // stage (first same as last).
+        if phase.prescribed.is_some() {
+            self.integrator.system_changed();
+        }
+        self.segment = Some(seg);
+        self.next_tick_s += self.period_s;
+        Ok(())
+    }
+
+    /// The ideal drive's profile ends with a jump in its jerk: a breakpoint, so that no step
+    /// straddles it (the step sizes stay smooth functions of the initial state, and replayed
+    /// schedules stay accurate when the end moves). ∞ when there is none ahead.
+    fn drive_end_s(&self) -> f64 {
+        match self.phase.prescribed {
+            Some((_, Drive::Profile(p))) if self.cur.t_s < p.start_s + p.duration_s - 1e-12 => {
+                p.start_s + p.duration_s
+            }
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// One integrator step from `cur`, up to the next tick or breakpoint (replayed when the
+    /// schedule says so).
+    fn step(&mut self, drive_end_s: f64) -> Result<Sample, StrideFailure> {
+        let cur = &self.cur;
+        let h_limit = (self.next_tick_s.min(drive_end_s) - cur.t_s).max(1e-12);
+        let mut next = match self.schedule.replayed() {
+            Some(h) => self
+                .integrator
+                .step_exact(&mut self.phase, cur, h.min(h_limit)),
+            None => self.integrator.advance(&mut self.phase, cur, h_limit),
+        }
+        .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+        self.phase.snap(&mut next);
+        if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
+            return Err(StrideFailure::new(
+                FailureKind::NonFiniteState,
+                next.t_s,
+                "state",
+            ));
+        }
+        Ok(next)
+    }
+
+    /// A grazing contact: the foot height is positive at both ends of the step but dips below
+    /// the floor inside it. The cubic Hermite interpolant of the height (from its values and
+    /// rates at both ends) is checked at interior points; if the exact flow confirms a dip, the
+    /// step is shortened to end inside it. Returns the step's end and the witness values at
+    /// both ends.
+    fn grazing_check(
+        &mut self,
+        mut next: Sample,
+    ) -> Result<(Sample, WitnessValues, WitnessValues), StrideFailure> {
+        let cur = &self.cur;
+        let w_cur = match self.w_cached {
+            Some(w) if w.t_s == cur.t_s => w,
+            _ => self.wit.eval(cur),
+        };
+        let mut w_next = self.wit.eval(&next);
+        if w_cur.foot_height_m > 0.0 && w_next.foot_height_m > 0.0 {
+            let n = self.settings.event_tolerance.grazing_samples;
+            let h = next.t_s - cur.t_s;
+            let knot = |w: &WitnessValues| Knot {
+                value: w.foot_height_m,
+                rate: w.foot_height_rate_m_s,
+            };
+            let height_at = |x: f64| hermite::scalar(knot(&w_cur), knot(&w_next), h, x).0;
+            if let Some(k) = (1..=n).find(|&k| height_at(k as f64 / (n + 1) as f64) <= 0.0) {
+                let t = cur.t_s + h * k as f64 / (n + 1) as f64;
+                let mut s = self
+                    .integrator
+                    .step_exact(&mut self.phase, cur, t - cur.t_s)
+                    .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+                self.phase.snap(&mut s);
+                let ws = self.wit.eval(&s);
+                if ws.foot_height_m <= 0.0 {
+                    next = s;
+                    w_next = ws;
+                }
+            }
+        }
+        self.w_cached = Some(w_next);
+        Ok((next, w_cur, w_next))
+    }
+
+    /// The string's limit the engagement witness compares with.
+    fn string_limit(&self) -> StringLimit {
+        match (&self.walker.ankle, &self.control, &self.segment) {
+            (None, _, _) => StringLimit::Slack,
+            (Some(r), None, _) => StringLimit::Fixed(r.engage_rad),
+            (Some(_), Some(_), Some(seg)) if !seg.released => StringLimit::Moving(*seg),
+            (Some(_), Some(_), _) => StringLimit::Slack,
+        }
+    }
+
+    /// A step without events: accepted.
+    fn accept(&mut self, next: Sample, drive_end_s: f64) -> Result<(), StrideFailure> {
+        self.power.accumulate(&self.cur, &next);
+        if self.options.contact {
+            self.contact
+                .add(self.walker, &mut self.phase, &mut self.wit, &next)
+                .map_err(|e| {
+                    StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
+                })?;
+        }
+        self.schedule.stepped(next.t_s - self.cur.t_s);
+        if next.t_s >= drive_end_s - 1e-12 {
+            // A new smooth phase: the schedule and the integrator's memory restart.
+            self.integrator.system_changed();
+            self.schedule.next_phase();
+        }
+        self.record(next);
+        Ok(())
+    }
+
+    /// A step whose only event was an ignored scuff: accepted (its damping from the scuff on).
+    fn accept_ignored(&mut self, at: &Sample, next: Sample) {
+        self.power.accumulate(at, &next);
+        self.schedule.stepped(next.t_s - self.cur.t_s);
+        self.record(next);
+    }
+
+    /// `s` becomes the current sample (and is recorded when asked).
+    fn record(&mut self, s: Sample) {
+        self.cur = s;
+        if self.options.record {
+            self.trajectory.push(self.cur.clone());
+        }
+    }
+
+    /// Locates each triggered event on the step `cur` → `next` and takes the earliest. A
+    /// mid-swing scuff that is ignored must not hide a later event of the same step (a knee
+    /// lock, the string's engagement): that one is taken instead.
+    fn earliest(
+        &mut self,
+        triggered: &[Watch],
+        next: &Sample,
+    ) -> Result<Option<(Watch, Sample)>, StrideFailure> {
+        let limit = self.string_limit();
+        let mut located: Vec<(Watch, Sample)> = Vec::new();
+        for &watch in triggered {
+            let wit = &mut self.wit;
+            let s = locate(
+                self.integrator.as_mut(),
+                &mut self.phase,
+                &self.cur,
+                next,
+                &mut |s: &Sample| wit.value(watch, limit, s),
+                &self.settings.event_tolerance,
+            )
+            .map_err(|e| StrideFailure::from_event(e, self.cur.t_s))?;
+            located.push((watch, s));
+        }
+        located.sort_by(|a, b| a.1.t_s.total_cmp(&b.1.t_s));
+        let hs = &self.walker.heel_strike;
+        if located.len() > 1
+            && located[0].0 == Watch::Heel
+            && hs.ignore_scuffing
+            && self.wit.eval(&located[0].1).foot_ahead_m < hs.min_ahead_m
+        {
+            located.remove(0);
+        }
+        Ok(located.into_iter().next())
+    }
+
+    /// Applies the event `watch` located at `at`.
+    fn apply(&mut self, watch: Watch, at: &Sample) -> Result<Applied, StrideFailure> {
+        let w = self.walker;
+        let fail = |kind, detail: &str| Err(StrideFailure::new(kind, at.t_s, detail));
+        match watch {
+            Watch::HipLow => {
+                let kind = if self.wit.eval(at).hip_ahead_m >= 0.0 {
+                    FailureKind::FellForward
+                } else {
+                    FailureKind::FellBackward
+                };
+                fail(kind, "hip below its minimum height")
+            }
+            Watch::HipBack => fail(
+                FailureKind::FellBackward,
+                "hip moved back behind the stance contact",
+            ),
+            Watch::HeelDrop => {
+                if self.phase.prescribed.is_some() {
+                    // The drive still holds the ankle: the push has failed.
+                    return fail(
+                        FailureKind::HeelReturnedToFloor,
+                        "the stance heel came back down during push-off",
+                    );
+                }
+                // The string is slack: the heel lands, an inelastic impact that stops the
+                // foot's pitch about its toe; the foot is flat again, the ankle free.
+                let Some(r) = &w.ankle else {
+                    return Ok(Applied::Skipped);
+                };
+                let toe = r.toe_pitch.0;
+                let l = w.lock_coordinate(&self.phase, at, toe, 0.0)?;
+                self.phase.active[toe] = false;
+                self.cur = l.after;
+                self.energy_loss_j += l.loss_j;
+                Ok(Applied::Impact("heel_down".into()))
+            }
+            Watch::Engage => {
+                let Some(r) = &w.ankle else {
+                    return Ok(Applied::Skipped);
+                };
+                // The string's far end: fixed (ideal reflex) or moving with the actuator.
+                let drive = match (&self.control, self.segment) {
+                    (Some(_), Some(seg)) => Drive::Segment(seg),
+                    _ => Drive::Profile(AnkleProfile {
+                        start_s: at.t_s,
+                        duration_s: r.duration_s,
+                        from_rad: r.engage_rad,
+                        to_rad: r.final_rad,
+                    }),
+                };
+                let e = w.engage_string(&self.phase, at, r, &drive)?;
+                self.power.work_j += e.drive_work_j;
+                self.energy_loss_j += e.drive_work_j;
+                self.cur = e.after;
+                self.energy_loss_j += e.dissipated_j;
+                self.phase.active = e.active;
+                self.phase.prescribed = Some((r.ankle, drive));
+                self.power.open(&w.model, &self.cur);
+                Ok(Applied::Impact("string_engaged".into()))
+            }
+            Watch::Knee(k) => {
+                let c = w.knees[k].coordinate.0;
+                self.power.close(&w.model, at);
+                let l = w.lock_coordinate(&self.phase, at, c, w.knees[k].stop_rad)?;
+                self.phase.active[c] = false;
+                self.cur = l.after;
+                self.power.work_j += l.drive_work_j;
+                self.energy_loss_j += l.loss_j;
+                if self.phase.prescribed.is_some() {
+                    self.power.open(&w.model, &self.cur);
+                }
+                Ok(Applied::Impact(format!(
+                    "knee_lock:{}",
+                    w.model.coordinates[c].name
+                )))
+            }
+            Watch::Heel => self.heel_strike(at),
+        }
+    }
+
+    /// The swing foot reached the floor at `at`: a scuff (ignored or a failure), or heel strike,
+    /// which ends the stride.
+    fn heel_strike(&mut self, at: &Sample) -> Result<Applied, StrideFailure> {
+        let w = self.walker;
+        let ahead = self.wit.eval(at).foot_ahead_m;
+        if ahead < w.heel_strike.min_ahead_m {
+            if w.heel_strike.ignore_scuffing {
+                return Ok(Applied::Ignored);
+            }
+            return Err(StrideFailure::new(
+                FailureKind::Scuffed,
+                at.t_s,
+                format!("swing foot touched the floor {ahead:.4} m ahead of the stance contact"),
+            ));
+        }
+        if let Some(knee) = w.knees.iter().find(|k| self.phase.active[k.coordinate.0]) {
+            return Err(StrideFailure::new(
+                FailureKind::HeelStrikeBeforeKneeLock,
+                at.t_s,
+                format!(
+                    "knee `{}` still free at heel strike",
+                    w.model.coordinates[knee.coordinate.0].name
+                ),
+            ));
+        }
+        self.power.close(&w.model, at);
+        if let Some(c) = self.control.as_mut() {
+            c.controller.heel_strike(c.t_walk_start_s + at.t_s);
+        }
+        self.events.push(StrideEvent {
+            name: "heel_strike".into(),
+            t_stride_s: at.t_s,
+        });
+        self.event_states.push((at.clone(), at.clone()));
+        if self.options.record {
+            self.trajectory.push(at.clone());
+        }
+        self.evaluations += self.integrator.evaluations();
+        let events = std::mem::take(&mut self.events);
+        let mut r = w.finish_stride(at.clone(), &self.phase.active, events, self.energy_loss_j)?;
+        r.actuator_work_j = self.power.work_j;
+        r.event_states = std::mem::take(&mut self.event_states);
+        r.evaluations = self.evaluations;
+        r.contact = std::mem::take(&mut self.contact);
+        r.damping_dissipation_j = self.power.dissipation_j;
+        Ok(Applied::Done(Box::new(r)))
+    }
+
+    /// After an impact at `at` (the state after it already in `cur`): the event is written
+    /// down, and the integrator and the step schedule start a new phase.
+    fn after_impact(&mut self, name: String, at: Sample) {
+        self.events.push(StrideEvent {
+            name,
+            t_stride_s: at.t_s,
+        });
+        self.event_states.push((at, self.cur.clone()));
+        // The integrator restarts after an impact; its evaluations so far are kept.
+        self.evaluations += self.integrator.evaluations();
+        self.integrator.reset();
+        self.schedule.next_phase();
+        if self.options.record {
+            self.trajectory.push(self.cur.clone());
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! What the stride loop watches: the witness functions of its events, evaluated from one
+//! kinematics update of a sample, and which of them a step triggers.
+//!
+//! Each event is a [`Watch`]; [`Witnesses::value`] evaluates its witness at any sample (for
+//! event location), [`Witnesses::triggered`] lists the watches whose witnesses changed sign in
+//! their direction over a step, in a fixed order (heel, knees, hip low, hip back, string
+//! engagement, heel drop) that breaks ties between events located at the same time.
+
+use super::phase::Phase;
+use crate::control::ActuatorSegment;
+use crate::events::Direction;
+use crate::integrators::Sample;
+use crate::kinematics::Kinematics;
+use crate::walker::Walker;
+use nalgebra::Vector3;
+
+/// An event the stride loop watches for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Watch {
+    /// The swing foot reaches the floor (heel strike, or a scuff).
+    Heel,
+    /// Knee `k` of [`Walker::knees`] reaches its stop.
+    Knee(usize),
+    /// The hip falls below its minimum height.
+    HipLow,
+    /// The hip, behind the stance contact, starts moving backward.
+    HipBack,
+    /// The stance ankle reaches the string's limit: the string becomes taut.
+    Engage,
+    /// The stance heel comes back down to the floor.
+    HeelDrop,
+}
+
+/// The string's limit on the stance ankle angle, which the engagement witness compares with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum StringLimit {
+    /// The ideal reflex: a fixed engagement angle [rad].
+    Fixed(f64),
+    /// A controller's segment over the current tick (stride time).
+    Moving(ActuatorSegment),
+    /// No limit: the string is slack (released, or no tick yet).
+    Slack,
+}
+
+impl StringLimit {
+    /// The limit angle [rad] at stride time `t_stride_s`, if any.
+    fn at(&self, t_stride_s: f64) -> Option<f64> {
+        match self {
+            StringLimit::Fixed(e) => Some(*e),
+            StringLimit::Moving(seg) => Some(seg.eval(t_stride_s).0),
+            StringLimit::Slack => None,
+        }
+    }
+}
+
+/// Everything the stride loop watches, from one kinematics evaluation of a sample.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct WitnessValues {
+    /// Stride time of the sample [s].
+    pub(super) t_s: f64,
+    pub(super) foot_height_m: f64,
+    pub(super) foot_height_rate_m_s: f64,
+    pub(super) foot_ahead_m: f64,
+    pub(super) hip_height_margin_m: f64,
+    pub(super) hip_ahead_m: f64,
+    pub(super) hip_forward_velocity_m_s: f64,
+}
+
+/// Witness values at a sample: what the stride loop watches.
+pub(super) struct Witnesses<'a> {
+    pub(super) walker: &'a Walker,
+    pub(super) kin: Kinematics,
+}
+
+impl<'a> Witnesses<'a> {
+    pub(super) fn new(walker: &'a Walker) -> Self {
+        Self {
+            walker,
+            kin: Kinematics::new(&walker.model),
+        }
+    }
+
+    pub(super) fn update(&mut self, s: &Sample) {
+        self.kin.update(&self.walker.model, &s.q, &s.qd);
+    }
+
+    pub(super) fn eval(&mut self, s: &Sample) -> WitnessValues {
+        self.update(s);
+        let m = &self.walker.model;
+        let foot = &m.points[self.walker.heel_strike.swing_foot.0];
+        let p_foot = self.kin.position_of(foot.link, &foot.p_link_m);
+        let hip = &m.points[self.walker.fall.hip.0];
+        let p_hip = self.kin.position_of(hip.link, &hip.p_link_m);
+        let p_contact = self
+            .kin
+            .point_position(m, self.walker.heel_strike.stance_contact);
+        let heading = self.heading();
+        WitnessValues {
+            t_s: s.t_s,
+            foot_height_m: p_foot.y,
+            foot_height_rate_m_s: self.kin.velocity_of(foot.link, &p_foot).y,
+            foot_ahead_m: (p_foot - p_contact).dot(&heading),
+            hip_height_margin_m: p_hip.y - self.walker.fall.min_hip_height_m,
+            hip_ahead_m: (p_hip - p_contact).dot(&heading),
+            hip_forward_velocity_m_s: self.kin.velocity_of(hip.link, &p_hip).dot(&heading),
+        }
+    }
+
+    /// The walking direction: the stance contact link's forward axis, level with the floor.
+    pub(super) fn heading(&self) -> Vector3<f64> {
+        let m = &self.walker.model;
+        let link = m.points[self.walker.heel_strike.stance_contact.0].link;
+        let mut d = self.kin.r_floor_link[link.0] * Vector3::x();
+        d.y = 0.0;
+        let n = d.norm();
+        if n > 1e-9 {
+            d / n
+        } else {
+            Vector3::x()
+        }
+    }
+
+    /// The witness of `watch` at `s` (its zero is the event), with the string's `limit`.
+    pub(super) fn value(&mut self, watch: Watch, limit: StringLimit, s: &Sample) -> f64 {
+        let w = self.walker;
+        match watch {
+            Watch::Heel => self.eval(s).foot_height_m,
+            Watch::Knee(k) => s.q[w.knees[k].coordinate.0] - w.knees[k].stop_rad,
+            Watch::HipLow => self.eval(s).hip_height_margin_m,
+            Watch::HipBack => self.eval(s).hip_forward_velocity_m_s,
+            Watch::Engage => {
+                let a = w.ankle.as_ref().map_or(0, |r| r.ankle.0);
+                s.q[a] - limit.at(s.t_s).unwrap_or(0.0)
+            }
+            Watch::HeelDrop => s.q[w.ankle.as_ref().map_or(0, |r| r.toe_pitch.0)],
+        }
+    }
+
+    /// The watches whose witnesses changed sign in their direction over the step `cur` →
+    /// `next` (witness values `w_cur`, `w_next`), in tie-breaking order.
+    pub(super) fn triggered(
+        &self,
+        phase: &Phase,
+        limit: StringLimit,
+        (cur, w_cur): (&Sample, &WitnessValues),
+        (next, w_next): (&Sample, &WitnessValues),
+    ) -> Vec<Watch> {
+        let w = self.walker;
+        let mut triggered: Vec<Watch> = Vec::new();
+        if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
+            triggered.push(Watch::Heel);
+        }
+        for (k, knee) in w.knees.iter().enumerate() {
+            let c = knee.coordinate.0;
+            if phase.active[c]
+                && knee
+                    .closing
+                    .triggered(cur.q[c] - knee.stop_rad, next.q[c] - knee.stop_rad)
+            {
+                triggered.push(Watch::Knee(k));
+            }
+        }
+        if Direction::Falling.triggered(w_cur.hip_height_margin_m, w_next.hip_height_margin_m) {
+            triggered.push(Watch::HipLow);
+        }
+        if w_next.hip_ahead_m < 0.0
+            && Direction::Falling.triggered(
+                w_cur.hip_forward_velocity_m_s,
+                w_next.hip_forward_velocity_m_s,
+            )
+        {
+            triggered.push(Watch::HipBack);
+        }
+        if let Some(r) = &w.ankle {
+            let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+            let flat = !phase.active[toe] && phase.prescribed.is_none();
+            if let (true, Some(l0), Some(l1)) = (flat, limit.at(cur.t_s), limit.at(next.t_s)) {
+                if Direction::Falling.triggered(cur.q[a] - l0, next.q[a] - l1) {
+                    triggered.push(Watch::Engage);
+                }
+            }
+            if phase.active[toe] && Direction::Rising.triggered(cur.q[toe], next.q[toe]) {
+                triggered.push(Watch::HeelDrop);
+            }
+        }
+        triggered
+    }
+}
