@@ -19,6 +19,9 @@ use std::fmt;
 
 use thiserror::Error;
 
+use crate::frame::Frame;
+use crate::spec::{self, Spec, SpecError};
+
 /// A node named in a fault: by name or by its number (the protocol's 4-bit node field).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum NodeRef {
@@ -201,133 +204,83 @@ fn parse_node(s: &str) -> Option<NodeRef> {
         .then(|| NodeRef::Name(s.to_string()))
 }
 
+/// A time in milliseconds (finite, 0 to 10¹² ms) as nanoseconds.
 fn parse_ms_to_ns(s: &str) -> Option<u64> {
-    let ms: f64 = s.parse().ok()?;
-    (ms.is_finite() && (0.0..=1e12).contains(&ms)).then(|| (ms * 1e6).round() as u64)
+    spec::parse_ms(s)
+        .filter(|ms| *ms <= 1e12)
+        .map(|ms| (ms * 1e6).round() as u64)
+}
+
+impl From<SpecError> for FaultParseError {
+    /// The same refusal, worded for a bus fault.
+    fn from(e: SpecError) -> Self {
+        match e {
+            SpecError::UnknownKind { kind } => FaultParseError::UnknownKind { kind },
+            SpecError::NotKeyValue { kind, part } => FaultParseError::NotKeyValue { kind, part },
+            SpecError::UnknownKey { kind, key, allowed } => {
+                FaultParseError::UnknownKey { kind, key, allowed }
+            }
+            SpecError::DuplicateKey { kind, key } => FaultParseError::DuplicateKey { kind, key },
+            SpecError::BadValue {
+                kind,
+                key,
+                value,
+                reason,
+            } => FaultParseError::BadValue {
+                kind,
+                key,
+                value,
+                reason,
+            },
+            SpecError::MissingKey { kind, key } => FaultParseError::MissingKey { kind, key },
+        }
+    }
 }
 
 impl std::str::FromStr for FaultSpec {
     type Err = FaultParseError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let (kind, rest) = match s.split_once(':') {
-            Some((k, r)) => (k.trim(), Some(r)),
-            None => (s.trim(), None),
-        };
-        let kind_s = kind.to_string();
-        let allowed = allowed_keys(kind).ok_or_else(|| FaultParseError::UnknownKind {
-            kind: kind_s.clone(),
+        let spec = Spec::parse(s, allowed_keys)?;
+        let ms = "a non-negative number of milliseconds";
+        let id = spec.optional(
+            "id",
+            "an 11-bit identifier, 0x000..0x7FF or 0..2047",
+            parse_id,
+        )?;
+        let node = spec.optional(
+            "node",
+            "a node name (letters, digits, _ or -) or number 0..255",
+            parse_node,
+        )?;
+        let prob = spec.optional("prob", "a probability between 0 and 1", |v| {
+            v.parse::<f64>().ok().filter(|p| (0.0..=1.0).contains(p))
         })?;
-        let mut pairs: Vec<(String, String)> = Vec::new();
-        if let Some(rest) = rest {
-            for part in rest.split(',') {
-                let part = part.trim();
-                let Some((k, v)) = part.split_once('=') else {
-                    return Err(FaultParseError::NotKeyValue {
-                        kind: kind_s,
-                        part: part.to_string(),
-                    });
-                };
-                let (k, v) = (k.trim(), v.trim());
-                if !allowed.split(", ").any(|a| a == k) {
-                    return Err(FaultParseError::UnknownKey {
-                        kind: kind_s,
-                        key: k.to_string(),
-                        allowed,
-                    });
-                }
-                if pairs.iter().any(|(pk, _)| pk == k) {
-                    return Err(FaultParseError::DuplicateKey {
-                        kind: kind_s,
-                        key: k.to_string(),
-                    });
-                }
-                pairs.push((k.to_string(), v.to_string()));
-            }
-        }
-        let get = |key: &str| {
-            pairs
-                .iter()
-                .find(|(k, _)| k == key)
-                .map(|(_, v)| v.as_str())
-        };
-        let bad = |key: &str, value: &str, reason: &'static str| FaultParseError::BadValue {
-            kind: kind_s.clone(),
-            key: key.to_string(),
-            value: value.to_string(),
-            reason,
-        };
-        let missing = |key: &'static str| FaultParseError::MissingKey {
-            kind: kind_s.clone(),
-            key,
-        };
-        let id = match get("id") {
-            Some(v) => Some(
-                parse_id(v)
-                    .ok_or_else(|| bad("id", v, "an 11-bit identifier, 0x000..0x7FF or 0..2047"))?,
-            ),
-            None => None,
-        };
-        let node = match get("node") {
-            Some(v) => Some(parse_node(v).ok_or_else(|| {
-                bad(
-                    "node",
-                    v,
-                    "a node name (letters, digits, _ or -) or number 0..255",
-                )
-            })?),
-            None => None,
-        };
-        let prob = match get("prob") {
-            Some(v) => Some(
-                v.parse::<f64>()
-                    .ok()
-                    .filter(|p| (0.0..=1.0).contains(p))
-                    .ok_or_else(|| bad("prob", v, "a probability between 0 and 1"))?,
-            ),
-            None => None,
-        };
-        let count = match get("count") {
-            Some(v) => Some(
-                v.parse::<u32>()
-                    .map_err(|_| bad("count", v, "a non-negative integer"))?,
-            ),
-            None => None,
-        };
-        let ms = |key: &str| -> Result<Option<u64>, FaultParseError> {
-            match get(key) {
-                Some(v) => Ok(Some(parse_ms_to_ns(v).ok_or_else(|| {
-                    bad(key, v, "a non-negative number of milliseconds")
-                })?)),
-                None => Ok(None),
-            }
-        };
-        let from_ns = ms("from_ms")?.unwrap_or(0);
-        let until_ns = ms("until_ms")?;
-        if let Some(u) = until_ns {
-            if u <= from_ns {
-                let v = get("until_ms").unwrap_or_default();
-                return Err(bad("until_ms", v, "a time after from_ms"));
-            }
+        let count = spec.optional("count", "a non-negative integer", |v| v.parse::<u32>().ok())?;
+        let from_ns = spec.optional("from_ms", ms, parse_ms_to_ns)?.unwrap_or(0);
+        let until_ns = spec.optional("until_ms", ms, parse_ms_to_ns)?;
+        if until_ns.is_some_and(|u| u <= from_ns) {
+            let v = spec.get("until_ms").unwrap_or_default();
+            return Err(spec.bad("until_ms", v, "a time after from_ms").into());
         }
         let filter = FrameFilter {
             id,
             node: node.clone(),
         };
         let hit = Hit { prob, count };
-        let kind = match kind {
+        let kind = match spec.kind() {
             "drop" => FaultKind::Drop { filter, hit },
             "corrupt" => FaultKind::Corrupt { filter, hit },
             "delay" => FaultKind::Delay {
                 filter,
-                delay_ns: ms("ms")?.ok_or_else(|| missing("ms"))?,
+                delay_ns: spec.required("ms", ms, parse_ms_to_ns)?,
             },
             "babble" => FaultKind::Babble {
-                node: node.ok_or_else(|| missing("node"))?,
+                node: node.ok_or_else(|| spec.missing("node"))?,
                 id: id.unwrap_or(Frame::MAX_ID),
             },
             _ => FaultKind::BusOff {
-                node: node.ok_or_else(|| missing("node"))?,
+                node: node.ok_or_else(|| spec.missing("node"))?,
             },
         };
         Ok(FaultSpec {
@@ -337,8 +290,6 @@ impl std::str::FromStr for FaultSpec {
         })
     }
 }
-
-use crate::frame::Frame;
 
 fn write_ms(f: &mut fmt::Formatter<'_>, key: &str, ns: u64) -> fmt::Result {
     write!(f, "{key}={}", ns as f64 / 1e6)

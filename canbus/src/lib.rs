@@ -8,6 +8,7 @@
 //! * [`candump`] — candump (`candump -L`) log writer and reader, compatible with python-can.
 //! * [`socketcand`] — a socketcand-protocol TCP server (python-can's `socketcand` interface
 //!   connects to it) that serves delivered frames and accepts frames from clients.
+//! * [`spec`] — the `kind:key=value,...` text form of faults, parsed once for every kind.
 //! * [`demo`] — two fake ankle nodes and a host sending the protocol's messages at their
 //!   nominal rates (the `canbus-demo` binary).
 //!
@@ -21,6 +22,7 @@ pub mod fault;
 pub mod frame;
 pub mod rng;
 pub mod socketcand;
+pub mod spec;
 
 pub use bus::{
     Bus, BusConfig, BusError, BusEvent, BusStats, Delivered, ErrorState, NodeHandle, SendOutcome,

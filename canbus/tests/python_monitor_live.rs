@@ -2,50 +2,22 @@
 //! running demo bus through its socketcand server, sends an emergency stop to the right
 //! ankle through it, and decodes heartbeats from both ankles with their states.
 //!
-//! Needs the project's venv (`scripts/python-venv`). When it cannot be created the test is
-//! skipped with a message — unless `WALKER_REQUIRE_PYTHON=1` (set by `scripts/test-all`),
-//! in which case it fails.
+//! Needs the project's venv (`scripts/python-venv`, through `walker_tools::python_venv`). When
+//! it cannot be created the test is skipped with a message — unless `WALKER_REQUIRE_PYTHON=1`
+//! (set by `scripts/test-all`), in which case it fails.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use canbus::candump::{read_log, LogFrame};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// Creates the venv; `None` (after printing why) when the test must be skipped.
-fn venv_python() -> Option<PathBuf> {
-    let out = Command::new(root().join("scripts/python-venv"))
-        .current_dir(root())
-        .output();
-    let ok = matches!(&out, Ok(o) if o.status.success());
-    if ok {
-        return Some(root().join(".venv/bin/python"));
-    }
-    let why = match out {
-        Ok(o) => format!(
-            "scripts/python-venv exited with {}: {}{}",
-            o.status,
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) => format!("scripts/python-venv could not run: {e}"),
-    };
-    if std::env::var_os("WALKER_REQUIRE_PYTHON").is_some() {
-        panic!("WALKER_REQUIRE_PYTHON is set and the venv cannot be created: {why}");
-    }
-    eprintln!("SKIPPED python_monitor_live: the Python venv cannot be created ({why})");
-    None
-}
+use walker_tools::python_venv::PythonVenv;
 
 #[test]
 fn python_monitor_decodes_the_live_demo_over_socketcand() {
-    let Some(python) = venv_python() else { return };
+    let venv = PythonVenv::for_test("python_monitor_live").unwrap_or_else(|e| panic!("{e}"));
+    let Some(venv) = venv else { return };
     let dir = std::env::temp_dir().join(format!("canbus-live-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let demo_log = dir.join("demo.log");
@@ -87,8 +59,8 @@ fn python_monitor_decodes_the_live_demo_over_socketcand() {
     });
     let port = addr.rsplit(':').next().unwrap().to_string();
 
-    let monitor = Command::new(&python)
-        .arg(root().join("python/walker_monitor.py"))
+    let monitor = venv
+        .monitor()
         .args([
             "--interface",
             "socketcand",

@@ -35,11 +35,9 @@ pub const STRIDE_TICKS: u32 = 1_000;
 pub const STANCE_TICKS: u32 = 700;
 /// The peer's heel strike, from the start of the own stance [ticks].
 pub const PEER_HEEL_STRIKE_TICK: u32 = 650;
-/// Encoder calibration of the scripted sensor.
-pub const CALIBRATION: AngleCalibration = AngleCalibration {
-    zero_counts: 4000,
-    reversed: false,
-};
+/// Encoder calibration of the scripted sensor: every simulated ankle's,
+/// [`crate::sensors::SIMULATED_CALIBRATION`].
+pub const CALIBRATION: AngleCalibration = crate::sensors::SIMULATED_CALIBRATION;
 
 /// A scripted encoder misbehaviour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -80,6 +80,17 @@ impl AngleCalibration {
     }
 }
 
+/// The encoder calibration of every simulated ankle: the scripted scenarios
+/// ([`crate::scenarios`], on the host and on the emulated Cortex-M4), the host tests and the
+/// simulator's software-in-the-loop runner. Zero at 4000 counts, not reversed: a zero away
+/// from the counts' wrap, so that a conversion that ignored the offset would show. A board's
+/// zero is measured after its magnet is mounted (`firmware/board-g431` sets its own), so this
+/// is no board default.
+pub const SIMULATED_CALIBRATION: AngleCalibration = AngleCalibration {
+    zero_counts: 4000,
+    reversed: false,
+};
+
 /// What the plausibility checks found in one sample; `Some(detail)` when a check fails,
 /// with the offending raw value for the fault event.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

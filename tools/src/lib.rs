@@ -2,6 +2,10 @@
 //!
 //! Regenerate everything with `cargo run -p walker-tools -- gen`; the test
 //! `tests/generated_files_fresh.rs` fails when a committed copy is stale.
+//!
+//! The project's Python venv, for the tests that run the Python bus monitor: [`python_venv`].
+
+pub mod python_venv;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;

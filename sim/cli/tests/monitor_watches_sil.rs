@@ -2,40 +2,21 @@
 //! software-in-the-loop walk (`walker sil --socketcand ... --realtime 1`) and decodes both
 //! ankle nodes' heartbeats and ankle states, and the heel strikes of the walk.
 //!
-//! Needs the project's venv (`scripts/python-venv`): skipped with a message when it cannot be
-//! created, unless `WALKER_REQUIRE_PYTHON=1` (set by `scripts/test-all`), which makes it fail.
+//! Needs the project's venv (`scripts/python-venv`, through `walker_tools::python_venv`):
+//! skipped with a message when it cannot be created, unless `WALKER_REQUIRE_PYTHON=1` (set by
+//! `scripts/test-all`), which makes it fail.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn venv_python() -> Option<PathBuf> {
-    let out = Command::new(root().join("scripts/python-venv"))
-        .current_dir(root())
-        .output();
-    if matches!(&out, Ok(o) if o.status.success()) {
-        return Some(root().join(".venv/bin/python"));
-    }
-    let why = match out {
-        Ok(o) => format!("exit {}: {}", o.status, String::from_utf8_lossy(&o.stderr)),
-        Err(e) => e.to_string(),
-    };
-    if std::env::var_os("WALKER_REQUIRE_PYTHON").is_some() {
-        panic!("WALKER_REQUIRE_PYTHON is set and the venv cannot be created: {why}");
-    }
-    eprintln!("SKIPPED monitor_watches_sil: the Python venv cannot be created ({why})");
-    None
-}
+use walker_tools::python_venv::PythonVenv;
 
 #[test]
 fn python_monitor_decodes_a_running_firmware_in_the_loop_walk() {
-    let Some(python) = venv_python() else { return };
+    let venv = PythonVenv::for_test("monitor_watches_sil").unwrap_or_else(|e| panic!("{e}"));
+    let Some(venv) = venv else { return };
     let mut sim = Command::new(env!("CARGO_BIN_EXE_walker"))
         .args([
             "sil",
@@ -73,8 +54,8 @@ fn python_monitor_decodes_a_running_firmware_in_the_loop_walk() {
             });
     }
     let addr = addr.expect("the simulation announces its socketcand address");
-    let monitor = Command::new(python)
-        .arg(root().join("python/walker_monitor.py"))
+    let monitor = venv
+        .monitor()
         .args(["--interface", "socketcand", "--channel", "vcan0"])
         .args([
             "--host",
@@ -83,7 +64,6 @@ fn python_monitor_decodes_a_running_firmware_in_the_loop_walk() {
             &addr.port().to_string(),
         ])
         .args(["--duration", "2.5", "--json"])
-        .current_dir(root())
         .output()
         .unwrap();
     let sim_out = sim.wait_with_output().unwrap();

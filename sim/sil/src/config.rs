@@ -3,89 +3,13 @@
 use std::path::PathBuf;
 
 use canbus::{BusConfig, FaultSpec};
-use firmware::scenarios::CALIBRATION;
-use firmware::sensors::AngleCalibration;
-use protocol::NodeId;
-use serde::Serialize;
+use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 
-use super::actuator::ActuatorParams;
-use super::sensors::SensorFault;
+use crate::actuator::ActuatorParams;
+use crate::sensors::{SensorFault, SensorFaultParseError};
 
-/// A physical side of the robot, i.e. one ankle node.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-pub enum Side {
-    /// The left ankle ([`NodeId::LeftAnkle`], node 2).
-    Left,
-    /// The right ankle ([`NodeId::RightAnkle`], node 3).
-    Right,
-}
-
-impl Side {
-    /// Both sides, left first (the order nodes are ticked and reported in).
-    pub const BOTH: [Side; 2] = [Side::Left, Side::Right];
-
-    /// The protocol's node.
-    pub const fn node(self) -> NodeId {
-        match self {
-            Side::Left => NodeId::LeftAnkle,
-            Side::Right => NodeId::RightAnkle,
-        }
-    }
-
-    /// The other side.
-    pub const fn other(self) -> Side {
-        match self {
-            Side::Left => Side::Right,
-            Side::Right => Side::Left,
-        }
-    }
-
-    /// Index 0 (left) or 1 (right).
-    pub const fn index(self) -> usize {
-        match self {
-            Side::Left => 0,
-            Side::Right => 1,
-        }
-    }
-
-    /// The bus node name (`left`, `right`), as `FaultSpec`s name it.
-    pub const fn bus_name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-}
-
-/// What the swing ankle's encoder reads. The swing foot is massless and not in the model, so
-/// its ankle angle is not simulated.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub enum SwingAnkleModel {
-    /// A fixed angle [rad]. A step between this and the stance angle at every heel strike
-    /// and lift-off: with 0 rad and the stance ankle at 0.2 rad that is 200 rad/s at 1 kHz,
-    /// which trips the firmware's 40 rad/s plausibility check (`EncoderRate`) every stride.
-    Fixed {
-        /// The angle [rad].
-        angle_rad: f64,
-    },
-    /// From its angle at lift-off, the ankle moves at `rate_rad_per_s` towards the angle this
-    /// foot last landed at (the other foot's until it has landed once), so that on a periodic
-    /// gait (period one or two strides) the reading is continuous when it lands again.
-    ToLandingAngle {
-        /// Rate of the move [rad/s].
-        rate_rad_per_s: f64,
-    },
-}
-
-impl Default for SwingAnkleModel {
-    /// `ToLandingAngle` at 2 rad/s: 0.3 rad in 0.15 s, a twentieth of the plausibility
-    /// limit.
-    fn default() -> Self {
-        SwingAnkleModel::ToLandingAngle {
-            rate_rad_per_s: 2.0,
-        }
-    }
-}
+pub use crate::side::Side;
+pub use crate::swing::SwingAnkleModel;
 
 /// A host command to put on the bus at a given time.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,7 +20,7 @@ pub struct HostCommand {
     pub command: protocol::Command,
 }
 
-/// Everything a [`super::FirmwareInTheLoop`] run needs.
+/// Everything a [`crate::FirmwareInTheLoop`] run needs.
 #[derive(Clone, Debug)]
 pub struct SilConfig {
     /// Control period of both nodes [s]. Default 1 ms (the board's 1 kHz).
@@ -106,8 +30,8 @@ pub struct SilConfig {
     pub bus: BusConfig,
     /// Side of the first stride's stance foot. Default left.
     pub first_stance: Side,
-    /// Encoder calibration of the left and right ankle. Default the firmware's scenario
-    /// calibration (`zero_counts` 4000, not reversed) for both.
+    /// Encoder calibration of the left and right ankle. Default the firmware's calibration of
+    /// simulated ankles ([`SIMULATED_CALIBRATION`]: `zero_counts` 4000, not reversed) for both.
     pub calibration: [AngleCalibration; 2],
     /// The swing ankle's reading. Default [`SwingAnkleModel::ToLandingAngle`] at 2 rad/s.
     pub swing_ankle: SwingAnkleModel,
@@ -152,7 +76,7 @@ impl Default for SilConfig {
             period_s: 1e-3,
             bus: BusConfig::default(),
             first_stance: Side::Left,
-            calibration: [CALIBRATION, CALIBRATION],
+            calibration: [SIMULATED_CALIBRATION, SIMULATED_CALIBRATION],
             swing_ankle: SwingAnkleModel::default(),
             debounce_samples: 3,
             trailing_contact_s: 0.010,
@@ -231,10 +155,7 @@ impl SilConfig {
     ///
     /// # Errors
     /// The parse error, naming the offending part.
-    pub fn with_sensor_fault_str(
-        self,
-        spec: &str,
-    ) -> Result<Self, super::sensors::SensorFaultParseError> {
+    pub fn with_sensor_fault_str(self, spec: &str) -> Result<Self, SensorFaultParseError> {
         Ok(self.with_sensor_fault(spec.parse()?))
     }
 }

@@ -5,7 +5,7 @@
 //! * [`SimSpi`] — an `embedded_hal::spi::SpiDevice` emulating the AS5047P encoder for
 //!   `firmware::drivers::encoder::MagneticEncoder`: 16-bit frames, most significant byte
 //!   first, the answer to a command in the *next* frame (pipelined), even parity in bit 15 and
-//!   the error flag in bit 14; the counts come from [`super::SimEncoder`] (its quantisation
+//!   the error flag in bit 14; the counts come from [`crate::SimEncoder`] (its quantisation
 //!   and its faults);
 //! * [`SimContactPin`] — an `embedded_hal::digital::InputPin`, active low as on the board
 //!   (switch to ground, pull-up), for `firmware::drivers::contact::ContactSwitch`, which
@@ -17,7 +17,7 @@
 //!   (the firmware decodes them and counts malformed ones itself);
 //! * [`SimClock`] — `firmware::time::Monotonic`, the tick time;
 //! * [`SimActuator`] — `firmware::drivers::actuator::Actuator` over the simulator's
-//!   [`super::ActuatorModel`].
+//!   [`crate::ActuatorModel`].
 //!
 //! The actuator is where the simulator departs from the board: the board's `PwmDirActuator`
 //! is a proportional loop over PWM duty and a direction pin driving a DC motor; the
@@ -28,7 +28,7 @@
 //! release) and the measured angle it is given, as any `Actuator` does, and moves the string's
 //! limit through the servo model.
 //!
-//! Every piece shares its state with the orchestrator ([`super::FirmwareInTheLoop`]) through
+//! Every piece shares its state with the orchestrator ([`crate::FirmwareInTheLoop`]) through
 //! `Rc<Cell<..>>` / `Rc<RefCell<..>>` handles: the simulation is single-threaded, and the
 //! orchestrator sets the sensor state before each `step` and collects frames and the
 //! actuator's segment after it.

@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 use canbus::BusStats;
 use serde::Serialize;
 
-use super::actuator::ActuatorStats;
-use super::config::Side;
+use crate::actuator::ActuatorStats;
+use crate::side::Side;
 
 /// A fault raised or cleared by a node (from the node's own `Fault` event, whether or not the
 /// bus delivered it).
@@ -240,4 +240,13 @@ impl SilReport {
     pub fn node(&self, side: Side) -> Option<&NodeReport> {
         self.nodes.get(&side)
     }
+}
+
+/// The names of the faults in `flags` (`EncoderRate`, ...), in the protocol's order.
+pub(crate) fn fault_names(flags: protocol::FaultFlags) -> Vec<String> {
+    protocol::FaultCode::ALL
+        .iter()
+        .filter(|c| flags.contains(**c))
+        .map(|c| format!("{c:?}"))
+        .collect()
 }

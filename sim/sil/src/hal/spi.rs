@@ -189,11 +189,11 @@ impl SpiDevice for SimSpi {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Side;
     use crate::sensors::SensorFault;
+    use crate::side::Side;
     use firmware::drivers::encoder::{parse_answer, read_command, MagneticEncoder, NOP};
-    use firmware::scenarios::CALIBRATION;
     use firmware::sensors::EncoderError;
+    use firmware::sensors::SIMULATED_CALIBRATION as CALIBRATION;
 
     fn word(spi: &mut SimSpi, command: u16) -> u16 {
         let mut buf = command.to_be_bytes();

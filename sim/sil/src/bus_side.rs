@@ -1,0 +1,216 @@
+//! The bus side of a firmware-in-the-loop run: the simulated CAN bus with the host attached,
+//! the candump log and the socketcand server that see every event, and the bus's own records
+//! (frames delivered, bus-off events).
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use canbus::candump::CandumpWriter;
+use canbus::socketcand::{ServerConfig, SocketcandServer};
+use canbus::{
+    Bus, BusConfig, BusError, BusEvent, ErrorState, FaultSpec, Frame, NodeHandle, SendOutcome,
+};
+use protocol::NodeId;
+use sim::control::ControlError;
+
+use crate::error::{control_error, SilError};
+use crate::history::BoundedLog;
+use crate::report::SocketcandReport;
+use crate::side::Side;
+
+/// The bus, its host node, its outputs and its records.
+pub(crate) struct BusSide {
+    bus: Bus,
+    host: NodeHandle,
+    candump: Option<CandumpWriter<BufWriter<File>>>,
+    server: Option<SocketcandServer>,
+    frames_delivered: u64,
+    /// Bus-off events: (time [s], node name).
+    bus_off: BoundedLog<(f64, String)>,
+}
+
+impl BusSide {
+    /// A bus with the host (node 1) attached; `history_capacity` bounds the bus-off record.
+    ///
+    /// # Errors
+    /// [`SilError::Bus`] when the bus refuses its configuration.
+    pub fn new(config: &BusConfig, history_capacity: usize) -> Result<Self, SilError> {
+        let mut bus = Bus::new(config.clone())?;
+        let host = bus.attach("host", Some(NodeId::Host.raw()));
+        Ok(BusSide {
+            bus,
+            host,
+            candump: None,
+            server: None,
+            frames_delivered: 0,
+            bus_off: BoundedLog::new(history_capacity),
+        })
+    }
+
+    /// Attach one ankle's node, named and numbered as the protocol's.
+    pub fn attach_ankle(&mut self, side: Side) -> NodeHandle {
+        self.bus.attach(side.bus_name(), Some(side.node().raw()))
+    }
+
+    /// Inject the faults (after every node is attached: they name nodes).
+    ///
+    /// # Errors
+    /// [`SilError::Bus`] for a fault the bus refuses (an unknown node, say).
+    pub fn add_faults(&mut self, faults: &[FaultSpec]) -> Result<(), SilError> {
+        for f in faults {
+            self.bus.add_fault(f.clone())?;
+        }
+        Ok(())
+    }
+
+    /// Write every bus event to a candump log at `candump`, and serve the bus over
+    /// socketcand on `socketcand`, each if given.
+    ///
+    /// # Errors
+    /// [`SilError::Candump`] when the log cannot be created, [`SilError::Socketcand`] when
+    /// the server cannot bind.
+    pub fn open_outputs(
+        &mut self,
+        candump: Option<&Path>,
+        socketcand: Option<&str>,
+    ) -> Result<(), SilError> {
+        if let Some(path) = candump {
+            let file = BufWriter::new(File::create(path)?);
+            self.candump = Some(CandumpWriter::new(file, "vcan0", 0));
+        }
+        if let Some(addr) = socketcand {
+            self.server = Some(SocketcandServer::bind(addr, ServerConfig::default())?);
+        }
+        Ok(())
+    }
+
+    /// Run the bus up to `t_ns`: every event goes to the candump log, every delivered frame
+    /// to the socketcand server, bus-off events to the record. The events, for routing.
+    ///
+    /// # Errors
+    /// The bus's or the log's error.
+    pub fn advance_to(&mut self, t_ns: u64) -> Result<Vec<BusEvent>, ControlError> {
+        let events = self.bus.advance_to(t_ns).map_err(control_error)?;
+        for ev in &events {
+            if let Some(w) = self.candump.as_mut() {
+                w.write_event(ev).map_err(control_error)?;
+            }
+            match ev {
+                BusEvent::Delivered(d) => {
+                    self.frames_delivered += 1;
+                    if let Some(s) = &self.server {
+                        s.publish(&d.frame, d.t_end_ns);
+                    }
+                }
+                BusEvent::BusOff { node, t_ns } => {
+                    let name = self.bus.node_name(*node).unwrap_or("?").to_string();
+                    self.bus_off.push((*t_ns as f64 * 1e-9, name));
+                }
+                BusEvent::ErrorFrame { .. } => {}
+            }
+        }
+        Ok(events)
+    }
+
+    /// The host's node.
+    pub fn host(&self) -> NodeHandle {
+        self.host
+    }
+
+    /// Queue a frame from the host at `t_ns` (a full host queue loses it, as a real
+    /// controller would).
+    ///
+    /// # Errors
+    /// Any other refusal of the bus.
+    pub fn send_from_host(&mut self, frame: Frame, t_ns: u64) -> Result<(), ControlError> {
+        match self.bus.send(self.host, frame, t_ns) {
+            Ok(_) | Err(BusError::QueueFull { .. }) => Ok(()),
+            Err(e) => Err(control_error(e)),
+        }
+    }
+
+    /// Queue a frame from `node` at `t_ns`.
+    ///
+    /// # Errors
+    /// The bus's refusal.
+    pub fn send(
+        &mut self,
+        node: NodeHandle,
+        frame: Frame,
+        t_ns: u64,
+    ) -> Result<SendOutcome, BusError> {
+        self.bus.send(node, frame, t_ns)
+    }
+
+    /// Frames socketcand clients sent since the last call.
+    pub fn take_client_frames(&self) -> Vec<Frame> {
+        self.server
+            .as_ref()
+            .map(SocketcandServer::take_inbound)
+            .unwrap_or_default()
+    }
+
+    /// `node` is bus-off: its controller takes no part in the bus.
+    pub fn is_bus_off(&self, node: NodeHandle) -> bool {
+        matches!(
+            self.bus.node_error_state(node),
+            Some((ErrorState::BusOff, _))
+        )
+    }
+
+    /// Room left in `node`'s transmit queue [frames].
+    pub fn tx_room(&self, node: NodeHandle) -> usize {
+        self.bus
+            .config()
+            .tx_queue_capacity
+            .saturating_sub(self.bus.queued_frames(node).unwrap_or(0))
+    }
+
+    /// The bus (read-only: statistics, node error states).
+    pub fn bus(&self) -> &Bus {
+        &self.bus
+    }
+
+    /// The live socketcand server's address, if one runs.
+    pub fn socketcand_addr(&self) -> Option<std::net::SocketAddr> {
+        self.server.as_ref().map(SocketcandServer::local_addr)
+    }
+
+    /// Frames delivered so far.
+    pub fn frames_delivered(&self) -> u64 {
+        self.frames_delivered
+    }
+
+    /// The bus-off record.
+    pub fn bus_off(&self) -> &BoundedLog<(f64, String)> {
+        &self.bus_off
+    }
+
+    /// The socketcand server's counters, if one runs.
+    pub fn socketcand_report(&self) -> Option<SocketcandReport> {
+        self.server.as_ref().map(|s| {
+            let st = s.stats();
+            SocketcandReport {
+                clients_accepted: st.clients_accepted,
+                frames_sent: st.frames_sent,
+                frames_dropped: st.frames_dropped,
+                frames_received: st.frames_received,
+            }
+        })
+    }
+
+    /// Flush the candump log and stop the server.
+    ///
+    /// # Errors
+    /// [`SilError::Candump`] when the log cannot be flushed.
+    pub fn close(&mut self) -> Result<(), SilError> {
+        if let Some(w) = self.candump.take() {
+            w.finish()?.flush()?;
+        }
+        if let Some(mut s) = self.server.take() {
+            s.shutdown();
+        }
+        Ok(())
+    }
+}
