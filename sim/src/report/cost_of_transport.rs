@@ -28,3 +28,28 @@ impl Serialize for CostOfTransport {
         m.end()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(serde::Serialize)]
+    struct Record {
+        speed_m_s: f64,
+        #[serde(flatten)]
+        cost_of_transport: CostOfTransport,
+    }
+
+    #[test]
+    fn flattened_it_writes_both_spellings_beside_the_other_keys_sorted() {
+        let r = Record {
+            speed_m_s: 0.5,
+            cost_of_transport: CostOfTransport { j_per_kg_m: 0.25 },
+        };
+        let text = serde_json::to_string(&crate::report::to_json(&r).unwrap()).unwrap();
+        assert_eq!(
+            text,
+            r#"{"cost_of_transport_J_per_kg_m":0.25,"cost_of_transport_j_per_kg_m":0.25,"speed_m_s":0.5}"#
+        );
+    }
+}
