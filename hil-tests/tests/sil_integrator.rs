@@ -35,16 +35,15 @@ fn walk_with(integrator: IntegratorChoice) -> (Walk, Figures) {
     let walk = sim::walk::walk(walker, &s.q0, &s.qd0, request);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), STEPS);
-    let g = sim::report::walk_gait_json(walker, &walk, STEPS);
-    let f = |k: &str| g[k].as_f64().unwrap();
+    let g = sim::report::WalkGaitRecord::of(walker, &walk, STEPS).unwrap();
     let mean = |x: &dyn Fn(&sim::walk::StepSummary) -> f64| {
         walk.steps.iter().map(x).sum::<f64>() / STEPS as f64
     };
     let figures = Figures {
-        period_s: f("step_period_s"),
-        speed_m_s: f("speed_m_s"),
-        step_length_m: f("step_length_m"),
-        cost_of_transport: f("cost_of_transport_J_per_kg_m"),
+        period_s: g.step_period_s,
+        speed_m_s: g.speed_m_s,
+        step_length_m: g.step_length_m,
+        cost_of_transport: g.cost_of_transport.j_per_kg_m,
         work_j: mean(&|s| s.actuator_work_j),
         impact_loss_j: mean(&|s| s.impact_energy_loss_j),
         evaluations: walk.steps.iter().map(|s| s.evaluations).sum(),

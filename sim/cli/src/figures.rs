@@ -2,9 +2,9 @@
 //! 13), the floor path of the hip-axle centre (Fig. 12), and joint angles over a stride.
 
 use crate::plot::{Plot, Series, Style, PALETTE};
+use sim::integrators::Sample;
 use sim::limit_cycle::Gait;
 use sim::stability::modes;
-use sim::stride::{StrideOptions, StrideRequest, StrideSettings};
 use sim::walk::Walk;
 use sim::walker::Walker;
 
@@ -77,20 +77,9 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
     }
 }
 
-/// Every joint coordinate over one stride from the gait's fixed point.
-pub fn joint_angles(walker: &Walker, settings: &StrideSettings, gait: &Gait, title: &str) -> Plot {
-    let (q, qd) = walker.unpack(&gait.fixed_point);
-    let samples = walker
-        .stride(
-            &q,
-            &qd,
-            StrideRequest::new(settings).options(StrideOptions {
-                record: true,
-                contact: false,
-            }),
-        )
-        .map(|r| r.trajectory)
-        .unwrap_or_default();
+/// Every joint coordinate over one stride, from that stride's recorded `samples` (those that
+/// stay at zero are left out).
+pub fn joint_angles(walker: &Walker, samples: &[Sample], title: &str) -> Plot {
     let series = walker
         .model
         .coordinates

@@ -1,0 +1,106 @@
+//! `walker accuracy`: speed against error of every integrator, against a tight reference.
+
+use super::print_json;
+use crate::figures;
+use crate::options::Common;
+use anyhow::Result;
+use clap::Args;
+use sim::accuracy;
+use sim::integrators::IntegratorChoice;
+use std::process::ExitCode;
+
+/// Options of `walker accuracy`.
+#[derive(Args)]
+pub struct AccuracyArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Write `accuracy.md` and log-log SVG plots into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<std::path::PathBuf>,
+}
+
+/// Picks one error measure from an accuracy point.
+type ErrorOf = fn(&accuracy::AccuracyPoint) -> Option<f64>;
+
+/// Runs `walker accuracy`: exit code 1 if there is no gait or no reference gait.
+pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
+    let AccuracyArgs { common, out } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let reference = IntegratorChoice::Dopri5 {
+        rtol: 1e-13,
+        atol: 1e-13,
+        h_max_s: 0.01,
+    };
+    let period = {
+        match setup.find_gait(&common.newton()) {
+            Ok(g) => g.stride.duration_s,
+            Err(e) => {
+                eprintln!("error: no gait: {e}");
+                return Ok(ExitCode::from(1));
+            }
+        }
+    };
+    let settings = accuracy::default_settings(period);
+    let study = match accuracy::study(&setup, reference, &settings, &common.newton()) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: no reference gait: {e}");
+            return Ok(ExitCode::from(1));
+        }
+    };
+    let table = accuracy_table(&study);
+    if common.json {
+        print_json(&study)?;
+    } else {
+        print!("{table}");
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(&dir)?;
+        std::fs::write(dir.join("accuracy.md"), &table)?;
+        let panels: [(&str, &str, ErrorOf); 3] = [
+            ("fixed_point_error.svg", "fixed-point error [-]", |p| {
+                p.fixed_point_error
+            }),
+            ("eigenvalue_error.svg", "eigenvalue error [-]", |p| {
+                p.eigenvalue_error
+            }),
+            (
+                "heel_strike_time_error.svg",
+                "heel-strike time error [s]",
+                |p| p.heel_strike_time_error_s,
+            ),
+        ];
+        for (file, what, f) in panels {
+            let plot = figures::accuracy(&study, f, what);
+            std::fs::write(dir.join(file), plot.to_svg(720.0, 480.0))?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A markdown table of an accuracy study.
+fn accuracy_table(study: &accuracy::AccuracyStudy) -> String {
+    let fmt = |v: Option<f64>| v.map_or("—".to_string(), |x| format!("{x:.2e}"));
+    let mut t = format!(
+        "Scene `{}`, reference: dopri5 at rtol = atol = 1e-13, step period {:.6} s.\n\n\
+         | integrator | step [s] or rtol | CPU per stride [µs] | evaluations | fixed point | eigenvalues (modulus ≥ 0.05) | heel-strike time [s] |\n\
+         | --- | --- | --- | --- | --- | --- | --- |\n",
+        study.scene, study.reference_step_period_s
+    );
+    for p in &study.points {
+        t.push_str(&format!(
+            "| {} | {:.3e} | {:.0} | {} | {} | {} | {} |\n",
+            p.integrator,
+            p.step_or_tolerance,
+            p.cpu_us_per_stride,
+            p.evaluations_per_stride,
+            p.failure
+                .as_ref()
+                .map_or(fmt(p.fixed_point_error), |_| "no gait".into()),
+            fmt(p.eigenvalue_error),
+            fmt(p.heel_strike_time_error_s)
+        ));
+    }
+    t
+}

@@ -1,0 +1,119 @@
+//! `walker gait`: find the periodic gait of a scene and its stability.
+
+use super::{print_json, shown};
+use crate::figures;
+use crate::options::Common;
+use anyhow::Result;
+use clap::Args;
+use sim::report::{GaitOutcome, GaitReport};
+use sim::stride::{StrideOptions, StrideRequest};
+use std::process::ExitCode;
+
+/// Options of `walker gait`.
+#[derive(Args)]
+pub struct GaitArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Write SVG figures (eigenvalues, joint angles over a stride) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
+/// Runs `walker gait`: exit code 1 if no gait is found.
+pub fn run(args: GaitArgs) -> Result<ExitCode> {
+    let GaitArgs { common, plot } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let walker = &setup.walker;
+    let result = setup.find_gait(&common.newton());
+    // The report's contact figures: one more stride from the fixed point, with contact on.
+    let contact = result.as_ref().ok().and_then(|g| {
+        let (q, qd) = walker.unpack(&g.fixed_point);
+        walker
+            .stride(
+                &q,
+                &qd,
+                StrideRequest::new(&setup.settings).options(StrideOptions {
+                    record: false,
+                    contact: true,
+                }),
+            )
+            .ok()
+            .map(|c| c.contact)
+    });
+    let report = GaitReport::new(
+        &scene,
+        walker,
+        &setup.settings.integrator,
+        &result,
+        contact.as_ref(),
+    );
+    if let (Some(dir), Ok(g)) = (&plot, &result) {
+        std::fs::create_dir_all(dir)?;
+        let name = scene.name();
+        let eig = figures::eigenvalues(
+            walker,
+            g,
+            &format!("{name}: eigenvalues of the stride Jacobian"),
+        );
+        std::fs::write(dir.join("eigenvalues.svg"), eig.to_svg(640.0, 600.0))?;
+        // The joint-angle figure's samples: the stride from the fixed point, recorded.
+        let (q, qd) = walker.unpack(&g.fixed_point);
+        let samples = walker
+            .stride(
+                &q,
+                &qd,
+                StrideRequest::new(&setup.settings).options(StrideOptions {
+                    record: true,
+                    contact: false,
+                }),
+            )
+            .map(|r| r.trajectory)
+            .unwrap_or_default();
+        let ang = figures::joint_angles(
+            walker,
+            &samples,
+            &format!("{name}: joint angles over one step"),
+        );
+        std::fs::write(dir.join("joint_angles.svg"), ang.to_svg(820.0, 480.0))?;
+    }
+    if common.json {
+        print_json(&report)?;
+    } else {
+        print_text(&report);
+    }
+    Ok(if result.is_ok() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn print_text(r: &GaitReport) {
+    println!("scene: {}", r.scene);
+    let g = match &r.outcome {
+        GaitOutcome::NotFound(e) => {
+            println!("no gait found: {}", e.error);
+            return;
+        }
+        GaitOutcome::Found(g) => g,
+    };
+    println!("fixed point (just after heel strike):");
+    for (k, v) in &g.fixed_point.0 {
+        println!("    {k:<28} {:>20.12}", shown(*v));
+    }
+    println!("eigenvalues of the stride Jacobian:");
+    for [re, im] in &g.eigenvalues {
+        let (re, im) = (shown(*re), shown(*im));
+        println!("    {re:>14.8} {im:>+14.8}i   |λ| = {:.8}", re.hypot(im));
+    }
+    println!(
+        "max |λ| = {:.8} ({}), period {:.6} s, step {:.6} m, speed {:.6} m/s, {} Newton iterations",
+        shown(g.max_abs_eigenvalue),
+        if g.stable { "stable" } else { "unstable" },
+        shown(g.step_period_s),
+        shown(g.step_length_m),
+        shown(g.speed_m_s),
+        g.newton_iterations,
+    );
+}

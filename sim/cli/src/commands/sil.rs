@@ -1,0 +1,260 @@
+//! `walker sil`: software in the loop. The ankle firmware (two nodes on a simulated CAN bus)
+//! actuates the walker; its gait is compared with the ideal-actuator gait.
+
+use super::{print_json, shown};
+use crate::input_error::InputError;
+use crate::options::Common;
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use sim::integrators::IntegratorChoice;
+use sim::report::{IdealGaitRecord, WalkGaitRecord};
+use sim::scene::Setup;
+use sim::walk::{StepSummary, WalkFailure, WalkRequest};
+use std::collections::BTreeMap;
+use std::process::ExitCode;
+
+/// Options of `walker sil`.
+#[derive(Args)]
+pub struct SilArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Number of steps.
+    #[arg(long)]
+    pub steps: usize,
+    /// A bus fault, e.g. `drop:id=0x101,count=5` (repeatable; docs/canbus.md).
+    #[arg(long = "fault", value_name = "SPEC")]
+    pub faults: Vec<String>,
+    /// An encoder fault (repeatable; docs/sil.md):
+    /// `glitch:side=left,at_ms=500[,delta_rad=0.1]`, `stuck:side=left,from_ms=500`,
+    /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
+    #[arg(long = "sensor-fault", value_name = "SPEC")]
+    pub sensor_faults: Vec<String>,
+    /// Host emergency stop to every ankle at this walk time [s].
+    #[arg(long, value_name = "SECONDS")]
+    pub estop_at: Option<f64>,
+    /// Write the bus traffic as a candump log.
+    #[arg(long, value_name = "FILE")]
+    pub candump: Option<std::path::PathBuf>,
+    /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
+    #[arg(long, value_name = "ADDR")]
+    pub socketcand: Option<String>,
+    /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor); by
+    /// default it runs as fast as it can.
+    #[arg(long, value_name = "FACTOR")]
+    pub realtime: Option<f64>,
+    /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
+    /// figures use the last 10 and `steps_completed` counts every step. For long runs:
+    /// memory and output stay bounded.
+    #[arg(long, value_name = "N")]
+    pub keep_steps: Option<usize>,
+}
+
+/// The `walker sil --json` object. `Bus` is the bus statistics' type (the `canbus` crate's,
+/// which this crate does not name).
+#[derive(Serialize)]
+struct SilWalkReport<'a, Bus: Serialize> {
+    /// Scene name.
+    scene: &'a str,
+    /// The integrator of the walk with the firmware.
+    integrator: &'a IntegratorChoice,
+    /// Steps completed.
+    steps_completed: usize,
+    /// The first failure (`null` if none).
+    failure: Option<&'a WalkFailure>,
+    /// The firmware's gait over the last 10 steps (`null` if no step completed).
+    gait: Option<WalkGaitRecord>,
+    /// The ideal-actuator gait.
+    ideal_gait: IdealGaitRecord,
+    /// Faults the nodes raised or cleared.
+    node_faults: &'a [sil::FaultRecord],
+    /// The left and the right node.
+    nodes: &'a BTreeMap<sil::Side, sil::NodeReport>,
+    /// Bus load [-].
+    bus_load: f64,
+    /// Bus statistics.
+    bus: &'a Bus,
+    /// Frames delivered on the bus.
+    frames: u64,
+    /// The step summaries kept (`--keep-steps`).
+    steps: &'a [StepSummary],
+}
+
+/// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from.
+pub fn run(args: SilArgs) -> Result<ExitCode> {
+    let SilArgs {
+        common,
+        steps,
+        faults,
+        sensor_faults,
+        estop_at,
+        candump,
+        socketcand,
+        realtime,
+        keep_steps,
+    } = args;
+    let scene = common.scene()?;
+    let Setup {
+        walker,
+        settings: mut stride_settings,
+        ..
+    } = common.setup(&scene)?;
+    let Some(reflex) = walker.ankle.clone() else {
+        return Err(InputError::Other(format!(
+            "scene `{}` has no actuated ankles (ankle_reflex)",
+            scene.name()
+        ))
+        .into());
+    };
+    let mut config = sil::config::SilConfig::default()
+        .with_reflex(&reflex)
+        .map_err(|e| InputError::Other(format!("reflex parameters: {e}")))?;
+    for f in &faults {
+        config = config
+            .with_fault_str(f)
+            .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
+    }
+    for f in &sensor_faults {
+        config = config
+            .with_sensor_fault_str(f)
+            .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
+    }
+    if let Some(addr) = &socketcand {
+        let parsed: std::net::SocketAddr = addr
+            .parse()
+            .map_err(|_| InputError::Other(format!("--socketcand `{addr}`: expected IP:PORT")))?;
+        if !parsed.ip().is_loopback() {
+            return Err(InputError::Other(format!(
+                "--socketcand `{addr}`: only loopback addresses are served"
+            ))
+            .into());
+        }
+    }
+    if let Some(r) = realtime {
+        if !(r.is_finite() && r > 0.0) {
+            return Err(InputError::Other(format!("--realtime must be positive, got {r}")).into());
+        }
+    }
+    config.candump = candump;
+    config.socketcand = socketcand;
+    // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
+    // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
+    // per 1 ms control tick) unless an integrator is given on the command line.
+    let ideal_setup = scene.setup()?;
+    let ideal_walker = &ideal_setup.walker;
+    let ideal = match ideal_setup.find_gait(&common.newton()) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("error: no ideal-actuator gait to start from: {e}");
+            return Ok(ExitCode::from(1));
+        }
+    };
+    if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
+        stride_settings.integrator = sil::SIL_INTEGRATOR;
+    }
+    // Its errors are about the configuration given (fault nodes, log path, address).
+    let mut ctl = sil::FirmwareInTheLoop::new(config)
+        .map_err(|e| InputError::Other(format!("software in the loop: {e}")))?;
+    if let Some(t) = estop_at {
+        ctl.emergency_stop_at(t);
+    }
+    if let Some(addr) = ctl.socketcand_addr() {
+        eprintln!("socketcand: serving the bus on {addr} (channel vcan0)");
+    }
+    let (q, qd) = walker.unpack(&ideal.fixed_point);
+    // The gait figures average the last 10 steps: keep at least those.
+    let options = sim::walk::WalkOptions {
+        record: false,
+        keep_steps: keep_steps.map(|n| n.max(10)),
+    };
+    let walk = match realtime {
+        None => sim::walk::walk(
+            &walker,
+            &q,
+            &qd,
+            WalkRequest::new(&stride_settings, steps)
+                .options(options)
+                .controlled(&mut ctl),
+        ),
+        Some(factor) => {
+            // Step by step, sleeping so that walk time keeps pace with wall time.
+            let start = std::time::Instant::now();
+            let mut paced = sim::control::Paced::new(&mut ctl, factor, start);
+            sim::walk::walk(
+                &walker,
+                &q,
+                &qd,
+                WalkRequest::new(&stride_settings, steps)
+                    .options(options)
+                    .controlled(&mut paced),
+            )
+        }
+    };
+    let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
+    let steps_kept = &walk.steps[walk.steps.len() - kept..];
+    let firmware = ctl
+        .finish()
+        .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
+    let report = SilWalkReport {
+        scene: scene.name(),
+        integrator: &stride_settings.integrator,
+        steps_completed: walk.steps_completed,
+        failure: walk.failure.as_ref(),
+        gait: WalkGaitRecord::of(&walker, &walk, 10),
+        ideal_gait: IdealGaitRecord::of(ideal_walker, &ideal),
+        node_faults: &firmware.faults,
+        nodes: &firmware.nodes,
+        bus_load: firmware.bus.load,
+        bus: &firmware.bus,
+        frames: firmware.frames_delivered,
+        steps: steps_kept,
+    };
+    if common.json {
+        print_json(&report)?;
+    } else {
+        print_text(&report, steps);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_text<Bus: Serialize>(r: &SilWalkReport<'_, Bus>, steps: usize) {
+    println!(
+        "scene {}: {} of {steps} steps with the firmware actuating",
+        r.scene, r.steps_completed
+    );
+    if let Some(f) = r.failure {
+        println!(
+            "failure: {:?} in step {} at t = {:.4} s: {}",
+            f.kind, f.step, f.t_walk_s, f.detail
+        );
+    }
+    // The four figures of each gait; all NaN for a walk without a completed step.
+    let figures =
+        |period: f64, length: f64, speed: f64, cost: f64| [period, length, speed, cost].map(shown);
+    let firmware = r.gait.as_ref().map_or([f64::NAN; 4], |g| {
+        figures(
+            g.step_period_s,
+            g.step_length_m,
+            g.speed_m_s,
+            g.cost_of_transport.j_per_kg_m,
+        )
+    });
+    let i = &r.ideal_gait;
+    let ideal = figures(
+        i.step_period_s,
+        i.step_length_m,
+        i.speed_m_s,
+        i.cost_of_transport.j_per_kg_m,
+    );
+    for (label, [period, length, speed, cost]) in [("firmware", firmware), ("ideal", ideal)] {
+        println!(
+            "{label:>9}: period {period:.5} s, step {length:.5} m, speed {speed:.5} m/s, cost of transport {cost:.5} J/(kg m)"
+        );
+    }
+    println!(
+        "bus load {:.2} %, {} frames, {} node fault events",
+        100.0 * r.bus_load,
+        r.frames,
+        r.node_faults.len()
+    );
+}

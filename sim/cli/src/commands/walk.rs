@@ -1,0 +1,208 @@
+//! `walker walk`: simulate N steps from the gait (or the scene's guess), optionally perturbed.
+
+mod start;
+
+use super::print_json;
+use crate::figures;
+use crate::input_error::InputError;
+use crate::options::Common;
+use anyhow::Result;
+use clap::Args;
+use sim::report::WalkReport;
+use sim::scene::Scene;
+use sim::walk::WalkRequest;
+use sim::walker::Walker;
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Options of `walker walk`.
+#[derive(Args)]
+pub struct WalkArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Number of steps.
+    #[arg(long)]
+    pub steps: usize,
+    /// Perturb a start-state entry: `coord=delta` (coordinate or `coord_dot`).
+    #[arg(long = "perturb", value_name = "COORD=DELTA")]
+    pub perturb: Vec<String>,
+    /// Start from `gait` (the fixed point) or `guess` (the scene's guess, no search).
+    #[arg(long, default_value = "gait")]
+    pub start: String,
+    /// Start from the gait of another scene instead, coordinate by coordinate (those this
+    /// scene lacks are dropped, those it adds start at 0), e.g. the compensated walker's
+    /// leg state for the uncompensated one.
+    #[arg(long, value_name = "SCENE")]
+    pub start_from_scene: Option<String>,
+    /// Set start-state entries from a JSON file: an object of stride-map entries
+    /// (`coord` or `coord_dot`, as `walker gait --json` names them) to numbers, or a
+    /// `walker gait --json` output (its `fixed_point`). Entries it does not name keep
+    /// their values from `--start`; applied before `--perturb`.
+    #[arg(long, value_name = "FILE.json")]
+    pub start_state: Option<std::path::PathBuf>,
+    /// Write the trajectory (every integrator sample) as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: Option<std::path::PathBuf>,
+    /// Write the floor path of the hip-axle centre as SVG into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+    /// Also walk this scene (with its own parameters) from its own gait, the same number of
+    /// steps, and draw its path in the same figure (e.g. the compensated walker beside the
+    /// uncompensated one).
+    #[arg(long, value_name = "SCENE")]
+    pub plot_with: Option<String>,
+}
+
+/// Runs `walker walk`: exit code 1 if there is no gait to start from.
+pub fn run(args: WalkArgs) -> Result<ExitCode> {
+    let WalkArgs {
+        common,
+        steps,
+        perturb,
+        start,
+        start_from_scene,
+        start_state,
+        out,
+        plot,
+        plot_with,
+    } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let walker = &setup.walker;
+    let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
+    let start_from_scene = match (start_from_scene, start.as_str()) {
+        (None, "gait") => match &scene.file.walk_start_scene {
+            Some(other) if setup.find_gait(&common.newton()).is_err() => {
+                eprintln!(
+                    "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
+                    scene.name()
+                );
+                Some(other.clone())
+            }
+            _ => None,
+        },
+        (s, _) => s,
+    };
+    let mut v = match (start_from_scene, start.as_str()) {
+        (Some(other), _) => match start::from_other_scene(&other, &scene, walker, &common)? {
+            Some(v) => v,
+            None => return Ok(ExitCode::from(1)),
+        },
+        (None, "guess") => v0,
+        (None, "gait") => match setup.find_gait(&common.newton()) {
+            Ok(g) => g.fixed_point,
+            Err(e) => {
+                eprintln!("error: no gait to start from: {e} (use --start guess)");
+                return Ok(ExitCode::from(1));
+            }
+        },
+        (None, other) => {
+            return Err(
+                InputError::Other(format!("--start `{other}`: expected gait or guess")).into(),
+            )
+        }
+    };
+    let names = walker.map_names();
+    if let Some(path) = &start_state {
+        for (i, x) in start::read_start_state(path, &names)? {
+            v[i] = x;
+        }
+    }
+    for p in &perturb {
+        let (i, d) = start::parse_perturbation(p, &names)?;
+        v[i] += d;
+    }
+    let (q, qd) = walker.unpack(&v);
+    let request =
+        WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
+    let walk = sim::walk::walk(walker, &q, &qd, request);
+    if let Some(dir) = &plot {
+        std::fs::create_dir_all(dir)?;
+        let mut walks = vec![(scene.name().to_string(), walk.clone())];
+        if let Some(other) = &plot_with {
+            // The other scene walks with its own defaults, from its own gait.
+            let os = Scene::load(other)?;
+            let oset = os.setup()?;
+            let ow = &oset.walker;
+            let v0 = ow.pack(&oset.guess.q, &oset.guess.qd);
+            let start = oset
+                .find_gait(&common.newton())
+                .map(|g| g.fixed_point)
+                .unwrap_or(v0);
+            let (oq, oqd) = ow.unpack(&start);
+            let request = WalkRequest::new(&oset.settings, steps).recording(true);
+            walks.push((
+                os.name().to_string(),
+                sim::walk::walk(ow, &oq, &oqd, request),
+            ));
+        }
+        let refs: Vec<(&str, &sim::walk::Walk)> =
+            walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
+        let fig = figures::floor_paths(&refs, "path of the hip-axle centre on the floor");
+        std::fs::write(dir.join("floor_path.svg"), fig.to_svg(820.0, 420.0))?;
+    }
+    if let Some(path) = out {
+        write_csv(&path, walker, &walk)?;
+    }
+    let report = WalkReport::new(&scene, &walk);
+    if common.json {
+        print_json(&report)?;
+    } else {
+        print_text(&report, steps);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_text(r: &WalkReport, steps: usize) {
+    println!("scene {}: {} of {steps} steps", r.scene, r.steps_completed);
+    println!(
+        "{:>5} {:>10} {:>10} {:>10} {:>12}",
+        "step", "t_s", "period_s", "length_m", "deviation"
+    );
+    for s in &r.steps {
+        println!(
+            "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
+            s.step, s.start_t_walk_s, s.duration_s, s.step_length_m, s.state_deviation
+        );
+    }
+    match &r.failure {
+        None => println!("no failure"),
+        Some(f) => println!(
+            "failure: {:?} in step {} at t = {:.4} s: {}",
+            f.kind, f.step, f.t_walk_s, f.detail
+        ),
+    }
+}
+
+/// The walk's trajectory as CSV: step, time, coordinates, rates and the hip-axle centre in the
+/// floor frame, one row per integrator sample.
+fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) -> Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let coords: Vec<&str> = walker
+        .model
+        .coordinates
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
+    write!(f, "step,time_s")?;
+    for c in &coords {
+        write!(f, ",{c}")?;
+    }
+    for c in &coords {
+        write!(f, ",{c}_dot")?;
+    }
+    writeln!(f, ",hip_x_m,hip_y_m,hip_z_m")?;
+    for s in &walk.path {
+        write!(f, "{},{}", s.step, s.t_walk_s)?;
+        for v in s.q.iter().chain(s.qd.iter()) {
+            write!(f, ",{v}")?;
+        }
+        writeln!(
+            f,
+            ",{},{},{}",
+            s.hip_floor_m.x, s.hip_floor_m.y, s.hip_floor_m.z
+        )?;
+    }
+    f.flush()?;
+    Ok(())
+}

@@ -1,0 +1,112 @@
+//! The options every scene command shares, and the settings they stand for.
+
+use crate::input_error::InputError;
+use clap::Args;
+use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::{JacobianMethod, NewtonSettings};
+use sim::scene::{Scene, Setup};
+
+/// Scene, parameters, output form, integrator and gait-search options.
+#[derive(Args)]
+pub struct Common {
+    /// Scene name (see `walker scenes`) or path to a scene .toml file.
+    #[arg(long)]
+    pub scene: String,
+    /// Set a parameter: `key=value` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Integrator: meijaard, rk4, dopri5 or dop853 (default: the scene's).
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// Fixed step for meijaard/rk4 [s].
+    #[arg(long)]
+    pub step_s: Option<f64>,
+    /// Relative and absolute tolerance for dopri5 and dop853.
+    #[arg(long)]
+    pub rtol: Option<f64>,
+    /// Newton tolerance on |Δv|.
+    #[arg(long, default_value_t = 1e-11)]
+    pub newton_tol: f64,
+    /// Newton iteration budget.
+    #[arg(long, default_value_t = 30)]
+    pub newton_max_iter: usize,
+    /// Perturbation step of the stride Jacobian.
+    #[arg(long, default_value_t = 1e-6)]
+    pub perturbation: f64,
+    /// The perturbed strides of the stride Jacobian replay the nominal stride's steps
+    /// (internal numerical differentiation) instead of choosing their own.
+    #[arg(long)]
+    pub frozen_steps: bool,
+    /// The stride Jacobian: `central` differences or the `variational` equations (exact
+    /// derivatives; strides they do not cover fall back to central differences, and the JSON's
+    /// `jacobian_method` says which was used).
+    #[arg(long, default_value = "central")]
+    pub jacobian: String,
+}
+
+impl Common {
+    /// The scene with the `--set` parameters applied.
+    pub fn scene(&self) -> Result<Scene, InputError> {
+        let mut scene = Scene::load(&self.scene)?;
+        for s in &self.set {
+            scene.set_text(s)?;
+        }
+        Ok(scene)
+    }
+
+    /// The walker of `scene` with the integrator options applied; checks every numeric option.
+    pub fn setup(&self, scene: &Scene) -> Result<Setup, InputError> {
+        let mut w = scene.setup()?;
+        let positive = |name: &str, v: Option<f64>| match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
+                "--{name} must be a positive number, got {x}"
+            ))),
+            _ => Ok(()),
+        };
+        positive("step-s", self.step_s)?;
+        positive("rtol", self.rtol)?;
+        positive("newton-tol", Some(self.newton_tol))?;
+        positive("perturbation", Some(self.perturbation))?;
+        if !matches!(self.jacobian.as_str(), "central" | "variational") {
+            return Err(InputError::Other(format!(
+                "--jacobian `{}`: expected central or variational",
+                self.jacobian
+            )));
+        }
+        if let Some(kind) = &self.integrator {
+            w.settings.integrator =
+                IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None).ok_or_else(
+                    || {
+                        InputError::Other(format!(
+                            "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
+                        ))
+                    },
+                )?;
+        } else {
+            w.settings.integrator = w
+                .settings
+                .integrator
+                .with_tolerance_or_step(self.rtol, self.step_s);
+        }
+        Ok(w)
+    }
+
+    /// The gait search's settings.
+    pub fn newton(&self) -> NewtonSettings {
+        NewtonSettings {
+            tolerance: self.newton_tol,
+            max_iterations: self.newton_max_iter,
+            perturbation: self.perturbation,
+            central: true,
+            max_halvings: 8,
+            frozen_steps: self.frozen_steps,
+            jacobian: match self.jacobian.as_str() {
+                "variational" => JacobianMethod::Variational,
+                _ => JacobianMethod::CentralDifferences,
+            },
+        }
+    }
+}

@@ -1,0 +1,249 @@
+//! The `walker gait` report: the gait found (or why none was), its stability and figures.
+
+use super::CostOfTransport;
+use super::{eigenvalue_pairs, gait_numbers, FixedPoint};
+use crate::integrators::IntegratorChoice;
+use crate::limit_cycle::{Gait, JacobianMethod, NewtonError};
+use crate::scene::Scene;
+use crate::stability::{modes, EigenMode};
+use crate::stride::{ContactSummary, StrideEvent, StrideFailure};
+use crate::walker::Walker;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The `walker gait --json` object: the scene, its parameter values and the integrator, with
+/// the outcome of the gait search flattened beside them.
+#[derive(Clone, Debug, Serialize)]
+pub struct GaitReport {
+    /// Scene name.
+    pub scene: String,
+    /// Parameter values the walker was built with.
+    pub parameters: BTreeMap<String, f64>,
+    /// The integrator the search ran with.
+    pub integrator: IntegratorChoice,
+    /// The gait, or why none was found.
+    #[serde(flatten)]
+    pub outcome: GaitOutcome,
+}
+
+/// The outcome of a gait search.
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum GaitOutcome {
+    /// A fixed point was found (`converged: true`).
+    Found(Box<FoundGait>),
+    /// None was (`converged: false`).
+    NotFound(GaitNotFound),
+}
+
+/// A gait that was found.
+#[derive(Clone, Debug, Serialize)]
+pub struct FoundGait {
+    /// Always `true`.
+    pub converged: bool,
+    /// The fixed point just after heel strike.
+    pub fixed_point: FixedPoint,
+    /// Eigenvalues of the stride Jacobian, `[re, im]`.
+    pub eigenvalues: Vec<[f64; 2]>,
+    /// Largest eigenvalue modulus.
+    pub max_abs_eigenvalue: f64,
+    /// All eigenvalues strictly inside the unit circle.
+    pub stable: bool,
+    /// Step period [s].
+    pub step_period_s: f64,
+    /// Distance between the contacts of one step [m].
+    pub step_length_m: f64,
+    /// Distance walked forward per step [m].
+    pub progress_m_per_step: f64,
+    /// Forward speed [m/s].
+    pub speed_m_s: f64,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// How the stride Jacobian was taken.
+    pub jacobian_method: JacobianMethod,
+    /// `|S(v) − v|` at the fixed point (∞-norm).
+    pub residual: f64,
+    /// Events of the stride, in order.
+    pub events: Vec<StrideEvent>,
+    /// Mechanical energy lost in the impacts of a stride [J].
+    pub impact_energy_loss_j: f64,
+    /// Impact loss over weight times step length [-] (absent for a massless walker or a zero
+    /// step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specific_cost_of_transport: Option<f64>,
+    /// Heading change per step [rad].
+    pub heading_change_rad_per_step: f64,
+    /// Total mass [kg].
+    pub total_mass_kg: f64,
+    /// Each eigenvalue with the freedoms that dominate its eigenvector.
+    pub eigenvalue_modes: Vec<EigenMode>,
+    /// Actuator figures (walkers with actuated ankles only).
+    #[serde(flatten)]
+    pub actuator: Option<ActuatorFigures>,
+    /// Contact figures of the stride from the fixed point (when the caller could compute them).
+    #[serde(flatten)]
+    pub contact: Option<ContactFigures>,
+}
+
+/// Energy figures of an actuated gait, per step.
+#[derive(Clone, Debug, Serialize)]
+pub struct ActuatorFigures {
+    /// Work done by the ankle actuator [J].
+    pub actuator_work_j_per_step: f64,
+    /// Energy dissipated by the joint dampers [J].
+    pub damping_dissipation_j_per_step: f64,
+    /// Actuator work per unit mass and forward distance, under the keys
+    /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
+    /// `cost_of_transport_j_per_kg_m`.
+    #[serde(flatten)]
+    pub cost_of_transport: CostOfTransport,
+    /// Actuator work minus impact loss minus damper dissipation [J]: over a periodic stride on
+    /// level ground the actuator's work is what the impacts and dampers take, so this checks
+    /// the quadrature.
+    pub energy_balance_residual_j: f64,
+}
+
+/// Contact and clearance figures of the stride from the fixed point.
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactFigures {
+    /// Largest |lateral centre of pressure| under the stance foot [m].
+    pub max_lateral_cop_m: f64,
+    /// Smallest normal force on the stance foot [N].
+    pub min_normal_force_n: f64,
+    /// Smallest swing-ankle height near mid-swing [m] (`null` if the swing ankle never passes).
+    pub mid_swing_clearance_m: Option<f64>,
+}
+
+impl From<&ContactSummary> for ContactFigures {
+    fn from(c: &ContactSummary) -> Self {
+        Self {
+            max_lateral_cop_m: c.max_lateral_cop_m,
+            min_normal_force_n: c.min_normal_force_n,
+            mid_swing_clearance_m: c.mid_swing_clearance_m,
+        }
+    }
+}
+
+/// A gait search that found nothing.
+#[derive(Clone, Debug, Serialize)]
+pub struct GaitNotFound {
+    /// Always `false`.
+    pub converged: bool,
+    /// Why, in words.
+    pub error: String,
+    /// The stride that failed, when one did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<StrideFailure>,
+    /// Newton iterations used (the failing iteration for a failed stride or a singular
+    /// system).
+    pub newton_iterations: usize,
+    /// `null`: no fixed point.
+    pub fixed_point: Option<FixedPoint>,
+    /// `null`.
+    pub eigenvalues: Option<Vec<[f64; 2]>>,
+    /// `null`.
+    pub max_abs_eigenvalue: Option<f64>,
+    /// `null`.
+    pub stable: Option<bool>,
+    /// `null`.
+    pub step_period_s: Option<f64>,
+    /// `null`.
+    pub step_length_m: Option<f64>,
+    /// `null`.
+    pub speed_m_s: Option<f64>,
+}
+
+impl GaitReport {
+    /// The report of a gait search by `walker` (built from `scene`, integrating with
+    /// `integrator`). `contact` is the contact summary of a stride from the fixed point, run
+    /// by the caller with contact figures on; `None` leaves the contact figures out.
+    pub fn new(
+        scene: &Scene,
+        walker: &Walker,
+        integrator: &IntegratorChoice,
+        result: &Result<Gait, NewtonError>,
+        contact: Option<&ContactSummary>,
+    ) -> Self {
+        let outcome = match result {
+            Ok(g) => GaitOutcome::Found(Box::new(FoundGait::new(scene, walker, g, contact))),
+            Err(e) => GaitOutcome::NotFound(GaitNotFound::new(e)),
+        };
+        Self {
+            scene: scene.name().to_string(),
+            parameters: scene.values.clone(),
+            integrator: integrator.clone(),
+            outcome,
+        }
+    }
+}
+
+impl FoundGait {
+    fn new(scene: &Scene, walker: &Walker, g: &Gait, contact: Option<&ContactSummary>) -> Self {
+        let n = gait_numbers(walker, g);
+        let mass = walker.model.total_mass_kg();
+        let g_m_s2 = walker.model.gravity_floor_m_s2.norm();
+        let s = &g.stride;
+        let actuator = walker.ankle.as_ref().map(|_| {
+            let cost = s.actuator_work_j / (mass * n.progress_m);
+            ActuatorFigures {
+                actuator_work_j_per_step: s.actuator_work_j,
+                damping_dissipation_j_per_step: s.damping_dissipation_j,
+                cost_of_transport: CostOfTransport { j_per_kg_m: cost },
+                energy_balance_residual_j: s.actuator_work_j
+                    - s.impact_energy_loss_j
+                    - s.damping_dissipation_j,
+            }
+        });
+        Self {
+            converged: true,
+            fixed_point: FixedPoint::of(scene, walker, g),
+            eigenvalues: eigenvalue_pairs(&g.eigenvalues),
+            max_abs_eigenvalue: g.max_abs_eigenvalue(),
+            stable: g.stable(),
+            step_period_s: n.step_period_s,
+            step_length_m: n.step_length_m,
+            progress_m_per_step: n.progress_m,
+            speed_m_s: n.speed_m_s,
+            newton_iterations: g.iterations,
+            jacobian_method: g.jacobian_method,
+            residual: g.residual,
+            events: s.events.clone(),
+            impact_energy_loss_j: s.impact_energy_loss_j,
+            specific_cost_of_transport: (mass > 0.0 && n.step_length_m > 0.0)
+                .then(|| s.impact_energy_loss_j / (mass * g_m_s2 * n.step_length_m)),
+            heading_change_rad_per_step: s.heading_change_rad,
+            total_mass_kg: mass,
+            eigenvalue_modes: modes(
+                &g.jacobian,
+                &g.eigenvalues,
+                &walker.map_names(),
+                &walker.three_d_freedoms,
+            ),
+            actuator,
+            contact: contact.map(ContactFigures::from),
+        }
+    }
+}
+
+impl GaitNotFound {
+    fn new(e: &NewtonError) -> Self {
+        let (newton_iterations, failure) = match e {
+            NewtonError::NotConverged { iterations, .. } => (*iterations, None),
+            NewtonError::StrideFailed { iteration, failure } => (*iteration, Some(failure.clone())),
+            NewtonError::Singular { iteration } => (*iteration, None),
+        };
+        Self {
+            converged: false,
+            error: e.to_string(),
+            failure,
+            newton_iterations,
+            fixed_point: None,
+            eigenvalues: None,
+            max_abs_eigenvalue: None,
+            stable: None,
+            step_period_s: None,
+            step_length_m: None,
+            speed_m_s: None,
+        }
+    }
+}

@@ -1,0 +1,34 @@
+//! The `walker walk` report: the steps of a walk and its first failure.
+
+use crate::scene::Scene;
+use crate::walk::{StepSummary, Walk, WalkFailure};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The `walker walk --json` object.
+#[derive(Clone, Debug, Serialize)]
+pub struct WalkReport {
+    /// Scene name.
+    pub scene: String,
+    /// Parameter values the walker was built with.
+    pub parameters: BTreeMap<String, f64>,
+    /// Steps completed.
+    pub steps_completed: usize,
+    /// The first failure (`null` if none).
+    pub failure: Option<WalkFailure>,
+    /// Summaries of the steps completed.
+    pub steps: Vec<StepSummary>,
+}
+
+impl WalkReport {
+    /// The report of `walk` by a walker built from `scene`.
+    pub fn new(scene: &Scene, walk: &Walk) -> Self {
+        Self {
+            scene: scene.name().to_string(),
+            parameters: scene.values.clone(),
+            steps_completed: walk.steps_completed,
+            failure: walk.failure.clone(),
+            steps: walk.steps.clone(),
+        }
+    }
+}
