@@ -1,0 +1,71 @@
+//! Criterion benchmarks of one evaluation of the equations of motion per scene, at the scene's
+//! gait guess (just after heel strike), in the phase the stride starts in: the kinematics
+//! alone, the assembly of `M̄` and `f̄`, and the accelerations (assembly and the active-set
+//! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions).
+//! Results and the machine: docs/performance.md.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use nalgebra::{DVector, SVector};
+use num_dual::{Derivative, DualSVec64};
+use sim::dynamics::{Dynamics, DynamicsOf};
+use sim::kinematics::Kinematics;
+use sim::scene::Scene;
+
+const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
+
+fn benches(c: &mut Criterion) {
+    for name in SCENES {
+        let setup = Scene::load(name).and_then(|s| s.setup()).unwrap();
+        let model = &setup.walker.model;
+        let (q, qd) = (setup.guess.q.clone(), setup.guess.qd.clone());
+        let mut active = vec![true; model.dof()];
+        for c in &setup.walker.initially_locked {
+            active[c.0] = false;
+        }
+        let mut group = c.benchmark_group(format!("dynamics/{name}"));
+        let mut kin = Kinematics::new(model);
+        group.bench_function("kinematics", |b| {
+            b.iter(|| kin.update(model, black_box(&q), black_box(&qd)))
+        });
+        let mut dynamics = Dynamics::new(model);
+        group.bench_function("assemble", |b| {
+            b.iter(|| dynamics.assemble(model, black_box(&q), black_box(&qd), None))
+        });
+        group.bench_function("accelerations", |b| {
+            b.iter(|| {
+                dynamics
+                    .accelerations(model, black_box(&q), black_box(&qd), &active, None)
+                    .unwrap()
+            })
+        });
+        if !model.has_infinitesimal_bodies() {
+            // Each coordinate carries a unit direction (mod 6), as the variational equations
+            // seed them.
+            let seed = |x: &DVector<f64>| {
+                DVector::from_fn(x.len(), |i, _| {
+                    let eps = SVector::<f64, 6>::from_fn(|k, _| f64::from(u8::from(k == i % 6)));
+                    DualSVec64::<6>::new(x[i], Derivative::some(eps))
+                })
+            };
+            let (qdual, qddual) = (seed(&q), seed(&qd));
+            let mut dual: DynamicsOf<DualSVec64<6>> = DynamicsOf::new(model);
+            group.bench_function("accelerations_dual6", |b| {
+                b.iter(|| {
+                    dual.accelerations_finite(
+                        model,
+                        black_box(&qdual),
+                        black_box(&qddual),
+                        &active,
+                        None,
+                    )
+                    .unwrap()
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(dynamics, benches);
+criterion_main!(dynamics);
