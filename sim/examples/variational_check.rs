@@ -28,9 +28,7 @@ fn main() {
         let fd = search.stride_jacobian(&g.fixed_point, &s).unwrap();
         let t_fd = t0.elapsed().as_secs_f64();
         let t0 = std::time::Instant::now();
-        let var = setup
-            .walker
-            .stride_jacobian_variational(&g.fixed_point, &setup.settings);
+        let var = sim::variational::stride_jacobian(&setup.walker, &g.fixed_point, &setup.settings);
         let t_var = t0.elapsed().as_secs_f64();
         match var {
             Ok((jv, _)) => {

@@ -188,7 +188,7 @@ impl<'a> GaitSearch<'a> {
         s_v: &DVector<f64>,
     ) -> Result<(DMatrix<f64>, JacobianMethod), StrideFailure> {
         if self.newton.jacobian == JacobianMethod::Variational {
-            match self.walker.stride_jacobian_variational(v, self.settings) {
+            match crate::variational::stride_jacobian(self.walker, v, self.settings) {
                 Ok((j, _)) => return Ok((j, JacobianMethod::Variational)),
                 Err(VariationalError::Stride(f)) => return Err(f),
                 Err(_) => {}

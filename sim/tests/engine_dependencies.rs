@@ -1,0 +1,49 @@
+//! The engine stands alone: it depends on no firmware, CAN or command-line crate (those link
+//! the engine, never the other way round; docs/engine.md).
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+const FORBIDDEN: [&str; 12] = [
+    "firmware",
+    "protocol",
+    "canbus",
+    "sil",
+    "walker-cli",
+    "embedded-hal",
+    "embedded-can",
+    "nb",
+    "heapless",
+    "defmt",
+    "clap",
+    "anyhow",
+];
+
+#[test]
+fn the_engine_depends_on_no_firmware_can_or_cli_crate() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
+    let manifest: toml::Table = std::fs::read_to_string(&path).unwrap().parse().unwrap();
+    let deps = manifest["dependencies"].as_table().unwrap();
+    assert!(
+        deps.contains_key("nalgebra"),
+        "read the engine's dependencies"
+    );
+    for name in FORBIDDEN {
+        assert!(
+            !deps.contains_key(name),
+            "the engine depends on `{name}` ({})",
+            path.display()
+        );
+    }
+    for (section, value) in &manifest {
+        if section == "target" {
+            for (cfg, table) in value.as_table().unwrap() {
+                let deps = table.get("dependencies").and_then(|d| d.as_table());
+                for name in FORBIDDEN {
+                    assert!(
+                        !deps.is_some_and(|d| d.contains_key(name)),
+                        "the engine depends on `{name}` for {cfg}"
+                    );
+                }
+            }
+        }
+    }
+}
