@@ -29,6 +29,19 @@ pub struct AnkleReflex {
     pub duration_s: f64,
 }
 
+impl AnkleReflex {
+    /// The ideal actuator's extension started at `start_s` (stride time [s], the string's
+    /// engagement): from the engagement angle to the final angle over the reflex's duration.
+    pub fn extension_from(&self, start_s: f64) -> AnkleProfile {
+        AnkleProfile {
+            start_s,
+            duration_s: self.duration_s,
+            from_rad: self.engage_rad,
+            to_rad: self.final_rad,
+        }
+    }
+}
+
 /// A prescribed ankle angle: a quintic smooth step (zero rate and acceleration at both ends)
 /// from `from_rad` at `start_s` to `to_rad` at `start_s + duration_s`, held after.
 #[derive(Clone, Copy, Debug, PartialEq)]

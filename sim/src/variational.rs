@@ -22,13 +22,13 @@
 //! supported (a typed error; the perturbation Jacobian is then the fallback): infinitesimal
 //! bodies (the simplest walker), controller-driven strides, the heel coming back down.
 
-use nalgebra::{Const, DMatrix, DVector, RealField, SVector, U1};
+use nalgebra::{Const, DMatrix, DVector, SVector, U1};
 use num_dual::{Derivative, DualSVec64};
 
 use crate::actuator::AnkleProfile;
 use crate::dynamics::{DynamicsError, DynamicsOf};
 use crate::hybrid::contact_rows::heel_strike_rows;
-use crate::hybrid::impact::solve_finite;
+use crate::hybrid::impact::{locked_state, solve_finite, unit_row};
 use crate::hybrid::phase::DriveValues;
 use crate::hybrid::profile::extension;
 use crate::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
@@ -178,13 +178,6 @@ impl<const N: usize> SecondOrderSystem for Augmented<'_, N> {
         }
         Ok(out)
     }
-}
-
-/// A unit constraint row on coordinate `c`.
-fn unit_row<T: RealField + Copy>(n: usize, c: usize) -> DMatrix<T> {
-    let mut g = DMatrix::zeros(1, n);
-    g[(0, c)] = T::one();
-    g
 }
 
 /// The stacked state `[q; q̇]` of a sample.
@@ -340,15 +333,7 @@ fn variational<const N: usize>(
                 after_active[a] = false;
                 let s = PhaseSpec {
                     active: after_active,
-                    drive: Some((
-                        a,
-                        AnkleProfile {
-                            start_s: t,
-                            duration_s: r.duration_s,
-                            from_rad: r.engage_rad,
-                            to_rad: r.final_rad,
-                        },
-                    )),
+                    drive: Some((a, r.extension_from(t))),
                 };
                 (a, r.engage_rad, act, s)
             } else {
@@ -361,7 +346,7 @@ fn variational<const N: usize>(
             &y,
             |q, qd, dy| {
                 let target = DVector::zeros(1);
-                let mut qd = solve_finite(
+                let qd_plus = solve_finite(
                     dy,
                     &walker.model,
                     q,
@@ -372,10 +357,13 @@ fn variational<const N: usize>(
                 )
                 .map_err(num)?
                 .qd_plus;
-                let mut q = q.clone();
-                q[c] = konst(value);
-                qd[c] = DualSVec64::<N>::from_re(0.0);
-                Ok((q, qd))
+                Ok(locked_state(
+                    q,
+                    qd_plus,
+                    c,
+                    konst(value),
+                    DualSVec64::<N>::from_re(0.0),
+                ))
             },
             &mut dy_d,
         )?;

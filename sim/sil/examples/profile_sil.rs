@@ -1,6 +1,6 @@
 //! Walks the 3D walker with both ankle nodes' firmware and the simulated bus in the loop, for
 //! profilers: real-time factor and right-hand-side evaluations per control tick
-//! (`cargo run --release -p sim --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`;
+//! (`cargo run --release -p sil --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`;
 //! without an integrator, `walker sil`'s own, `sil::SIL_INTEGRATOR`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 

@@ -89,3 +89,27 @@ pub(crate) fn scatter<T: RealField + Copy>(
         impulse: x.rows(n, x.len() - n).into_owned(),
     }
 }
+
+/// A unit constraint row on coordinate `c` of `n`: the row of a joint stop, a foot landing
+/// flat or a taut string.
+pub fn unit_row<T: RealField + Copy>(n: usize, c: usize) -> DMatrix<T> {
+    let mut g = DMatrix::zeros(1, n);
+    g[(0, c)] = T::one();
+    g
+}
+
+/// The state after a locking impact on coordinate `c`: the coordinate put exactly at
+/// `value` [rad or m] moving at `rate` [rad/s or m/s] (zero at a stop, the drive's rate for a
+/// string), the others at their positions `q` with their post-impact rates `qd_plus`.
+pub fn locked_state<T: RealField + Copy>(
+    q: &DVector<T>,
+    mut qd_plus: DVector<T>,
+    c: usize,
+    value: T,
+    rate: T,
+) -> (DVector<T>, DVector<T>) {
+    let mut q = q.clone();
+    q[c] = value;
+    qd_plus[c] = rate;
+    (q, qd_plus)
+}

@@ -13,12 +13,13 @@ use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use crate::actuator::AnkleReflex;
 use crate::dynamics::Dynamics;
 use crate::hybrid::contact_rows::{heel_strike_rows, HeelStrikeRows};
+use crate::hybrid::impact::{locked_state, unit_row};
 use crate::impact::{resolve, resolve_to, ImpactError};
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
 use crate::relabel::LinkStates;
 use crate::walker::Walker;
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DVector, Vector3};
 
 /// The heel-strike impact on the impact model (coordinates: released root first).
 #[derive(Clone, Debug)]
@@ -70,8 +71,7 @@ impl Walker {
         c: usize,
         value: f64,
     ) -> Result<Locked, StrideFailure> {
-        let mut g = DMatrix::zeros(1, self.model.dof());
-        g[(0, c)] = 1.0;
+        let g = unit_row(self.model.dof(), c);
         let mut dynamics = Dynamics::new(&self.model);
         let before = energy(&mut dynamics, &self.model, at);
         let imp = resolve(
@@ -94,10 +94,7 @@ impl Walker {
             }
             None => 0.0,
         };
-        let mut qd = imp.qd_plus;
-        qd[c] = 0.0;
-        let mut q = at.q.clone();
-        q[c] = value;
+        let (q, qd) = locked_state(&at.q, imp.qd_plus, c, value, 0.0);
         let after = Sample { t_s: at.t_s, q, qd };
         let loss_j = before - energy(&mut dynamics, &self.model, &after) + drive_work_j;
         Ok(Locked {
@@ -121,8 +118,7 @@ impl Walker {
         let (a, toe) = (reflex.ankle.0, reflex.toe_pitch.0);
         let mut act = phase.active.clone();
         act[toe] = true;
-        let mut g = DMatrix::zeros(1, self.model.dof());
-        g[(0, a)] = 1.0;
+        let g = unit_row(self.model.dof(), a);
         let (p_rad, v_rad_s, _) = drive.eval(at.t_s);
         let mut dynamics = Dynamics::new(&self.model);
         let before = energy(&mut dynamics, &self.model, at);
@@ -132,10 +128,7 @@ impl Walker {
         // The string's impulse on the ankle, with its far end moving at the drive's rate, is
         // work the actuator does (zero for the ideal drive, which starts at rest).
         let drive_work_j = imp.impulse[0] * v_rad_s;
-        let mut q = at.q.clone();
-        q[a] = p_rad;
-        let mut qd = imp.qd_plus;
-        qd[a] = v_rad_s;
+        let (q, qd) = locked_state(&at.q, imp.qd_plus, a, p_rad, v_rad_s);
         if qd[toe] > 0.0 {
             return Err(StrideFailure::new(
                 FailureKind::HeelDidNotLift,

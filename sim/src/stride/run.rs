@@ -14,7 +14,6 @@ use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use super::schedule::ScheduleCursor;
 use super::settings::StrideSettings;
 use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
-use crate::actuator::AnkleProfile;
 use crate::control::{ActuatorSegment, AnkleSensing};
 use crate::events::locate;
 use crate::hermite::{self, Knot};
@@ -477,12 +476,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 // The string's far end: fixed (ideal reflex) or moving with the actuator.
                 let drive = match (&self.control, self.segment) {
                     (Some(_), Some(seg)) => Drive::Segment(seg),
-                    _ => Drive::Profile(AnkleProfile {
-                        start_s: at.t_s,
-                        duration_s: r.duration_s,
-                        from_rad: r.engage_rad,
-                        to_rad: r.final_rad,
-                    }),
+                    _ => Drive::Profile(r.extension_from(at.t_s)),
                 };
                 let e = w.engage_string(&self.phase, at, r, &drive)?;
                 self.power.work_j += e.drive_work_j;
