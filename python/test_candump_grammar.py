@@ -7,8 +7,8 @@ Run: scripts/python-venv && .venv/bin/python -m pytest python/
 """
 
 import json
+import io
 import math
-import os
 import pathlib
 import random
 import subprocess
@@ -95,8 +95,7 @@ def test_good_lines_give_the_messages_python_can_reads():
     for line in log_lines(GOOD):
         rec = cg.parse_line(line)
         ours = rec.to_message()
-        theirs = next(iter(can.io.canutils.CanutilsLogReader(
-            __import__("io").StringIO(line.decode() + "\n"))))
+        theirs = next(iter(can.io.canutils.CanutilsLogReader(io.StringIO(line.decode() + "\n"))))
         assert ours.timestamp == pytest.approx(theirs.timestamp, abs=1e-6), line
         assert ours.is_error_frame == (rec.kind == "err")
         if rec.kind == "err":

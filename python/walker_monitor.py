@@ -398,15 +398,14 @@ def port_number(text: str) -> int:
     return v
 
 
-def seconds(text: str, allow_zero: bool = False) -> float:
-    """argparse type: a finite number of seconds > 0 (>= 0 with allow_zero)."""
+def seconds(text: str) -> float:
+    """argparse type: a finite number of seconds > 0."""
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a finite number of seconds {'>=' if allow_zero else '>'} 0")
+    if not math.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number of seconds > 0")
     return v
 
 
