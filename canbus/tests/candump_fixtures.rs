@@ -3,6 +3,7 @@
 //! `candump_good.expected` describes, every line of `candump_malformed.log` (reasons in
 //! `candump_malformed.why`) is rejected with its line number. `python/test_candump_grammar.py`
 //! reads the same files through the monitor's reader.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
 use std::path::PathBuf;
 
