@@ -16,25 +16,43 @@ frames, undecodable frames) and the bus load; can record what it sees to a candu
 
 Bus load = bits on the wire (actual bit stuffing of each frame, CRC-15 included, plus the
 3-bit interframe space, as the Rust simulator counts them) / (bit rate x observed time span).
+
+A log is read line by line in bounded pieces with the grammar of canbus/src/candump.rs
+(candump_grammar.py): a malformed line is counted (`malformed_lines`), the first few quoted
+(`bad_lines`, cut short), never decoded; memory does not grow with the log. Bad flags exit 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import io
 import json
+import math
 import pathlib
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Iterable, Iterator, Optional
+from typing import BinaryIO, Iterable, Iterator, Optional, Union
 
 import can
 import cantools
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import candump_grammar  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DEFAULT_DBC = ROOT / "protocol" / "walker.dbc"
 NODES = ("HOST", "LEFT_ANKLE", "RIGHT_ANKLE")
+#: Malformed log lines quoted in `bad_lines` and on stderr; the rest are only counted.
+MAX_QUOTED_LINES = 5
+#: Fault events kept in `faults.events` (`faults.events_total` counts them all).
+MAX_FAULT_EVENTS = 1000
+#: Distinct unknown identifiers counted one by one (`faults.unknown_ids`); frames with further
+#: identifiers go to `faults.unknown_ids_other`.
+MAX_UNKNOWN_IDS = 256
+#: The bus-load window is summed in this many buckets (its resolution: window / buckets).
+WINDOW_BUCKETS = 1000
 
 
 # --- frame length on the wire -------------------------------------------------------------
@@ -108,6 +126,11 @@ class Monitor:
     """Accumulates what a stream of can.Message shows."""
 
     def __init__(self, db, bitrate: int = 500_000, stale_s: float = 0.3, window_s: float = 1.0):
+        if isinstance(bitrate, bool) or not isinstance(bitrate, int) or bitrate <= 0:
+            raise ValueError(f"bit rate {bitrate!r} is not a positive whole number of bit/s")
+        for name, v in (("stale_s", stale_s), ("window_s", window_s)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} {v!r} is not a positive finite number of seconds")
         self.db = db
         self.bitrate = bitrate
         self.stale_s = stale_s
@@ -115,14 +138,18 @@ class Monitor:
         self.messages: dict[int, MessageStats] = {}
         self.nodes: dict[str, NodeStatus] = {n: NodeStatus() for n in NODES}
         self.fault_events: list[dict] = []
+        self.fault_events_total = 0
         self.error_frames = 0
         self.unknown: dict[int, int] = {}
+        self.unknown_other = 0
         self.undecodable = 0
         self.frames = 0
         self.bits = 0
         self.first: Optional[float] = None
         self.last: Optional[float] = None
-        self.recent: list[tuple[float, int]] = []  # (timestamp, bits) within the window
+        # (bucket index, bits) of the last window, oldest first, at most WINDOW_BUCKETS + 1
+        self.recent: collections.deque[tuple[int, int]] = collections.deque()
+        self.bucket_s = window_s / WINDOW_BUCKETS
         fault = db.get_message_by_name("Fault_LEFT_ANKLE").get_signal_by_name("code")
         self.fault_names = {int(k): str(v) for k, v in fault.choices.items()}
 
@@ -139,16 +166,14 @@ class Monitor:
         else:
             nbits = worst_case_bits(msg.dlc) + 20
         self.bits += nbits
-        self.recent.append((ts, nbits))
-        while self.recent and self.recent[0][0] < ts - self.window_s:
-            self.recent.pop(0)
+        self._window_add(ts, nbits)
         try:
             m = self.db.get_message_by_frame_id(msg.arbitration_id)
         except KeyError:
-            self.unknown[msg.arbitration_id] = self.unknown.get(msg.arbitration_id, 0) + 1
+            self._count_unknown(msg.arbitration_id)
             return
         if msg.is_extended_id != m.is_extended_frame:
-            self.unknown[msg.arbitration_id] = self.unknown.get(msg.arbitration_id, 0) + 1
+            self._count_unknown(msg.arbitration_id)
             return
         try:
             sig = m.decode(bytes(msg.data), decode_choices=True)
@@ -174,7 +199,30 @@ class Monitor:
             n.uptime_s = sig.get("uptime")
             n.last_seen = ts
         elif kind == "Fault":
-            self.fault_events.append({"t": ts, "node": sender, **sig})
+            self.fault_events_total += 1
+            if len(self.fault_events) < MAX_FAULT_EVENTS:
+                self.fault_events.append({"t": ts, "node": sender, **sig})
+
+    def _count_unknown(self, ident: int) -> None:
+        if ident in self.unknown or len(self.unknown) < MAX_UNKNOWN_IDS:
+            self.unknown[ident] = self.unknown.get(ident, 0) + 1
+        else:
+            self.unknown_other += 1
+
+    def _window_add(self, ts: float, nbits: int) -> None:
+        """Bits into the window's buckets; a frame older than the newest bucket (timestamps
+        out of order) counts in the newest."""
+        if not math.isfinite(ts):
+            return
+        key = math.floor(ts / self.bucket_s)
+        if self.recent and key <= self.recent[-1][0]:
+            k, b = self.recent[-1]
+            self.recent[-1] = (k, b + nbits)
+        else:
+            self.recent.append((key, nbits))
+        newest = self.recent[-1][0]
+        while self.recent and self.recent[0][0] < newest - WINDOW_BUCKETS:
+            self.recent.popleft()
 
     def span(self) -> float:
         if self.first is None or self.last is None:
@@ -217,7 +265,9 @@ class Monitor:
                 "events": self.fault_events,
                 "error_frames": self.error_frames,
                 "unknown_ids": {f"0x{k:03X}": v for k, v in sorted(self.unknown.items())},
+                "unknown_ids_other": self.unknown_other,
                 "undecodable": self.undecodable,
+                "events_total": self.fault_events_total,
             },
         }
 
@@ -237,27 +287,50 @@ def render(summary: dict) -> str:
         out.write(f"{name:<13}{str(n['state']):<15}{'yes' if n['alive'] else 'NO':<7}"
                   f"{n['heartbeats']:>10}  {','.join(n['faults']) or '-'}\n")
     f = s["faults"]
-    out.write(f"fault events {len(f['events'])}  error frames {f['error_frames']}  "
+    out.write(f"fault events {f['events_total']}  error frames {f['error_frames']}  "
               f"unknown ids {f['unknown_ids'] or '-'}  undecodable {f['undecodable']}\n")
+    if s.get("malformed_lines"):
+        out.write(f"malformed log lines {s['malformed_lines']}\n")
     return out.getvalue()
 
 
 # --- sources ----------------------------------------------------------------------------
 
-def read_log(path: str, bad_lines: list) -> Iterator[can.Message]:
-    """Messages of a candump log; a bad line is reported (line number, text, reason) and
-    skipped, every other line kept."""
-    with open(path, encoding="ascii", errors="replace") as f:
-        for no, line in enumerate(f, 1):
-            if not line.strip():
+@dataclass
+class ReadStats:
+    """What reading a log found besides its frames."""
+
+    malformed: int = 0
+    lines: int = 0
+
+
+def read_log(path: Union[str, BinaryIO], bad_lines: list,
+             stats: Optional[ReadStats] = None) -> Iterator[can.Message]:
+    """Messages of a candump log (a path or a binary file), streamed line by line. A malformed
+    line is counted in `stats` and, for the first MAX_QUOTED_LINES, appended to `bad_lines`
+    (line number, quoted text cut to candump_grammar.QUOTE_BYTES, reason) and named on stderr;
+    every other line is kept."""
+    stats = stats if stats is not None else ReadStats()
+    name = path if isinstance(path, str) else getattr(path, "name", "log")
+    f = open(path, "rb") if isinstance(path, str) else path
+    try:
+        for raw, rec in candump_grammar.records(f):
+            stats.lines = raw.number
+            if isinstance(rec, candump_grammar.Malformed):
+                stats.malformed += 1
+                if len(bad_lines) < MAX_QUOTED_LINES:
+                    text = raw.quote()
+                    bad_lines.append({"line": raw.number, "text": text, "reason": str(rec)})
+                    print(f"{name}:{raw.number}: bad candump line ({rec}): {text}",
+                          file=sys.stderr)
                 continue
-            try:
-                msgs = list(can.io.canutils.CanutilsLogReader(io.StringIO(line)))
-            except Exception as e:  # noqa: BLE001 - python-can raises assorted errors
-                bad_lines.append({"line": no, "text": line.rstrip("\n"), "reason": repr(e)})
-                print(f"{path}:{no}: bad candump line ({e!r}): {line.rstrip()}", file=sys.stderr)
-                continue
-            yield from msgs
+            yield rec.to_message()
+    finally:
+        if isinstance(path, str):
+            f.close()
+    if stats.malformed > len(bad_lines):
+        print(f"{name}: {stats.malformed} malformed lines in all (the first "
+              f"{len(bad_lines)} named)", file=sys.stderr)
 
 
 def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float]) -> Iterator[can.Message]:
@@ -280,7 +353,10 @@ def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float])
 def parse_send(text: str) -> can.Message:
     """`ID#HEXDATA` (cansend syntax, standard identifiers) as a can.Message."""
     ident, _, data = text.partition("#")
+    hexdigits = set("0123456789abcdefABCDEF")
     try:
+        if not ident or not set(ident) <= hexdigits or not set(data) <= hexdigits:
+            raise ValueError("hex digits only")
         arb = int(ident, 16)
         payload = bytes.fromhex(data)
     except ValueError as e:
@@ -300,6 +376,50 @@ def open_bus(args) -> can.BusABC:
     return can.Bus(**kwargs)
 
 
+def positive_int(text: str) -> int:
+    """argparse type: a whole number > 0 (a bit rate)."""
+    try:
+        v = int(text, 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not positive")
+    return v
+
+
+def port_number(text: str) -> int:
+    """argparse type: a TCP port, 1..65535."""
+    try:
+        v = int(text, 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 1 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port number 1..65535")
+    return v
+
+
+def seconds(text: str) -> float:
+    """argparse type: a finite number of seconds > 0."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number of seconds > 0")
+    return v
+
+
+def finite_json(value):
+    """`value` with every non-finite float replaced by None (strict JSON has no NaN/Infinity)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: finite_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_json(v) for v in value]
+    return value
+
+
 def main(argv: Optional[list] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     src = p.add_mutually_exclusive_group(required=True)
@@ -307,16 +427,16 @@ def main(argv: Optional[list] = None) -> int:
     src.add_argument("--log", help="read a candump log instead of a live bus")
     p.add_argument("--channel", default="vcan0", help="interface channel (default vcan0)")
     p.add_argument("--host", default="127.0.0.1", help="socketcand host (default 127.0.0.1)")
-    p.add_argument("--port", type=int, default=29536, help="socketcand port (default 29536)")
-    p.add_argument("--bitrate", type=int, default=500_000, help="bus bit rate [bit/s]")
+    p.add_argument("--port", type=port_number, default=29536, help="socketcand port (default 29536)")
+    p.add_argument("--bitrate", type=positive_int, default=500_000, help="bus bit rate [bit/s]")
     p.add_argument("--dbc", default=str(DEFAULT_DBC), help="DBC file (default protocol/walker.dbc)")
     p.add_argument("--record", help="also write every received frame to this candump log")
-    p.add_argument("--duration", type=float,
+    p.add_argument("--duration", type=seconds,
                    help="stop after this many seconds (wall clock live, log time for --log)")
-    p.add_argument("--idle-exit", type=float,
+    p.add_argument("--idle-exit", type=seconds,
                    help="live: stop when nothing arrived for this many seconds after the first frame")
-    p.add_argument("--interval", type=float, default=1.0, help="live table refresh [s] (text mode)")
-    p.add_argument("--stale", type=float, default=0.3,
+    p.add_argument("--interval", type=seconds, default=1.0, help="live table refresh [s] (text mode)")
+    p.add_argument("--stale", type=seconds, default=0.3,
                    help="a node is not alive when its last heartbeat is older than this [s]")
     p.add_argument("--json", action="store_true", help="print one JSON summary at the end")
     p.add_argument("--send", type=parse_send, action="append", default=[], metavar="ID#DATA",
@@ -325,14 +445,30 @@ def main(argv: Optional[list] = None) -> int:
     if args.send and args.log:
         p.error("--send needs a live --interface, not --log")
 
-    db = cantools.database.load_file(args.dbc, strict=True)
-    mon = Monitor(db, bitrate=args.bitrate, stale_s=args.stale)
-    writer = can.CanutilsLogWriter(args.record, channel=args.channel) if args.record else None
-    bad_lines: list = []
-    bus = None
     try:
-        if args.log:
-            source: Iterable[can.Message] = read_log(args.log, bad_lines)
+        db = cantools.database.load_file(args.dbc, strict=True)
+    except Exception as e:  # noqa: BLE001 - cantools raises assorted errors
+        p.error(f"--dbc {args.dbc}: {e}")
+    mon = Monitor(db, bitrate=args.bitrate, stale_s=args.stale)
+    log_file = None
+    if args.log:
+        try:
+            log_file = open(args.log, "rb")
+        except OSError as e:
+            p.error(f"--log {args.log}: {e.strerror or e}")
+    try:
+        writer = can.CanutilsLogWriter(args.record, channel=args.channel) if args.record else None
+    except OSError as e:
+        if log_file is not None:
+            log_file.close()
+        p.error(f"--record {args.record}: {e.strerror or e}")
+    bad_lines: list = []
+    stats = ReadStats()
+    bus = None
+    failed = None
+    try:
+        if log_file is not None:
+            source: Iterable[can.Message] = read_log(log_file, bad_lines, stats)
         else:
             bus = open_bus(args)
             for m in args.send:
@@ -351,18 +487,26 @@ def main(argv: Optional[list] = None) -> int:
                 next_print = time.monotonic() + args.interval
     except KeyboardInterrupt:
         pass
+    except OSError as e:  # the log or the record file failed mid-way: report what was seen
+        failed = f"walker_monitor: {e}"
     finally:
         if bus is not None:
             bus.shutdown()
         if writer is not None:
             writer.stop()
+        if log_file is not None:
+            log_file.close()
     summary = mon.summary()
     summary["bad_lines"] = bad_lines
+    summary["malformed_lines"] = stats.malformed
     if args.json:
-        json.dump(summary, sys.stdout, indent=1, default=str)
+        json.dump(finite_json(summary), sys.stdout, indent=1, default=str, allow_nan=False)
         print()
     else:
         print(render(summary), end="")
+    if failed is not None:
+        print(failed, file=sys.stderr)
+        return 1
     return 0
 
 

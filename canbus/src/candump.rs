@@ -11,7 +11,8 @@
 //! (three hex digits: standard, eight: extended; `CAN_ERR_FLAG` 0x20000000 set: error frame),
 //! `#`, data as hex pairs (or `R[dlc]` for a remote frame), optionally ` R`/` T` (received or
 //! transmitted, written by python-can). [`read_log`] keeps every good line and reports each bad
-//! one with its line number.
+//! one with its line number. [`parse_line`] documents the grammar, which `python/walker_monitor.py`
+//! shares (both read `canbus/tests/fixtures/candump_{good,malformed}.log`).
 
 use std::io::{self, BufRead, Write};
 
@@ -87,7 +88,8 @@ pub struct LogRecord {
 pub struct LineError {
     /// 1-based line number.
     pub line_no: usize,
-    /// The line as read.
+    /// The line as read, cut to its first [`QUOTE_BYTES`] bytes (`...` appended when cut),
+    /// bytes that are not UTF-8 replaced.
     pub line: String,
     /// What is wrong.
     pub reason: String,
@@ -101,58 +103,128 @@ pub enum ReadError {
     Io(#[from] io::Error),
 }
 
+/// The longest line [`read_log`] and [`parse_line`] accept, in bytes before the newline
+/// (a `\r` before it included); a longer line is malformed. The longest record python-can or
+/// [`CandumpWriter`] write is about 60 bytes plus the channel name. `python/walker_monitor.py`
+/// uses the same bound.
+pub const MAX_LINE_BYTES: usize = 256;
+
+/// How much of a bad line a [`LineError`] keeps (bytes, before lossy UTF-8 decoding).
+pub const QUOTE_BYTES: usize = 120;
+
+/// The largest timestamp, in ns, that fits a `u64`.
+const MAX_TIMESTAMP_NS: u64 = u64::MAX;
+
+/// `(SECONDS.FRACTION)`: ASCII digits, 1 to 9 fraction digits, the value in ns within 64 bits.
 fn parse_timestamp(s: &str) -> Result<u64, String> {
     let inner = s
         .strip_prefix('(')
         .and_then(|t| t.strip_suffix(')'))
         .ok_or_else(|| format!("timestamp `{s}` is not of the form (SECONDS.FRACTION)"))?;
-    let (secs, frac) = inner.split_once('.').unwrap_or((inner, ""));
-    let bad = || format!("timestamp `{s}` is not a non-negative decimal number");
+    let bad = || format!("timestamp `{s}` is not of the form (SECONDS.FRACTION), digits only");
+    let (secs, frac) = inner.split_once('.').ok_or_else(bad)?;
     if secs.is_empty() || !secs.bytes().all(|b| b.is_ascii_digit()) {
         return Err(bad());
     }
-    if frac.len() > 9 || !frac.bytes().all(|b| b.is_ascii_digit()) {
-        return Err(bad());
+    if frac.is_empty() || frac.len() > 9 || !frac.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!(
+            "timestamp `{s}` needs 1 to 9 digits after the decimal point"
+        ));
     }
-    let secs: u64 = secs.parse().map_err(|_| bad())?;
+    let too_big = || format!("timestamp `{s}` exceeds {MAX_TIMESTAMP_NS} ns");
+    // leading zeros are allowed; the value decides
+    let secs = secs.trim_start_matches('0');
+    if secs.len() > 11 {
+        return Err(too_big());
+    }
+    let mut secs_n: u64 = 0;
+    for b in secs.bytes() {
+        secs_n = secs_n * 10 + u64::from(b - b'0');
+    }
     let mut frac_ns: u64 = 0;
-    for (i, b) in frac
-        .bytes()
-        .chain(std::iter::repeat(b'0'))
-        .take(9)
-        .enumerate()
-    {
-        let _ = i;
+    for b in frac.bytes().chain(std::iter::repeat(b'0')).take(9) {
         frac_ns = frac_ns * 10 + u64::from(b - b'0');
     }
-    secs.checked_mul(1_000_000_000)
+    secs_n
+        .checked_mul(1_000_000_000)
         .and_then(|n| n.checked_add(frac_ns))
-        .ok_or_else(bad)
+        .ok_or_else(too_big)
+}
+
+/// Hex digits only (`u8::from_str_radix` would take a leading `+`).
+fn is_hex(s: &str) -> bool {
+    s.bytes().all(|b| b.is_ascii_hexdigit())
+}
+
+fn hex_value(b: u8) -> u8 {
+    match b {
+        b'0'..=b'9' => b - b'0',
+        b'a'..=b'f' => b - b'a' + 10,
+        b'A'..=b'F' => b - b'A' + 10,
+        _ => 0,
+    }
 }
 
 fn parse_hex_bytes(s: &str) -> Result<Vec<u8>, String> {
+    if !is_hex(s) {
+        return Err(format!("data `{s}` is not hex"));
+    }
     if !s.len().is_multiple_of(2) {
         return Err(format!("data `{s}` has an odd number of hex digits"));
     }
     if s.len() > 16 {
         return Err(format!("data `{s}` is longer than 8 bytes"));
     }
-    (0..s.len())
-        .step_by(2)
-        .map(|i| {
-            s.get(i..i + 2)
-                .and_then(|h| u8::from_str_radix(h, 16).ok())
-                .ok_or_else(|| format!("data `{s}` is not hex"))
-        })
-        .collect()
+    Ok(s.as_bytes()
+        .chunks_exact(2)
+        .map(|p| hex_value(p[0]) << 4 | hex_value(p[1]))
+        .collect())
 }
 
-/// Parse one line (without the newline).
+/// Space or tab: the only field separators.
+fn is_blank(c: char) -> bool {
+    c == ' ' || c == '\t'
+}
+
+/// Parse one line (without the newline). The grammar (docs/canbus.md, "candump logs"):
+///
+/// ```text
+/// line       = [blanks] timestamp blanks channel blanks frame [blanks direction] [blanks]
+/// blanks     = 1*(SP / TAB)          ; a trailing CR is a blank too
+/// timestamp  = "(" 1*DIGIT "." 1*9DIGIT ")"        ; ≤ u64::MAX ns
+/// channel    = 1*VCHAR                              ; printable ASCII, no blank
+/// frame      = std-id "#" data / ext-id "#" data / (std-id / ext-id) "#" remote
+///            / err-id "#" data
+/// std-id     = 3HEXDIG                              ; ≤ 7FF
+/// ext-id     = 8HEXDIG                              ; ≤ 1FFFFFFF
+/// err-id     = 8HEXDIG                              ; 20000000..3FFFFFFF (CAN_ERR_FLAG)
+/// data       = 0*8(2HEXDIG)
+/// remote     = ("R" / "r") [%x30-38]                ; requested length 0..8
+/// direction  = "R" / "r" / "T" / "t"
+/// ```
+///
+/// Only printable ASCII and tabs; at most [`MAX_LINE_BYTES`] bytes. CAN FD (`##`) is refused.
 ///
 /// # Errors
 /// A description of the first problem; [`read_log`] wraps it in a [`LineError`].
 pub fn parse_line(line: &str) -> Result<LogRecord, String> {
-    let mut parts = line.split_whitespace();
+    if line.len() > MAX_LINE_BYTES {
+        return Err(format!(
+            "line of {} bytes is longer than {MAX_LINE_BYTES} bytes",
+            line.len()
+        ));
+    }
+    let line = line.trim_matches(|c| is_blank(c) || c == '\r');
+    if let Some(c) = line
+        .chars()
+        .find(|c| !(c.is_ascii_graphic() || is_blank(*c)))
+    {
+        return Err(format!(
+            "character `{}` is not printable ASCII",
+            c.escape_default()
+        ));
+    }
+    let mut parts = line.split(is_blank).filter(|p| !p.is_empty());
     let (Some(ts), Some(channel), Some(body)) = (parts.next(), parts.next(), parts.next()) else {
         return Err("expected `(TIMESTAMP) CHANNEL ID#DATA`".to_string());
     };
@@ -177,29 +249,37 @@ pub fn parse_line(line: &str) -> Result<LogRecord, String> {
         8 => true,
         _ => return Err(format!("identifier `{id_s}` must have 3 or 8 hex digits")),
     };
+    if !is_hex(id_s) {
+        return Err(format!("identifier `{id_s}` is not hexadecimal"));
+    }
     let id = u32::from_str_radix(id_s, 16)
         .map_err(|_| format!("identifier `{id_s}` is not hexadecimal"))?;
+    let error_frame = extended && id & CAN_ERR_FLAG != 0;
+    if extended && id > (CAN_ERR_FLAG | 0x1FFF_FFFF) {
+        return Err(format!(
+            "identifier `{id_s}` exceeds 29 bits (error frames: 20000000..3FFFFFFF)"
+        ));
+    }
     let frame = if let Some(r) = data_s.strip_prefix(['R', 'r']) {
-        let dlc = if r.is_empty() {
-            0
-        } else {
-            r.parse::<u8>()
-                .ok()
-                .filter(|d| *d <= 8)
-                .ok_or_else(|| format!("remote length `{r}` is not 0..8"))?
+        if error_frame {
+            return Err(format!(
+                "identifier `{id_s}` exceeds 29 bits (an error class cannot be a remote frame)"
+            ));
+        }
+        let dlc = match r.as_bytes() {
+            [] => 0,
+            [d @ b'0'..=b'8'] => d - b'0',
+            _ => return Err(format!("remote length `{r}` is not one digit 0..8")),
         };
         LogFrame::Remote { id, extended, dlc }
     } else {
         let data = parse_hex_bytes(data_s)?;
-        if extended && id & CAN_ERR_FLAG != 0 {
+        if error_frame {
             LogFrame::Error {
                 class: id & !CAN_ERR_FLAG,
                 data,
             }
         } else if extended {
-            if id > 0x1FFF_FFFF {
-                return Err(format!("identifier `{id_s}` exceeds 29 bits"));
-            }
             LogFrame::Extended { id, data }
         } else {
             LogFrame::Standard(Frame::new(id, &data).map_err(|e| e.to_string())?)
@@ -213,24 +293,98 @@ pub fn parse_line(line: &str) -> Result<LogRecord, String> {
     })
 }
 
-/// Read every record; bad lines are reported, the others kept. Blank lines are skipped.
+/// One line of a byte stream, read in bounded pieces.
+enum RawLine {
+    /// The line (without its `\n`), at most [`MAX_LINE_BYTES`] bytes.
+    Fits(Vec<u8>),
+    /// Longer than [`MAX_LINE_BYTES`]: its first [`QUOTE_BYTES`] + 1 bytes and its length.
+    TooLong(Vec<u8>, usize),
+}
+
+/// Read the next line without holding more than [`MAX_LINE_BYTES`] + 1 bytes of it; the rest
+/// of an over-long line is skipped. `None` at the end of the input.
+fn next_line<R: BufRead>(reader: &mut R) -> io::Result<Option<RawLine>> {
+    let mut kept: Vec<u8> = Vec::new();
+    let mut len = 0usize;
+    let mut any = false;
+    // each pass consumes at least one byte of the reader (or ends): bounded by the input
+    loop {
+        let buf = match reader.fill_buf() {
+            Ok(b) => b,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if buf.is_empty() {
+            break;
+        }
+        any = true;
+        let (piece, done) = match buf.iter().position(|&b| b == b'\n') {
+            Some(i) => (&buf[..i], Some(i + 1)),
+            None => (buf, None),
+        };
+        let room = (MAX_LINE_BYTES + 1).saturating_sub(kept.len());
+        kept.extend_from_slice(&piece[..piece.len().min(room)]);
+        len = len.saturating_add(piece.len());
+        let used = done.unwrap_or(buf.len());
+        reader.consume(used);
+        if done.is_some() {
+            break;
+        }
+    }
+    if !any {
+        return Ok(None);
+    }
+    Ok(Some(if len > MAX_LINE_BYTES {
+        kept.truncate(QUOTE_BYTES + 1);
+        RawLine::TooLong(kept, len)
+    } else {
+        RawLine::Fits(kept)
+    }))
+}
+
+/// At most [`QUOTE_BYTES`] of a line, lossily decoded, `...` appended when cut.
+fn quote(bytes: &[u8]) -> String {
+    let mut q = String::from_utf8_lossy(&bytes[..bytes.len().min(QUOTE_BYTES)]).into_owned();
+    if bytes.len() > QUOTE_BYTES {
+        q.push_str("...");
+    }
+    q
+}
+
+/// Read every record; bad lines are reported (their text cut to [`QUOTE_BYTES`]), the others
+/// kept. Blank lines are skipped. Lines are read in bounded pieces: a line longer than
+/// [`MAX_LINE_BYTES`] is reported without being held, and bytes that are not UTF-8 make their
+/// line bad, not the read.
 ///
 /// # Errors
 /// [`ReadError::Io`] when the reader fails (not for bad lines).
-pub fn read_log<R: BufRead>(reader: R) -> Result<(Vec<LogRecord>, Vec<LineError>), ReadError> {
+pub fn read_log<R: BufRead>(mut reader: R) -> Result<(Vec<LogRecord>, Vec<LineError>), ReadError> {
     let mut records = Vec::new();
     let mut errors = Vec::new();
-    for (i, line) in reader.lines().enumerate() {
-        let line = line?;
-        let t = line.trim();
-        if t.is_empty() {
-            continue;
-        }
-        match parse_line(t) {
+    let mut line_no = 0usize;
+    while let Some(raw) = next_line(&mut reader)? {
+        line_no += 1;
+        let (bytes, result) = match raw {
+            RawLine::TooLong(head, len) => (
+                head,
+                Err(format!(
+                    "line of {len} bytes is longer than {MAX_LINE_BYTES} bytes"
+                )),
+            ),
+            RawLine::Fits(bytes) => {
+                let result = match std::str::from_utf8(&bytes) {
+                    Err(_) => Err("bytes that are not ASCII".to_string()),
+                    Ok(t) if t.trim_matches(|c| is_blank(c) || c == '\r').is_empty() => continue,
+                    Ok(t) => parse_line(t),
+                };
+                (bytes, result)
+            }
+        };
+        match result {
             Ok(r) => records.push(r),
             Err(reason) => errors.push(LineError {
-                line_no: i + 1,
-                line: line.clone(),
+                line_no,
+                line: quote(&bytes),
                 reason,
             }),
         }
