@@ -19,6 +19,7 @@ use thiserror::Error;
 
 use crate::bus::BusEvent;
 use crate::frame::Frame;
+use crate::timestamp::{stamp_ns, TimestampOverflow};
 
 /// Linux `CAN_ERR_FLAG`: the identifier is an error class, not a frame identifier.
 pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
@@ -274,6 +275,17 @@ pub fn format_record(r: &LogRecord) -> String {
     format!("{ts} {} {body}{dir}", r.channel)
 }
 
+/// Errors of [`CandumpWriter::write_event`].
+#[derive(Debug, Error)]
+pub enum WriteError {
+    /// The writer failed.
+    #[error("writing the log: {0}")]
+    Io(#[from] io::Error),
+    /// The event's timestamp (origin plus simulated time) does not fit.
+    #[error(transparent)]
+    Timestamp(#[from] TimestampOverflow),
+}
+
 /// Writes bus events as a candump log.
 #[derive(Debug)]
 pub struct CandumpWriter<W: Write> {
@@ -303,7 +315,10 @@ impl<W: Write> CandumpWriter<W> {
     /// The record for a bus event: a delivered frame (stamped at the end of its interframe
     /// space), an error frame (`CAN_ERR_PROT | CAN_ERR_BUSERROR`, data byte 2 =
     /// `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF | CAN_ERR_BUSERROR`).
-    pub fn record_for(&self, ev: &BusEvent) -> LogRecord {
+    ///
+    /// # Errors
+    /// [`TimestampOverflow`] when the origin plus the event's time does not fit.
+    pub fn record_for(&self, ev: &BusEvent) -> Result<LogRecord, TimestampOverflow> {
         let (t, frame) = match ev {
             BusEvent::Delivered(d) => (d.t_end_ns, LogFrame::Standard(d.frame)),
             BusEvent::ErrorFrame { t_end_ns, .. } => (
@@ -321,21 +336,22 @@ impl<W: Write> CandumpWriter<W> {
                 },
             ),
         };
-        LogRecord {
-            timestamp_ns: self.origin_ns + t,
+        Ok(LogRecord {
+            timestamp_ns: stamp_ns(self.origin_ns, t)?,
             channel: self.channel.clone(),
             frame,
             direction: None,
-        }
+        })
     }
 
     /// Write one bus event.
     ///
     /// # Errors
-    /// The writer's.
-    pub fn write_event(&mut self, ev: &BusEvent) -> io::Result<()> {
-        let r = self.record_for(ev);
-        self.write_record(&r)
+    /// [`WriteError::Timestamp`] when its timestamp does not fit (nothing is written),
+    /// [`WriteError::Io`] when the writer fails.
+    pub fn write_event(&mut self, ev: &BusEvent) -> Result<(), WriteError> {
+        let r = self.record_for(ev)?;
+        Ok(self.write_record(&r)?)
     }
 
     /// Flush and return the writer.
