@@ -134,7 +134,7 @@ struct Checked {
 
 fn check(cli: &Cli) -> Result<Checked> {
     if !(cli.seconds.is_finite() && cli.seconds > 0.0 && cli.seconds <= 1e6) {
-        return Err(input(format!("--seconds {} is not in (0, 1e6]", cli.seconds)));
+        return Err(input(format!("--seconds {:?} is not in (0, 1e6]", cli.seconds)));
     }
     if cli.channel.is_empty()
         || cli.channel.len() > 64
@@ -150,7 +150,7 @@ fn check(cli: &Cli) -> Result<Checked> {
         .unwrap_or(if cli.socketcand.is_some() { 1.0 } else { 0.0 });
     if !(speed == 0.0 || (speed >= SPEED_RANGE.0 && speed <= SPEED_RANGE.1)) {
         return Err(input(format!(
-            "--speed {speed}: expected 0 (as fast as possible) or a factor in [{}, {}]",
+            "--speed {speed:?}: expected 0 (as fast as possible) or a factor in [{}, {}]",
             SPEED_RANGE.0, SPEED_RANGE.1
         )));
     }
@@ -162,7 +162,7 @@ fn check(cli: &Cli) -> Result<Checked> {
                 .and_then(|w| Duration::try_from_secs_f64(w).ok())
                 .ok_or_else(|| {
                     input(format!(
-                        "--wait-client {w}: expected seconds in [0, {MAX_WAIT_CLIENT_S}]"
+                        "--wait-client {w:?}: expected seconds in [0, {MAX_WAIT_CLIENT_S}]"
                     ))
                 })?,
         ),
