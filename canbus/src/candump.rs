@@ -440,6 +440,30 @@ mod tests {
         assert!(errs[5].reason.contains("8 bytes"), "{}", errs[5].reason);
     }
 
+    #[test]
+    fn a_timestamp_past_u64_is_an_error_not_a_wrap() {
+        let ev = BusEvent::BusOff {
+            node: crate::bus::NodeHandle(0),
+            t_ns: 2_000_000_000,
+        };
+        let origin_ns = 18_446_744_073_000_000_000;
+        let mut w = CandumpWriter::new(Vec::new(), "vcan0", origin_ns);
+        match w.write_event(&ev) {
+            Err(WriteError::Timestamp(e)) => {
+                assert_eq!((e.origin_ns, e.t_ns), (origin_ns, 2_000_000_000));
+            }
+            other => panic!("{other:?}"),
+        }
+        let early = BusEvent::BusOff {
+            node: crate::bus::NodeHandle(0),
+            t_ns: 500_000_000,
+        };
+        w.write_event(&early).unwrap();
+        let text = String::from_utf8(w.finish().unwrap()).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        assert!(text.starts_with("(18446744073.500000) vcan0 "), "{text}");
+    }
+
     proptest! {
         #[test]
         fn standard_frames_round_trip(ts in 0u64..4_000_000_000_000_000, id in 0u32..0x800,

@@ -670,8 +670,7 @@ fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
                 Err(e) if transient(&e) => {}
                 Err(_) => return,
             }
-            if s.pending() > 0 && now.duration_since(last_progress) > shared.config.write_timeout
-            {
+            if s.pending() > 0 && now.duration_since(last_progress) > shared.config.write_timeout {
                 bump(&shared.counters.clients_stalled);
                 return;
             }
@@ -732,8 +731,12 @@ mod tests {
         c.write_all(b"< rawmode >").unwrap();
         assert_eq!(read_until(&mut c, ">"), "< ok >");
         assert!(server.wait_for_client(Duration::from_secs(5)));
-        server.publish(&Frame::new(0x72, &[1, 2, 0xAB]).unwrap(), 1_500_000_000).unwrap();
-        server.publish(&Frame::new(0x61, &[]).unwrap(), 2_000_001_000).unwrap();
+        server
+            .publish(&Frame::new(0x72, &[1, 2, 0xAB]).unwrap(), 1_500_000_000)
+            .unwrap();
+        server
+            .publish(&Frame::new(0x61, &[]).unwrap(), 2_000_001_000)
+            .unwrap();
         let got = read_until(&mut c, "2.000001  >");
         assert!(got.contains("< frame 072 1.500000 0102AB >"), "{got}");
         assert!(got.contains("< frame 061 2.000001  >"), "{got}");
@@ -763,6 +766,22 @@ mod tests {
         let t = Instant::now();
         s.shutdown();
         assert!(t.elapsed() < Duration::from_secs(2));
+    }
+
+    #[test]
+    fn a_timestamp_past_u64_is_refused() {
+        let server = SocketcandServer::bind(
+            "127.0.0.1:0",
+            ServerConfig {
+                origin_ns: u64::MAX - 10,
+                ..ServerConfig::default()
+            },
+        )
+        .unwrap();
+        let f = Frame::new(0x72, &[1]).unwrap();
+        assert!(server.publish(&f, 10).is_ok());
+        let e = server.publish(&f, 11).unwrap_err();
+        assert_eq!((e.origin_ns, e.t_ns), (u64::MAX - 10, 11));
     }
 
     #[test]

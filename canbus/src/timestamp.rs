@@ -34,10 +34,16 @@ mod tests {
 
     #[test]
     fn sums_or_names_both_terms() {
-        assert_eq!(stamp_ns(1_700_000_000_000_000_000, 5), Ok(1_700_000_000_000_000_005));
+        assert_eq!(
+            stamp_ns(1_700_000_000_000_000_000, 5),
+            Ok(1_700_000_000_000_000_005)
+        );
         assert_eq!(stamp_ns(u64::MAX, 0), Ok(u64::MAX));
         let e = stamp_ns(18_446_744_073_000_000_000, 1_000_000_000).unwrap_err();
         let msg = e.to_string();
-        assert!(msg.contains("18446744073000000000") && msg.contains("1000000000"), "{msg}");
+        assert!(
+            msg.contains("18446744073000000000") && msg.contains("1000000000"),
+            "{msg}"
+        );
     }
 }

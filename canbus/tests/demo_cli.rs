@@ -48,14 +48,29 @@ fn absurd_speeds_are_bad_input_not_panics() {
     }
     // the limits themselves run
     let out = demo(&["--seconds", "0.01", "--speed", "1e6"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
 fn absurd_client_waits_are_bad_input_not_panics() {
-    for (w, shown) in [("1e300", "1e300"), ("-1", "-1"), ("NaN", "NaN"), ("86401", "86401")] {
+    for (w, shown) in [
+        ("1e300", "1e300"),
+        ("-1", "-1"),
+        ("NaN", "NaN"),
+        ("86401", "86401"),
+    ] {
         assert_bad_input(
-            &["--seconds", "0.01", "--socketcand", "127.0.0.1:0", &format!("--wait-client={w}")],
+            &[
+                "--seconds",
+                "0.01",
+                "--socketcand",
+                "127.0.0.1:0",
+                &format!("--wait-client={w}"),
+            ],
             &["--wait-client", shown],
         );
     }
@@ -65,7 +80,10 @@ fn absurd_client_waits_are_bad_input_not_panics() {
 fn other_bad_input_exits_2() {
     assert_bad_input(&["--seconds", "0"], &["--seconds"]);
     assert_bad_input(&["--seconds", "0.01", "--bitrate", "0"], &["bit rate"]);
-    assert_bad_input(&["--seconds", "0.01", "--origin", "soon"], &["--origin", "soon"]);
+    assert_bad_input(
+        &["--seconds", "0.01", "--origin", "soon"],
+        &["--origin", "soon"],
+    );
     assert_bad_input(&["--seconds", "0.01", "--channel", "a b"], &["--channel"]);
     assert_bad_input(
         &["--seconds", "0.01", "--socketcand", "0.0.0.0:0"],
@@ -81,14 +99,20 @@ fn other_bad_input_exits_2() {
 fn candump_errors_name_the_path() {
     let bad = temp_dir("nopath").join("no").join("such").join("dir.log");
     let bad_s = bad.to_str().unwrap();
-    assert_bad_input(&["--seconds", "0.01", "--candump", bad_s], &["--candump", bad_s]);
+    assert_bad_input(
+        &["--seconds", "0.01", "--candump", bad_s],
+        &["--candump", bad_s],
+    );
 }
 
 #[test]
 fn a_far_origin_is_refused_or_stamped_without_wrapping() {
     // 18446744073 s + 5 s is past u64 nanoseconds: the log's timestamps used to wrap to 1970
     assert_bad_input(&["--origin", "18446744073"], &["--origin", "18446744073"]);
-    assert_bad_input(&["--origin", "18446744074", "--seconds", "0.01"], &["18446744074"]);
+    assert_bad_input(
+        &["--origin", "18446744074", "--seconds", "0.01"],
+        &["18446744074"],
+    );
     assert_bad_input(
         &["--origin", "99999999999999999999", "--seconds", "0.01"],
         &["--origin"],
@@ -103,9 +127,12 @@ fn a_far_origin_is_refused_or_stamped_without_wrapping() {
         "--candump",
         log.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let (records, errors) =
-        read_log(BufReader::new(std::fs::File::open(&log).unwrap())).unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (records, errors) = read_log(BufReader::new(std::fs::File::open(&log).unwrap())).unwrap();
     assert!(errors.is_empty(), "{errors:?}");
     assert!(records.len() > 100, "{}", records.len());
     let origin_ns = 18_446_744_073_000_000_000u64;
@@ -170,15 +197,20 @@ fn a_client_that_never_reads_does_not_keep_the_demo_alive() {
         std::thread::sleep(Duration::from_millis(10));
     };
     let elapsed_s = t0.elapsed().as_secs_f64();
-    eprintln!("exited {elapsed_s:.3} s after the client connected");
     let mut stdout = String::new();
-    child.stdout.take().unwrap().read_to_string(&mut stdout).unwrap();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
     assert!(status.success(), "{status:?}");
     let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     let sc = &j["socketcand"];
     assert!(sc["frames_dropped"].as_u64().unwrap() > 0, "{sc}");
     assert_eq!(sc["flushed"], false, "{sc}");
     let wall_s = j["wall_s"].as_f64().unwrap();
+    eprintln!("exited {elapsed_s:.3} s after the client connected, the run took {wall_s:.3} s");
     // after the run: the rawmode grace (0.2 s) before it, the flush and the shutdown after
     // it; measured: about 0.35 s
     assert!(

@@ -96,19 +96,22 @@ fn hundreds_of_connections_leave_no_memory_behind() {
     let cycle = |i: u32| {
         let mut c = TcpStream::connect(addr).unwrap();
         assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
-        if i % 3 == 0 {
+        if i.is_multiple_of(3) {
             // garbage, then gone
-            c.write_all(b"<<< \xff\xfe nonsense >>> < send zz >").unwrap();
+            c.write_all(b"<<< \xff\xfe nonsense >>> < send zz >")
+                .unwrap();
             return;
         }
         c.write_all(b"< open vcan0 >< rawmode >").unwrap();
         let got = read_until(&mut c, "< ok >< ok >", Duration::from_secs(5));
         assert!(got.contains("< ok >< ok >"), "{got}");
-        assert!(wait_until(Duration::from_secs(5), || server.rawmode_clients() > 0));
+        assert!(wait_until(Duration::from_secs(5), || server
+            .rawmode_clients()
+            > 0));
         for k in 0..50 {
             server.publish(&frame(k), u64::from(i) * 1_000_000).unwrap();
         }
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             let got = read_until(&mut c, "< frame", Duration::from_secs(5));
             assert!(got.contains("< frame 072"), "{got}");
         }
@@ -159,9 +162,9 @@ fn garbage_input_is_bounded_and_the_server_keeps_serving() {
             .collect()
     };
     let garbage: Vec<Vec<u8>> = vec![
-        junk(1 << 20),               // random bytes
-        vec![b'<'; 1 << 20],         // an opening that never closes
-        b"<>".repeat(200_000),       // empty commands, answered with errors
+        junk(1 << 20),                                            // random bytes
+        vec![b'<'; 1 << 20],                                      // an opening that never closes
+        b"<>".repeat(200_000), // empty commands, answered with errors
         [b"< ".as_slice(), &vec![b'x'; 300_000], b" >"].concat(), // one huge command
         b"< open vcan0 >< rawmode >< send 7FF 9 1 2 3 4 5 6 7 8 9 >< send 1 1 zz >".repeat(5000),
     ];
@@ -284,7 +287,9 @@ fn a_client_that_never_reads_loses_frames_and_does_not_hold_shutdown() {
         c.write_all(b"< open vcan0 >< rawmode >").unwrap();
         c
     };
-    assert!(wait_until(Duration::from_secs(5), || server.rawmode_clients() == 1));
+    assert!(wait_until(Duration::from_secs(5), || server
+        .rawmode_clients()
+        == 1));
     publish_until_stalled(&server);
     let st = server.stats();
     assert!(st.frames_dropped > 0, "{st:?}");
@@ -316,7 +321,9 @@ fn a_stalled_client_is_disconnected_after_the_write_timeout() {
     .unwrap();
     let mut c = TcpStream::connect(server.local_addr()).unwrap();
     c.write_all(b"< open vcan0 >< rawmode >").unwrap();
-    assert!(wait_until(Duration::from_secs(5), || server.rawmode_clients() == 1));
+    assert!(wait_until(Duration::from_secs(5), || server
+        .rawmode_clients()
+        == 1));
     publish_until_stalled(&server);
     assert!(wait_until(Duration::from_secs(5), || server
         .connected_clients()

@@ -134,11 +134,17 @@ struct Checked {
 
 fn check(cli: &Cli) -> Result<Checked> {
     if !(cli.seconds.is_finite() && cli.seconds > 0.0 && cli.seconds <= 1e6) {
-        return Err(input(format!("--seconds {:?} is not in (0, 1e6]", cli.seconds)));
+        return Err(input(format!(
+            "--seconds {:?} is not in (0, 1e6]",
+            cli.seconds
+        )));
     }
     if cli.channel.is_empty()
         || cli.channel.len() > 64
-        || cli.channel.chars().any(|c| c.is_whitespace() || c == '<' || c == '>')
+        || cli
+            .channel
+            .chars()
+            .any(|c| c.is_whitespace() || c == '<' || c == '>')
     {
         return Err(input(format!(
             "--channel `{}`: expected 1 to 64 characters without spaces, `<` or `>`",
@@ -206,16 +212,17 @@ fn run(cli: &Cli) -> Result<()> {
         ..BusConfig::default()
     };
     let mut demo = Demo::new(config, &cli.faults).map_err(|e| input(e.to_string()))?;
-    let mut log = match &cli.candump {
-        Some(p) => Some(CandumpWriter::new(
-            BufWriter::new(File::create(p).map_err(|e| {
-                input(format!("--candump {}: creating the log: {e}", p.display()))
-            })?),
-            &cli.channel,
-            origin_ns,
-        )),
-        None => None,
-    };
+    let mut log =
+        match &cli.candump {
+            Some(p) => Some(CandumpWriter::new(
+                BufWriter::new(File::create(p).map_err(|e| {
+                    input(format!("--candump {}: creating the log: {e}", p.display()))
+                })?),
+                &cli.channel,
+                origin_ns,
+            )),
+            None => None,
+        };
     let server = match &cli.socketcand {
         Some(addr) => {
             let s = SocketcandServer::bind(
@@ -230,7 +237,10 @@ fn run(cli: &Cli) -> Result<()> {
             eprintln!("socketcand: listening on {}", s.local_addr());
             if let Some(w) = wait_client {
                 if !s.wait_for_client(w) {
-                    bail!("no socketcand client in rawmode within {} s", w.as_secs_f64());
+                    bail!(
+                        "no socketcand client in rawmode within {} s",
+                        w.as_secs_f64()
+                    );
                 }
                 eprintln!("socketcand: client connected");
             }
