@@ -20,6 +20,7 @@ use thiserror::Error;
 
 use crate::bus::BusEvent;
 use crate::frame::Frame;
+use crate::timestamp::{stamp_ns, TimestampOverflow};
 
 /// Linux `CAN_ERR_FLAG`: the identifier is an error class, not a frame identifier.
 pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
@@ -428,6 +429,17 @@ pub fn format_record(r: &LogRecord) -> String {
     format!("{ts} {} {body}{dir}", r.channel)
 }
 
+/// Errors of [`CandumpWriter::write_event`].
+#[derive(Debug, Error)]
+pub enum WriteError {
+    /// The writer failed.
+    #[error("writing the log: {0}")]
+    Io(#[from] io::Error),
+    /// The event's timestamp (origin plus simulated time) does not fit.
+    #[error(transparent)]
+    Timestamp(#[from] TimestampOverflow),
+}
+
 /// Writes bus events as a candump log.
 #[derive(Debug)]
 pub struct CandumpWriter<W: Write> {
@@ -457,7 +469,10 @@ impl<W: Write> CandumpWriter<W> {
     /// The record for a bus event: a delivered frame (stamped at the end of its interframe
     /// space), an error frame (`CAN_ERR_PROT | CAN_ERR_BUSERROR`, data byte 2 =
     /// `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF | CAN_ERR_BUSERROR`).
-    pub fn record_for(&self, ev: &BusEvent) -> LogRecord {
+    ///
+    /// # Errors
+    /// [`TimestampOverflow`] when the origin plus the event's time does not fit.
+    pub fn record_for(&self, ev: &BusEvent) -> Result<LogRecord, TimestampOverflow> {
         let (t, frame) = match ev {
             BusEvent::Delivered(d) => (d.t_end_ns, LogFrame::Standard(d.frame)),
             BusEvent::ErrorFrame { t_end_ns, .. } => (
@@ -475,21 +490,22 @@ impl<W: Write> CandumpWriter<W> {
                 },
             ),
         };
-        LogRecord {
-            timestamp_ns: self.origin_ns + t,
+        Ok(LogRecord {
+            timestamp_ns: stamp_ns(self.origin_ns, t)?,
             channel: self.channel.clone(),
             frame,
             direction: None,
-        }
+        })
     }
 
     /// Write one bus event.
     ///
     /// # Errors
-    /// The writer's.
-    pub fn write_event(&mut self, ev: &BusEvent) -> io::Result<()> {
-        let r = self.record_for(ev);
-        self.write_record(&r)
+    /// [`WriteError::Timestamp`] when its timestamp does not fit (nothing is written),
+    /// [`WriteError::Io`] when the writer fails.
+    pub fn write_event(&mut self, ev: &BusEvent) -> Result<(), WriteError> {
+        let r = self.record_for(ev)?;
+        Ok(self.write_record(&r)?)
     }
 
     /// Flush and return the writer.
@@ -576,6 +592,30 @@ mod tests {
         assert!(errs[1].reason.contains("8000"), "{}", errs[1].reason);
         assert!(errs[4].reason.contains("0x800"), "{}", errs[4].reason);
         assert!(errs[5].reason.contains("8 bytes"), "{}", errs[5].reason);
+    }
+
+    #[test]
+    fn a_timestamp_past_u64_is_an_error_not_a_wrap() {
+        let ev = BusEvent::BusOff {
+            node: crate::bus::NodeHandle(0),
+            t_ns: 2_000_000_000,
+        };
+        let origin_ns = 18_446_744_073_000_000_000;
+        let mut w = CandumpWriter::new(Vec::new(), "vcan0", origin_ns);
+        match w.write_event(&ev) {
+            Err(WriteError::Timestamp(e)) => {
+                assert_eq!((e.origin_ns, e.t_ns), (origin_ns, 2_000_000_000));
+            }
+            other => panic!("{other:?}"),
+        }
+        let early = BusEvent::BusOff {
+            node: crate::bus::NodeHandle(0),
+            t_ns: 500_000_000,
+        };
+        w.write_event(&early).unwrap();
+        let text = String::from_utf8(w.finish().unwrap()).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        assert!(text.starts_with("(18446744073.500000) vcan0 "), "{text}");
     }
 
     proptest! {

@@ -9,6 +9,7 @@
 //! * [`socketcand`] — a socketcand-protocol TCP server (python-can's `socketcand` interface
 //!   connects to it) that serves delivered frames and accepts frames from clients.
 //! * [`spec`] — the `kind:key=value,...` text form of faults, parsed once for every kind.
+//! * [`timestamp`] — origin plus simulated time, checked (a far origin is an error).
 //! * [`demo`] — two fake ankle nodes and a host sending the protocol's messages at their
 //!   nominal rates (the `canbus-demo` binary).
 //!
@@ -23,6 +24,7 @@ pub mod frame;
 pub mod rng;
 pub mod socketcand;
 pub mod spec;
+pub mod timestamp;
 
 pub use bus::{
     Bus, BusConfig, BusError, BusEvent, BusStats, Delivered, ErrorState, NodeHandle, SendOutcome,

@@ -10,20 +10,30 @@
 //! client: < echo >                server: < echo >
 //! ```
 //!
-//! Frames are queued per client in a bounded queue (frames that do not fit are counted and
-//! dropped, never blocking the simulation); frames sent by clients are queued in a bounded
-//! inbound queue that the simulation drains with [`SocketcandServer::take_inbound`] and puts on
-//! the bus as a host node. python-can reads the `< ok >` of `rawmode` with a single `recv` and
-//! compares it exactly, so the server waits [`ServerConfig::rawmode_grace`] before the first
-//! frame. Only standard identifiers; error frames are not sent (socketcand's rawmode has no
-//! form python-can parses). The server stops when dropped or on
-//! [`SocketcandServer::shutdown`]: the threads poll a stop flag every 10 ms.
+//! Frames are queued per client in a bounded queue (frames that do not fit are counted in
+//! [`ServerStats::frames_dropped`], never blocking the simulation); frames sent by clients are
+//! queued in a bounded inbound queue that the simulation drains with
+//! [`SocketcandServer::take_inbound`] and puts on the bus as a host node. python-can reads the
+//! `< ok >` of `rawmode` with a single `recv` and compares it exactly, so the server waits
+//! [`ServerConfig::rawmode_grace`] before the first frame. Only standard identifiers; error
+//! frames are not sent (socketcand's rawmode has no form python-can parses).
+//!
+//! Bounds, whatever the clients do:
+//! * at most [`ServerConfig::max_clients`] clients at once; more are answered
+//!   `< error too many clients ... >`, closed and counted in [`ServerStats::clients_refused`];
+//! * per client, memory for at most [`ServerConfig::client_queue_frames`] queued frames (taken
+//!   as needed, not up front), 64 KiB of output and 64 KiB of unparsed input; a client whose
+//!   output makes no progress for [`ServerConfig::write_timeout`] is disconnected
+//!   ([`ServerStats::clients_stalled`]); [`ServerConfig::memory_bound_bytes`] sums it up;
+//! * sockets are non-blocking: no thread ever waits on a client, finished clients are joined
+//!   and forgotten at once, and [`SocketcandServer::shutdown`] (also run on drop) returns within
+//!   a few polls of 10 ms.
 
 use std::collections::VecDeque;
+use std::fmt::Write as _;
 use std::io::{self, ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -31,6 +41,7 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 
 use crate::frame::Frame;
+use crate::timestamp::{stamp_ns, TimestampOverflow};
 
 /// Server parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,7 +50,8 @@ pub struct ServerConfig {
     pub channel: String,
     /// Clients served at once; more are refused. Default 8.
     pub max_clients: usize,
-    /// Frames queued per client before new ones are dropped. Default 65536.
+    /// Frames queued per client before new ones are dropped (memory is taken as the queue
+    /// fills, 24 bytes a frame). Default 65536.
     pub client_queue_frames: usize,
     /// Frames from clients queued before new ones are dropped. Default 1024.
     pub inbound_queue_frames: usize,
@@ -47,6 +59,9 @@ pub struct ServerConfig {
     pub rawmode_grace: Duration,
     /// Added to simulated time in frame timestamps [ns since the Unix epoch]. Default 0.
     pub origin_ns: u64,
+    /// A client whose pending output makes no progress for this long (it does not read) is
+    /// disconnected. Default 5 s.
+    pub write_timeout: Duration,
 }
 
 impl Default for ServerConfig {
@@ -58,7 +73,39 @@ impl Default for ServerConfig {
             inbound_queue_frames: 1024,
             rawmode_grace: Duration::from_millis(200),
             origin_ns: 0,
+            write_timeout: Duration::from_secs(5),
         }
+    }
+}
+
+/// Output bytes a client may have pending; no command is read from it beyond this.
+const OUT_LIMIT_BYTES: usize = 64 * 1024;
+/// Unparsed input kept per client; a longer text without a complete command is discarded.
+const INPUT_LIMIT_BYTES: usize = 64 * 1024;
+/// Bytes read from a client at once.
+const READ_CHUNK_BYTES: usize = 4096;
+/// Stack of a client thread [bytes].
+const CLIENT_STACK_BYTES: usize = 256 * 1024;
+/// Characters of a bad command echoed in the error answer.
+const ECHO_CHARS: usize = 64;
+/// Longest wait of [`SocketcandServer::wait_for_client`] and [`SocketcandServer::flush`].
+const MAX_WAIT: Duration = Duration::from_secs(7 * 86_400);
+/// [`SocketcandServer::flush`] gives up when no frame was written for this long.
+const FLUSH_STALL: Duration = Duration::from_millis(100);
+
+impl ServerConfig {
+    /// An upper bound of the memory the clients hold at once [bytes]: per client, its frame
+    /// queue (at most twice its capacity in frames, as a growing `VecDeque`), its output and
+    /// input buffers (each at most twice its limit) and its thread's stack, times
+    /// [`ServerConfig::max_clients`].
+    pub fn memory_bound_bytes(&self) -> usize {
+        let queue = self
+            .client_queue_frames
+            .saturating_mul(2 * std::mem::size_of::<(Frame, u64)>());
+        let buffers = 2 * (OUT_LIMIT_BYTES + ECHO_CHARS + 256) + 2 * INPUT_LIMIT_BYTES;
+        queue
+            .saturating_add(buffers + READ_CHUNK_BYTES + CLIENT_STACK_BYTES)
+            .saturating_mul(self.max_clients)
     }
 }
 
@@ -94,6 +141,13 @@ pub struct ServerStats {
     pub frames_received: u64,
     /// Client commands that could not be parsed.
     pub bad_commands: u64,
+    /// Connections refused (too many clients, or no thread for one).
+    pub clients_refused: u64,
+    /// Clients disconnected because their output made no progress for
+    /// [`ServerConfig::write_timeout`].
+    pub clients_stalled: u64,
+    /// Frames from clients dropped because the inbound queue was full.
+    pub inbound_dropped: u64,
 }
 
 #[derive(Default)]
@@ -103,13 +157,35 @@ struct Counters {
     frames_dropped: AtomicU64,
     frames_received: AtomicU64,
     bad_commands: AtomicU64,
+    clients_refused: AtomicU64,
+    clients_stalled: AtomicU64,
+    inbound_dropped: AtomicU64,
+}
+
+fn bump(c: &AtomicU64) {
+    c.fetch_add(1, Ordering::Relaxed);
+}
+
+/// What a client's thread shares with the server.
+#[derive(Default)]
+struct ClientState {
+    /// In rawmode: frames are queued for it.
+    rawmode: AtomicBool,
+    /// Frames to send, with their timestamps [ns since the Unix epoch].
+    queue: Mutex<VecDeque<(Frame, u64)>>,
+    /// Output not yet written (frames taken from the queue, answers).
+    out_pending: AtomicBool,
 }
 
 struct Client {
-    tx: SyncSender<String>,
-    rawmode: Arc<AtomicBool>,
-    alive: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    state: Arc<ClientState>,
+    thread: JoinHandle<()>,
+}
+
+impl Client {
+    fn connected(&self) -> bool {
+        !self.thread.is_finished()
+    }
 }
 
 struct Shared {
@@ -177,32 +253,27 @@ impl SocketcandServer {
         self.addr
     }
 
-    /// Send a delivered frame, stamped at simulated time `t_ns`, to every client in rawmode.
-    pub fn publish(&self, frame: &Frame, t_ns: u64) {
-        let t = self.shared.config.origin_ns + t_ns;
-        let data: String = frame.data().iter().map(|b| format!("{b:02X}")).collect();
-        let line = format!(
-            "< frame {:03X} {}.{:06} {} >",
-            frame.id(),
-            t / 1_000_000_000,
-            (t % 1_000_000_000) / 1000,
-            data
-        );
+    /// Queue a delivered frame, stamped at simulated time `t_ns` (plus
+    /// [`ServerConfig::origin_ns`]), for every client in rawmode. Never waits on a client: a
+    /// full queue loses the frame, counted in [`ServerStats::frames_dropped`].
+    ///
+    /// # Errors
+    /// [`TimestampOverflow`] when the origin plus `t_ns` does not fit (nothing is queued).
+    pub fn publish(&self, frame: &Frame, t_ns: u64) -> Result<(), TimestampOverflow> {
+        let t = stamp_ns(self.shared.config.origin_ns, t_ns)?;
         let clients = lock(&self.shared.clients);
         for c in clients.iter() {
-            if !c.rawmode.load(Ordering::Acquire) || !c.alive.load(Ordering::Acquire) {
+            if !c.state.rawmode.load(Ordering::Acquire) || !c.connected() {
                 continue;
             }
-            match c.tx.try_send(line.clone()) {
-                Ok(()) => {}
-                Err(TrySendError::Full(_)) | Err(TrySendError::Disconnected(_)) => {
-                    self.shared
-                        .counters
-                        .frames_dropped
-                        .fetch_add(1, Ordering::Relaxed);
-                }
+            let mut q = lock(&c.state.queue);
+            if q.len() < self.shared.config.client_queue_frames {
+                q.push_back((*frame, t));
+            } else {
+                bump(&self.shared.counters.frames_dropped);
             }
         }
+        Ok(())
     }
 
     /// Frames clients sent since the last call, in arrival order.
@@ -214,15 +285,24 @@ impl SocketcandServer {
     pub fn rawmode_clients(&self) -> usize {
         lock(&self.shared.clients)
             .iter()
-            .filter(|c| c.rawmode.load(Ordering::Acquire) && c.alive.load(Ordering::Acquire))
+            .filter(|c| c.state.rawmode.load(Ordering::Acquire) && c.connected())
+            .count()
+    }
+
+    /// Number of connected clients (finished ones are forgotten within a poll of 10 ms).
+    pub fn connected_clients(&self) -> usize {
+        lock(&self.shared.clients)
+            .iter()
+            .filter(|c| c.connected())
             .count()
     }
 
     /// Wait until at least one client is in rawmode and past its grace time, at most
-    /// `timeout`. Returns whether one is.
+    /// `timeout` (at most a week). Returns whether one is.
     pub fn wait_for_client(&self, timeout: Duration) -> bool {
-        let end = Instant::now() + timeout;
-        while Instant::now() < end {
+        let start = Instant::now();
+        let timeout = timeout.min(MAX_WAIT);
+        while start.elapsed() < timeout {
             if self.rawmode_clients() > 0 {
                 std::thread::sleep(self.shared.config.rawmode_grace);
                 return true;
@@ -232,42 +312,66 @@ impl SocketcandServer {
         false
     }
 
-    /// Block until every client's queue is written out or `timeout` passes.
-    pub fn flush(&self, timeout: Duration) {
-        let end = Instant::now() + timeout;
-        while Instant::now() < end {
-            let sent = self.shared.counters.frames_sent.load(Ordering::Relaxed);
-            std::thread::sleep(Duration::from_millis(50));
-            if self.shared.counters.frames_sent.load(Ordering::Relaxed) == sent {
-                return;
+    /// Wait until every client's queue is written out, at most `timeout` (at most a week) and
+    /// no longer than 100 ms without a frame written (a client that does not read is not
+    /// waited for). Returns whether everything was written.
+    pub fn flush(&self, timeout: Duration) -> bool {
+        let start = Instant::now();
+        let timeout = timeout.min(MAX_WAIT);
+        let sent = || self.shared.counters.frames_sent.load(Ordering::Relaxed);
+        let (mut last_sent, mut last_change) = (sent(), start);
+        loop {
+            if self.all_written() {
+                return true;
             }
+            let now = Instant::now();
+            if now.duration_since(start) >= timeout {
+                return false;
+            }
+            let s = sent();
+            if s != last_sent {
+                (last_sent, last_change) = (s, now);
+            } else if now.duration_since(last_change) >= FLUSH_STALL {
+                return false;
+            }
+            std::thread::sleep(POLL);
         }
+    }
+
+    fn all_written(&self) -> bool {
+        lock(&self.shared.clients).iter().all(|c| {
+            !c.connected()
+                || !c.state.rawmode.load(Ordering::Acquire)
+                || (lock(&c.state.queue).is_empty() && !c.state.out_pending.load(Ordering::Acquire))
+        })
     }
 
     /// Counters so far.
     pub fn stats(&self) -> ServerStats {
         let c = &self.shared.counters;
+        let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
         ServerStats {
-            clients_accepted: c.clients_accepted.load(Ordering::Relaxed),
-            frames_sent: c.frames_sent.load(Ordering::Relaxed),
-            frames_dropped: c.frames_dropped.load(Ordering::Relaxed),
-            frames_received: c.frames_received.load(Ordering::Relaxed),
-            bad_commands: c.bad_commands.load(Ordering::Relaxed),
+            clients_accepted: get(&c.clients_accepted),
+            frames_sent: get(&c.frames_sent),
+            frames_dropped: get(&c.frames_dropped),
+            frames_received: get(&c.frames_received),
+            bad_commands: get(&c.bad_commands),
+            clients_refused: get(&c.clients_refused),
+            clients_stalled: get(&c.clients_stalled),
+            inbound_dropped: get(&c.inbound_dropped),
         }
     }
 
-    /// Stop accepting, close every client and join the threads.
+    /// Stop accepting, close every client and join the threads (none waits on a socket, so
+    /// this takes a few polls of 10 ms whatever the clients do).
     pub fn shutdown(&mut self) {
         self.shared.stop.store(true, Ordering::Release);
         if let Some(a) = self.acceptor.take() {
             let _ = a.join();
         }
-        let threads: Vec<JoinHandle<()>> = lock(&self.shared.clients)
-            .iter_mut()
-            .filter_map(|c| c.thread.take())
-            .collect();
-        for t in threads {
-            let _ = t.join();
+        let clients: Vec<Client> = lock(&self.shared.clients).drain(..).collect();
+        for c in clients {
+            let _ = c.thread.join();
         }
     }
 }
@@ -282,44 +386,63 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
+/// Join and forget the clients whose threads have finished.
+fn reap(shared: &Shared) {
+    let finished: Vec<Client> = {
+        let mut clients = lock(&shared.clients);
+        if clients.iter().all(Client::connected) {
+            return;
+        }
+        let (done, live): (Vec<Client>, Vec<Client>) =
+            clients.drain(..).partition(|c| !c.connected());
+        *clients = live;
+        done
+    };
+    for c in finished {
+        let _ = c.thread.join();
+    }
+}
+
+fn refuse(mut stream: TcpStream, why: &str, shared: &Shared) {
+    bump(&shared.counters.clients_refused);
+    if stream.set_nonblocking(true).is_ok() {
+        let _ = stream.write(format!("< error {why} >").as_bytes());
+    }
+}
+
+fn admit(stream: TcpStream, shared: &Arc<Shared>) {
+    let mut clients = lock(&shared.clients);
+    let max = shared.config.max_clients;
+    if clients.len() >= max {
+        drop(clients);
+        refuse(
+            stream,
+            &format!("too many clients ({max} connected, the limit)"),
+            shared,
+        );
+        return;
+    }
+    let state = Arc::new(ClientState::default());
+    let (s2, st2) = (Arc::clone(shared), Arc::clone(&state));
+    let spawned = std::thread::Builder::new()
+        .name("socketcand-client".into())
+        .stack_size(CLIENT_STACK_BYTES)
+        .spawn(move || serve_client(stream, &s2, &st2));
+    match spawned {
+        Ok(thread) => {
+            bump(&shared.counters.clients_accepted);
+            clients.push(Client { state, thread });
+        }
+        // the stream went with the closure and is closed
+        Err(_) => bump(&shared.counters.clients_refused),
+    }
+}
+
 fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
     while !shared.stop.load(Ordering::Acquire) {
+        reap(shared);
         match listener.accept() {
-            Ok((mut stream, _)) => {
-                let mut clients = lock(&shared.clients);
-                clients.retain(|c| c.alive.load(Ordering::Acquire) || c.thread.is_some());
-                let live = clients
-                    .iter()
-                    .filter(|c| c.alive.load(Ordering::Acquire))
-                    .count();
-                if live >= shared.config.max_clients {
-                    let _ = stream.write_all(b"< error too many clients >");
-                    continue;
-                }
-                let (tx, rx) = sync_channel(shared.config.client_queue_frames);
-                let rawmode = Arc::new(AtomicBool::new(false));
-                let alive = Arc::new(AtomicBool::new(true));
-                let s2 = Arc::clone(shared);
-                let (r2, a2) = (Arc::clone(&rawmode), Arc::clone(&alive));
-                let thread = std::thread::Builder::new()
-                    .name("socketcand-client".into())
-                    .spawn(move || {
-                        let _ = serve_client(stream, &s2, &rx, &r2);
-                        a2.store(false, Ordering::Release);
-                    })
-                    .ok();
-                shared
-                    .counters
-                    .clients_accepted
-                    .fetch_add(1, Ordering::Relaxed);
-                clients.push(Client {
-                    tx,
-                    rawmode,
-                    alive,
-                    thread,
-                });
-            }
-            Err(e) if e.kind() == ErrorKind::WouldBlock => std::thread::sleep(POLL),
+            Ok((stream, _)) => admit(stream, shared),
             Err(_) => std::thread::sleep(POLL),
         }
     }
@@ -353,99 +476,223 @@ enum Phase {
     Raw { first_frame_at: Instant },
 }
 
-fn serve_client(
-    mut stream: TcpStream,
-    shared: &Shared,
-    rx: &Receiver<String>,
-    rawmode: &AtomicBool,
-) -> io::Result<()> {
-    stream.set_nodelay(true)?;
-    stream.set_read_timeout(Some(POLL))?;
-    stream.write_all(b"< hi >")?;
-    let mut phase = Phase::NoBus;
-    let mut buf: Vec<u8> = Vec::new();
-    let mut chunk = [0u8; 4096];
-    while !shared.stop.load(Ordering::Acquire) {
-        if let Phase::Raw { first_frame_at } = phase {
-            if Instant::now() >= first_frame_at {
-                let mut out = String::new();
-                let mut n = 0u64;
-                while let Ok(line) = rx.try_recv() {
-                    out.push_str(&line);
-                    n += 1;
-                    if out.len() > 64 * 1024 {
-                        break;
-                    }
-                }
-                if n > 0 {
-                    stream.write_all(out.as_bytes())?;
-                    shared.counters.frames_sent.fetch_add(n, Ordering::Relaxed);
-                }
-            }
-        }
-        match stream.read(&mut chunk) {
-            Ok(0) => return Ok(()),
-            Ok(k) => buf.extend_from_slice(chunk.get(..k).unwrap_or(&[])),
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-            Err(e) => return Err(e),
-        }
-        if buf.len() > 64 * 1024 {
-            buf.clear();
-            shared.counters.bad_commands.fetch_add(1, Ordering::Relaxed);
-        }
-        while let (Some(start), Some(end)) = (
-            buf.iter().position(|&b| b == b'<'),
-            buf.iter().position(|&b| b == b'>'),
-        ) {
-            if end < start {
-                buf.drain(..=end);
-                continue;
-            }
-            let cmd = String::from_utf8_lossy(buf.get(start + 1..end).unwrap_or(&[])).to_string();
-            buf.drain(..=end);
-            let words: Vec<&str> = cmd.split_whitespace().collect();
-            let reply: Option<String> = match (&phase, words.as_slice()) {
-                (_, ["echo"]) => Some("< echo >".into()),
-                (Phase::NoBus, ["open", ch]) if *ch == shared.config.channel => {
-                    phase = Phase::Opened;
-                    Some("< ok >".into())
-                }
-                (Phase::NoBus, ["open", ch]) => Some(format!("< error could not open bus {ch} >")),
-                (Phase::Opened | Phase::Raw { .. }, ["rawmode"]) => {
-                    phase = Phase::Raw {
-                        first_frame_at: Instant::now() + shared.config.rawmode_grace,
-                    };
-                    rawmode.store(true, Ordering::Release);
-                    Some("< ok >".into())
-                }
-                (Phase::Raw { .. }, ["send", rest @ ..]) => match parse_send(rest) {
-                    Ok(f) => {
-                        let mut q = lock(&shared.inbound);
-                        if q.len() < shared.config.inbound_queue_frames {
-                            q.push_back(f);
-                            shared
-                                .counters
-                                .frames_received
-                                .fetch_add(1, Ordering::Relaxed);
-                        }
-                        None
-                    }
-                    Err(e) => {
-                        shared.counters.bad_commands.fetch_add(1, Ordering::Relaxed);
-                        Some(format!("< error {e} >"))
-                    }
-                },
-                _ => {
-                    shared.counters.bad_commands.fetch_add(1, Ordering::Relaxed);
-                    Some(format!("< error unexpected command {} >", words.join(" ")))
-                }
-            };
-            if let Some(r) = reply {
-                stream.write_all(r.as_bytes())?;
-            }
+/// One client's protocol state and buffers.
+struct Session<'a> {
+    shared: &'a Shared,
+    me: &'a ClientState,
+    phase: Phase,
+    /// Output; `out[out_pos..]` is still to be written.
+    out: String,
+    out_pos: usize,
+    /// Frames in `out`, counted as sent once `out` is written.
+    out_frames: u64,
+    /// Input not parsed yet.
+    input: Vec<u8>,
+}
+
+impl Session<'_> {
+    fn pending(&self) -> usize {
+        self.out.len() - self.out_pos
+    }
+
+    fn push_out(&mut self, text: &str) {
+        self.out.push_str(text);
+        self.me.out_pending.store(true, Ordering::Release);
+    }
+
+    /// `n` more bytes are written.
+    fn wrote(&mut self, n: usize) {
+        self.out_pos = (self.out_pos + n).min(self.out.len());
+        if self.out_pos == self.out.len() {
+            self.out.clear();
+            self.out_pos = 0;
+            self.shared
+                .counters
+                .frames_sent
+                .fetch_add(self.out_frames, Ordering::Relaxed);
+            self.out_frames = 0;
+            self.me.out_pending.store(false, Ordering::Release);
         }
     }
-    Ok(())
+
+    /// With nothing pending and in rawmode past the grace time, take queued frames (up to
+    /// about [`OUT_LIMIT_BYTES`] of text) into the output.
+    fn take_frames(&mut self, now: Instant) {
+        let Phase::Raw { first_frame_at } = self.phase else {
+            return;
+        };
+        if now < first_frame_at || self.pending() > 0 {
+            return;
+        }
+        let mut q = lock(&self.me.queue);
+        if q.is_empty() {
+            return;
+        }
+        self.me.out_pending.store(true, Ordering::Release);
+        while self.out.len() < OUT_LIMIT_BYTES {
+            let Some((f, t)) = q.pop_front() else { break };
+            let _ = write!(
+                self.out,
+                "< frame {:03X} {}.{:06} ",
+                f.id(),
+                t / 1_000_000_000,
+                (t % 1_000_000_000) / 1000
+            );
+            for b in f.data() {
+                let _ = write!(self.out, "{b:02X}");
+            }
+            self.out.push_str(" >");
+            self.out_frames += 1;
+        }
+    }
+
+    /// Answer the complete commands in the input, while the output has room. A long text
+    /// without a complete command is discarded (one bad command).
+    fn handle_commands(&mut self) {
+        let mut pos = 0;
+        let mut held_back = false;
+        while pos < self.input.len() {
+            if self.pending() >= OUT_LIMIT_BYTES {
+                held_back = true;
+                break;
+            }
+            let rest = self.input.get(pos..).unwrap_or(&[]);
+            let Some(start) = rest.iter().position(|&b| b == b'<').map(|i| pos + i) else {
+                pos = self.input.len();
+                break;
+            };
+            let after = self.input.get(start + 1..).unwrap_or(&[]);
+            let Some(end) = after.iter().position(|&b| b == b'>').map(|i| start + 1 + i) else {
+                pos = start;
+                break;
+            };
+            let cmd =
+                String::from_utf8_lossy(self.input.get(start + 1..end).unwrap_or(&[])).to_string();
+            pos = end + 1;
+            self.command(&cmd);
+        }
+        self.input.drain(..pos.min(self.input.len()));
+        if !held_back && self.input.len() > INPUT_LIMIT_BYTES {
+            self.input.clear();
+            bump(&self.shared.counters.bad_commands);
+        }
+    }
+
+    fn command(&mut self, cmd: &str) {
+        let shared = self.shared;
+        let words: Vec<&str> = cmd.split_whitespace().collect();
+        let reply: Option<String> = match (&self.phase, words.as_slice()) {
+            (_, ["echo"]) => Some("< echo >".into()),
+            (Phase::NoBus, ["open", ch]) if *ch == shared.config.channel => {
+                self.phase = Phase::Opened;
+                Some("< ok >".into())
+            }
+            (Phase::NoBus, ["open", ch]) => Some(format!(
+                "< error could not open bus {} >",
+                ch.chars().take(ECHO_CHARS).collect::<String>()
+            )),
+            (Phase::Opened | Phase::Raw { .. }, ["rawmode"]) => {
+                self.phase = Phase::Raw {
+                    first_frame_at: Instant::now() + shared.config.rawmode_grace,
+                };
+                self.me.rawmode.store(true, Ordering::Release);
+                Some("< ok >".into())
+            }
+            (Phase::Raw { .. }, ["send", rest @ ..]) => match parse_send(rest) {
+                Ok(f) => {
+                    let mut q = lock(&shared.inbound);
+                    if q.len() < shared.config.inbound_queue_frames {
+                        q.push_back(f);
+                        bump(&shared.counters.frames_received);
+                    } else {
+                        bump(&shared.counters.inbound_dropped);
+                    }
+                    None
+                }
+                Err(e) => {
+                    bump(&shared.counters.bad_commands);
+                    Some(format!(
+                        "< error {} >",
+                        e.chars().take(2 * ECHO_CHARS).collect::<String>()
+                    ))
+                }
+            },
+            _ => {
+                bump(&shared.counters.bad_commands);
+                let shown: String = words.join(" ").chars().take(ECHO_CHARS).collect();
+                Some(format!("< error unexpected command {shown} >"))
+            }
+        };
+        if let Some(r) = reply {
+            self.push_out(&r);
+        }
+    }
+}
+
+fn transient(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+    )
+}
+
+/// Serve one client until it closes, fails, stalls or the server stops. The socket is
+/// non-blocking: the loop sleeps one poll when nothing moved.
+fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
+    if stream.set_nonblocking(true).is_err() {
+        return;
+    }
+    let _ = stream.set_nodelay(true);
+    let mut s = Session {
+        shared,
+        me,
+        phase: Phase::NoBus,
+        out: String::new(),
+        out_pos: 0,
+        out_frames: 0,
+        input: Vec::new(),
+    };
+    s.push_out("< hi >");
+    let mut chunk = [0u8; READ_CHUNK_BYTES];
+    let mut last_progress = Instant::now();
+    while !shared.stop.load(Ordering::Acquire) {
+        let now = Instant::now();
+        let mut busy = false;
+        s.take_frames(now);
+        if s.pending() > 0 {
+            match stream.write(s.out.as_bytes().get(s.out_pos..).unwrap_or(&[])) {
+                Ok(0) => return,
+                Ok(n) => {
+                    s.wrote(n);
+                    last_progress = now;
+                    busy = true;
+                }
+                Err(e) if transient(&e) => {}
+                Err(_) => return,
+            }
+            if s.pending() > 0 && now.duration_since(last_progress) > shared.config.write_timeout {
+                bump(&shared.counters.clients_stalled);
+                return;
+            }
+        } else {
+            last_progress = now;
+        }
+        if s.pending() < OUT_LIMIT_BYTES {
+            match stream.read(&mut chunk) {
+                Ok(0) => return,
+                Ok(k) => {
+                    s.input.extend_from_slice(chunk.get(..k).unwrap_or(&[]));
+                    busy = true;
+                }
+                Err(e) if transient(&e) => {}
+                Err(_) => return,
+            }
+        }
+        s.handle_commands();
+        if !busy {
+            std::thread::sleep(POLL);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -484,8 +731,12 @@ mod tests {
         c.write_all(b"< rawmode >").unwrap();
         assert_eq!(read_until(&mut c, ">"), "< ok >");
         assert!(server.wait_for_client(Duration::from_secs(5)));
-        server.publish(&Frame::new(0x72, &[1, 2, 0xAB]).unwrap(), 1_500_000_000);
-        server.publish(&Frame::new(0x61, &[]).unwrap(), 2_000_001_000);
+        server
+            .publish(&Frame::new(0x72, &[1, 2, 0xAB]).unwrap(), 1_500_000_000)
+            .unwrap();
+        server
+            .publish(&Frame::new(0x61, &[]).unwrap(), 2_000_001_000)
+            .unwrap();
         let got = read_until(&mut c, "2.000001  >");
         assert!(got.contains("< frame 072 1.500000 0102AB >"), "{got}");
         assert!(got.contains("< frame 061 2.000001  >"), "{got}");
@@ -515,6 +766,22 @@ mod tests {
         let t = Instant::now();
         s.shutdown();
         assert!(t.elapsed() < Duration::from_secs(2));
+    }
+
+    #[test]
+    fn a_timestamp_past_u64_is_refused() {
+        let server = SocketcandServer::bind(
+            "127.0.0.1:0",
+            ServerConfig {
+                origin_ns: u64::MAX - 10,
+                ..ServerConfig::default()
+            },
+        )
+        .unwrap();
+        let f = Frame::new(0x72, &[1]).unwrap();
+        assert!(server.publish(&f, 10).is_ok());
+        let e = server.publish(&f, 11).unwrap_err();
+        assert_eq!((e.origin_ns, e.t_ns), (u64::MAX - 10, 11));
     }
 
     #[test]

@@ -1,15 +1,20 @@
 //! `canbus-demo`: the demonstration bus (host and two fake ankle nodes, see
 //! `canbus::demo`), optionally served over socketcand and written as a candump log.
+//!
+//! Exit codes: 0 on success, 2 for bad input (a message names the option and its value), 1
+//! for any other error (no socketcand client in time, a failing write).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 use canbus::candump::CandumpWriter;
-use canbus::demo::Demo;
+use canbus::demo::{Demo, TICK_NS};
 use canbus::socketcand::{ServerConfig, SocketcandServer};
+use canbus::timestamp::stamp_ns;
 use canbus::{BusConfig, BusEvent, FaultSpec, Stuffing};
 use clap::{Parser, ValueEnum};
 
@@ -32,7 +37,8 @@ struct Cli {
     /// socketcand channel name.
     #[arg(long, default_value = "vcan0")]
     channel: String,
-    /// With --socketcand: wait up to this long [s] for a client in rawmode before starting.
+    /// With --socketcand: wait up to this long [s] for a client in rawmode before starting
+    /// (0 to 86400).
     #[arg(long, value_name = "SECONDS")]
     wait_client: Option<f64>,
     /// Write a candump log of the bus (frames, error frames, bus-off).
@@ -41,8 +47,8 @@ struct Cli {
     /// Inject a fault (repeatable), e.g. `drop:id=0x072,count=5`, `busoff:node=right`.
     #[arg(long = "fault", value_name = "SPEC")]
     faults: Vec<FaultSpec>,
-    /// Simulated seconds per wall-clock second; 0 = as fast as possible. Default: 1 with
-    /// --socketcand, else 0.
+    /// Simulated seconds per wall-clock second (0.001 to 1e6); 0 = as fast as possible.
+    /// Default: 1 with --socketcand, else 0.
     #[arg(long)]
     speed: Option<f64>,
     /// Bit rate [bit/s].
@@ -55,7 +61,8 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Timestamp origin [s since the Unix epoch] added to simulated time in logs and frames;
-    /// default 1700000000 (reproducible logs). `now` for the wall clock.
+    /// default 1700000000 (reproducible logs). `now` for the wall clock. The last timestamp
+    /// must fit in u64 nanoseconds (before 18446744073.709551615 s).
     #[arg(long, default_value = "1700000000")]
     origin: String,
     /// Print a JSON summary on stdout.
@@ -63,24 +70,138 @@ struct Cli {
     json: bool,
 }
 
-fn main() -> Result<()> {
+/// Bad input: the message names the option and its value; exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct InputError(String);
+
+fn input(msg: String) -> anyhow::Error {
+    InputError(msg).into()
+}
+
+/// Longest --wait-client [s] (a day).
+const MAX_WAIT_CLIENT_S: f64 = 86_400.0;
+/// Slowest and fastest --speed other than 0.
+const SPEED_RANGE: (f64, f64) = (1e-3, 1e6);
+/// How long the end of a run waits for socketcand clients to read what is queued.
+const FLUSH_TIMEOUT: Duration = Duration::from_millis(500);
+
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    if !(cli.seconds.is_finite() && cli.seconds > 0.0 && cli.seconds <= 1e6) {
-        bail!("--seconds {} is not in (0, 1e6]", cli.seconds);
+    match run(&cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if e.downcast_ref::<InputError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
     }
-    let origin_ns = if cli.origin == "now" {
-        std::time::SystemTime::now()
+}
+
+/// The timestamp origin [ns since the Unix epoch] of `--origin`.
+fn origin_ns(origin: &str) -> Result<u64> {
+    if origin == "now" {
+        let since = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
-            .context("system clock before 1970")?
-            .as_micros() as u64
-            * 1000
-    } else {
-        let s: u64 = cli
-            .origin
-            .parse()
-            .with_context(|| format!("--origin `{}`: whole seconds or `now`", cli.origin))?;
-        s * 1_000_000_000
+            .context("system clock before 1970")?;
+        return u64::try_from(since.as_micros())
+            .ok()
+            .and_then(|us| us.checked_mul(1000))
+            .context("the system clock is past the latest u64 nanosecond timestamp");
+    }
+    let s: u64 = origin.parse().map_err(|_| {
+        input(format!(
+            "--origin `{origin}`: expected whole seconds since the Unix epoch or `now`"
+        ))
+    })?;
+    s.checked_mul(1_000_000_000).ok_or_else(|| {
+        input(format!(
+            "--origin {origin}: later than the latest u64 nanosecond timestamp (18446744073 s)"
+        ))
+    })
+}
+
+/// The checked options: (end of the run [ns], origin [ns], speed, wait for a client).
+struct Checked {
+    end_ns: u64,
+    origin_ns: u64,
+    speed: f64,
+    wait_client: Option<Duration>,
+}
+
+fn check(cli: &Cli) -> Result<Checked> {
+    if !(cli.seconds.is_finite() && cli.seconds > 0.0 && cli.seconds <= 1e6) {
+        return Err(input(format!(
+            "--seconds {:?} is not in (0, 1e6]",
+            cli.seconds
+        )));
+    }
+    if cli.channel.is_empty()
+        || cli.channel.len() > 64
+        || cli
+            .channel
+            .chars()
+            .any(|c| c.is_whitespace() || c == '<' || c == '>')
+    {
+        return Err(input(format!(
+            "--channel `{}`: expected 1 to 64 characters without spaces, `<` or `>`",
+            cli.channel
+        )));
+    }
+    let speed = cli
+        .speed
+        .unwrap_or(if cli.socketcand.is_some() { 1.0 } else { 0.0 });
+    if !(speed == 0.0 || (speed >= SPEED_RANGE.0 && speed <= SPEED_RANGE.1)) {
+        return Err(input(format!(
+            "--speed {speed:?}: expected 0 (as fast as possible) or a factor in [{}, {}]",
+            SPEED_RANGE.0, SPEED_RANGE.1
+        )));
+    }
+    let wait_client = match cli.wait_client {
+        None => None,
+        Some(w) => Some(
+            Some(w)
+                .filter(|w| (0.0..=MAX_WAIT_CLIENT_S).contains(w))
+                .and_then(|w| Duration::try_from_secs_f64(w).ok())
+                .ok_or_else(|| {
+                    input(format!(
+                        "--wait-client {w:?}: expected seconds in [0, {MAX_WAIT_CLIENT_S}]"
+                    ))
+                })?,
+        ),
     };
+    let end_ns = (cli.seconds * 1e9).round() as u64;
+    let origin_ns = origin_ns(&cli.origin)?;
+    // the last event ends with the last tick
+    let last_ns = end_ns.div_ceil(TICK_NS) * TICK_NS;
+    stamp_ns(origin_ns, last_ns).map_err(|e| {
+        input(format!(
+            "--origin {} with --seconds {}: {e}",
+            cli.origin, cli.seconds
+        ))
+    })?;
+    Ok(Checked {
+        end_ns,
+        origin_ns,
+        speed,
+        wait_client,
+    })
+}
+
+fn candump_context(p: &Path) -> String {
+    format!("writing the candump log {}", p.display())
+}
+
+fn run(cli: &Cli) -> Result<()> {
+    let Checked {
+        end_ns,
+        origin_ns,
+        speed,
+        wait_client,
+    } = check(cli)?;
     let config = BusConfig {
         bitrate_bps: cli.bitrate,
         stuffing: match cli.stuffing {
@@ -90,7 +211,18 @@ fn main() -> Result<()> {
         seed: cli.seed,
         ..BusConfig::default()
     };
-    let mut demo = Demo::new(config, &cli.faults)?;
+    let mut demo = Demo::new(config, &cli.faults).map_err(|e| input(e.to_string()))?;
+    let mut log =
+        match &cli.candump {
+            Some(p) => Some(CandumpWriter::new(
+                BufWriter::new(File::create(p).map_err(|e| {
+                    input(format!("--candump {}: creating the log: {e}", p.display()))
+                })?),
+                &cli.channel,
+                origin_ns,
+            )),
+            None => None,
+        };
     let server = match &cli.socketcand {
         Some(addr) => {
             let s = SocketcandServer::bind(
@@ -100,11 +232,15 @@ fn main() -> Result<()> {
                     origin_ns,
                     ..ServerConfig::default()
                 },
-            )?;
+            )
+            .map_err(|e| input(format!("--socketcand {addr}: {e}")))?;
             eprintln!("socketcand: listening on {}", s.local_addr());
-            if let Some(w) = cli.wait_client {
-                if !s.wait_for_client(Duration::from_secs_f64(w.max(0.0))) {
-                    bail!("no socketcand client in rawmode within {w} s");
+            if let Some(w) = wait_client {
+                if !s.wait_for_client(w) {
+                    bail!(
+                        "no socketcand client in rawmode within {} s",
+                        w.as_secs_f64()
+                    );
                 }
                 eprintln!("socketcand: client connected");
             }
@@ -112,18 +248,6 @@ fn main() -> Result<()> {
         }
         None => None,
     };
-    let mut log = match &cli.candump {
-        Some(p) => Some(CandumpWriter::new(
-            BufWriter::new(File::create(p).with_context(|| format!("creating {}", p.display()))?),
-            &cli.channel,
-            origin_ns,
-        )),
-        None => None,
-    };
-    let speed = cli
-        .speed
-        .unwrap_or(if server.is_some() { 1.0 } else { 0.0 });
-    let end_ns = (cli.seconds * 1e9).round() as u64;
     let wall0 = Instant::now();
     let mut events_total = 0u64;
     while demo.now_ns() < end_ns {
@@ -135,28 +259,27 @@ fn main() -> Result<()> {
         let events = demo.tick()?;
         events_total += events.len() as u64;
         for e in &events {
-            if let Some(l) = log.as_mut() {
-                l.write_event(e).context("writing the candump log")?;
+            if let (Some(l), Some(p)) = (log.as_mut(), &cli.candump) {
+                l.write_event(e).with_context(|| candump_context(p))?;
             }
             if let (Some(s), BusEvent::Delivered(d)) = (&server, e) {
-                s.publish(&d.frame, d.t_end_ns);
+                s.publish(&d.frame, d.t_end_ns)
+                    .context("serving a frame over socketcand")?;
             }
         }
         if speed > 0.0 && demo.now_ns() % 10_000_000 == 0 {
-            let due = Duration::from_secs_f64(demo.now_ns() as f64 / 1e9 / speed);
+            let due = Duration::try_from_secs_f64(demo.now_ns() as f64 / 1e9 / speed)
+                .with_context(|| format!("pacing at --speed {speed}"))?;
             if let Some(wait) = due.checked_sub(wall0.elapsed()) {
                 std::thread::sleep(wait);
             }
         }
     }
     let wall_s = wall0.elapsed().as_secs_f64();
-    if let Some(l) = log {
-        l.finish().context("writing the candump log")?;
+    if let (Some(l), Some(p)) = (log, &cli.candump) {
+        l.finish().with_context(|| candump_context(p))?;
     }
-    let server_stats = server.as_ref().map(|s| {
-        s.flush(Duration::from_secs(5));
-        s.stats()
-    });
+    let server_stats = server.as_ref().map(|s| (s.flush(FLUSH_TIMEOUT), s.stats()));
     drop(server);
     let stats = demo.bus.stats();
     let sim_s = demo.now_ns() as f64 / 1e9;
@@ -168,7 +291,11 @@ fn main() -> Result<()> {
             "events": events_total,
             "faults": cli.faults.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
             "bus": stats,
-            "socketcand": server_stats.map(|s| serde_json::json!({
+            "socketcand": server_stats.map(|(flushed, s)| serde_json::json!({
+                "flushed": flushed,
+                "clients_refused": s.clients_refused,
+                "clients_stalled": s.clients_stalled,
+                "inbound_dropped": s.inbound_dropped,
                 "clients_accepted": s.clients_accepted,
                 "frames_sent": s.frames_sent,
                 "frames_dropped": s.frames_dropped,
@@ -180,6 +307,12 @@ fn main() -> Result<()> {
         serde_json::to_writer_pretty(&mut out, &j)?;
         writeln!(out)?;
     } else {
+        if let Some((_, s)) = server_stats {
+            eprintln!(
+                "socketcand: {} clients, {} frames sent, {} dropped (full client queues), {} clients refused, {} stalled",
+                s.clients_accepted, s.frames_sent, s.frames_dropped, s.clients_refused, s.clients_stalled
+            );
+        }
         eprintln!(
             "{sim_s:.3} s simulated in {wall_s:.3} s: {} frames, {} error frames, {} dropped, {} queue overflows, bus load {:.2} %",
             stats.frames,

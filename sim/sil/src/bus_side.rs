@@ -100,7 +100,7 @@ impl BusSide {
                 BusEvent::Delivered(d) => {
                     self.frames_delivered += 1;
                     if let Some(s) = &self.server {
-                        s.publish(&d.frame, d.t_end_ns);
+                        s.publish(&d.frame, d.t_end_ns).map_err(control_error)?;
                     }
                 }
                 BusEvent::BusOff { node, t_ns } => {

@@ -1,0 +1,222 @@
+//! `canbus-demo` on bad input (exit code 2, a message naming the option, never a panic), on
+//! a far timestamp origin (no wrapped timestamps), and with a socketcand client that never
+//! reads (the process still exits promptly at the end of the run).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use canbus::candump::read_log;
+
+fn demo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_canbus-demo"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Exit code 2 and a message on stderr containing every one of `names`, no panic.
+fn assert_bad_input(args: &[&str], names: &[&str]) {
+    let out = demo(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    for n in names {
+        assert!(err.contains(n), "{args:?}: `{n}` not in {err}");
+    }
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("canbus-demo-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn absurd_speeds_are_bad_input_not_panics() {
+    for (s, shown) in [
+        ("1e-300", "1e-300"),
+        ("-1", "-1"),
+        ("NaN", "NaN"),
+        ("inf", "inf"),
+        ("1e7", "10000000"),
+    ] {
+        let arg = format!("--speed={s}");
+        assert_bad_input(&["--seconds", "0.01", &arg], &["--speed", shown]);
+    }
+    // the limits themselves run
+    let out = demo(&["--seconds", "0.01", "--speed", "1e6"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn absurd_client_waits_are_bad_input_not_panics() {
+    for (w, shown) in [
+        ("1e300", "1e300"),
+        ("-1", "-1"),
+        ("NaN", "NaN"),
+        ("86401", "86401"),
+    ] {
+        assert_bad_input(
+            &[
+                "--seconds",
+                "0.01",
+                "--socketcand",
+                "127.0.0.1:0",
+                &format!("--wait-client={w}"),
+            ],
+            &["--wait-client", shown],
+        );
+    }
+}
+
+#[test]
+fn other_bad_input_exits_2() {
+    assert_bad_input(&["--seconds", "0"], &["--seconds"]);
+    assert_bad_input(&["--seconds", "0.01", "--bitrate", "0"], &["bit rate"]);
+    assert_bad_input(
+        &["--seconds", "0.01", "--origin", "soon"],
+        &["--origin", "soon"],
+    );
+    assert_bad_input(&["--seconds", "0.01", "--channel", "a b"], &["--channel"]);
+    assert_bad_input(
+        &["--seconds", "0.01", "--socketcand", "0.0.0.0:0"],
+        &["--socketcand", "loopback"],
+    );
+    assert_bad_input(
+        &["--seconds", "0.01", "--fault", "busoff:node=nobody"],
+        &["nobody"],
+    );
+}
+
+#[test]
+fn candump_errors_name_the_path() {
+    let bad = temp_dir("nopath").join("no").join("such").join("dir.log");
+    let bad_s = bad.to_str().unwrap();
+    assert_bad_input(
+        &["--seconds", "0.01", "--candump", bad_s],
+        &["--candump", bad_s],
+    );
+}
+
+#[test]
+fn a_far_origin_is_refused_or_stamped_without_wrapping() {
+    // 18446744073 s + 5 s is past u64 nanoseconds: the log's timestamps used to wrap to 1970
+    assert_bad_input(&["--origin", "18446744073"], &["--origin", "18446744073"]);
+    assert_bad_input(
+        &["--origin", "18446744074", "--seconds", "0.01"],
+        &["18446744074"],
+    );
+    assert_bad_input(
+        &["--origin", "99999999999999999999", "--seconds", "0.01"],
+        &["--origin"],
+    );
+    // 0.5 s still fits: every timestamp follows the origin, in order
+    let log = temp_dir("origin").join("far.log");
+    let out = demo(&[
+        "--origin",
+        "18446744073",
+        "--seconds",
+        "0.5",
+        "--candump",
+        log.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (records, errors) = read_log(BufReader::new(std::fs::File::open(&log).unwrap())).unwrap();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert!(records.len() > 100, "{}", records.len());
+    let origin_ns = 18_446_744_073_000_000_000u64;
+    let mut last = origin_ns;
+    for r in &records {
+        assert!(r.timestamp_ns >= last, "{} after {last}", r.timestamp_ns);
+        last = r.timestamp_ns;
+    }
+    assert!(last <= origin_ns + 501_000_000, "{last}");
+}
+
+/// A client that opens rawmode and never reads used to keep the demo alive for ever after its
+/// run (the server's shutdown joined a thread stuck in `write_all`).
+#[test]
+fn a_client_that_never_reads_does_not_keep_the_demo_alive() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_canbus-demo"))
+        .args([
+            "--seconds",
+            "3000",
+            "--speed",
+            "0",
+            "--socketcand",
+            "127.0.0.1:0",
+            "--wait-client",
+            "60",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    let mut addr = None;
+    while addr.is_none() {
+        line.clear();
+        if err.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        addr = line
+            .trim()
+            .strip_prefix("socketcand: listening on ")
+            .map(str::to_string);
+    }
+    let addr = addr.unwrap_or_else(|| {
+        let _ = child.kill();
+        panic!("no address announced: {line}")
+    });
+    let mut client = TcpStream::connect(addr).unwrap();
+    client.write_all(b"< open vcan0 >< rawmode >").unwrap();
+    let t0 = Instant::now();
+    // the demo runs 3000 simulated seconds as fast as it can (measured: about 2 s), far more
+    // than the socket buffers hold
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if t0.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("canbus-demo still running 120 s after its client connected");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let elapsed_s = t0.elapsed().as_secs_f64();
+    let mut stdout = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+    assert!(status.success(), "{status:?}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let sc = &j["socketcand"];
+    assert!(sc["frames_dropped"].as_u64().unwrap() > 0, "{sc}");
+    assert_eq!(sc["flushed"], false, "{sc}");
+    let wall_s = j["wall_s"].as_f64().unwrap();
+    eprintln!("exited {elapsed_s:.3} s after the client connected, the run took {wall_s:.3} s");
+    // after the run: the rawmode grace (0.2 s) before it, the flush and the shutdown after
+    // it; measured: about 0.35 s
+    assert!(
+        elapsed_s - wall_s < 1.2,
+        "exited {:.3} s after a run of {wall_s:.3} s",
+        elapsed_s
+    );
+    drop(client);
+}

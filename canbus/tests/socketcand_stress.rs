@@ -1,0 +1,332 @@
+//! The socketcand server under abuse, over real TCP on 127.0.0.1: hundreds of connections,
+//! garbage input, more clients than allowed, a client that never reads. Memory (VmRSS of this
+//! process) and shutdown time are bounded generously; the measured values are in comments.
+//!
+//! The tests take a lock so that they run one at a time: each measures the process's memory.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::io::{ErrorKind, Read, Write};
+use std::net::TcpStream;
+use std::sync::{mpsc, Mutex, MutexGuard, PoisonError};
+use std::time::{Duration, Instant};
+
+use canbus::socketcand::{ServerConfig, SocketcandServer};
+use canbus::Frame;
+
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn one_at_a_time() -> MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Resident memory of this process [bytes], from /proc/self/status.
+fn vm_rss_bytes() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let line = status
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))
+        .expect("VmRSS in /proc/self/status");
+    let kib: u64 = line
+        .split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .expect("VmRSS value");
+    kib * 1024
+}
+
+const MIB: u64 = 1024 * 1024;
+
+fn config() -> ServerConfig {
+    ServerConfig {
+        rawmode_grace: Duration::from_millis(1),
+        ..ServerConfig::default()
+    }
+}
+
+/// Read until `want` is in the text or `budget` passes.
+fn read_until(s: &mut TcpStream, want: &str, budget: Duration) -> String {
+    s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
+    let mut got = String::new();
+    let mut b = [0u8; 4096];
+    let end = Instant::now() + budget;
+    while !got.contains(want) && Instant::now() < end {
+        match s.read(&mut b) {
+            Ok(0) => break,
+            Ok(n) => got.push_str(&String::from_utf8_lossy(&b[..n])),
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(_) => break,
+        }
+    }
+    got
+}
+
+fn wait_until(budget: Duration, mut done: impl FnMut() -> bool) -> bool {
+    let end = Instant::now() + budget;
+    while Instant::now() < end {
+        if done() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    done()
+}
+
+/// Shut the server down on another thread; how long it took, or `None` if not within 10 s.
+fn timed_shutdown(mut server: SocketcandServer) -> Option<Duration> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let t = Instant::now();
+        server.shutdown();
+        let _ = tx.send(t.elapsed());
+    });
+    rx.recv_timeout(Duration::from_secs(10)).ok()
+}
+
+fn frame(i: u32) -> Frame {
+    Frame::new(0x072, &i.to_le_bytes()).unwrap()
+}
+
+/// Each connection used to keep a 65,536-slot channel (2 MB) for ever: 300 cycles took
+/// hundreds of MB. Now a finished client is joined and forgotten.
+#[test]
+fn hundreds_of_connections_leave_no_memory_behind() {
+    let _guard = one_at_a_time();
+    let server = SocketcandServer::bind("127.0.0.1:0", config()).unwrap();
+    let addr = server.local_addr();
+    let cycle = |i: u32| {
+        let mut c = TcpStream::connect(addr).unwrap();
+        assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+        if i.is_multiple_of(3) {
+            // garbage, then gone
+            c.write_all(b"<<< \xff\xfe nonsense >>> < send zz >")
+                .unwrap();
+            return;
+        }
+        c.write_all(b"< open vcan0 >< rawmode >").unwrap();
+        let got = read_until(&mut c, "< ok >< ok >", Duration::from_secs(5));
+        assert!(got.contains("< ok >< ok >"), "{got}");
+        assert!(wait_until(Duration::from_secs(5), || server
+            .rawmode_clients()
+            > 0));
+        for k in 0..50 {
+            server.publish(&frame(k), u64::from(i) * 1_000_000).unwrap();
+        }
+        if i.is_multiple_of(2) {
+            let got = read_until(&mut c, "< frame", Duration::from_secs(5));
+            assert!(got.contains("< frame 072"), "{got}");
+        }
+    };
+    for i in 0..20 {
+        cycle(i);
+    }
+    assert!(wait_until(Duration::from_secs(5), || server
+        .connected_clients()
+        == 0));
+    let rss0 = vm_rss_bytes();
+    for i in 0..300 {
+        cycle(i);
+    }
+    assert!(
+        wait_until(Duration::from_secs(5), || server.connected_clients() == 0),
+        "{} clients still held",
+        server.connected_clients()
+    );
+    let grown = vm_rss_bytes().saturating_sub(rss0);
+    eprintln!("VmRSS grew by {} KiB", grown / 1024);
+    // measured: well under 1 MiB (before: about 2 MiB a connection, 600 MiB here)
+    assert!(grown < 48 * MIB, "VmRSS grew by {} MiB", grown / MIB);
+    let st = server.stats();
+    assert_eq!(st.clients_accepted, 320);
+    assert!(st.bad_commands >= 100, "{st:?}");
+    // measured: about 2 ms
+    let took = timed_shutdown(server).expect("shutdown returns");
+    eprintln!("shutdown took {took:?}");
+    assert!(took < Duration::from_secs(1), "{took:?}");
+}
+
+/// Garbage of every kind is answered or discarded within bounds, and a well-behaved client is
+/// served afterwards.
+#[test]
+fn garbage_input_is_bounded_and_the_server_keeps_serving() {
+    let _guard = one_at_a_time();
+    let server = SocketcandServer::bind("127.0.0.1:0", config()).unwrap();
+    let addr = server.local_addr();
+    let rss0 = vm_rss_bytes();
+    let mut x: u32 = 12345;
+    let mut junk = |n: usize| -> Vec<u8> {
+        (0..n)
+            .map(|_| {
+                x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                (x >> 16) as u8
+            })
+            .collect()
+    };
+    let garbage: Vec<Vec<u8>> = vec![
+        junk(1 << 20),                                            // random bytes
+        vec![b'<'; 1 << 20],                                      // an opening that never closes
+        b"<>".repeat(200_000), // empty commands, answered with errors
+        [b"< ".as_slice(), &vec![b'x'; 300_000], b" >"].concat(), // one huge command
+        b"< open vcan0 >< rawmode >< send 7FF 9 1 2 3 4 5 6 7 8 9 >< send 1 1 zz >".repeat(5000),
+    ];
+    for g in &garbage {
+        let mut c = TcpStream::connect(addr).unwrap();
+        // the server stops reading while its answers are not read: read them meanwhile
+        let mut r = c.try_clone().unwrap();
+        let reader = std::thread::spawn(move || {
+            r.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+            let mut total = 0usize;
+            let mut b = [0u8; 65536];
+            while let Ok(n @ 1..) = r.read(&mut b) {
+                total += n;
+            }
+            total
+        });
+        c.write_all(g).unwrap();
+        c.shutdown(std::net::Shutdown::Write).unwrap();
+        let answered = reader.join().unwrap();
+        assert!(answered >= "< hi >".len());
+    }
+    assert!(wait_until(Duration::from_secs(5), || server
+        .connected_clients()
+        == 0));
+    let st = server.stats();
+    assert!(st.bad_commands > 1000, "{st:?}");
+    assert_eq!(st.frames_received, 0);
+    // measured: about 4 MiB
+    let grown = vm_rss_bytes().saturating_sub(rss0);
+    eprintln!("VmRSS grew by {} KiB", grown / 1024);
+    assert!(grown < 48 * MIB, "VmRSS grew by {} MiB", grown / MIB);
+
+    let mut c = TcpStream::connect(addr).unwrap();
+    c.write_all(b"< open vcan0 >< rawmode >< send 123 2 AB CD >")
+        .unwrap();
+    assert!(read_until(&mut c, "< ok >< ok >", Duration::from_secs(5)).contains("< ok >< ok >"));
+    assert!(wait_until(Duration::from_secs(5), || !server
+        .take_inbound()
+        .is_empty()));
+    server.publish(&frame(7), 1_000).unwrap();
+    let got = read_until(&mut c, "< frame", Duration::from_secs(5));
+    assert!(got.contains("< frame 072 0.000001 07000000 >"), "{got}");
+}
+
+/// Beyond `max_clients`, connections are refused with a clear answer; a slot frees as soon as
+/// a client leaves.
+#[test]
+fn clients_beyond_the_cap_are_refused_clearly() {
+    let _guard = one_at_a_time();
+    let server = SocketcandServer::bind(
+        "127.0.0.1:0",
+        ServerConfig {
+            max_clients: 4,
+            ..config()
+        },
+    )
+    .unwrap();
+    let addr = server.local_addr();
+    let mut kept = Vec::new();
+    for _ in 0..4 {
+        let mut c = TcpStream::connect(addr).unwrap();
+        assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+        kept.push(c);
+    }
+    for _ in 0..200 {
+        let mut c = TcpStream::connect(addr).unwrap();
+        let got = read_until(&mut c, ">", Duration::from_secs(5));
+        assert!(
+            got.contains("< error too many clients (4 connected, the limit) >"),
+            "{got}"
+        );
+    }
+    assert_eq!(server.stats().clients_refused, 200);
+    assert_eq!(server.connected_clients(), 4);
+    drop(kept.pop());
+    assert!(wait_until(Duration::from_secs(5), || server
+        .connected_clients()
+        == 3));
+    let mut c = TcpStream::connect(addr).unwrap();
+    assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+}
+
+/// Publish frames until the client's socket buffers are full (nothing written for 300 ms).
+fn publish_until_stalled(server: &SocketcandServer) {
+    let end = Instant::now() + Duration::from_secs(30);
+    let mut last = (server.stats().frames_sent, Instant::now());
+    let mut i = 0u32;
+    while Instant::now() < end {
+        for _ in 0..2000 {
+            server.publish(&frame(i), u64::from(i) * 1000).unwrap();
+            i = i.wrapping_add(1);
+        }
+        std::thread::sleep(Duration::from_millis(2));
+        let sent = server.stats().frames_sent;
+        if sent != last.0 {
+            last = (sent, Instant::now());
+        } else if last.1.elapsed() > Duration::from_millis(300) {
+            return;
+        }
+    }
+    panic!("the client's output never stalled: {:?}", server.stats());
+}
+
+/// A client in rawmode that never reads used to block its thread in `write_all` for ever, and
+/// `shutdown` with it. Now it loses frames (counted), the simulation never waits, memory stays
+/// bounded and shutdown is prompt.
+#[test]
+fn a_client_that_never_reads_loses_frames_and_does_not_hold_shutdown() {
+    let _guard = one_at_a_time();
+    let cfg = ServerConfig {
+        // keep the stalled client connected until shutdown: the hard case
+        write_timeout: Duration::from_secs(600),
+        ..config()
+    };
+    let bound = cfg.memory_bound_bytes() as u64;
+    let server = SocketcandServer::bind("127.0.0.1:0", cfg).unwrap();
+    let rss0 = vm_rss_bytes();
+    let c = {
+        let mut c = TcpStream::connect(server.local_addr()).unwrap();
+        c.write_all(b"< open vcan0 >< rawmode >").unwrap();
+        c
+    };
+    assert!(wait_until(Duration::from_secs(5), || server
+        .rawmode_clients()
+        == 1));
+    publish_until_stalled(&server);
+    let st = server.stats();
+    assert!(st.frames_dropped > 0, "{st:?}");
+    assert!(st.frames_sent > 0, "{st:?}");
+    assert_eq!(server.connected_clients(), 1);
+    assert!(!server.flush(Duration::from_secs(5)));
+    // measured: about 2 MiB (mostly the full 65,536-frame queue); the documented bound, 30 MiB
+    let grown = vm_rss_bytes().saturating_sub(rss0);
+    eprintln!("VmRSS grew by {} KiB", grown / 1024);
+    assert!(grown < bound, "VmRSS grew by {grown} B, bound {bound} B");
+    // measured: about 10 ms
+    let took = timed_shutdown(server).expect("shutdown returns within 10 s");
+    eprintln!("shutdown took {took:?}");
+    assert!(took < Duration::from_secs(1), "{took:?}");
+    drop(c);
+}
+
+/// A client whose output makes no progress for `write_timeout` is disconnected and counted.
+#[test]
+fn a_stalled_client_is_disconnected_after_the_write_timeout() {
+    let _guard = one_at_a_time();
+    let server = SocketcandServer::bind(
+        "127.0.0.1:0",
+        ServerConfig {
+            write_timeout: Duration::from_millis(200),
+            ..config()
+        },
+    )
+    .unwrap();
+    let mut c = TcpStream::connect(server.local_addr()).unwrap();
+    c.write_all(b"< open vcan0 >< rawmode >").unwrap();
+    assert!(wait_until(Duration::from_secs(5), || server
+        .rawmode_clients()
+        == 1));
+    publish_until_stalled(&server);
+    assert!(wait_until(Duration::from_secs(5), || server
+        .connected_clients()
+        == 0));
+    assert_eq!(server.stats().clients_stalled, 1);
+}
