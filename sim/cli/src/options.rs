@@ -91,6 +91,10 @@ impl Common {
                 .integrator
                 .with_tolerance_or_step(self.rtol, self.step_s);
         }
+        // A step too small for the stride's budgets would only run out of them, slowly.
+        w.settings
+            .validate()
+            .map_err(|e| InputError::Other(e.to_string()))?;
         Ok(w)
     }
 

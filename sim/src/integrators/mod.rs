@@ -80,6 +80,45 @@ pub enum IntegrationError {
     },
 }
 
+/// Why an integrator's settings cannot run a stride (from a scene file or the command line),
+/// naming the setting and its value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegratorError {
+    /// A step, largest step or tolerance that is zero, negative, NaN or infinite.
+    #[error("integrator {kind}: `{setting}` = {value:e} must be a positive, finite number")]
+    NotPositive {
+        /// The integrator's kind.
+        kind: &'static str,
+        /// The setting (`h_s`, `h_max_s`, `rtol`, `atol`).
+        setting: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A (largest) step so small that the stride time budget takes more steps than the
+    /// stride's step budget allows.
+    #[error("integrator {kind}: `{setting}` = {value:e} s is too small: {steps:.3e} steps to cover the stride time budget of {max_stride_time_s} s, more than the step budget of {max_steps}")]
+    TooManySteps {
+        /// The integrator's kind.
+        kind: &'static str,
+        /// The setting (`h_s` or `h_max_s`).
+        setting: &'static str,
+        /// Its value [s].
+        value: f64,
+        /// Steps the time budget needs at this step.
+        steps: f64,
+        /// The stride time budget [s].
+        max_stride_time_s: f64,
+        /// The stride step budget.
+        max_steps: usize,
+    },
+    /// A stride time budget that is zero, negative, NaN or infinite.
+    #[error("stride time budget max_stride_time_s = {value} s must be a positive, finite number")]
+    BadTimeBudget {
+        /// Its value [s].
+        value: f64,
+    },
+}
+
 /// The step-size controller of the embedded pairs (DOPRI5, DOP853): from `h`, try a step;
 /// accept it when its scaled error is at most 1 and propose the next step
 /// `h · clamp(0.9 · err^(−exponent), min, max)` (at most `h_max_s`); otherwise shrink and retry,
@@ -237,6 +276,90 @@ impl IntegratorChoice {
             (IntegratorChoice::Rk4 { .. }, _, Some(h)) => IntegratorChoice::Rk4 { h_s: h },
             (other, _, _) => other,
         }
+    }
+
+    /// The kind's name (`meijaard`, `rk4`, `dopri5`, `dop853`), as [`Self::from_kind`] takes it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            IntegratorChoice::Meijaard { .. } => "meijaard",
+            IntegratorChoice::Rk4 { .. } => "rk4",
+            IntegratorChoice::Dopri5 { .. } => "dopri5",
+            IntegratorChoice::Dop853 { .. } => "dop853",
+        }
+    }
+
+    /// Checks the settings against the default stride step budget
+    /// ([`crate::stride::StrideSettings::DEFAULT_MAX_STEPS`]): see
+    /// [`Self::validate_with_budget`]. For settings from the command line.
+    ///
+    /// # Errors
+    /// As [`Self::validate_with_budget`].
+    pub fn validate(&self, max_stride_time_s: f64) -> Result<(), IntegratorError> {
+        self.validate_with_budget(
+            max_stride_time_s,
+            crate::stride::StrideSettings::DEFAULT_MAX_STEPS,
+        )
+    }
+
+    /// Checks that these settings can run a stride: every step, largest step and tolerance
+    /// positive and finite, and the (largest) step long enough to cover `max_stride_time_s`
+    /// [s] within `max_steps` steps (a smaller one could only end in a budget failure, after
+    /// a long time).
+    ///
+    /// # Errors
+    /// [`IntegratorError`] naming the setting and its value.
+    pub fn validate_with_budget(
+        &self,
+        max_stride_time_s: f64,
+        max_steps: usize,
+    ) -> Result<(), IntegratorError> {
+        let kind = self.kind();
+        if !(max_stride_time_s.is_finite() && max_stride_time_s > 0.0) {
+            return Err(IntegratorError::BadTimeBudget {
+                value: max_stride_time_s,
+            });
+        }
+        let positive = |setting: &'static str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(IntegratorError::NotPositive {
+                    kind,
+                    setting,
+                    value,
+                })
+            }
+        };
+        let (setting, step_s) = match *self {
+            IntegratorChoice::Meijaard { h_s, .. } | IntegratorChoice::Rk4 { h_s } => ("h_s", h_s),
+            IntegratorChoice::Dopri5 {
+                rtol,
+                atol,
+                h_max_s,
+            }
+            | IntegratorChoice::Dop853 {
+                rtol,
+                atol,
+                h_max_s,
+            } => {
+                positive("rtol", rtol)?;
+                positive("atol", atol)?;
+                ("h_max_s", h_max_s)
+            }
+        };
+        positive(setting, step_s)?;
+        let steps = max_stride_time_s / step_s;
+        if steps > max_steps as f64 {
+            return Err(IntegratorError::TooManySteps {
+                kind,
+                setting,
+                value: step_s,
+                steps,
+                max_stride_time_s,
+                max_steps,
+            });
+        }
+        Ok(())
     }
 
     /// A short label for tables.

@@ -1,7 +1,18 @@
 //! A tiny arithmetic language for scene files: numbers, parameter names, `+ - * / ^`,
 //! parentheses, and `sqrt sin cos tan atan asin acos abs`, `pi`.
+//!
+//! The parser is recursive descent with a nesting budget ([`MAX_DEPTH`]): parentheses, leading
+//! signs and exponents nested deeper than that are a [`ExprError::TooDeep`], never a stack
+//! overflow, however long the text.
 
 use std::collections::BTreeMap;
+
+/// How deeply an expression may nest: each parenthesis or function call, each leading sign and
+/// each exponent opens one level.
+pub const MAX_DEPTH: usize = 64;
+
+/// Longest excerpt of an expression quoted in a nesting error [characters].
+const QUOTED_CHARS: usize = 60;
 
 /// Why an expression could not be evaluated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -24,6 +35,55 @@ pub enum ExprError {
         /// The name.
         name: String,
     },
+    /// Nested deeper than [`MAX_DEPTH`].
+    #[error("`{excerpt}`: nested deeper than {max_depth} levels (parentheses, signs, exponents) at column {column}")]
+    TooDeep {
+        /// The expression's start (at most 60 characters, then `…`).
+        excerpt: String,
+        /// The nesting budget.
+        max_depth: usize,
+        /// 1-based column where the budget ran out.
+        column: usize,
+    },
+}
+
+/// The parameter names an expression refers to (not `pi`, not function names), found
+/// lexically with the parser's own rules for numbers and names; empty for text that is not
+/// an expression's tokens.
+pub fn names(expr: &str) -> Vec<String> {
+    let s = expr.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < s.len() {
+        let c = s[i];
+        if c.is_ascii_digit() || c == b'.' {
+            i += 1;
+            while i < s.len()
+                && (s[i].is_ascii_digit()
+                    || matches!(s[i], b'.' | b'e' | b'E')
+                    || (matches!(s[i], b'-' | b'+') && matches!(s[i - 1], b'e' | b'E')))
+            {
+                i += 1;
+            }
+        } else if c.is_ascii_alphabetic() || c == b'_' {
+            let start = i;
+            while i < s.len() && (s[i].is_ascii_alphanumeric() || s[i] == b'_') {
+                i += 1;
+            }
+            let name = &expr[start..i];
+            let mut j = i;
+            while j < s.len() && s[j].is_ascii_whitespace() {
+                j += 1;
+            }
+            let call = s.get(j) == Some(&b'(');
+            if !call && name != "pi" {
+                out.push(name.to_string());
+            }
+        } else {
+            i += 1;
+        }
+    }
+    out
 }
 
 /// Evaluates `expr` with `vars` bound.
@@ -31,6 +91,7 @@ pub fn eval(expr: &str, vars: &BTreeMap<String, f64>) -> Result<f64, ExprError> 
     let mut p = Parser {
         s: expr.as_bytes(),
         i: 0,
+        depth: 0,
         expr,
         vars,
     };
@@ -45,6 +106,8 @@ pub fn eval(expr: &str, vars: &BTreeMap<String, f64>) -> Result<f64, ExprError> 
 struct Parser<'a> {
     s: &'a [u8],
     i: usize,
+    /// Current nesting, against [`MAX_DEPTH`].
+    depth: usize,
     expr: &'a str,
     vars: &'a BTreeMap<String, f64>,
 }
@@ -94,7 +157,26 @@ impl Parser<'_> {
         }
         Ok(base)
     }
+    /// Every recursion of the parser passes through here (a parenthesis, a call's argument, a
+    /// sign, an exponent): the nesting budget is counted here.
     fn unary(&mut self) -> Result<f64, ExprError> {
+        if self.depth >= MAX_DEPTH {
+            let mut excerpt: String = self.expr.chars().take(QUOTED_CHARS).collect();
+            if self.expr.chars().nth(QUOTED_CHARS).is_some() {
+                excerpt.push('…');
+            }
+            return Err(ExprError::TooDeep {
+                excerpt,
+                max_depth: MAX_DEPTH,
+                column: self.i + 1,
+            });
+        }
+        self.depth += 1;
+        let v = self.unary_at_depth();
+        self.depth -= 1;
+        v
+    }
+    fn unary_at_depth(&mut self) -> Result<f64, ExprError> {
         match self.peek() {
             Some(b'-') => {
                 self.i += 1;
@@ -204,5 +286,40 @@ mod tests {
         );
         assert!(matches!(eval("1 +", &v), Err(ExprError::Syntax { .. })));
         assert!(matches!(eval("(1", &v), Err(ExprError::Syntax { .. })));
+    }
+
+    #[test]
+    fn deep_nesting_is_an_error_not_a_stack_overflow() {
+        let v = BTreeMap::new();
+        let deep = format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000));
+        assert!(matches!(
+            eval(&deep, &v),
+            Err(ExprError::TooDeep {
+                max_depth: MAX_DEPTH,
+                ..
+            })
+        ));
+        let signs = format!("{}1", "-".repeat(50_000));
+        let e = eval(&signs, &v).unwrap_err();
+        assert!(matches!(e, ExprError::TooDeep { .. }), "{e}");
+        assert!(
+            e.to_string().len() < 200,
+            "the message quotes an excerpt: {e}"
+        );
+        let powers = vec!["2"; 10_000].join("^");
+        assert!(matches!(eval(&powers, &v), Err(ExprError::TooDeep { .. })));
+        // Within the budget, nesting still works.
+        let ok = format!("{}1{}", "(".repeat(30), ")".repeat(30));
+        assert_eq!(eval(&ok, &v).unwrap(), 1.0);
+        assert_eq!(eval(&format!("{}1", "-".repeat(40)), &v).unwrap(), 1.0);
+    }
+
+    #[test]
+    fn names_are_the_parameters_an_expression_uses() {
+        assert_eq!(
+            names("sqrt(leg_m / g_m_s2) * 1e-3 + pi - x2^2 + 2E+3"),
+            vec!["leg_m", "g_m_s2", "x2"]
+        );
+        assert!(names("1.5e-3").is_empty());
     }
 }

@@ -5,11 +5,12 @@
 
 pub mod expr;
 pub mod file;
+mod usage;
 pub mod variant;
 
 use crate::actuator::AnkleReflex;
 use crate::events::{Direction, EventTolerance};
-use crate::integrators::IntegratorChoice;
+use crate::integrators::{IntegratorChoice, IntegratorError};
 use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
 use crate::relabel::Relabel;
@@ -17,7 +18,7 @@ use crate::stride::StrideSettings;
 use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker};
 use file::{Num, SceneFile};
 use nalgebra::{DVector, Matrix3, Vector3};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The built-in scenes: `(name, TOML text)`.
 pub const BUILTIN: &[(&str, &str)] = &[
@@ -108,6 +109,24 @@ pub enum SceneError {
     /// A reference to something undefined, or a bad keyword.
     #[error("{0}")]
     Invalid(String),
+    /// The `[integrator]` settings cannot run a stride.
+    #[error("scene `{scene}` [integrator]: {error}")]
+    Integrator {
+        /// Scene.
+        scene: String,
+        /// What is wrong.
+        error: IntegratorError,
+    },
+    /// `--set` of a parameter that acts on nothing of this walker.
+    #[error("scene `{scene}`: parameter `{name}` acts on nothing of this walker (no expression uses it{}), so setting it would change nothing", variant_of.as_ref().map(|b| format!("; the variant of `{b}` removed or welded the bodies it belongs to")).unwrap_or_default())]
+    UnusedParameter {
+        /// Scene.
+        scene: String,
+        /// Parameter.
+        name: String,
+        /// The base scene of the variant, if the scene is one.
+        variant_of: Option<String>,
+    },
 }
 
 /// Everything a scene file sets up: the walker's physics, the solver settings of its strides,
@@ -139,6 +158,11 @@ pub struct Scene {
     pub file: SceneFile,
     /// Current parameter values.
     pub values: BTreeMap<String, f64>,
+    /// The built-in scenes this one derives from by `[variant]`, nearest first.
+    bases: Vec<String>,
+    /// Parameters no expression of the file uses (after its variant is applied): those of
+    /// removed or welded bodies. They cannot be changed ([`Self::set`]).
+    unused: BTreeSet<String>,
 }
 
 impl Scene {
@@ -166,7 +190,7 @@ impl Scene {
 
     /// Parses scene text; `origin` names it in errors.
     pub fn parse(origin: &str, text: &str) -> Result<Self, SceneError> {
-        let table = Self::resolve(origin, text, 0)?;
+        let (table, bases) = Self::resolve(origin, text, 0)?;
         let file: SceneFile = table
             .try_into()
             .map_err(|e: toml::de::Error| SceneError::File {
@@ -178,15 +202,33 @@ impl Scene {
             .iter()
             .map(|(k, p)| (k.clone(), p.default))
             .collect();
-        let scene = Self { file, values };
+        let unused = usage::unused_parameters(&file);
+        let scene = Self {
+            file,
+            values,
+            bases,
+            unused,
+        };
         for (k, p) in &scene.file.parameters {
+            for (bound, v) in [("min", p.min), ("max", p.max)] {
+                if v.is_some_and(f64::is_nan) {
+                    return Err(SceneError::Invalid(format!(
+                        "parameter `{k}`: {bound} is NaN"
+                    )));
+                }
+            }
             scene.check_range(k, p.default)?;
         }
         Ok(scene)
     }
 
     /// Parses text to a TOML table, resolving `[variant] base = ...` (at most 4 deep).
-    fn resolve(origin: &str, text: &str, depth: usize) -> Result<toml::Table, SceneError> {
+    /// Returns the table and the chain of bases, nearest first.
+    fn resolve(
+        origin: &str,
+        text: &str,
+        depth: usize,
+    ) -> Result<(toml::Table, Vec<String>), SceneError> {
         let file_err = |message: String| SceneError::File {
             path: origin.to_string(),
             message,
@@ -194,23 +236,22 @@ impl Scene {
         let table: toml::Table = text
             .parse()
             .map_err(|e: toml::de::Error| file_err(e.to_string()))?;
-        let Some(base) = table
-            .get("variant")
-            .and_then(|v| v.get("base"))
-            .and_then(|b| b.as_str())
+        let Some(spec) = variant::VariantDef::of(&table).map_err(|e| file_err(e.to_string()))?
         else {
-            return Ok(table);
+            return Ok((table, Vec::new()));
         };
         if depth > 4 {
             return Err(file_err("variant chain too deep".into()));
         }
+        let base = spec.base;
         let base_text = BUILTIN
             .iter()
             .find(|(n, _)| *n == base)
             .map(|(_, t)| *t)
             .ok_or_else(|| file_err(format!("variant base `{base}` is not a built-in scene")))?;
-        let base_table = Self::resolve(base, base_text, depth + 1)?;
-        variant::apply(base_table, table)
+        let (base_table, mut bases) = Self::resolve(&base, base_text, depth + 1)?;
+        bases.insert(0, base);
+        Ok((variant::apply(base_table, table)?, bases))
     }
 
     /// The scene's name.
@@ -269,9 +310,30 @@ impl Scene {
             })
     }
 
-    /// Sets a parameter (by name or alias) to a value, checking its range.
+    /// The built-in scenes this one derives from by `[variant]`, nearest first (empty for a
+    /// scene that is not a variant).
+    pub fn variant_bases(&self) -> &[String] {
+        &self.bases
+    }
+
+    /// Whether a parameter (canonical name) is used by no expression of the scene, i.e. acts
+    /// on nothing of its walker (a body its variant removed or a joint it welded).
+    pub fn is_unused(&self, name: &str) -> bool {
+        self.unused.contains(name)
+    }
+
+    /// Sets a parameter (by name or alias) to a value, checking its range. A parameter that
+    /// acts on nothing of this walker ([`Self::is_unused`]) cannot be changed: setting it to
+    /// another value than its current one is an error naming the variant.
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), SceneError> {
         let name = self.parameter_name(key)?;
+        if self.unused.contains(&name) && self.values.get(&name) != Some(&value) {
+            return Err(SceneError::UnusedParameter {
+                scene: self.name().to_string(),
+                name,
+                variant_of: self.bases.first().cloned(),
+            });
+        }
         self.check_range(&name, value)?;
         self.values.insert(name, value);
         Ok(())
@@ -420,20 +482,28 @@ impl Scene {
         let release = hs
             .release
             .iter()
-            .map(|r| {
-                let axis = match &r[1..] {
-                    "x" => Vector3::x(),
-                    "y" => Vector3::y(),
-                    "z" => Vector3::z(),
-                    _ => Vector3::zeros(),
-                };
-                match (r.as_bytes().first(), axis.norm() > 0.0 && r.len() == 2) {
-                    (Some(b't'), true) => Ok(JointKind::Prismatic { axis_parent: axis }),
-                    (Some(b'r'), true) => Ok(JointKind::Revolute { axis_parent: axis }),
-                    _ => Err(SceneError::Invalid(format!(
-                        "heel_strike.release: unknown `{r}`"
-                    ))),
-                }
+            .map(|r| match r.as_str() {
+                "tx" => Ok(JointKind::Prismatic {
+                    axis_parent: Vector3::x(),
+                }),
+                "ty" => Ok(JointKind::Prismatic {
+                    axis_parent: Vector3::y(),
+                }),
+                "tz" => Ok(JointKind::Prismatic {
+                    axis_parent: Vector3::z(),
+                }),
+                "rx" => Ok(JointKind::Revolute {
+                    axis_parent: Vector3::x(),
+                }),
+                "ry" => Ok(JointKind::Revolute {
+                    axis_parent: Vector3::y(),
+                }),
+                "rz" => Ok(JointKind::Revolute {
+                    axis_parent: Vector3::z(),
+                }),
+                _ => Err(SceneError::Invalid(format!(
+                    "heel_strike.release: unknown `{r}` (expected tx, ty, tz, rx, ry or rz)"
+                ))),
             })
             .collect::<Result<Vec<_>, _>>()?;
         let heel_strike = HeelStrikeRule {
@@ -548,18 +618,59 @@ impl Scene {
             initially_locked,
             three_d_freedoms: f.three_d_freedoms.clone(),
         };
+        let settings = StrideSettings {
+            integrator,
+            event_tolerance: EventTolerance::default(),
+            max_stride_time_s,
+            ..StrideSettings::default()
+        };
+        settings
+            .validate()
+            .map_err(|error| SceneError::Integrator {
+                scene: self.name().to_string(),
+                error,
+            })?;
+        self.check_convention(&walker)?;
         Ok(Setup {
             walker,
-            settings: StrideSettings {
-                integrator,
-                event_tolerance: EventTolerance::default(),
-                max_stride_time_s,
-            },
+            settings,
             guess: GaitGuess {
                 q: guess_q,
                 qd: guess_qd,
             },
         })
+    }
+
+    /// Checks the `[convention]` section against the built walker: a positive, finite time
+    /// scale, finite offsets, and finite coefficients of coordinates the walker has.
+    fn check_convention(&self, walker: &Walker) -> Result<(), SceneError> {
+        let Some(conv) = &self.file.convention else {
+            return Ok(());
+        };
+        let ts = self.num(&conv.time_scale_s, "convention.time_scale_s")?;
+        if ts <= 0.0 {
+            return Err(SceneError::Invalid(format!(
+                "convention.time_scale_s must be positive, got {ts}"
+            )));
+        }
+        for o in &conv.outputs {
+            self.opt(&o.offset, &format!("convention output `{}`.offset", o.name))?;
+            for (name, c) in &o.coefficients {
+                if walker.model.coord_index(name).is_none() {
+                    return Err(SceneError::Invalid(format!(
+                        "convention output `{}`: unknown coordinate `{name}`",
+                        o.name
+                    )));
+                }
+                if !c.is_finite() {
+                    return Err(SceneError::NonFinite {
+                        what: format!("convention output `{}`: coefficient of `{name}`", o.name),
+                        value: *c,
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Outputs in the publication's convention for a state (empty if the scene has none).

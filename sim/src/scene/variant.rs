@@ -14,8 +14,40 @@
 //! except `[parameters]`, which is merged entry by entry.
 
 use super::SceneError;
+use serde::Deserialize;
 use std::collections::BTreeSet;
 use toml::{Table, Value};
+
+/// A scene file's `[variant]` table. Unknown keys are rejected (a typo such as `wled` would
+/// otherwise leave the base walker unchanged).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariantDef {
+    /// The built-in scene this one derives from.
+    pub base: String,
+    /// Links whose joints become welds (their coordinates disappear).
+    #[serde(default)]
+    pub weld: Vec<String>,
+    /// Links removed, with everything hanging from them.
+    #[serde(default)]
+    pub remove: Vec<String>,
+}
+
+impl VariantDef {
+    /// The `[variant]` table of a scene file's table, if it has one.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] for a `[variant]` that is not a table of the fields above.
+    pub fn of(table: &Table) -> Result<Option<Self>, SceneError> {
+        let Some(v) = table.get("variant") else {
+            return Ok(None);
+        };
+        v.clone()
+            .try_into()
+            .map(Some)
+            .map_err(|e: toml::de::Error| invalid(format!("[variant]: {}", e.message())))
+    }
+}
 
 fn invalid(msg: String) -> SceneError {
     SceneError::Invalid(msg)
@@ -24,29 +56,9 @@ fn invalid(msg: String) -> SceneError {
 /// Resolves a variant table against its base table (already resolved).
 pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
     let mut out = base;
-    let spec = variant
-        .get("variant")
-        .and_then(Value::as_table)
-        .cloned()
+    let spec = VariantDef::of(&variant)?
         .ok_or_else(|| invalid("variant: missing [variant] table".into()))?;
-    let names = |key: &str| -> Result<Vec<String>, SceneError> {
-        match spec.get(key) {
-            None => Ok(Vec::new()),
-            Some(Value::Array(a)) => a
-                .iter()
-                .map(|v| {
-                    v.as_str()
-                        .map(String::from)
-                        .ok_or_else(|| invalid(format!("variant.{key}: expected strings")))
-                })
-                .collect(),
-            Some(_) => Err(invalid(format!(
-                "variant.{key}: expected an array of link names"
-            ))),
-        }
-    };
-    let weld = names("weld")?;
-    let remove = names("remove")?;
+    let (weld, remove) = (spec.weld, spec.remove);
     for (k, v) in variant {
         match k.as_str() {
             "variant" => {}

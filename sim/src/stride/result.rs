@@ -40,6 +40,12 @@ pub enum FailureKind {
     ImpactSingular,
     /// The relabelled state could not be matched to the model.
     RelabelFailed,
+    /// The stride took its step budget ([`super::StrideSettings::max_steps`]) of integrator
+    /// steps without ending.
+    StepBudgetExceeded,
+    /// The stride evaluated the equations of motion as often as its budget
+    /// ([`super::StrideSettings::max_evaluations`]) allows without ending.
+    EvaluationBudgetExceeded,
 }
 
 /// A failed stride.

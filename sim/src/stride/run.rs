@@ -89,6 +89,8 @@ struct Run<'w, 'r, 't> {
     schedule: ScheduleCursor<'r>,
     /// Evaluations of earlier phases (the integrator restarts after each impact).
     evaluations: usize,
+    /// Integrator steps taken so far (accepted or not), against the step budget.
+    steps: usize,
     phase: Phase<'w>,
     power: Power,
     contact: ContactSummary,
@@ -151,6 +153,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             integrator,
             schedule: ScheduleCursor::new(schedule),
             evaluations: 0,
+            steps: 0,
             phase,
             power: Power::new(&walker.model),
             contact: ContactSummary::default(),
@@ -182,6 +185,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                     ),
                 ));
             }
+            self.check_budgets()?;
             let drive_end_s = self.drive_end_s();
             let next = self.step(drive_end_s)?;
             let (next, w_cur, w_next) = self.grazing_check(next)?;
@@ -205,6 +209,34 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 Applied::Impact(name) => self.after_impact(name, at),
             }
         }
+    }
+
+    /// The stride's step and evaluation budgets: a stride that has used either up fails,
+    /// naming the budget, so that no stride loops forever (e.g. on steps that do not advance
+    /// time).
+    fn check_budgets(&self) -> Result<(), StrideFailure> {
+        let evaluations = self.evaluations + self.integrator.evaluations();
+        if self.steps >= self.settings.max_steps {
+            return Err(StrideFailure::new(
+                FailureKind::StepBudgetExceeded,
+                self.cur.t_s,
+                format!(
+                    "no heel strike within the step budget max_steps = {} ({} evaluations)",
+                    self.settings.max_steps, evaluations
+                ),
+            ));
+        }
+        if evaluations >= self.settings.max_evaluations {
+            return Err(StrideFailure::new(
+                FailureKind::EvaluationBudgetExceeded,
+                self.cur.t_s,
+                format!(
+                    "no heel strike within the evaluation budget max_evaluations = {} ({} steps)",
+                    self.settings.max_evaluations, self.steps
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// A control tick, when one is due: the controller sees the stance ankle and sets the
@@ -291,6 +323,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     /// One integrator step from `cur`, up to the next tick or breakpoint (replayed when the
     /// schedule says so).
     fn step(&mut self, drive_end_s: f64) -> Result<Sample, StrideFailure> {
+        self.steps += 1;
         let cur = &self.cur;
         let h_limit = (self.next_tick_s.min(drive_end_s) - cur.t_s).max(1e-12);
         let mut next = match self.schedule.replayed() {
