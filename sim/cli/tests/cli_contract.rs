@@ -126,7 +126,8 @@ fn walk_json_reports_steps_and_the_first_failure() {
     for s in ok["steps"].as_array().unwrap() {
         assert!(s["state_deviation"].as_f64().unwrap() < 1e-8);
     }
-    let bad = json(&walker(&[
+    // A walk that falls exits 3 (issue #14), its report unchanged.
+    let fell = walker(&[
         "walk",
         "--scene",
         "compass",
@@ -135,7 +136,9 @@ fn walk_json_reports_steps_and_the_first_failure() {
         "--perturb",
         "stance_leg_dot=0.6",
         "--json",
-    ]));
+    ]);
+    assert_eq!(fell.status.code(), Some(3));
+    let bad: Value = serde_json::from_slice(&fell.stdout).expect("valid json");
     assert_eq!(bad["steps_completed"], 0);
     assert_eq!(bad["failure"]["kind"], "fell_backward");
     assert_eq!(bad["failure"]["step"], 0);
