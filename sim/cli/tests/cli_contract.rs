@@ -20,6 +20,17 @@ fn json(out: &Output) -> Value {
     serde_json::from_slice(&out.stdout).expect("valid json")
 }
 
+/// The JSON of a run that exited with `code` (3: the walk fell).
+fn json_exiting(code: i32, out: &Output) -> Value {
+    assert_eq!(
+        out.status.code(),
+        Some(code),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid json")
+}
+
 #[test]
 fn bad_input_is_named_and_exits_2() {
     let cases: &[(&[&str], &str)] = &[
@@ -321,8 +332,9 @@ fn sil_takes_encoder_faults_and_names_a_bad_one() {
         );
     }
     // Two faults (the flag repeats): a glitch on the left ankle (rate fault the same tick) and
-    // a parity error on the right's encoder link (comms fault, detail 2).
-    let v = json(&walker(&[
+    // a parity error on the right's encoder link (comms fault, detail 2). The walker falls in
+    // its second step: exit code 3 (issue #14).
+    let v = json_exiting(3, &walker(&[
         "sil",
         "--scene",
         "wisse3d",

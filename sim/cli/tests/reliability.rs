@@ -79,8 +79,7 @@ fn a_realtime_factor_outside_its_range_is_refused() {
                 "wisse3d",
                 "--steps",
                 "1",
-                "--realtime",
-                factor,
+                &format!("--realtime={factor}"),
             ],
             2,
             &["--realtime"],
@@ -91,7 +90,8 @@ fn a_realtime_factor_outside_its_range_is_refused() {
 #[test]
 fn an_emergency_stop_time_that_is_not_a_time_is_refused() {
     // `--estop-at NaN` and `-1` were taken and stopped the walker at once, exit 0.
-    for t in ["NaN", "-1", "inf", "-inf"] {
+    // (`--estop-at=-inf`: clap reads a bare `-inf` as an option.)
+    for t in ["NaN", "-1", "inf", "-inf", "-1e-300"] {
         assert_refused(
             &[
                 "sil",
@@ -99,8 +99,7 @@ fn an_emergency_stop_time_that_is_not_a_time_is_refused() {
                 "wisse3d",
                 "--steps",
                 "1",
-                "--estop-at",
-                t,
+                &format!("--estop-at={t}"),
             ],
             2,
             &["--estop-at"],

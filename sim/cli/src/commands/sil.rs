@@ -36,7 +36,7 @@ pub struct SilArgs {
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
     /// Host emergency stop to every ankle at this walk time [s] (finite, not negative).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub estop_at: Option<f64>,
     /// Write the bus traffic as a candump log.
     #[arg(long, value_name = "FILE")]
@@ -46,7 +46,7 @@ pub struct SilArgs {
     pub socketcand: Option<String>,
     /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor; 0.001 to
     /// 1000); by default it runs as fast as it can.
-    #[arg(long, value_name = "FACTOR")]
+    #[arg(long, value_name = "FACTOR", allow_negative_numbers = true)]
     pub realtime: Option<f64>,
     /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
     /// figures use the last 10 and `steps_completed` counts every step. For long runs:
