@@ -79,8 +79,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            if e
-                .downcast_ref::<output::StdoutError>()
+            if e.downcast_ref::<output::StdoutError>()
                 .is_some_and(output::StdoutError::is_broken_pipe)
             {
                 return ExitCode::SUCCESS;

@@ -45,9 +45,7 @@ impl PathError {
 
 /// Writes text output with `print` into a buffered, locked standard output and flushes it;
 /// every error of `print` or of the flush comes back as a [`StdoutError`].
-pub fn text(
-    print: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), StdoutError> {
+pub fn text(print: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), StdoutError> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     print(&mut out).map_err(StdoutError)?;
     out.flush().map_err(StdoutError)

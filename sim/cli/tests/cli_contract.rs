@@ -334,18 +334,21 @@ fn sil_takes_encoder_faults_and_names_a_bad_one() {
     // Two faults (the flag repeats): a glitch on the left ankle (rate fault the same tick) and
     // a parity error on the right's encoder link (comms fault, detail 2). The walker falls in
     // its second step: exit code 3 (issue #14).
-    let v = json_exiting(3, &walker(&[
-        "sil",
-        "--scene",
-        "wisse3d",
-        "--steps",
-        "2",
-        "--sensor-fault",
-        "glitch:side=left,at_ms=300,delta_rad=0.1",
-        "--sensor-fault",
-        "parity:side=right,at_ms=400",
-        "--json",
-    ]));
+    let v = json_exiting(
+        3,
+        &walker(&[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "2",
+            "--sensor-fault",
+            "glitch:side=left,at_ms=300,delta_rad=0.1",
+            "--sensor-fault",
+            "parity:side=right,at_ms=400",
+            "--json",
+        ]),
+    );
     let faults = v["node_faults"].as_array().expect("node_faults");
     let raised = |side: &str, code: &str| {
         faults

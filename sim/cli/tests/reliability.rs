@@ -35,7 +35,8 @@ fn assert_refused(args: &[&str], code: i32, needles: &[&str]) {
 
 /// A fresh scratch folder for one test.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("walker-reliability-{name}-{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("walker-reliability-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -47,8 +48,17 @@ fn counts_that_would_allocate_without_bound_are_refused_before_any_work() {
     for points in ["18446744073709551615", "1000000000000", "10001", "1"] {
         assert_refused(
             &[
-                "sweep", "--scene", "compass", "--param", "slope_rad", "--from", "0.005", "--to",
-                "0.01", "--points", points,
+                "sweep",
+                "--scene",
+                "compass",
+                "--param",
+                "slope_rad",
+                "--from",
+                "0.005",
+                "--to",
+                "0.01",
+                "--points",
+                points,
             ],
             2,
             &["--points", points],
@@ -130,8 +140,19 @@ fn a_closed_pipe_ends_quietly_with_exit_0() {
         &["scenes", "--json"],
         &["gait", "--scene", "compass"],
         &["walk", "--scene", "compass", "--steps", "2"],
-        &["sweep", "--scene", "compass", "--param", "slope_rad", "--from", "0.005", "--to",
-          "0.01", "--points", "2"],
+        &[
+            "sweep",
+            "--scene",
+            "compass",
+            "--param",
+            "slope_rad",
+            "--from",
+            "0.005",
+            "--to",
+            "0.01",
+            "--points",
+            "2",
+        ],
     ] {
         let out = with_closed_stdout(args);
         assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
@@ -146,7 +167,11 @@ fn a_full_disk_on_standard_output_is_an_error_with_exit_1() {
         eprintln!("no /dev/full here: skipped");
         return;
     }
-    for args in [&["scenes"][..], &["scenes", "--json"], &["gait", "--scene", "compass"]] {
+    for args in [
+        &["scenes"][..],
+        &["scenes", "--json"],
+        &["gait", "--scene", "compass"],
+    ] {
         let out = Command::new(env!("CARGO_BIN_EXE_walker"))
             .args(args)
             .stdout(Stdio::from(std::fs::File::create(full).unwrap()))
@@ -154,7 +179,10 @@ fn a_full_disk_on_standard_output_is_an_error_with_exit_1() {
             .unwrap();
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.contains("standard output") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.contains("standard output") && !err.contains("panicked"),
+            "{err}"
+        );
     }
 }
 
@@ -203,7 +231,10 @@ fn tune_refuses_a_parameter_twice_and_no_evaluations_and_keeps_its_budget() {
         assert!(out.status.success(), "{}", stderr(&out));
         let v: Value = serde_json::from_slice(&out.stdout).unwrap();
         let done = v["history"].as_array().unwrap().len();
-        assert!(done <= n && done >= n.min(3), "--evaluations {n}: {done} gait searches");
+        assert!(
+            done <= n && done >= n.min(3),
+            "--evaluations {n}: {done} gait searches"
+        );
     }
 }
 
@@ -237,7 +268,10 @@ fn a_fault_on_an_identifier_no_node_sends_is_refused_naming_those_that_exist() {
     assert!(out.status.success(), "{}", stderr(&out));
     let help = walker(&["sil", "--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
-    assert!(help.contains("drop:id=0x022") && !help.contains("0x101"), "{help}");
+    assert!(
+        help.contains("drop:id=0x022") && !help.contains("0x101"),
+        "{help}"
+    );
 }
 
 #[test]
@@ -305,7 +339,9 @@ fn a_walk_that_falls_exits_3_with_its_report_unchanged() {
     assert_eq!(text.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&text.stdout).contains("failure: FellBackward"));
     assert_eq!(
-        walker(&["walk", "--scene", "compass", "--steps", "2"]).status.code(),
+        walker(&["walk", "--scene", "compass", "--steps", "2"])
+            .status
+            .code(),
         Some(0)
     );
     // The firmware walk stopped by an emergency stop falls.

@@ -244,7 +244,10 @@ mod tests {
             .with_fault_str("drop:id=0x101,count=5")
             .unwrap_err();
         let text = e.to_string();
-        assert!(matches!(e, BusFaultError::UnknownId { id: 0x101, .. }), "{e}");
+        assert!(
+            matches!(e, BusFaultError::UnknownId { id: 0x101, .. }),
+            "{e}"
+        );
         assert!(text.contains("0x101"), "{text}");
         assert!(text.contains("0x022 HeelStrike LEFT_ANKLE"), "{text}");
         assert!(text.contains("0x04F Command ALL"), "{text}");
@@ -261,14 +264,19 @@ mod tests {
             .expect("valid faults");
         assert_eq!(c.bus_faults.len(), 5);
         // A parse error still names the offending part.
-        let e = SilConfig::default().with_fault_str("drop:idx=5").unwrap_err();
+        let e = SilConfig::default()
+            .with_fault_str("drop:idx=5")
+            .unwrap_err();
         assert!(e.to_string().contains("idx"), "{e}");
     }
 
     #[test]
     fn the_identifier_table_is_the_protocol_table() {
         let ids = protocol_ids();
-        let n: usize = protocol::MESSAGES.iter().map(|m| m.node_fields().count()).sum();
+        let n: usize = protocol::MESSAGES
+            .iter()
+            .map(|m| m.node_fields().count())
+            .sum();
         assert_eq!(ids.len(), n);
         assert!(ids.windows(2).all(|w| w[0].0 < w[1].0), "{ids:?}");
         for (id, _) in &ids {

@@ -76,11 +76,9 @@ fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
                 "{:>14.6} {:>10.6} {:>8}",
                 g.value, g.max_abs_eigenvalue, g.stable
             )?,
-            SweepPointRecord::Failed(e) => writeln!(
-                out,
-                "{:>14.6} {:>10} {:>8}  {}",
-                e.value, "-", "-", e.error
-            )?,
+            SweepPointRecord::Failed(e) => {
+                writeln!(out, "{:>14.6} {:>10} {:>8}  {}", e.value, "-", "-", e.error)?
+            }
         }
     }
     for b in &r.stability_boundaries {

@@ -57,10 +57,7 @@ pub fn read_start_state(
     // refused instead of filling memory.
     let mut text = String::new();
     std::fs::File::open(path)
-        .and_then(|f| {
-            f.take(MAX_START_STATE_BYTES + 1)
-                .read_to_string(&mut text)
-        })
+        .and_then(|f| f.take(MAX_START_STATE_BYTES + 1).read_to_string(&mut text))
         .map_err(|e| bad(e.to_string()))?;
     if text.len() as u64 > MAX_START_STATE_BYTES {
         return Err(bad(format!(
@@ -98,10 +95,7 @@ pub fn parse_start_state(text: &str, names: &[String]) -> Result<Vec<(usize, f64
             if from_gait {
                 continue;
             }
-            return Err(format!(
-                "unknown entry `{k}` (known: {})",
-                names.join(", ")
-            ));
+            return Err(format!("unknown entry `{k}` (known: {})", names.join(", ")));
         };
         let x = x
             .as_f64()
@@ -209,8 +203,8 @@ mod tests {
 
     #[test]
     fn a_key_given_twice_is_named_not_silently_overwritten() {
-        let e = parse_start_state(r#"{"stance_leg": 0.1, "stance_leg": 0.2}"#, &names())
-            .unwrap_err();
+        let e =
+            parse_start_state(r#"{"stance_leg": 0.1, "stance_leg": 0.2}"#, &names()).unwrap_err();
         assert!(e.contains("duplicate key `stance_leg`"), "{e}");
         // Also inside a gait output's `fixed_point`, and in any nested object.
         let e = parse_start_state(
@@ -252,7 +246,8 @@ mod tests {
         ];
         leaf.prop_recursive(4, 48, 6, move |inner| {
             prop_oneof![
-                prop::collection::vec(inner.clone(), 0..6).prop_map(|v| format!("[{}]", v.join(","))),
+                prop::collection::vec(inner.clone(), 0..6)
+                    .prop_map(|v| format!("[{}]", v.join(","))),
                 prop::collection::vec((key.clone(), inner), 0..6).prop_map(|v| {
                     let parts: Vec<String> = v
                         .into_iter()
