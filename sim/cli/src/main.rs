@@ -40,6 +40,7 @@ enum Command {
     /// Find the periodic gait of a scene and its stability.
     Gait(gait::GaitArgs),
     /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
+    #[command(after_help = WALK_EXIT_CODES)]
     Walk(walk::WalkArgs),
     /// Continuation: follow the gait while one parameter changes.
     Sweep(sweep::SweepArgs),
@@ -50,6 +51,7 @@ enum Command {
     Accuracy(accuracy::AccuracyArgs),
     /// Software in the loop: the ankle firmware (two nodes on a simulated CAN bus) actuates
     /// the walker; compared with the ideal-actuator gait.
+    #[command(after_help = WALK_EXIT_CODES)]
     Sil(sil::SilArgs),
     /// List the scenes and their parameters.
     Scenes {
@@ -58,6 +60,11 @@ enum Command {
         json: bool,
     },
 }
+
+/// The exit codes of a walk, as `walker walk --help` and `walker sil --help` state them.
+const WALK_EXIT_CODES: &str = "Exit codes: 0 every step walked; 1 no gait to start from, or an \
+                               error writing output; 2 bad input; 3 the walker fell before the \
+                               last step (the report's `failure` says how; the JSON is the same).";
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {

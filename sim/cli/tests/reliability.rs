@@ -79,6 +79,25 @@ fn counts_that_would_allocate_without_bound_are_refused_before_any_work() {
 }
 
 #[test]
+fn keeping_more_step_summaries_than_exist_keeps_them_all() {
+    // `--keep-steps 18446744073709551615` overflowed `2 * keep` in the walk (a panic in a
+    // debug build).
+    let out = walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "2",
+        "--keep-steps",
+        "18446744073709551615",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["steps"].as_array().unwrap().len(), 2);
+}
+
+#[test]
 fn a_realtime_factor_outside_its_range_is_refused() {
     // `--realtime 1e-300` panicked in `Duration::from_secs_f64`.
     for factor in ["1e-300", "0", "-1", "NaN", "inf", "1e9"] {
@@ -360,6 +379,11 @@ fn a_walk_that_falls_exits_3_with_its_report_unchanged() {
     assert!(v["failure"].is_object(), "{v}");
     let help = walker(&["--help"]);
     assert!(String::from_utf8_lossy(&help.stdout).contains("3 the walk"));
+    for command in ["walk", "sil"] {
+        let help = walker(&[command, "--help"]);
+        let help = String::from_utf8_lossy(&help.stdout);
+        assert!(help.contains("3 the walker fell"), "{command}: {help}");
+    }
 }
 
 #[test]

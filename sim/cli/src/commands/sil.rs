@@ -178,10 +178,11 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         ));
     }
     let (q, qd) = walker.unpack(&ideal.fixed_point);
-    // The gait figures average the last 10 steps: keep at least those.
+    // The gait figures average the last 10 steps: keep at least those; keeping more than
+    // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
     let options = sim::walk::WalkOptions {
         record: false,
-        keep_steps: keep_steps.map(|n| n.max(10)),
+        keep_steps: keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
     let walk = match realtime {
         None => sim::walk::walk(
