@@ -104,7 +104,9 @@ pub trait AnkleController {
 }
 
 /// Wraps a controller so that walk time keeps pace with wall-clock time (times `factor`): each
-/// tick sleeps until its walk time is due. For watching a simulation live.
+/// tick sleeps until its walk time is due. For watching a simulation live. A factor whose
+/// waits are not representable durations (0, NaN, 1e-300) does not pace (and does not panic);
+/// callers validate the factor (`walker sil --realtime` takes 0.001 to 1000).
 pub struct Paced<'a> {
     inner: &'a mut dyn AnkleController,
     factor: f64,
@@ -127,10 +129,15 @@ impl AnkleController for Paced<'_> {
         self.inner.period_s()
     }
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
-        let due = std::time::Duration::from_secs_f64((sensing.t_walk_s / self.factor).max(0.0));
-        let elapsed = self.start.elapsed();
-        if due > elapsed {
-            std::thread::sleep(due - elapsed);
+        // A due time that is no duration (a factor of 0 or NaN, or one so small that the wait
+        // overflows) is not waited for: pacing never panics.
+        if let Ok(due) =
+            std::time::Duration::try_from_secs_f64((sensing.t_walk_s / self.factor).max(0.0))
+        {
+            let elapsed = self.start.elapsed();
+            if due > elapsed {
+                std::thread::sleep(due - elapsed);
+            }
         }
         self.inner.tick(sensing)
     }
@@ -210,6 +217,44 @@ impl AnkleController for SampledReflex {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Holds the limit at 0, counting its ticks.
+    struct Counting(usize);
+
+    impl AnkleController for Counting {
+        fn period_s(&self) -> f64 {
+            1e-3
+        }
+        fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
+            self.0 += 1;
+            Ok(ActuatorSegment::hold(
+                sensing.t_walk_s,
+                sensing.t_walk_s + 1e-3,
+                0.0,
+            ))
+        }
+        fn heel_strike(&mut self, _t_walk_s: f64) {}
+    }
+
+    #[test]
+    fn pacing_by_a_factor_whose_wait_is_no_duration_neither_panics_nor_waits() {
+        // `walker sil --realtime 1e-300` panicked in `Duration::from_secs_f64`.
+        for factor in [1e-300, 0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let mut inner = Counting(0);
+            let mut paced = Paced::new(&mut inner, factor, std::time::Instant::now());
+            let sensing = AnkleSensing {
+                t_walk_s: 1.0,
+                stance_ankle_rad: 0.0,
+                stance_ankle_rate_rad_s: 0.0,
+                stance_foot_on_floor: true,
+                swing_foot_on_floor: false,
+                string_engaged: false,
+                string_torque_n_m: 0.0,
+            };
+            assert!(paced.tick(&sensing).is_ok(), "{factor}");
+            assert_eq!(inner.0, 1, "{factor}");
+        }
+    }
 
     #[test]
     fn segment_is_a_c1_cubic_with_consistent_derivatives() {

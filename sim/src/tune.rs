@@ -64,6 +64,11 @@ pub fn tune(
     let mut warm: Option<DVector<f64>> = None;
     let mut history: Vec<TunePoint> = Vec::new();
     let mut eval = |x: &[f64], history: &mut Vec<TunePoint>| -> Result<f64, SceneError> {
+        // The budget holds per gait search: a simplex step may want several searches, and
+        // those beyond `evaluations` are not run (the loop below then stops).
+        if history.len() >= evaluations {
+            return Ok(f64::INFINITY);
+        }
         let clamped: Vec<f64> = x
             .iter()
             .zip(params)

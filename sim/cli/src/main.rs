@@ -1,13 +1,17 @@
 //! `walker`: find gaits, walk, sweep parameters, list scenes.
 //!
 //! Bad input (unknown scene, unknown or ill-typed parameter, non-physical value) exits with
-//! code 2 and a message naming the problem; a gait that cannot be found exits with code 1.
-//! Each subcommand lives in its own module under [`commands`].
+//! code 2 and a message naming the problem; a gait that cannot be found exits with code 1; a
+//! walk (`walk`, `sil`) that ended early because the walker fell exits with code 3. A closed
+//! pipe on standard output ends the command quietly with code 0, any other write error with
+//! code 1 and a message. Each subcommand lives in its own module under [`commands`].
 
 mod commands;
 mod figures;
 mod input_error;
+mod limits;
 mod options;
+mod output;
 mod plot;
 
 use anyhow::Result;
@@ -21,7 +25,10 @@ use std::process::ExitCode;
 #[command(
     name = "walker",
     version,
-    about = "Passive dynamic walker simulator (Wisse, Schwab & van der Linde 2001)"
+    about = "Passive dynamic walker simulator (Wisse, Schwab & van der Linde 2001)",
+    after_help = "Exit codes: 0 success; 1 no gait found, or an error writing output; 2 bad input; \
+                  3 the walk (`walk`, `sil`) ended early: the walker fell (the JSON's `failure` \
+                  says how)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -33,6 +40,7 @@ enum Command {
     /// Find the periodic gait of a scene and its stability.
     Gait(gait::GaitArgs),
     /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
+    #[command(after_help = WALK_EXIT_CODES)]
     Walk(walk::WalkArgs),
     /// Continuation: follow the gait while one parameter changes.
     Sweep(sweep::SweepArgs),
@@ -43,6 +51,7 @@ enum Command {
     Accuracy(accuracy::AccuracyArgs),
     /// Software in the loop: the ankle firmware (two nodes on a simulated CAN bus) actuates
     /// the walker; compared with the ideal-actuator gait.
+    #[command(after_help = WALK_EXIT_CODES)]
     Sil(sil::SilArgs),
     /// List the scenes and their parameters.
     Scenes {
@@ -51,6 +60,11 @@ enum Command {
         json: bool,
     },
 }
+
+/// The exit codes of a walk, as `walker walk --help` and `walker sil --help` state them.
+const WALK_EXIT_CODES: &str = "Exit codes: 0 every step walked; 1 no gait to start from, or an \
+                               error writing output; 2 bad input; 3 the walker fell before the \
+                               last step (the report's `failure` says how; the JSON is the same).";
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -65,13 +79,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
 }
 
 /// Exit codes: 0 on success, 2 for bad input, 1 for any other error (and for a command's own
-/// "nothing found", which it returns itself).
+/// "nothing found", which it returns itself), 3 for a walk that ended early (returned by
+/// `walk` and `sil` themselves). A broken pipe on standard output is a quiet success.
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e}");
+            if e.downcast_ref::<output::StdoutError>()
+                .is_some_and(output::StdoutError::is_broken_pipe)
+            {
+                return ExitCode::SUCCESS;
+            }
+            output::note(format_args!("error: {e}"));
             if e.downcast_ref::<InputError>().is_some() || e.downcast_ref::<SceneError>().is_some()
             {
                 ExitCode::from(2)

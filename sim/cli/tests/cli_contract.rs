@@ -20,6 +20,17 @@ fn json(out: &Output) -> Value {
     serde_json::from_slice(&out.stdout).expect("valid json")
 }
 
+/// The JSON of a run that exited with `code` (3: the walk fell).
+fn json_exiting(code: i32, out: &Output) -> Value {
+    assert_eq!(
+        out.status.code(),
+        Some(code),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid json")
+}
+
 #[test]
 fn bad_input_is_named_and_exits_2() {
     let cases: &[(&[&str], &str)] = &[
@@ -126,7 +137,8 @@ fn walk_json_reports_steps_and_the_first_failure() {
     for s in ok["steps"].as_array().unwrap() {
         assert!(s["state_deviation"].as_f64().unwrap() < 1e-8);
     }
-    let bad = json(&walker(&[
+    // A walk that falls exits 3 (issue #14), its report unchanged.
+    let fell = walker(&[
         "walk",
         "--scene",
         "compass",
@@ -135,7 +147,9 @@ fn walk_json_reports_steps_and_the_first_failure() {
         "--perturb",
         "stance_leg_dot=0.6",
         "--json",
-    ]));
+    ]);
+    assert_eq!(fell.status.code(), Some(3));
+    let bad: Value = serde_json::from_slice(&fell.stdout).expect("valid json");
     assert_eq!(bad["steps_completed"], 0);
     assert_eq!(bad["failure"]["kind"], "fell_backward");
     assert_eq!(bad["failure"]["step"], 0);
@@ -318,19 +332,23 @@ fn sil_takes_encoder_faults_and_names_a_bad_one() {
         );
     }
     // Two faults (the flag repeats): a glitch on the left ankle (rate fault the same tick) and
-    // a parity error on the right's encoder link (comms fault, detail 2).
-    let v = json(&walker(&[
-        "sil",
-        "--scene",
-        "wisse3d",
-        "--steps",
-        "2",
-        "--sensor-fault",
-        "glitch:side=left,at_ms=300,delta_rad=0.1",
-        "--sensor-fault",
-        "parity:side=right,at_ms=400",
-        "--json",
-    ]));
+    // a parity error on the right's encoder link (comms fault, detail 2). The walker falls in
+    // its second step: exit code 3 (issue #14).
+    let v = json_exiting(
+        3,
+        &walker(&[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "2",
+            "--sensor-fault",
+            "glitch:side=left,at_ms=300,delta_rad=0.1",
+            "--sensor-fault",
+            "parity:side=right,at_ms=400",
+            "--json",
+        ]),
+    );
     let faults = v["node_faults"].as_array().expect("node_faults");
     let raised = |side: &str, code: &str| {
         faults

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use canbus::{BusConfig, FaultSpec};
+use canbus::{BusConfig, FaultKind, FaultSpec};
 use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 
 use crate::actuator::ActuatorParams;
@@ -18,6 +18,49 @@ pub struct HostCommand {
     pub at_s: f64,
     /// What.
     pub command: protocol::Command,
+}
+
+/// Why a bus fault was refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BusFaultError {
+    /// Its text form does not parse.
+    #[error(transparent)]
+    Parse(#[from] canbus::FaultParseError),
+    /// Its filter names an identifier no node of the walker's bus sends.
+    #[error(
+        "no node sends identifier 0x{id:03X}, so the fault would never apply (identifiers on \
+         the bus: {known})"
+    )]
+    UnknownId {
+        /// The offending identifier.
+        id: u16,
+        /// The identifiers of the protocol's message table, each with its message and node.
+        known: String,
+    },
+}
+
+/// Every identifier the walker's bus carries, ascending, with its message and node
+/// (`HeelStrike LEFT_ANKLE`), from the protocol's message table
+/// ([`protocol::MESSAGES`]).
+pub fn protocol_ids() -> Vec<(u16, String)> {
+    let mut ids: Vec<(u16, String)> = protocol::MESSAGES
+        .iter()
+        .flat_map(|m| {
+            m.node_fields().map(move |node| {
+                let id = protocol::CanId::new(m.class, node).raw();
+                let who = match m.direction {
+                    protocol::signal::Direction::FromNode(_) => m.sender_name(node),
+                    protocol::signal::Direction::ToNode(targets) => targets
+                        .iter()
+                        .find(|t| t.raw() == node)
+                        .map_or("?", |t| t.dbc_name()),
+                };
+                (id, format!("{} {who}", m.name))
+            })
+        })
+        .collect();
+    ids.sort();
+    ids
 }
 
 /// Everything a [`crate::FirmwareInTheLoop`] run needs.
@@ -97,9 +140,38 @@ impl SilConfig {
     /// Add a bus fault from its text form (`drop:id=0x022`, `busoff:node=right,from_ms=500`).
     ///
     /// # Errors
-    /// The parse error, naming the offending part.
-    pub fn with_fault_str(mut self, spec: &str) -> Result<Self, canbus::FaultParseError> {
-        self.bus_faults.push(spec.parse()?);
+    /// [`BusFaultError::Parse`], naming the offending part; [`BusFaultError::UnknownId`] as
+    /// for [`SilConfig::with_fault`].
+    pub fn with_fault_str(self, spec: &str) -> Result<Self, BusFaultError> {
+        self.with_fault(spec.parse()?)
+    }
+
+    /// Add a bus fault.
+    ///
+    /// # Errors
+    /// [`BusFaultError::UnknownId`] when a `drop`, `delay` or `corrupt` filter names an
+    /// identifier no node of the walker's bus sends (it would never apply); the error lists
+    /// those that exist. A babbler's own identifier may be any.
+    pub fn with_fault(mut self, fault: FaultSpec) -> Result<Self, BusFaultError> {
+        let filter = match &fault.kind {
+            FaultKind::Drop { filter, .. }
+            | FaultKind::Delay { filter, .. }
+            | FaultKind::Corrupt { filter, .. } => Some(filter),
+            FaultKind::Babble { .. } | FaultKind::BusOff { .. } => None,
+        };
+        if let Some(id) = filter.and_then(|f| f.id) {
+            if !protocol_ids().iter().any(|(known, _)| *known == id) {
+                return Err(BusFaultError::UnknownId {
+                    id,
+                    known: protocol_ids()
+                        .iter()
+                        .map(|(id, name)| format!("0x{id:03X} {name}"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                });
+            }
+        }
+        self.bus_faults.push(fault);
         Ok(self)
     }
 
@@ -157,5 +229,58 @@ impl SilConfig {
     /// The parse error, naming the offending part.
     pub fn with_sensor_fault_str(self, spec: &str) -> Result<Self, SensorFaultParseError> {
         Ok(self.with_sensor_fault(spec.parse()?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+
+    #[test]
+    fn a_fault_on_an_identifier_no_node_sends_is_refused_naming_those_that_exist() {
+        // 0x101 was the documented example; no message of the protocol uses it.
+        let e = SilConfig::default()
+            .with_fault_str("drop:id=0x101,count=5")
+            .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            matches!(e, BusFaultError::UnknownId { id: 0x101, .. }),
+            "{e}"
+        );
+        assert!(text.contains("0x101"), "{text}");
+        assert!(text.contains("0x022 HeelStrike LEFT_ANKLE"), "{text}");
+        assert!(text.contains("0x04F Command ALL"), "{text}");
+        for spec in ["delay:id=0x2A0,ms=20", "corrupt:id=0x000"] {
+            assert!(SilConfig::default().with_fault_str(spec).is_err(), "{spec}");
+        }
+        // Real identifiers, faults without an identifier filter and any babbler are taken.
+        let c = SilConfig::default()
+            .with_fault_str("drop:id=0x022,count=5")
+            .and_then(|c| c.with_fault_str("delay:id=0x072,ms=20"))
+            .and_then(|c| c.with_fault_str("corrupt:prob=0.01"))
+            .and_then(|c| c.with_fault_str("babble:node=3,id=0x7FF"))
+            .and_then(|c| c.with_fault_str("busoff:node=left"))
+            .expect("valid faults");
+        assert_eq!(c.bus_faults.len(), 5);
+        // A parse error still names the offending part.
+        let e = SilConfig::default()
+            .with_fault_str("drop:idx=5")
+            .unwrap_err();
+        assert!(e.to_string().contains("idx"), "{e}");
+    }
+
+    #[test]
+    fn the_identifier_table_is_the_protocol_table() {
+        let ids = protocol_ids();
+        let n: usize = protocol::MESSAGES
+            .iter()
+            .map(|m| m.node_fields().count())
+            .sum();
+        assert_eq!(ids.len(), n);
+        assert!(ids.windows(2).all(|w| w[0].0 < w[1].0), "{ids:?}");
+        for (id, _) in &ids {
+            assert!(protocol::CanId::from_raw(*id).is_ok(), "0x{id:03X}");
+        }
     }
 }

@@ -3,6 +3,7 @@
 use super::print_json;
 use crate::figures;
 use crate::options::Common;
+use crate::output;
 use anyhow::Result;
 use clap::Args;
 use sim::accuracy;
@@ -27,6 +28,10 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     let AccuracyArgs { common, out } = args;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
+    // The output folder before the study: a path that cannot be used fails at once.
+    if let Some(dir) = &out {
+        output::create_dir("--out", dir)?;
+    }
     let reference = IntegratorChoice::Dopri5 {
         rtol: 1e-13,
         atol: 1e-13,
@@ -36,7 +41,7 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
         match setup.find_gait(&common.newton()) {
             Ok(g) => g.stride.duration_s,
             Err(e) => {
-                eprintln!("error: no gait: {e}");
+                output::note(format_args!("error: no gait: {e}"));
                 return Ok(ExitCode::from(1));
             }
         }
@@ -45,7 +50,7 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     let study = match accuracy::study(&setup, reference, &settings, &common.newton()) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: no reference gait: {e}");
+            output::note(format_args!("error: no reference gait: {e}"));
             return Ok(ExitCode::from(1));
         }
     };
@@ -53,11 +58,10 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     if common.json {
         print_json(&study)?;
     } else {
-        print!("{table}");
+        output::text(|out| out.write_all(table.as_bytes()))?;
     }
     if let Some(dir) = out {
-        std::fs::create_dir_all(&dir)?;
-        std::fs::write(dir.join("accuracy.md"), &table)?;
+        output::write_file("--out", &dir.join("accuracy.md"), &table)?;
         let panels: [(&str, &str, ErrorOf); 3] = [
             ("fixed_point_error.svg", "fixed-point error [-]", |p| {
                 p.fixed_point_error
@@ -73,7 +77,7 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
         ];
         for (file, what, f) in panels {
             let plot = figures::accuracy(&study, f, what);
-            std::fs::write(dir.join(file), plot.to_svg(720.0, 480.0))?;
+            output::write_file("--out", &dir.join(file), &plot.to_svg(720.0, 480.0))?;
         }
     }
     Ok(ExitCode::SUCCESS)

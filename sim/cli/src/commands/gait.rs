@@ -3,10 +3,12 @@
 use super::{print_json, shown};
 use crate::figures;
 use crate::options::Common;
+use crate::output;
 use anyhow::Result;
 use clap::Args;
 use sim::report::{GaitOutcome, GaitReport};
 use sim::stride::{StrideOptions, StrideRequest};
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Options of `walker gait`.
@@ -24,6 +26,10 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     let GaitArgs { common, plot } = args;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
+    // The figures' folder before the gait search: a path that cannot be used fails at once.
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
     let walker = &setup.walker;
     let result = setup.find_gait(&common.newton());
     // The report's contact figures: one more stride from the fixed point, with contact on.
@@ -49,14 +55,17 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
         contact.as_ref(),
     );
     if let (Some(dir), Ok(g)) = (&plot, &result) {
-        std::fs::create_dir_all(dir)?;
         let name = scene.name();
         let eig = figures::eigenvalues(
             walker,
             g,
             &format!("{name}: eigenvalues of the stride Jacobian"),
         );
-        std::fs::write(dir.join("eigenvalues.svg"), eig.to_svg(640.0, 600.0))?;
+        output::write_file(
+            "--plot",
+            &dir.join("eigenvalues.svg"),
+            &eig.to_svg(640.0, 600.0),
+        )?;
         // The joint-angle figure's samples: the stride from the fixed point, recorded.
         let (q, qd) = walker.unpack(&g.fixed_point);
         let samples = walker
@@ -75,12 +84,16 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
             &samples,
             &format!("{name}: joint angles over one step"),
         );
-        std::fs::write(dir.join("joint_angles.svg"), ang.to_svg(820.0, 480.0))?;
+        output::write_file(
+            "--plot",
+            &dir.join("joint_angles.svg"),
+            &ang.to_svg(820.0, 480.0),
+        )?;
     }
     if common.json {
         print_json(&report)?;
     } else {
-        print_text(&report);
+        output::text(|out| print_text(out, &report))?;
     }
     Ok(if result.is_ok() {
         ExitCode::SUCCESS
@@ -89,25 +102,29 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     })
 }
 
-fn print_text(r: &GaitReport) {
-    println!("scene: {}", r.scene);
+fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
+    writeln!(out, "scene: {}", r.scene)?;
     let g = match &r.outcome {
         GaitOutcome::NotFound(e) => {
-            println!("no gait found: {}", e.error);
-            return;
+            return writeln!(out, "no gait found: {}", e.error);
         }
         GaitOutcome::Found(g) => g,
     };
-    println!("fixed point (just after heel strike):");
+    writeln!(out, "fixed point (just after heel strike):")?;
     for (k, v) in &g.fixed_point.0 {
-        println!("    {k:<28} {:>20.12}", shown(*v));
+        writeln!(out, "    {k:<28} {:>20.12}", shown(*v))?;
     }
-    println!("eigenvalues of the stride Jacobian:");
+    writeln!(out, "eigenvalues of the stride Jacobian:")?;
     for [re, im] in &g.eigenvalues {
         let (re, im) = (shown(*re), shown(*im));
-        println!("    {re:>14.8} {im:>+14.8}i   |λ| = {:.8}", re.hypot(im));
+        writeln!(
+            out,
+            "    {re:>14.8} {im:>+14.8}i   |λ| = {:.8}",
+            re.hypot(im)
+        )?;
     }
-    println!(
+    writeln!(
+        out,
         "max |λ| = {:.8} ({}), period {:.6} s, step {:.6} m, speed {:.6} m/s, {} Newton iterations",
         shown(g.max_abs_eigenvalue),
         if g.stable { "stable" } else { "unstable" },
@@ -115,5 +132,5 @@ fn print_text(r: &GaitReport) {
         shown(g.step_length_m),
         shown(g.speed_m_s),
         g.newton_iterations,
-    );
+    )
 }

@@ -9,19 +9,35 @@ pub mod sweep;
 pub mod tune;
 pub mod walk;
 
+use crate::output;
 use anyhow::Result;
 use serde::Serialize;
-use std::io::Write;
+use std::process::ExitCode;
 
 /// Prints a report as pretty JSON on stdout, every object key-sorted
-/// ([`sim::report::to_json`]).
+/// ([`sim::report::to_json`]); a write error is an [`output::StdoutError`].
 pub fn print_json<T: Serialize + ?Sized>(report: &T) -> Result<()> {
     let value = sim::report::to_json(report)?;
-    let mut out = std::io::stdout().lock();
-    serde_json::to_writer_pretty(&mut out, &value)?;
-    writeln!(out)?;
+    output::text(|out| {
+        // serde_json hands an I/O error back unchanged through this conversion.
+        serde_json::to_writer_pretty(&mut *out, &value).map_err(std::io::Error::from)?;
+        writeln!(out)
+    })?;
     Ok(())
 }
+
+/// The exit code of a walk (`walk`, `sil`): 0 if it completed every step, 3 if it ended early
+/// because the walker fell (its report's `failure`).
+pub fn walk_exit_code(walk: &sim::walk::Walk) -> ExitCode {
+    if walk.failure.is_some() {
+        ExitCode::from(FELL)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Exit code of a walk that ended early: the walker fell.
+pub const FELL: u8 = 3;
 
 /// A number as the text output shows it: JSON has no non-finite numbers, so a value the JSON
 /// writes as `null` reads back (and prints) as NaN.

@@ -1,9 +1,11 @@
 //! `walker sil`: software in the loop. The ankle firmware (two nodes on a simulated CAN bus)
 //! actuates the walker; its gait is compared with the ideal-actuator gait.
 
-use super::{print_json, shown};
+use super::{print_json, shown, walk_exit_code};
 use crate::input_error::InputError;
+use crate::limits;
 use crate::options::Common;
+use crate::output::{self, PathError};
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
@@ -12,6 +14,7 @@ use sim::report::{IdealGaitRecord, WalkGaitRecord};
 use sim::scene::Setup;
 use sim::walk::{StepSummary, WalkFailure, WalkRequest};
 use std::collections::BTreeMap;
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Options of `walker sil`.
@@ -19,10 +22,12 @@ use std::process::ExitCode;
 pub struct SilArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Number of steps.
+    /// Number of steps (at most 100,000).
     #[arg(long)]
     pub steps: usize,
-    /// A bus fault, e.g. `drop:id=0x101,count=5` (repeatable; docs/canbus.md).
+    /// A bus fault, e.g. `drop:id=0x022,count=5` (the left ankle's heel strikes; repeatable;
+    /// docs/canbus.md). A `drop`, `delay` or `corrupt` filter must name an identifier a node
+    /// sends (heel strike 0x022/0x023, heartbeat 0x061-0x063, ankle state 0x072/0x073, ...).
     #[arg(long = "fault", value_name = "SPEC")]
     pub faults: Vec<String>,
     /// An encoder fault (repeatable; docs/sil.md):
@@ -30,8 +35,8 @@ pub struct SilArgs {
     /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
-    /// Host emergency stop to every ankle at this walk time [s].
-    #[arg(long, value_name = "SECONDS")]
+    /// Host emergency stop to every ankle at this walk time [s] (finite, not negative).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub estop_at: Option<f64>,
     /// Write the bus traffic as a candump log.
     #[arg(long, value_name = "FILE")]
@@ -39,9 +44,9 @@ pub struct SilArgs {
     /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
     #[arg(long, value_name = "ADDR")]
     pub socketcand: Option<String>,
-    /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor); by
-    /// default it runs as fast as it can.
-    #[arg(long, value_name = "FACTOR")]
+    /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor; 0.001 to
+    /// 1000); by default it runs as fast as it can.
+    #[arg(long, value_name = "FACTOR", allow_negative_numbers = true)]
     pub realtime: Option<f64>,
     /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
     /// figures use the last 10 and `steps_completed` counts every step. For long runs:
@@ -80,7 +85,8 @@ struct SilWalkReport<'a, Bus: Serialize> {
     steps: &'a [StepSummary],
 }
 
-/// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from.
+/// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
+/// walker fell (the report's `failure`).
 pub fn run(args: SilArgs) -> Result<ExitCode> {
     let SilArgs {
         common,
@@ -93,6 +99,18 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         realtime,
         keep_steps,
     } = args;
+    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
+    if let Some(t) = estop_at {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(InputError::Other(format!(
+                "--estop-at must be a finite walk time of 0 s or more, got {t}"
+            ))
+            .into());
+        }
+    }
+    if let Some(r) = realtime {
+        limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
+    }
     let scene = common.scene()?;
     let Setup {
         walker,
@@ -130,12 +148,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             .into());
         }
     }
-    if let Some(r) = realtime {
-        if !(r.is_finite() && r > 0.0) {
-            return Err(InputError::Other(format!("--realtime must be positive, got {r}")).into());
-        }
-    }
-    config.candump = candump;
+    config.candump = candump.clone();
     config.socketcand = socketcand;
     // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
     // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
@@ -145,7 +158,9 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     let ideal = match ideal_setup.find_gait(&common.newton()) {
         Ok(g) => g,
         Err(e) => {
-            eprintln!("error: no ideal-actuator gait to start from: {e}");
+            output::note(format_args!(
+                "error: no ideal-actuator gait to start from: {e}"
+            ));
             return Ok(ExitCode::from(1));
         }
     };
@@ -153,19 +168,21 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         stride_settings.integrator = sil::SIL_INTEGRATOR;
     }
     // Its errors are about the configuration given (fault nodes, log path, address).
-    let mut ctl = sil::FirmwareInTheLoop::new(config)
-        .map_err(|e| InputError::Other(format!("software in the loop: {e}")))?;
+    let mut ctl = sil::FirmwareInTheLoop::new(config).map_err(|e| candump_error(&candump, e))?;
     if let Some(t) = estop_at {
         ctl.emergency_stop_at(t);
     }
     if let Some(addr) = ctl.socketcand_addr() {
-        eprintln!("socketcand: serving the bus on {addr} (channel vcan0)");
+        output::note(format_args!(
+            "socketcand: serving the bus on {addr} (channel vcan0)"
+        ));
     }
     let (q, qd) = walker.unpack(&ideal.fixed_point);
-    // The gait figures average the last 10 steps: keep at least those.
+    // The gait figures average the last 10 steps: keep at least those; keeping more than
+    // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
     let options = sim::walk::WalkOptions {
         record: false,
-        keep_steps: keep_steps.map(|n| n.max(10)),
+        keep_steps: keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
     let walk = match realtime {
         None => sim::walk::walk(
@@ -192,9 +209,11 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     };
     let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
     let steps_kept = &walk.steps[walk.steps.len() - kept..];
-    let firmware = ctl
-        .finish()
-        .map_err(|e| anyhow::anyhow!("software in the loop: {e}"))?;
+    let firmware = ctl.finish().map_err(|e| match candump_error(&candump, e) {
+        // Only the log's flush can fail here: not bad input.
+        InputError::Other(m) => anyhow::anyhow!(m),
+        other => anyhow::Error::from(other),
+    })?;
     let report = SilWalkReport {
         scene: scene.name(),
         integrator: &stride_settings.integrator,
@@ -212,21 +231,38 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     if common.json {
         print_json(&report)?;
     } else {
-        print_text(&report, steps);
+        output::text(|out| print_text(out, &report, steps))?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(walk_exit_code(&walk))
 }
 
-fn print_text<Bus: Serialize>(r: &SilWalkReport<'_, Bus>, steps: usize) {
-    println!(
+/// An error of the firmware in the loop's set-up as bad input; a candump log's error names
+/// the `--candump` path.
+fn candump_error(candump: &Option<std::path::PathBuf>, e: sil::SilError) -> InputError {
+    match (e, candump) {
+        (sil::SilError::Candump(io), Some(path)) => {
+            InputError::Other(PathError::new("--candump", path, io).to_string())
+        }
+        (e, _) => InputError::Other(format!("software in the loop: {e}")),
+    }
+}
+
+fn print_text<Bus: Serialize>(
+    out: &mut dyn Write,
+    r: &SilWalkReport<'_, Bus>,
+    steps: usize,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
         "scene {}: {} of {steps} steps with the firmware actuating",
         r.scene, r.steps_completed
-    );
+    )?;
     if let Some(f) = r.failure {
-        println!(
+        writeln!(
+            out,
             "failure: {:?} in step {} at t = {:.4} s: {}",
             f.kind, f.step, f.t_walk_s, f.detail
-        );
+        )?;
     }
     // The four figures of each gait; all NaN for a walk without a completed step.
     let figures =
@@ -247,14 +283,16 @@ fn print_text<Bus: Serialize>(r: &SilWalkReport<'_, Bus>, steps: usize) {
         i.cost_of_transport.j_per_kg_m,
     );
     for (label, [period, length, speed, cost]) in [("firmware", firmware), ("ideal", ideal)] {
-        println!(
+        writeln!(
+            out,
             "{label:>9}: period {period:.5} s, step {length:.5} m, speed {speed:.5} m/s, cost of transport {cost:.5} J/(kg m)"
-        );
+        )?;
     }
-    println!(
+    writeln!(
+        out,
         "bus load {:.2} %, {} frames, {} node fault events",
         100.0 * r.bus_load,
         r.frames,
         r.node_faults.len()
-    );
+    )
 }

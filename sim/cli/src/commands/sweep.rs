@@ -2,11 +2,14 @@
 
 use super::print_json;
 use crate::input_error::InputError;
+use crate::limits;
 use crate::options::Common;
+use crate::output;
 use anyhow::Result;
 use clap::Args;
 use sim::continuation::sweep;
 use sim::report::{SweepPointRecord, SweepReport};
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Options of `walker sweep`.
@@ -23,7 +26,7 @@ pub struct SweepArgs {
     /// Last value.
     #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
-    /// Number of points (≥ 2).
+    /// Number of points (2 to 10,000).
     #[arg(long)]
     pub points: usize,
 }
@@ -42,9 +45,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
-    if points < 2 {
-        return Err(InputError::Other(format!("--points must be at least 2, got {points}")).into());
-    }
+    let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let (pts, bounds) =
         sweep(&scene, &param, from, to, points, &common.newton()).map_err(|e| match e {
             sim::continuation::SweepError::Scene(s) => InputError::Scene(s),
@@ -60,26 +61,28 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     if common.json {
         print_json(&report)?;
     } else {
-        print_text(&report);
+        output::text(|out| print_text(out, &report))?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_text(r: &SweepReport) {
+fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
     let param = &r.param;
-    println!("{:>14} {:>10} {:>8}", param, "max|λ|", "stable");
+    writeln!(out, "{:>14} {:>10} {:>8}", param, "max|λ|", "stable")?;
     for p in &r.points {
         match p {
-            SweepPointRecord::Converged(g) => println!(
+            SweepPointRecord::Converged(g) => writeln!(
+                out,
                 "{:>14.6} {:>10.6} {:>8}",
                 g.value, g.max_abs_eigenvalue, g.stable
-            ),
+            )?,
             SweepPointRecord::Failed(e) => {
-                println!("{:>14.6} {:>10} {:>8}  {}", e.value, "-", "-", e.error)
+                writeln!(out, "{:>14.6} {:>10} {:>8}  {}", e.value, "-", "-", e.error)?
             }
         }
     }
     for b in &r.stability_boundaries {
-        println!("stability {} at {} ≈ {:.6}", b.change, param, b.value);
+        writeln!(out, "stability {} at {} ≈ {:.6}", b.change, param, b.value)?;
     }
+    Ok(())
 }

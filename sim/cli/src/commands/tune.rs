@@ -2,10 +2,13 @@
 
 use super::print_json;
 use crate::input_error::InputError;
+use crate::limits;
 use crate::options::Common;
+use crate::output;
 use anyhow::Result;
 use clap::Args;
-use sim::tune::{tune, TunedParameter};
+use sim::tune::{tune, TuneResult, TunedParameter};
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Options of `walker tune`.
@@ -13,10 +16,10 @@ use std::process::ExitCode;
 pub struct TuneArgs {
     #[command(flatten)]
     pub common: Common,
-    /// A parameter the search may change: `name=min:max` (repeatable).
+    /// A parameter the search may change: `name=min:max` (repeatable, each name once).
     #[arg(long = "vary", value_name = "NAME=MIN:MAX", required = true)]
     pub vary: Vec<String>,
-    /// Gait searches allowed.
+    /// Gait searches allowed (1 to 10,000; the report's `history` has at most this many).
     #[arg(long, default_value_t = 60)]
     pub evaluations: usize,
 }
@@ -30,27 +33,47 @@ pub fn run(args: TuneArgs) -> Result<ExitCode> {
     } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
+    let evaluations = limits::count(
+        "--evaluations",
+        evaluations,
+        1,
+        limits::MAX_TUNE_EVALUATIONS,
+    )?;
     let params = vary
         .iter()
         .map(|v| parse_vary(v))
         .collect::<Result<Vec<_>, _>>()?;
+    for (i, p) in params.iter().enumerate() {
+        if params[..i].iter().any(|q| q.name == p.name) {
+            return Err(InputError::Other(format!(
+                "--vary: parameter `{}` given twice (each parameter once)",
+                p.name
+            ))
+            .into());
+        }
+    }
     let result = tune(&scene, &params, evaluations, &common.newton())?;
     if common.json {
         print_json(&result)?;
     } else {
-        println!("{} evaluations", result.history.len());
-        for (p, v) in result.parameters.iter().zip(&result.best.values) {
-            println!(
-                "    {:<36} {:>12.6}   (bounds {} .. {})",
-                p.name, v, p.min, p.max
-            );
-        }
-        match result.best.max_abs_eigenvalue {
-            Some(m) => println!("best max |λ| = {m:.6}"),
-            None => println!("no gait found"),
-        }
+        output::text(|out| print_text(out, &result))?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn print_text(out: &mut dyn Write, result: &TuneResult) -> std::io::Result<()> {
+    writeln!(out, "{} evaluations", result.history.len())?;
+    for (p, v) in result.parameters.iter().zip(&result.best.values) {
+        writeln!(
+            out,
+            "    {:<36} {:>12.6}   (bounds {} .. {})",
+            p.name, v, p.min, p.max
+        )?;
+    }
+    match result.best.max_abs_eigenvalue {
+        Some(m) => writeln!(out, "best max |λ| = {m:.6}"),
+        None => writeln!(out, "no gait found"),
+    }
 }
 
 /// A `--vary name=min:max` option.

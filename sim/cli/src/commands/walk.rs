@@ -2,10 +2,12 @@
 
 mod start;
 
-use super::print_json;
+use super::{print_json, walk_exit_code};
 use crate::figures;
 use crate::input_error::InputError;
+use crate::limits;
 use crate::options::Common;
+use crate::output::{self, PathError};
 use anyhow::Result;
 use clap::Args;
 use sim::report::WalkReport;
@@ -20,7 +22,7 @@ use std::process::ExitCode;
 pub struct WalkArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Number of steps.
+    /// Number of steps (at most 100,000).
     #[arg(long)]
     pub steps: usize,
     /// Perturb a start-state entry: `coord=delta` (coordinate or `coord_dot`).
@@ -53,7 +55,8 @@ pub struct WalkArgs {
     pub plot_with: Option<String>,
 }
 
-/// Runs `walker walk`: exit code 1 if there is no gait to start from.
+/// Runs `walker walk`: exit code 1 if there is no gait to start from, 3 if the walker fell
+/// (the report's `failure`).
 pub fn run(args: WalkArgs) -> Result<ExitCode> {
     let WalkArgs {
         common,
@@ -66,17 +69,29 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         plot,
         plot_with,
     } = args;
+    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
     let walker = &setup.walker;
+    // The output paths before the walk: a path that cannot be used fails at once.
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
+    let csv = match &out {
+        Some(path) => Some((
+            path,
+            std::fs::File::create(path).map_err(|e| PathError::new("--out", path, e))?,
+        )),
+        None => None,
+    };
     let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
     let start_from_scene = match (start_from_scene, start.as_str()) {
         (None, "gait") => match &scene.file.walk_start_scene {
             Some(other) if setup.find_gait(&common.newton()).is_err() => {
-                eprintln!(
+                output::note(format_args!(
                     "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
                     scene.name()
-                );
+                ));
                 Some(other.clone())
             }
             _ => None,
@@ -92,7 +107,9 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         (None, "gait") => match setup.find_gait(&common.newton()) {
             Ok(g) => g.fixed_point,
             Err(e) => {
-                eprintln!("error: no gait to start from: {e} (use --start guess)");
+                output::note(format_args!(
+                    "error: no gait to start from: {e} (use --start guess)"
+                ));
                 return Ok(ExitCode::from(1));
             }
         },
@@ -117,7 +134,6 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
     let walk = sim::walk::walk(walker, &q, &qd, request);
     if let Some(dir) = &plot {
-        std::fs::create_dir_all(dir)?;
         let mut walks = vec![(scene.name().to_string(), walk.clone())];
         if let Some(other) = &plot_with {
             // The other scene walks with its own defaults, from its own gait.
@@ -139,35 +155,46 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         let refs: Vec<(&str, &sim::walk::Walk)> =
             walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
         let fig = figures::floor_paths(&refs, "path of the hip-axle centre on the floor");
-        std::fs::write(dir.join("floor_path.svg"), fig.to_svg(820.0, 420.0))?;
+        output::write_file(
+            "--plot",
+            &dir.join("floor_path.svg"),
+            &fig.to_svg(820.0, 420.0),
+        )?;
     }
-    if let Some(path) = out {
-        write_csv(&path, walker, &walk)?;
+    if let Some((path, file)) = csv {
+        write_csv(file, walker, &walk).map_err(|e| PathError::new("--out", path, e))?;
     }
     let report = WalkReport::new(&scene, &walk);
     if common.json {
         print_json(&report)?;
     } else {
-        print_text(&report, steps);
+        output::text(|out| print_text(out, &report, steps))?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(walk_exit_code(&walk))
 }
 
-fn print_text(r: &WalkReport, steps: usize) {
-    println!("scene {}: {} of {steps} steps", r.scene, r.steps_completed);
-    println!(
+fn print_text(out: &mut dyn Write, r: &WalkReport, steps: usize) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "scene {}: {} of {steps} steps",
+        r.scene, r.steps_completed
+    )?;
+    writeln!(
+        out,
         "{:>5} {:>10} {:>10} {:>10} {:>12}",
         "step", "t_s", "period_s", "length_m", "deviation"
-    );
+    )?;
     for s in &r.steps {
-        println!(
+        writeln!(
+            out,
             "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
             s.step, s.start_t_walk_s, s.duration_s, s.step_length_m, s.state_deviation
-        );
+        )?;
     }
     match &r.failure {
-        None => println!("no failure"),
-        Some(f) => println!(
+        None => writeln!(out, "no failure"),
+        Some(f) => writeln!(
+            out,
             "failure: {:?} in step {} at t = {:.4} s: {}",
             f.kind, f.step, f.t_walk_s, f.detail
         ),
@@ -176,8 +203,8 @@ fn print_text(r: &WalkReport, steps: usize) {
 
 /// The walk's trajectory as CSV: step, time, coordinates, rates and the hip-axle centre in the
 /// floor frame, one row per integrator sample.
-fn write_csv(path: &std::path::Path, walker: &Walker, walk: &sim::walk::Walk) -> Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+fn write_csv(file: std::fs::File, walker: &Walker, walk: &sim::walk::Walk) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(file);
     let coords: Vec<&str> = walker
         .model
         .coordinates
