@@ -3,9 +3,9 @@
 //! ```text
 //! kind[:key=value[,key=value]...]
 //!
-//! drop:id=0x101,count=5        drop the next 5 frames with identifier 0x101 at the sender
+//! drop:id=0x022,count=5        drop the next 5 frames with identifier 0x022 at the sender
 //! drop:node=left,prob=0.1      drop each frame of node `left` with probability 0.1
-//! delay:id=0x2A0,ms=20         hold each 0x2A0 frame back 20 ms before it may arbitrate
+//! delay:id=0x072,ms=20         hold each 0x072 frame back 20 ms before it may arbitrate
 //! corrupt:prob=0.01            flip a bit in 1 % of transmissions (error frame, retransmit)
 //! babble:node=3,id=0x7FF       node 3 sends frames with id 0x7FF back to back
 //! busoff:node=left             every transmission of `left` fails until it is bus-off
