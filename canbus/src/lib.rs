@@ -21,6 +21,7 @@ pub mod candump;
 pub mod demo;
 pub mod fault;
 pub mod frame;
+pub mod protocol_ids;
 pub mod rng;
 pub mod socketcand;
 pub mod spec;

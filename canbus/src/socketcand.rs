@@ -496,6 +496,17 @@ impl Session<'_> {
     }
 
     fn push_out(&mut self, text: &str) {
+        // Drop what is written before appending, so that the buffer holds only what is
+        // pending (at most about `OUT_LIMIT_BYTES` plus one answer) even for a client that
+        // reads slowly but never lets its output drain completely. Compacted when the written
+        // part is at least half of the buffer (amortised), at a character boundary.
+        if self.out_pos > 0
+            && self.out_pos >= self.out.len() / 2
+            && self.out.is_char_boundary(self.out_pos)
+        {
+            self.out.drain(..self.out_pos);
+            self.out_pos = 0;
+        }
         self.out.push_str(text);
         self.me.out_pending.store(true, Ordering::Release);
     }
@@ -698,6 +709,47 @@ fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A client that reads, but never fast enough for its output to drain completely: the
+    /// buffer keeps only what is pending (before the fix it kept every byte ever written,
+    /// 1.75 MiB/s against a slow reader flooding commands).
+    #[test]
+    fn output_of_a_slow_reader_that_never_drains_stays_bounded() {
+        let shared = Shared {
+            config: ServerConfig::default(),
+            stop: AtomicBool::new(false),
+            clients: Mutex::new(Vec::new()),
+            inbound: Mutex::new(VecDeque::new()),
+            counters: Counters::default(),
+        };
+        let me = ClientState {
+            rawmode: AtomicBool::new(false),
+            queue: Mutex::new(VecDeque::new()),
+            out_pending: AtomicBool::new(false),
+        };
+        let mut s = Session {
+            shared: &shared,
+            me: &me,
+            phase: Phase::NoBus,
+            out: String::new(),
+            out_pos: 0,
+            out_frames: 0,
+            input: Vec::new(),
+        };
+        s.push_out("< hi >");
+        for _ in 0..200_000 {
+            s.push_out("< echo >");
+            // Everything but the last byte is written: the output never drains.
+            let n = s.pending() - 1;
+            s.wrote(n);
+            assert_eq!(s.pending(), 1);
+        }
+        assert!(
+            s.out.len() < 4 * OUT_LIMIT_BYTES,
+            "output buffer {} bytes for 1 byte pending",
+            s.out.len()
+        );
+    }
 
     fn read_until(s: &mut TcpStream, want: &str) -> String {
         let mut got = String::new();

@@ -93,6 +93,11 @@ fn other_bad_input_exits_2() {
         &["--seconds", "0.01", "--fault", "busoff:node=nobody"],
         &["nobody"],
     );
+    // A fault on an identifier no node sends did nothing, silently (the old example 0x101).
+    assert_bad_input(
+        &["--seconds", "0.01", "--fault", "drop:id=0x101,count=5"],
+        &["0x101", "0x022 HeelStrike"],
+    );
 }
 
 #[test]

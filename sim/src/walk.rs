@@ -282,11 +282,8 @@ pub fn walk(
                 }
                 out.steps_completed += 1;
                 out.steps.push(summary);
-                // Bounded: drop the oldest half once twice the kept number accumulate.
                 if let Some(keep) = keep_steps {
-                    if out.steps.len() >= 2 * keep.max(1) {
-                        out.steps.drain(..out.steps.len() - keep);
-                    }
+                    trim_to_kept(&mut out.steps, keep);
                 }
                 frame = frame.next(&r.step_m, r.heading_change_rad, walker.relabel.mirror);
                 t0 += r.duration_s;
@@ -320,5 +317,36 @@ fn path_sample(
         q: s.q.clone(),
         qd: s.qd.clone(),
         hip_floor_m: frame.apply(&kin.position_of(hip.link, &hip.p_link_m)),
+    }
+}
+
+/// Bounded step summaries: once twice the kept number (at least 2) accumulate, the oldest are
+/// dropped down to the last `keep`. Amortised O(1) per step; any `keep`, however large, is safe.
+fn trim_to_kept<T>(steps: &mut Vec<T>, keep: usize) {
+    if steps.len() >= keep.max(1).saturating_mul(2) {
+        let drop = steps.len().saturating_sub(keep);
+        steps.drain(..drop);
+    }
+}
+
+#[cfg(test)]
+mod trim_tests {
+    use super::trim_to_kept;
+
+    #[test]
+    fn trimming_keeps_the_last_and_survives_any_keep() {
+        let mut v: Vec<u32> = (0..10).collect();
+        trim_to_kept(&mut v, 3);
+        assert_eq!(v, vec![7, 8, 9]);
+        let mut v: Vec<u32> = (0..5).collect();
+        trim_to_kept(&mut v, 3);
+        assert_eq!(v.len(), 5, "under twice the kept number nothing is dropped");
+        // `2 * keep` wrapped to 2 for this `keep` (also in release builds) and the drain
+        // panicked; `usize::MAX` overflowed in debug builds.
+        for keep in [usize::MAX / 2 + 1, usize::MAX] {
+            let mut v: Vec<u32> = (0..3).collect();
+            trim_to_kept(&mut v, keep);
+            assert_eq!(v, vec![0, 1, 2]);
+        }
     }
 }

@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 use canbus::candump::CandumpWriter;
 use canbus::demo::{Demo, TICK_NS};
+use canbus::protocol_ids::check_fault_id;
 use canbus::socketcand::{ServerConfig, SocketcandServer};
 use canbus::timestamp::stamp_ns;
 use canbus::{BusConfig, BusEvent, FaultSpec, Stuffing};
@@ -211,6 +212,9 @@ fn run(cli: &Cli) -> Result<()> {
         seed: cli.seed,
         ..BusConfig::default()
     };
+    for f in &cli.faults {
+        check_fault_id(f).map_err(|e| input(format!("--fault `{f}`: {e}")))?;
+    }
     let mut demo = Demo::new(config, &cli.faults).map_err(|e| input(e.to_string()))?;
     let mut log =
         match &cli.candump {

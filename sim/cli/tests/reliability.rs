@@ -220,6 +220,20 @@ fn tune_refuses_a_parameter_twice_and_no_evaluations_and_keeps_its_budget() {
         2,
         &["slope_rad", "twice"],
     );
+    // The same parameter under its alias and its name is one parameter given twice.
+    assert_refused(
+        &[
+            "tune",
+            "--scene",
+            "compass",
+            "--vary",
+            "slope=0.005:0.015",
+            "--vary",
+            "slope_rad=0.006:0.012",
+        ],
+        2,
+        &["slope_rad", "twice"],
+    );
     assert_refused(
         &[
             "tune",
@@ -476,5 +490,26 @@ proptest! {
             other => prop_assert!(false, "{text}: exit {other:?}: {err}"),
         }
         std::fs::remove_file(&f).ok();
+    }
+}
+
+/// A fixed step too small for the stride's time budget used to integrate for ever
+/// (`--integrator rk4 --step-s 1e-300`, also Meijaard, also 1e-9): refused before any stride.
+#[test]
+fn a_fixed_step_too_small_for_the_stride_budget_is_refused() {
+    for (kind, step) in [("rk4", "1e-300"), ("meijaard", "1e-9"), ("rk4", "1e-9")] {
+        assert_refused(
+            &[
+                "gait",
+                "--scene",
+                "compass",
+                "--integrator",
+                kind,
+                "--step-s",
+                step,
+            ],
+            2,
+            &[step],
+        );
     }
 }

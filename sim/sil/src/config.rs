@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use canbus::{BusConfig, FaultKind, FaultSpec};
+use canbus::protocol_ids::{check_fault_id, UnknownFaultId};
+use canbus::{BusConfig, FaultSpec};
 use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 
 use crate::actuator::ActuatorParams;
@@ -27,40 +28,8 @@ pub enum BusFaultError {
     #[error(transparent)]
     Parse(#[from] canbus::FaultParseError),
     /// Its filter names an identifier no node of the walker's bus sends.
-    #[error(
-        "no node sends identifier 0x{id:03X}, so the fault would never apply (identifiers on \
-         the bus: {known})"
-    )]
-    UnknownId {
-        /// The offending identifier.
-        id: u16,
-        /// The identifiers of the protocol's message table, each with its message and node.
-        known: String,
-    },
-}
-
-/// Every identifier the walker's bus carries, ascending, with its message and node
-/// (`HeelStrike LEFT_ANKLE`), from the protocol's message table
-/// ([`protocol::MESSAGES`]).
-pub fn protocol_ids() -> Vec<(u16, String)> {
-    let mut ids: Vec<(u16, String)> = protocol::MESSAGES
-        .iter()
-        .flat_map(|m| {
-            m.node_fields().map(move |node| {
-                let id = protocol::CanId::new(m.class, node).raw();
-                let who = match m.direction {
-                    protocol::signal::Direction::FromNode(_) => m.sender_name(node),
-                    protocol::signal::Direction::ToNode(targets) => targets
-                        .iter()
-                        .find(|t| t.raw() == node)
-                        .map_or("?", |t| t.dbc_name()),
-                };
-                (id, format!("{} {who}", m.name))
-            })
-        })
-        .collect();
-    ids.sort();
-    ids
+    #[error(transparent)]
+    UnknownId(#[from] UnknownFaultId),
 }
 
 /// Everything a [`crate::FirmwareInTheLoop`] run needs.
@@ -153,24 +122,7 @@ impl SilConfig {
     /// identifier no node of the walker's bus sends (it would never apply); the error lists
     /// those that exist. A babbler's own identifier may be any.
     pub fn with_fault(mut self, fault: FaultSpec) -> Result<Self, BusFaultError> {
-        let filter = match &fault.kind {
-            FaultKind::Drop { filter, .. }
-            | FaultKind::Delay { filter, .. }
-            | FaultKind::Corrupt { filter, .. } => Some(filter),
-            FaultKind::Babble { .. } | FaultKind::BusOff { .. } => None,
-        };
-        if let Some(id) = filter.and_then(|f| f.id) {
-            if !protocol_ids().iter().any(|(known, _)| *known == id) {
-                return Err(BusFaultError::UnknownId {
-                    id,
-                    known: protocol_ids()
-                        .iter()
-                        .map(|(id, name)| format!("0x{id:03X} {name}"))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                });
-            }
-        }
+        check_fault_id(&fault)?;
         self.bus_faults.push(fault);
         Ok(self)
     }
@@ -245,7 +197,10 @@ mod tests {
             .unwrap_err();
         let text = e.to_string();
         assert!(
-            matches!(e, BusFaultError::UnknownId { id: 0x101, .. }),
+            matches!(
+                e,
+                BusFaultError::UnknownId(UnknownFaultId { id: 0x101, .. })
+            ),
             "{e}"
         );
         assert!(text.contains("0x101"), "{text}");
@@ -268,19 +223,5 @@ mod tests {
             .with_fault_str("drop:idx=5")
             .unwrap_err();
         assert!(e.to_string().contains("idx"), "{e}");
-    }
-
-    #[test]
-    fn the_identifier_table_is_the_protocol_table() {
-        let ids = protocol_ids();
-        let n: usize = protocol::MESSAGES
-            .iter()
-            .map(|m| m.node_fields().count())
-            .sum();
-        assert_eq!(ids.len(), n);
-        assert!(ids.windows(2).all(|w| w[0].0 < w[1].0), "{ids:?}");
-        for (id, _) in &ids {
-            assert!(protocol::CanId::from_raw(*id).is_ok(), "0x{id:03X}");
-        }
     }
 }

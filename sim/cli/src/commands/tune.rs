@@ -43,11 +43,20 @@ pub fn run(args: TuneArgs) -> Result<ExitCode> {
         .iter()
         .map(|v| parse_vary(v))
         .collect::<Result<Vec<_>, _>>()?;
-    for (i, p) in params.iter().enumerate() {
-        if params[..i].iter().any(|q| q.name == p.name) {
+    // Each parameter once, whatever name or alias it is given by (`slope`, `slope_rad`).
+    let canonical = params
+        .iter()
+        .map(|p| scene.parameter_name(&p.name))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, (p, name)) in params.iter().zip(&canonical).enumerate() {
+        if let Some(q) = params[..i]
+            .iter()
+            .zip(&canonical)
+            .find(|(_, other)| *other == name)
+        {
             return Err(InputError::Other(format!(
-                "--vary: parameter `{}` given twice (each parameter once)",
-                p.name
+                "--vary: parameter `{name}` given twice (as `{}` and `{}`; each parameter once)",
+                q.0.name, p.name
             ))
             .into());
         }
