@@ -490,7 +490,20 @@ struct Session<'a> {
     input: Vec<u8>,
 }
 
-impl Session<'_> {
+impl<'a> Session<'a> {
+    /// A new client's session: no bus opened yet, nothing buffered.
+    fn new(shared: &'a Shared, me: &'a ClientState) -> Self {
+        Self {
+            shared,
+            me,
+            phase: Phase::NoBus,
+            out: String::new(),
+            out_pos: 0,
+            out_frames: 0,
+            input: Vec::new(),
+        }
+    }
+
     fn pending(&self) -> usize {
         self.out.len() - self.out_pos
     }
@@ -654,15 +667,7 @@ fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
         return;
     }
     let _ = stream.set_nodelay(true);
-    let mut s = Session {
-        shared,
-        me,
-        phase: Phase::NoBus,
-        out: String::new(),
-        out_pos: 0,
-        out_frames: 0,
-        input: Vec::new(),
-    };
+    let mut s = Session::new(shared, me);
     s.push_out("< hi >");
     let mut chunk = [0u8; READ_CHUNK_BYTES];
     let mut last_progress = Instant::now();
@@ -727,15 +732,7 @@ mod tests {
             queue: Mutex::new(VecDeque::new()),
             out_pending: AtomicBool::new(false),
         };
-        let mut s = Session {
-            shared: &shared,
-            me: &me,
-            phase: Phase::NoBus,
-            out: String::new(),
-            out_pos: 0,
-            out_frames: 0,
-            input: Vec::new(),
-        };
+        let mut s = Session::new(&shared, &me);
         s.push_out("< hi >");
         for _ in 0..200_000 {
             s.push_out("< echo >");

@@ -2,14 +2,10 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use serde_json::Value;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn walker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_walker"))
-        .args(args)
-        .output()
-        .expect("walker runs")
-}
+mod common;
+use common::walker;
 
 fn json(out: &Output) -> Value {
     assert!(

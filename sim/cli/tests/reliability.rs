@@ -10,16 +10,8 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-fn walker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_walker"))
-        .args(args)
-        .output()
-        .expect("walker runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{stderr, walker};
 
 /// Runs `args` and asserts exit code `code` and a message on stderr containing each needle
 /// (and no panic).
