@@ -32,27 +32,27 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     }
     let walker = &setup.walker;
     let result = setup.find_gait(&common.newton());
-    // The report's contact figures: one more stride from the fixed point, with contact on.
-    let contact = result.as_ref().ok().and_then(|g| {
+    // One more stride from the fixed point: the report's contact figures and, for the
+    // joint-angle figure, its samples.
+    let figures_stride = result.as_ref().ok().and_then(|g| {
         let (q, qd) = walker.unpack(&g.fixed_point);
         walker
             .stride(
                 &q,
                 &qd,
                 StrideRequest::new(&setup.settings).options(StrideOptions {
-                    record: false,
+                    record: plot.is_some(),
                     contact: true,
                 }),
             )
             .ok()
-            .map(|c| c.contact)
     });
     let report = GaitReport::new(
         &scene,
         walker,
         &setup.settings.integrator,
         &result,
-        contact.as_ref(),
+        figures_stride.as_ref().map(|r| &r.contact),
     );
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let name = scene.name();
@@ -66,22 +66,12 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
             &dir.join("eigenvalues.svg"),
             &eig.to_svg(640.0, 600.0),
         )?;
-        // The joint-angle figure's samples: the stride from the fixed point, recorded.
-        let (q, qd) = walker.unpack(&g.fixed_point);
-        let samples = walker
-            .stride(
-                &q,
-                &qd,
-                StrideRequest::new(&setup.settings).options(StrideOptions {
-                    record: true,
-                    contact: false,
-                }),
-            )
-            .map(|r| r.trajectory)
-            .unwrap_or_default();
+        let samples = figures_stride
+            .as_ref()
+            .map_or(&[][..], |r| r.trajectory.as_slice());
         let ang = figures::joint_angles(
             walker,
-            &samples,
+            samples,
             &format!("{name}: joint angles over one step"),
         );
         output::write_file(
