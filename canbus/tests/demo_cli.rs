@@ -3,10 +3,11 @@
 //! reads (the process still exits promptly at the end of the run).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::net::TcpStream;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
+use walker_tools::announced::announced_address;
 
 use canbus::candump::read_log;
 
@@ -170,21 +171,14 @@ fn a_client_that_never_reads_does_not_keep_the_demo_alive() {
         .spawn()
         .unwrap();
     let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    let mut addr = None;
-    while addr.is_none() {
-        line.clear();
-        if err.read_line(&mut line).unwrap() == 0 {
-            break;
-        }
-        addr = line
-            .trim()
-            .strip_prefix("socketcand: listening on ")
-            .map(str::to_string);
-    }
-    let addr = addr.unwrap_or_else(|| {
+    let addr = announced_address(
+        &mut err,
+        "socketcand: listening on ",
+        Duration::from_secs(60),
+    )
+    .unwrap_or_else(|last| {
         let _ = child.kill();
-        panic!("no address announced: {line}")
+        panic!("no address announced: {last}")
     });
     let mut client = TcpStream::connect(addr).unwrap();
     client.write_all(b"< open vcan0 >< rawmode >").unwrap();

@@ -7,9 +7,10 @@
 //! (set by `scripts/test-all`), in which case it fails.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufReader, Read};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use walker_tools::announced::announced_address;
 
 use canbus::candump::{read_log, LogFrame};
 use walker_tools::python_venv::PythonVenv;
@@ -40,22 +41,14 @@ fn python_monitor_decodes_the_live_demo_over_socketcand() {
         .spawn()
         .unwrap();
     let mut err = BufReader::new(demo.stderr.take().unwrap());
-    let mut addr = None;
-    let mut line = String::new();
-    let t0 = Instant::now();
-    while addr.is_none() && t0.elapsed() < Duration::from_secs(30) {
-        line.clear();
-        if err.read_line(&mut line).unwrap() == 0 {
-            break;
-        }
-        addr = line
-            .trim()
-            .strip_prefix("socketcand: listening on ")
-            .map(str::to_string);
-    }
-    let addr = addr.unwrap_or_else(|| {
+    let addr = announced_address(
+        &mut err,
+        "socketcand: listening on ",
+        Duration::from_secs(30),
+    )
+    .unwrap_or_else(|last| {
         let _ = demo.kill();
-        panic!("demo did not report its address: {line}")
+        panic!("demo did not report its address: {last}")
     });
     let port = addr.rsplit(':').next().unwrap().to_string();
 

@@ -3,8 +3,10 @@
 //! Regenerate everything with `cargo run -p walker-tools -- gen`; the test
 //! `tests/generated_files_fresh.rs` fails when a committed copy is stale.
 //!
-//! The project's Python venv, for the tests that run the Python bus monitor: [`python_venv`].
+//! The project's Python venv, for the tests that run the Python bus monitor: [`python_venv`];
+//! the address a server process announces, for the tests that connect to one: [`announced`].
 
+pub mod announced;
 pub mod python_venv;
 
 use std::fmt::Write as _;

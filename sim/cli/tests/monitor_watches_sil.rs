@@ -7,9 +7,10 @@
 //! `scripts/test-all`), which makes it fail.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use std::io::{BufRead, BufReader};
+use std::io::BufReader;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use walker_tools::announced::announced_address;
 
 use walker_tools::python_venv::PythonVenv;
 
@@ -34,26 +35,14 @@ fn python_monitor_decodes_a_running_firmware_in_the_loop_walk() {
         .unwrap();
     // The server's address, from the simulation's first lines on stderr.
     let mut err = BufReader::new(sim.stderr.take().unwrap());
-    let mut addr = None;
-    let mut line = String::new();
-    let t0 = Instant::now();
-    while addr.is_none() && t0.elapsed() < Duration::from_secs(60) {
-        line.clear();
-        if err.read_line(&mut line).unwrap() == 0 {
-            break;
-        }
-        addr = line
-            .trim()
-            .strip_prefix("socketcand: serving the bus on ")
-            .map(|s| {
-                s.split_whitespace()
-                    .next()
-                    .unwrap()
-                    .parse::<std::net::SocketAddr>()
-                    .unwrap()
-            });
-    }
-    let addr = addr.expect("the simulation announces its socketcand address");
+    let addr: std::net::SocketAddr = announced_address(
+        &mut err,
+        "socketcand: serving the bus on ",
+        Duration::from_secs(60),
+    )
+    .expect("the simulation announces its socketcand address")
+    .parse()
+    .unwrap();
     let monitor = venv
         .monitor()
         .args(["--interface", "socketcand", "--channel", "vcan0"])
