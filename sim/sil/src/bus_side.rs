@@ -124,10 +124,9 @@ impl BusSide {
     /// # Errors
     /// Any other refusal of the bus.
     pub fn send_from_host(&mut self, frame: Frame, t_ns: u64) -> Result<(), ControlError> {
-        match self.bus.send(self.host, frame, t_ns) {
-            Ok(_) | Err(BusError::QueueFull { .. }) => Ok(()),
-            Err(e) => Err(control_error(e)),
-        }
+        self.bus
+            .send_lossy(self.host, frame, t_ns)
+            .map_err(control_error)
     }
 
     /// Queue a frame from `node` at `t_ns`.
