@@ -170,15 +170,16 @@ fn every_builtin_scene_passes_the_integrator_checks() {
 fn integrator_choices_from_the_command_line_are_validated() {
     let (_, w) = common::walker("compass");
     let t = w.settings.max_stride_time_s;
+    let budget = sim::stride::StrideSettings::DEFAULT_MAX_STEPS;
     for (kind, h) in [("rk4", 1e-300), ("meijaard", 1e-9)] {
         let c = IntegratorChoice::from_kind(kind, Some(h), None, None, None).unwrap();
         assert!(
-            matches!(c.validate(t), Err(IntegratorError::TooManySteps { value, .. }) if value == h),
+            matches!(c.validate_with_budget(t, budget), Err(IntegratorError::TooManySteps { value, .. }) if value == h),
             "{kind} {h}"
         );
         let c = w.settings.integrator.with_tolerance_or_step(None, Some(h));
         // The scene's integrator is adaptive: a step does not apply and it stays valid.
-        assert!(c.validate(t).is_ok());
+        assert!(c.validate_with_budget(t, budget).is_ok());
     }
     for c in [
         IntegratorChoice::from_kind("dopri5", None, Some(-1e-6), None, None).unwrap(),
@@ -186,13 +187,16 @@ fn integrator_choices_from_the_command_line_are_validated() {
         IntegratorChoice::from_kind("meijaard", Some(0.0), None, None, None).unwrap(),
     ] {
         assert!(matches!(
-            c.validate(t),
+            c.validate_with_budget(t, budget),
             Err(IntegratorError::NotPositive { .. })
         ));
     }
     let ok = IntegratorChoice::from_kind("rk4", Some(1e-3), None, None, None).unwrap();
-    assert!(ok.validate(t).is_ok());
-    assert!(ok.validate(f64::NAN).is_err(), "a NaN time budget");
+    assert!(ok.validate_with_budget(t, budget).is_ok());
+    assert!(
+        ok.validate_with_budget(f64::NAN, budget).is_err(),
+        "a NaN time budget"
+    );
 }
 
 // --- stride budgets -----------------------------------------------------------------------

@@ -288,19 +288,6 @@ impl IntegratorChoice {
         }
     }
 
-    /// Checks the settings against the default stride step budget
-    /// ([`crate::stride::StrideSettings::DEFAULT_MAX_STEPS`]): see
-    /// [`Self::validate_with_budget`]. For settings from the command line.
-    ///
-    /// # Errors
-    /// As [`Self::validate_with_budget`].
-    pub fn validate(&self, max_stride_time_s: f64) -> Result<(), IntegratorError> {
-        self.validate_with_budget(
-            max_stride_time_s,
-            crate::stride::StrideSettings::DEFAULT_MAX_STEPS,
-        )
-    }
-
     /// Checks that these settings can run a stride: every step, largest step and tolerance
     /// positive and finite, and the (largest) step long enough to cover `max_stride_time_s`
     /// [s] within `max_steps` steps (a smaller one could only end in a budget failure, after
