@@ -24,6 +24,7 @@ pub mod reflex;
 pub mod runner;
 pub mod scenarios;
 pub mod sensors;
+pub mod supervisor;
 pub mod time;
 
 pub use node::{AnkleNode, DriverHealth, NodeConfig, TickInputs, TickOutputs};

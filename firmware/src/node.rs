@@ -72,8 +72,11 @@ pub enum ConfigError {
 pub struct DriverHealth {
     /// The actuator driver failed to apply the last command.
     pub actuator_error: bool,
-    /// The CAN controller reported an error, or a frame could not be queued.
+    /// A frame could not be queued for transmission (the queue was full).
     pub can_error: bool,
+    /// The CAN controller is bus-off (from its status register; error frames and
+    /// error-passive are not faults).
+    pub can_bus_off: bool,
 }
 
 /// Inputs of one tick.
@@ -345,7 +348,13 @@ impl AnkleNode {
             &mut out,
             now,
             FaultCode::CanBus,
-            inputs.drivers.can_error.then_some(0),
+            if inputs.drivers.can_bus_off {
+                Some(2)
+            } else if inputs.drivers.can_error {
+                Some(1)
+            } else {
+                None
+            },
         );
 
         // 4. Contact edges; the own heel strike is announced in every state.

@@ -32,15 +32,20 @@ pub enum EncoderError {
         /// The 16-bit word received.
         word: u16,
     },
+    /// No fresh reading arrived in time (a PWM-output encoder whose line went quiet, or a
+    /// frame whose period is not the sensor's).
+    NoSignal,
 }
 
 impl EncoderError {
-    /// A small code for the fault event's `detail` field: 1 bus, 2 parity, 3 error flag.
+    /// A small code for the fault event's `detail` field: 1 bus, 2 parity, 3 error flag,
+    /// 4 no signal.
     pub fn detail(&self) -> i16 {
         match self {
             EncoderError::Bus(_) => 1,
             EncoderError::Parity { .. } => 2,
             EncoderError::ErrorFlag { .. } => 3,
+            EncoderError::NoSignal => 4,
         }
     }
 }

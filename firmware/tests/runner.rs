@@ -11,7 +11,7 @@ use std::rc::Rc;
 use embedded_can::{Frame, Id, StandardId};
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::drivers::actuator::{PwmDirActuator, PwmDirGains};
-use firmware::drivers::can::CanPort;
+use firmware::drivers::can::{BusState, CanPort, ControllerHealth, ControllerStatus};
 use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
 use firmware::drivers::encoder::{read_command, MagneticEncoder, ANGLECOM};
 use firmware::runner::AnkleDrivers;
@@ -30,6 +30,7 @@ struct World {
     tx: RefCell<Vec<TestFrame>>,
     tx_room: Cell<usize>,
     bus_error: Cell<bool>,
+    bus_state: Cell<BusState>,
     now_us: Cell<u64>,
 }
 
@@ -178,6 +179,17 @@ impl embedded_can::nb::Can for Can {
     }
 }
 
+impl ControllerHealth for Can {
+    fn status(&mut self) -> ControllerStatus {
+        ControllerStatus {
+            state: self.0.bus_state.get(),
+            tx_errors: 0,
+            rx_errors: 0,
+            rx_lost: 0,
+        }
+    }
+}
+
 struct Clock(Rc<World>);
 impl Monotonic for Clock {
     fn now(&mut self) -> Instant {
@@ -185,7 +197,7 @@ impl Monotonic for Clock {
     }
 }
 
-type Drivers = AnkleDrivers<Spi, Pin, PwmDirActuator<Pwm, Dir>, Can, Clock>;
+type Drivers = AnkleDrivers<MagneticEncoder<Spi>, Pin, PwmDirActuator<Pwm, Dir>, Can, Clock>;
 
 fn setup() -> (Rc<World>, Drivers) {
     let w = Rc::new(World::default());
@@ -339,10 +351,22 @@ fn encoder_and_bus_errors_become_faults() {
     step(&w, &mut d);
     step(&w, &mut d);
     assert!(!d.node.faults().contains(FaultCode::EncoderComms));
+    // One error frame reported through the receive path: counted, not a fault.
     w.bus_error.set(true);
     step(&w, &mut d);
-    assert!(d.node.faults().contains(FaultCode::CanBus));
+    assert!(!d.node.faults().contains(FaultCode::CanBus));
     assert_eq!(d.can.stats().bus_errors, 1);
+    // Error-passive: reported in the stats, not a fault.
+    w.bus_state.set(BusState::ErrorPassive);
+    step(&w, &mut d);
+    assert!(!d.node.faults().contains(FaultCode::CanBus));
+    assert_eq!(d.can.stats().status.state, BusState::ErrorPassive);
+    // Bus-off from the status register: a fault.
+    w.bus_state.set(BusState::BusOff);
+    step(&w, &mut d);
+    assert!(d.node.faults().contains(FaultCode::CanBus));
+    assert_eq!(d.can.stats().bus_off_events, 1);
+    w.bus_state.set(BusState::ErrorActive);
     step(&w, &mut d);
     assert!(!d.node.faults().contains(FaultCode::CanBus));
 }

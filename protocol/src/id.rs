@@ -226,8 +226,39 @@ impl CanId {
     }
 }
 
+/// Identifiers an ankle's acceptance filters let through, and nothing else: emergency stop
+/// and command addressed to it or to every ankle, and the other ankle's heel strike, fault and
+/// heartbeat (the node follows the peer's state). `None` for the host.
+pub const fn accepted_by_ankle(me: NodeId) -> Option<[u16; ACCEPTED_BY_ANKLE]> {
+    let Some(peer) = me.peer() else {
+        return None;
+    };
+    let all = Target::Broadcast.raw();
+    Some([
+        CanId::new(MessageClass::EmergencyStop, me.raw()).raw(),
+        CanId::new(MessageClass::EmergencyStop, all).raw(),
+        CanId::new(MessageClass::HeelStrike, peer.raw()).raw(),
+        CanId::new(MessageClass::Fault, peer.raw()).raw(),
+        CanId::new(MessageClass::Command, me.raw()).raw(),
+        CanId::new(MessageClass::Command, all).raw(),
+        CanId::new(MessageClass::Heartbeat, peer.raw()).raw(),
+    ])
+}
+
+/// Number of identifiers in [`accepted_by_ankle`].
+pub const ACCEPTED_BY_ANKLE: usize = 7;
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn ankle_filters_accept_only_what_the_node_reads() {
+        let left = accepted_by_ankle(NodeId::LeftAnkle).unwrap();
+        assert_eq!(left, [0x012, 0x01F, 0x023, 0x033, 0x042, 0x04F, 0x063]);
+        let right = accepted_by_ankle(NodeId::RightAnkle).unwrap();
+        assert_eq!(right, [0x013, 0x01F, 0x022, 0x032, 0x043, 0x04F, 0x062]);
+        assert!(accepted_by_ankle(NodeId::Host).is_none());
+    }
+
     use super::*;
 
     #[test]

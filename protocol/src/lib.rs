@@ -24,7 +24,7 @@ pub mod values;
 pub mod vectors;
 
 pub use error::{DecodeError, EncodeError, RangeError};
-pub use id::{CanId, MessageClass, NodeId, Target};
+pub use id::{accepted_by_ankle, CanId, MessageClass, NodeId, Target, ACCEPTED_BY_ANKLE};
 pub use messages::{
     spec, AnkleState, Command, CommandKind, FaultEvent, Heartbeat, HeelStrike, Message, ParamAck,
     RawFrame, Version, BITRATE_BPS, MESSAGES, PROTOCOL_VERSION,

@@ -43,6 +43,23 @@ pub fn parse_answer(word: u16) -> Result<u16, EncoderError> {
     Ok(word & 0x3FFF)
 }
 
+/// Anything that reads the ankle angle once per control tick: the SPI encoder here, or the
+/// PWM-output encoder of [`crate::drivers::pwm_encoder`] (the B-G431B-ESC1 has no free SPI
+/// pins).
+pub trait AngleSensor {
+    /// Read the ankle angle.
+    ///
+    /// # Errors
+    /// [`EncoderError`]; the node raises `EncoderComms`.
+    fn read_angle(&mut self) -> Result<AngleSample, EncoderError>;
+}
+
+impl<S: SpiDevice> AngleSensor for MagneticEncoder<S> {
+    fn read_angle(&mut self) -> Result<AngleSample, EncoderError> {
+        self.read()
+    }
+}
+
 /// The encoder on an SPI device.
 pub struct MagneticEncoder<S> {
     spi: S,

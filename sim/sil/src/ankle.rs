@@ -30,7 +30,8 @@ use crate::side::Side;
 use crate::tick::TickTime;
 
 /// The board's drivers over the simulator's hardware.
-type SimDrivers = AnkleDrivers<SimSpi, SimContactPin, SimActuator, SimCan, SimClock>;
+type SimDrivers =
+    AnkleDrivers<MagneticEncoder<SimSpi>, SimContactPin, SimActuator, SimCan, SimClock>;
 
 /// The orchestrator's ends of one ankle's hardware (shared with the drivers' ends).
 struct Wiring {
@@ -48,6 +49,8 @@ pub(crate) struct BusAccess {
     pub tx_room: usize,
     /// The node is bus-off.
     pub bus_off: bool,
+    /// The node's fault-confinement state and transmit error counter.
+    pub error_state: (canbus::ErrorState, u16),
 }
 
 /// What one step of an ankle's firmware did, for the records.
@@ -160,6 +163,7 @@ impl Ankle {
             let mut can = w.can.borrow_mut();
             can.set_tx_room(access.tx_room);
             can.set_bus_off(access.bus_off);
+            can.set_error_state(access.error_state.0, access.error_state.1);
         }
         // The string's torque acts on the stance ankle's servo only.
         w.actuator

@@ -190,6 +190,7 @@ impl FirmwareInTheLoop {
         let access = BusAccess {
             tx_room: self.bus.tx_room(ankle.handle()),
             bus_off: self.bus.is_bus_off(ankle.handle()),
+            error_state: self.bus.error_state(ankle.handle()),
         };
         let step = ankle.step(t, &scene, access);
         self.records.observe(t.t_s, side, scene.stance, &step);
