@@ -18,6 +18,8 @@ pub(crate) mod fmt;
 
 pub mod drivers;
 pub mod estimator;
+pub mod fault_report;
+pub mod following;
 pub mod node;
 pub mod params;
 pub mod reflex;

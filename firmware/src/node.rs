@@ -11,7 +11,9 @@ use protocol::{
 };
 
 use crate::estimator::{AngleEstimator, EstimatorGains};
+use crate::fault_report::FaultReporter;
 use crate::fmt::{log_info, log_warn};
+use crate::following::FollowingErrorMonitor;
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
 use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
@@ -21,7 +23,7 @@ use crate::time::Instant;
 pub const MAX_RX_PER_TICK: usize = 8;
 /// Capacity of the per-tick transmit list: heel strike, every fault code changing at once,
 /// one acknowledgement per received message, state, heartbeat and version.
-pub const MAX_TX_PER_TICK: usize = 1 + 8 + MAX_RX_PER_TICK + 3;
+pub const MAX_TX_PER_TICK: usize = 1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3;
 
 /// Firmware version sent in the [`Version`] message.
 pub const FIRMWARE_VERSION: (u8, u8, u8) = (0, 1, 0);
@@ -125,6 +127,11 @@ pub struct AnkleNode {
     next_heartbeat_at: Instant,
     next_version_at: Instant,
     dropped_tx: u32,
+    following: FollowingErrorMonitor,
+    driven_setpoint: Option<f32>,
+    enabled_at: Option<Instant>,
+    peer_state: Option<(Instant, NodeState)>,
+    reporter: FaultReporter,
 }
 
 /// Accumulates one tick's transmissions, counting what does not fit.
@@ -176,6 +183,11 @@ impl AnkleNode {
             next_heartbeat_at: Instant(0),
             next_version_at: Instant(0),
             dropped_tx: 0,
+            following: FollowingErrorMonitor::default(),
+            driven_setpoint: None,
+            enabled_at: None,
+            peer_state: None,
+            reporter: FaultReporter::default(),
         })
     }
 
@@ -215,28 +227,48 @@ impl AnkleNode {
         if present == self.faults.contains(code) {
             return;
         }
-        let transition = if present {
+        if present {
             self.faults.insert(code);
             log_warn!("fault raised: {}", code);
-            FaultTransition::Raised
         } else {
             self.faults.remove(code);
             log_info!("fault cleared: {}", code);
-            FaultTransition::Cleared
-        };
+        }
+        if let Some(r) = self
+            .reporter
+            .changed(now, code, present, detail.unwrap_or(0))
+        {
+            self.send_fault(out, now, r.code, r.transition, r.detail);
+        }
+    }
+
+    fn send_fault(
+        &self,
+        out: &mut Outbox,
+        now: Instant,
+        code: FaultCode,
+        transition: FaultTransition,
+        detail: i16,
+    ) {
         out.push(Message::Fault(FaultEvent {
             node: self.config.node,
             code,
             transition,
-            detail: detail.unwrap_or(0),
+            detail,
             uptime_ms: now.uptime_ms(),
         }));
     }
 
-    fn enter(&mut self, state: NodeState, contact_closed: bool) {
+    /// Fault changes held back by the inhibit time (see [`crate::fault_report`]).
+    pub fn suppressed_fault_events(&self) -> u32 {
+        self.reporter.suppressed()
+    }
+
+    fn enter(&mut self, now: Instant, state: NodeState, contact_closed: bool) {
         if state == self.state {
             return;
         }
+        self.enabled_at = (state == NodeState::Enabled).then_some(now);
         log_info!("node state {} -> {}", self.state, state);
         self.state = state;
         if state == NodeState::Enabled {
@@ -246,19 +278,25 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, contact_closed: bool) {
+    fn handle_command(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        cmd: &Command,
+        contact_closed: bool,
+    ) {
         if !cmd.target.addresses(self.config.node) {
             return;
         }
         match cmd.kind {
-            CommandKind::EmergencyStop => self.enter(NodeState::EmergencyStop, contact_closed),
-            CommandKind::Disable => self.enter(NodeState::Disabled, contact_closed),
+            CommandKind::EmergencyStop => self.enter(now, NodeState::EmergencyStop, contact_closed),
+            CommandKind::Disable => self.enter(now, NodeState::Disabled, contact_closed),
             CommandKind::Enable => {
                 // From Disabled or Safe only, and only without a safety-relevant fault;
                 // emergency stop needs a Disable first.
                 let allowed = matches!(self.state, NodeState::Disabled | NodeState::Safe);
                 if allowed && !self.faults.any_safety_relevant() {
-                    self.enter(NodeState::Enabled, contact_closed);
+                    self.enter(now, NodeState::Enabled, contact_closed);
                 }
             }
             CommandKind::SetParam { param, value } => {
@@ -294,17 +332,20 @@ impl AnkleNode {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(&mut out, c, contact),
+                Message::Command(c) => self.handle_command(&mut out, now, c, contact),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
+                    self.peer_state = Some((now, h.state));
                 }
                 Message::HeelStrike(h) if h.node == self.peer => peer_heel_strike = true,
                 _ => {}
             }
         }
 
-        // 2. Sensors: plausibility, then the estimator on good samples.
-        let driving = self.reflex.phase() == ReflexPhase::Push;
+        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check runs
+        // in every driven phase (push and hold): a working encoder's reading always moves by
+        // its noise, a frozen one does not.
+        let driving = matches!(self.reflex.phase(), ReflexPhase::Push | ReflexPhase::Hold);
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
@@ -312,6 +353,13 @@ impl AnkleNode {
         self.set_fault(&mut out, now, FaultCode::EncoderRange, found.range);
         self.set_fault(&mut out, now, FaultCode::EncoderRate, found.rate);
         self.set_fault(&mut out, now, FaultCode::EncoderStuck, found.stuck);
+        // Following error against the previous tick's setpoint, on a plausible reading.
+        let measured = match inputs.angle {
+            Ok(s) if found.range.is_none() && found.rate.is_none() => Some(s.angle_rad),
+            _ => None,
+        };
+        let following = self.following.check(now, self.driven_setpoint, measured);
+        self.set_fault(&mut out, now, FaultCode::FollowingError, following);
         match inputs.angle {
             Ok(s) if found.range.is_none() && found.rate.is_none() => {
                 let dt = self
@@ -370,9 +418,25 @@ impl AnkleNode {
             }));
         }
 
-        // 5. Safe state on any safety-relevant fault.
+        // 5. The peer's own state, from heartbeats received since this node was enabled: a
+        // peer in its safe state or emergency stop cannot walk, so neither can this one.
+        let peer_safe = match (self.enabled_at, self.peer_state) {
+            (Some(since), Some((at, st))) if at > since => {
+                matches!(st, NodeState::Safe | NodeState::EmergencyStop)
+            }
+            _ => false,
+        };
+        let peer_detail = self.peer_state.map(|(_, st)| st.raw() as i16);
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::PeerSafe,
+            if peer_safe { peer_detail } else { None },
+        );
+
+        // Safe state on any safety-relevant fault.
         if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
-            self.enter(NodeState::Safe, contact);
+            self.enter(now, NodeState::Safe, contact);
         }
 
         // 6. The reflex.
@@ -398,6 +462,15 @@ impl AnkleNode {
         }
         if self.state != NodeState::Enabled {
             self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+        }
+        self.driven_setpoint = match actuator {
+            ActuatorCommand::Position { ankle_angle_rad } => Some(ankle_angle_rad),
+            ActuatorCommand::Released => None,
+        };
+        // Fault events held back by their inhibit time.
+        let faults = self.faults;
+        for r in self.reporter.due(now, |c| faults.contains(c)) {
+            self.send_fault(&mut out, now, r.code, r.transition, r.detail);
         }
 
         // 7. Periodic messages.

@@ -5,7 +5,7 @@
 
 use firmware::node::{AnkleNode, DriverHealth, NodeConfig, TickInputs, TickOutputs};
 use firmware::scenarios::CALIBRATION;
-use firmware::sensors::{AngleSample, EncoderError};
+use firmware::sensors::{with_simulated_noise, AngleSample, EncoderError};
 use firmware::{ActuatorCommand, Instant};
 use protocol::*;
 
@@ -21,6 +21,8 @@ struct Bench {
     frozen: Option<u16>,
     drivers: DriverHealth,
     heartbeats: bool,
+    peer_state: NodeState,
+    reversed_motor: bool,
 }
 
 fn cmd(kind: CommandKind) -> Message {
@@ -41,6 +43,8 @@ impl Bench {
             frozen: None,
             drivers: DriverHealth::default(),
             heartbeats: true,
+            peer_state: NodeState::Enabled,
+            reversed_motor: false,
         }
     }
 
@@ -49,7 +53,7 @@ impl Bench {
         if self.heartbeats && self.ms.is_multiple_of(50) {
             rx.push(Message::Heartbeat(Heartbeat {
                 node: PEER,
-                state: NodeState::Enabled,
+                state: self.peer_state,
                 faults: FaultFlags::NONE,
                 uptime_ms: self.ms as u32,
             }));
@@ -57,9 +61,9 @@ impl Bench {
         let angle = match self.encoder_error {
             Some(e) => Err(e),
             None => {
-                let counts = self
-                    .frozen
-                    .unwrap_or_else(|| CALIBRATION.counts(self.angle));
+                let counts = self.frozen.unwrap_or_else(|| {
+                    with_simulated_noise(CALIBRATION.counts(self.angle), self.ms as u32)
+                });
                 Ok(AngleSample {
                     counts,
                     angle_rad: CALIBRATION.angle_rad(counts),
@@ -76,9 +80,12 @@ impl Bench {
             },
         );
         self.ms += 1;
-        // The plant: a taut string holds the ankle at or above the setpoint.
+        // The plant: a taut string holds the ankle at or above the setpoint; a reversed
+        // motor pays the string out instead (the ankle sinks at 2 rad/s).
         if let ActuatorCommand::Position { ankle_angle_rad } = out.actuator {
-            if ankle_angle_rad > self.angle {
+            if self.reversed_motor {
+                self.angle -= 0.002;
+            } else if ankle_angle_rad > self.angle {
                 self.angle = ankle_angle_rad;
             }
         }
@@ -572,4 +579,122 @@ fn estimator_reports_angle_and_rate_in_telemetry() {
     let s = state.unwrap();
     assert!((s.rate.to_si() + 0.5).abs() < 0.02, "{:?}", s.rate);
     assert!((s.angle.to_si() - (0.1 - 0.5e-3 * 495.0)).abs() < 0.01);
+}
+
+/// Runs an enabled node through its push into Hold.
+fn bench_in_hold() -> Bench {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    for _ in 0..300 {
+        if b.node.phase() == ReflexPhase::Hold {
+            break;
+        }
+        b.tick();
+    }
+    assert_eq!(b.node.phase(), ReflexPhase::Hold);
+    // Hold for a while with a healthy (noisy) encoder: no stuck fault.
+    for _ in 0..200 {
+        assert_eq!(b.tick().state, NodeState::Enabled);
+    }
+    b
+}
+
+#[test]
+fn stuck_encoder_during_hold_releases_within_50_ms() {
+    let mut b = bench_in_hold();
+    b.frozen = Some(CALIBRATION.counts(b.angle));
+    let mut released_after = None;
+    let mut msgs = Vec::new();
+    // Tick k (from 0) runs k ms after the first frozen sample.
+    for k in 0..=60 {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.actuator == ActuatorCommand::Released {
+            assert_eq!(o.state, NodeState::Safe);
+            released_after = Some(k);
+            break;
+        }
+    }
+    let ms = released_after.expect("released");
+    assert!(ms <= 50, "released {ms} ms after the freeze");
+    assert_eq!(
+        fault_events(&msgs, FaultCode::EncoderStuck),
+        [FaultTransition::Raised]
+    );
+}
+
+#[test]
+fn following_error_catches_a_reversed_motor() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.reversed_motor = true;
+    let mut msgs = Vec::new();
+    let mut safe_after = None;
+    for ms in 1..=200 {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.state == NodeState::Safe {
+            assert_eq!(o.actuator, ActuatorCommand::Released);
+            safe_after = Some(ms);
+            break;
+        }
+    }
+    let ms = safe_after.expect("the following error stops a reversed motor");
+    // The setpoint rises while the ankle sinks: 0.05 rad of shortfall within ~10 ms, then
+    // 30 ms of it.
+    assert!(ms <= 60, "{ms} ms");
+    assert_eq!(
+        fault_events(&msgs, FaultCode::FollowingError),
+        [FaultTransition::Raised]
+    );
+    assert!(!b.node.faults().contains(FaultCode::EncoderStuck));
+}
+
+#[test]
+fn a_healthy_push_and_hold_raise_no_following_error() {
+    let b = bench_in_hold();
+    assert!(b.node.faults().is_empty(), "{:?}", b.node.faults());
+}
+
+#[test]
+fn a_peer_in_its_safe_state_makes_this_node_safe_until_enabled_again() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.peer_state = NodeState::Safe;
+    let msgs = b.run(150);
+    assert_eq!(b.node.state(), NodeState::Safe);
+    assert_eq!(
+        fault_events(&msgs, FaultCode::PeerSafe),
+        [FaultTransition::Raised, FaultTransition::Cleared],
+        "raised, then cleared once this node left Enabled"
+    );
+    // Both re-enabled: the peer's heartbeats say Enabled again, and so does this node.
+    b.peer_state = NodeState::Enabled;
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Enable)]).state,
+        NodeState::Enabled
+    );
+    b.run(200);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+    // A peer that is merely disabled is no fault.
+    b.peer_state = NodeState::Disabled;
+    b.run(200);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+}
+
+#[test]
+fn a_flapping_fault_is_reported_at_most_once_per_inhibit_time() {
+    let mut b = Bench::enabled();
+    let mut msgs = Vec::new();
+    for k in 0..200 {
+        b.drivers.actuator_error = k % 2 == 0;
+        msgs.extend(b.tick().transmit);
+    }
+    let events = fault_events(&msgs, FaultCode::Actuator);
+    assert!(
+        (2..=5).contains(&events.len()),
+        "{} events in 200 ms",
+        events.len()
+    );
+    assert!(b.node.suppressed_fault_events() > 100);
 }

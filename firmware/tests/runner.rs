@@ -370,3 +370,66 @@ fn encoder_and_bus_errors_become_faults() {
     step(&w, &mut d);
     assert!(!d.node.faults().contains(FaultCode::CanBus));
 }
+
+fn enable(w: &World, d: &mut Drivers) {
+    send(
+        w,
+        Message::Command(Command {
+            target: Target::Broadcast,
+            kind: CommandKind::Enable,
+        }),
+    );
+    assert_eq!(step(w, d).state, NodeState::Enabled);
+}
+
+#[test]
+fn boot_with_the_foot_down_sends_no_heel_strike() {
+    let (w, mut d) = setup();
+    w.contact_closed.set(true);
+    for _ in 0..100 {
+        step(&w, &mut d);
+    }
+    enable(&w, &mut d);
+    for _ in 0..100 {
+        step(&w, &mut d);
+    }
+    assert!(
+        !sent(&w).iter().any(|m| matches!(m, Message::HeelStrike(_))),
+        "a foot already down at power-up is no heel strike"
+    );
+    // The next real strike is announced.
+    w.contact_closed.set(false);
+    for _ in 0..10 {
+        step(&w, &mut d);
+    }
+    w.contact_closed.set(true);
+    for _ in 0..10 {
+        step(&w, &mut d);
+    }
+    let strikes = sent(&w)
+        .iter()
+        .filter(|m| matches!(m, Message::HeelStrike(_)))
+        .count();
+    assert_eq!(strikes, 1);
+}
+
+#[test]
+fn one_error_frame_is_no_safe_state_but_bus_off_is() {
+    let (w, mut d) = setup();
+    step(&w, &mut d);
+    enable(&w, &mut d);
+    w.bus_error.set(true);
+    for _ in 0..20 {
+        assert_eq!(step(&w, &mut d).state, NodeState::Enabled);
+    }
+    assert_eq!(d.can.stats().bus_errors, 1);
+    w.bus_state.set(BusState::ErrorPassive);
+    for _ in 0..20 {
+        assert_eq!(step(&w, &mut d).state, NodeState::Enabled);
+    }
+    w.bus_state.set(BusState::BusOff);
+    let o = step(&w, &mut d);
+    assert_eq!(o.state, NodeState::Safe);
+    assert_eq!(o.actuator, firmware::ActuatorCommand::Released);
+    assert!(d.node.faults().contains(FaultCode::CanBus));
+}

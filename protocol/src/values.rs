@@ -134,17 +134,27 @@ wire_enum!(
         EncoderRange = 2,
         /// The angle changed faster than the ankle can move.
         EncoderRate = 3,
-        /// The angle did not change at all for too long while the actuator was driving.
+        /// The angle did not change at all for too long while the actuator was driving (push
+        /// or hold; a working magnetic encoder's output always moves by its noise).
         EncoderStuck = 4,
         /// No heartbeat from the other ankle within the timeout.
         PeerHeartbeatLost = 5,
         /// The actuator driver reported an error.
         Actuator = 6,
-        /// The CAN controller reported an error or the transmit queue overflowed.
+        /// The CAN controller went bus-off (status register), or the transmit queue
+        /// overflowed. Error frames and error-passive are not faults.
         CanBus = 7,
         /// The other foot's heel-strike message did not arrive before the own foot lifted
         /// (the own contact switch released the string). Not safety-relevant.
         PeerHeelStrikeLate = 8,
+        /// The measured ankle angle stayed more than the limit below the actuator's setpoint
+        /// for longer than the allowed time while driving (push or hold): the string is not
+        /// where it is commanded — a reversed or failed motor, a broken string, a frozen
+        /// encoder reading.
+        FollowingError = 9,
+        /// The other ankle reported (in its heartbeat, after this node was enabled) that it is
+        /// in its safe state or emergency stop: one ankle cannot walk alone.
+        PeerSafe = 10,
     }
 );
 

@@ -77,6 +77,11 @@ impl<S: SpiDevice> MagneticEncoder<S> {
         self.calibration
     }
 
+    /// The SPI device.
+    pub fn device(&self) -> &S {
+        &self.spi
+    }
+
     /// Give the SPI device back.
     pub fn release(self) -> S {
         self.spi

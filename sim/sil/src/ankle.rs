@@ -80,9 +80,6 @@ pub(crate) struct Ankle {
     handle: NodeHandle,
     drivers: SimDrivers,
     wiring: Wiring,
-    debounce_samples: u8,
-    /// The contact switch has been sampled for the debounce length before the first tick.
-    settled: bool,
 }
 
 impl Ankle {
@@ -131,8 +128,6 @@ impl Ankle {
             handle,
             drivers,
             wiring,
-            debounce_samples: config.debounce_samples,
-            settled: false,
         })
     }
 
@@ -157,6 +152,7 @@ impl Ankle {
     pub fn step(&mut self, t: TickTime, scene: &AnkleScene, access: BusAccess) -> AnkleStep {
         let w = &self.wiring;
         w.shaft.set(t.t_s, scene.angle_rad);
+        w.shaft.set_phase(self.drivers.node.phase());
         w.contact.set_closed(scene.contact_closed);
         w.clock.set(Instant::from_micros(t.t_ns / 1000));
         {
@@ -169,14 +165,6 @@ impl Ankle {
         w.actuator
             .borrow_mut()
             .set_tick(t.t_s, t.t_end_s, scene.angle_rad, scene.string_load_n_m);
-        if !self.settled {
-            // Power-up: the switch is sampled for the debounce length before the first tick,
-            // so that the firmware's debounced state (which starts open) is the foot's.
-            self.settled = true;
-            for _ in 0..self.debounce_samples {
-                let _ = self.drivers.contact.sample();
-            }
-        }
         // The firmware, as on the board.
         let outputs = self.drivers.step();
         let peer = self.side.other().node();
@@ -229,6 +217,11 @@ impl Ankle {
             .borrow_mut()
             .take_segment()
             .ok_or_else(|| control_error("the firmware applied no actuator command"))
+    }
+
+    /// The injected encoder faults that took effect at this ankle.
+    pub fn sensor_faults_applied(&self) -> &[crate::sensors::AppliedSensorFault] {
+        self.drivers.encoder.device().encoder().applied()
     }
 
     /// Fill in what the firmware, its CAN port, the controller and the actuator counted.

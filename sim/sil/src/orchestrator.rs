@@ -132,6 +132,11 @@ impl FirmwareInTheLoop {
             bus: self.bus.bus().stats(),
             host: self.host.report(),
             socketcand: self.bus.socketcand_report(),
+            sensor_faults_applied: self
+                .ankles
+                .iter()
+                .flat_map(|a| a.sensor_faults_applied().iter().cloned())
+                .collect(),
         }
     }
 
