@@ -21,6 +21,7 @@ pub mod estimator;
 pub mod fault_report;
 pub mod following;
 pub mod node;
+pub mod param_store;
 pub mod params;
 pub mod reflex;
 pub mod runner;

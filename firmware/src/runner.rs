@@ -10,7 +10,7 @@ use crate::drivers::actuator::Actuator;
 use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
-use crate::node::{AnkleNode, DriverHealth, TickInputs, TickOutputs, MAX_RX_PER_TICK};
+use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
 use crate::time::Monotonic;
 
 /// Every driver of one ankle, and its node.
@@ -81,6 +81,11 @@ where
             },
         };
         let out = self.node.tick(now, &inputs);
+        // An encoder-zero calibration takes effect at once; a save is the caller's (it needs
+        // the flash), reported back with `AnkleNode::storage_done`.
+        if let Some(NodeRequest::SetEncoderZero { zero_counts }) = out.request {
+            self.encoder.set_zero_counts(zero_counts);
+        }
         let measured = self.node.estimate().map(|(a, _)| a);
         self.health.actuator_error = self.actuator.apply(out.actuator, measured).is_err();
         self.health.can_error = self.can.transmit(&out.transmit);

@@ -169,7 +169,9 @@ fn starts_disabled_and_sends_version_heartbeat_and_state() {
         [
             MessageClass::Heartbeat,
             MessageClass::AnkleState,
-            MessageClass::Version
+            MessageClass::Version,
+            MessageClass::Identity,
+            MessageClass::BootInfo
         ]
     );
     // Over one second: 200 states, 20 heartbeats, one version.
@@ -697,4 +699,130 @@ fn a_flapping_fault_is_reported_at_most_once_per_inhibit_time() {
         events.len()
     );
     assert!(b.node.suppressed_fault_events() > 100);
+}
+
+#[test]
+fn identity_at_boot_and_on_request() {
+    let mut config = NodeConfig::nominal(ME);
+    config.uid = [0x11, 0x22, 0x33];
+    config.build_id = 0xC0FFEE;
+    config.reset_cause = ResetCause::IndependentWatchdog;
+    let mut b = Bench::new();
+    b.node = AnkleNode::new(config).unwrap();
+    let boot = b.tick().transmit;
+    let versions = boot
+        .iter()
+        .filter(|m| matches!(m, Message::Version(v) if v.build == 0xC0FFEE))
+        .count();
+    assert_eq!(versions, 1, "one Version at boot, with the identity");
+    assert!(boot.contains(&Message::Identity(Identity {
+        node: ME,
+        uid_low: 0x11,
+        uid_mid: 0x22
+    })));
+    assert!(boot.iter().any(|m| matches!(m,
+        Message::BootInfo(i) if i.uid_high == 0x33
+            && i.reset_cause == ResetCause::IndependentWatchdog)));
+    assert!(!b
+        .tick()
+        .transmit
+        .iter()
+        .any(|m| matches!(m, Message::Identity(_))));
+    let again = b.tick_with(&[cmd(CommandKind::GetIdentity), cmd(CommandKind::GetIdentity)]);
+    let n = again
+        .transmit
+        .iter()
+        .filter(|m| matches!(m, Message::Identity(_)))
+        .count();
+    assert_eq!(n, 1, "answered once per tick");
+}
+
+#[test]
+fn get_param_reads_the_value_in_force() {
+    let mut b = Bench::new();
+    b.tick();
+    let o = b.tick_with(&[cmd(CommandKind::GetParam {
+        param: ParamId::ExtendedAngle,
+    })]);
+    assert!(o.transmit.contains(&Message::ParamAck(ParamAck {
+        node: ME,
+        param: ParamId::ExtendedAngle,
+        status: ParamStatus::Read,
+        value: ParamValue(200_000),
+    })));
+}
+
+#[test]
+fn fault_history_says_why_the_node_went_safe_and_clear_errors_empties_it() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.encoder_error = Some(EncoderError::Parity { word: 1 });
+    assert_eq!(b.tick().state, NodeState::Safe);
+    b.encoder_error = None;
+    b.run(10);
+    let o = b.tick_with(&[cmd(CommandKind::GetFaultHistory)]);
+    let entries: Vec<FaultHistoryEntry> = o
+        .transmit
+        .iter()
+        .filter_map(|m| match m {
+            Message::FaultHistory(e) => Some(*e),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    assert_eq!(entries[0].entry, 0);
+    assert_eq!(entries[0].code, FaultCode::EncoderComms);
+    assert_eq!(entries[0].state_after, NodeState::Safe, "the cause of Safe");
+    assert_eq!(entries[0].detail, 2);
+    let o = b.tick_with(&[cmd(CommandKind::ClearErrors)]);
+    assert!(o.transmit.contains(&Message::CommandAck(CommandAck {
+        node: ME,
+        opcode: Opcode::ClearErrors,
+        result: CommandResult::Done,
+    })));
+    assert_eq!(b.node.fault_history().count(), 0);
+}
+
+#[test]
+fn save_params_asks_the_board_and_acknowledges_its_outcome() {
+    let mut b = Bench::new();
+    b.tick();
+    let o = b.tick_with(&[cmd(CommandKind::SaveParams)]);
+    assert_eq!(o.request, Some(firmware::node::NodeRequest::SaveParams));
+    assert!(!o
+        .transmit
+        .iter()
+        .any(|m| matches!(m, Message::CommandAck(_))));
+    b.node.storage_done(false);
+    let o = b.tick();
+    assert!(o.transmit.contains(&Message::CommandAck(CommandAck {
+        node: ME,
+        opcode: Opcode::SaveParams,
+        result: CommandResult::Failed,
+    })));
+    // Not while enabled.
+    let mut b = Bench::enabled();
+    let o = b.tick_with(&[cmd(CommandKind::SaveParams)]);
+    assert_eq!(o.request, None);
+    assert!(o.transmit.iter().any(|m| matches!(m,
+        Message::CommandAck(a) if a.result == CommandResult::NotWhileEnabled)));
+}
+
+#[test]
+fn encoder_zero_calibration_takes_the_current_reading() {
+    let mut b = Bench::new();
+    b.tick();
+    b.angle = 0.3;
+    b.frozen = Some(5000);
+    let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
+    assert_eq!(
+        o.request,
+        Some(firmware::node::NodeRequest::SetEncoderZero { zero_counts: 5000 })
+    );
+    assert!(o.transmit.iter().any(|m| matches!(m,
+        Message::CommandAck(a) if a.opcode == Opcode::CalibrateEncoderZero
+            && a.result == CommandResult::Done)));
+    b.encoder_error = Some(EncoderError::Parity { word: 1 });
+    let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
+    assert_eq!(o.request, None, "no reading, no calibration");
 }

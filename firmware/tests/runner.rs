@@ -328,13 +328,15 @@ fn full_controller_queues_then_sends_in_order() {
     w.tx_room.set(1000);
     step(&w, &mut d);
     let classes: Vec<_> = sent(&w).iter().map(Message::class).collect();
-    // Tick 0's heartbeat, state and version, then tick 1's (nothing periodic due at 1 ms).
+    // Tick 0's heartbeat, state, version and identity, then tick 1's (nothing periodic due at 1 ms).
     assert_eq!(
         classes,
         [
             MessageClass::Heartbeat,
             MessageClass::AnkleState,
-            MessageClass::Version
+            MessageClass::Version,
+            MessageClass::Identity,
+            MessageClass::BootInfo
         ]
     );
     assert_eq!(d.can.stats().dropped, 0);

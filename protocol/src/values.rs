@@ -191,6 +191,8 @@ wire_enum!(
         Inconsistent = 2,
         /// Parameters may only change while the node is disabled; the old value stays.
         NotWhileEnabled = 3,
+        /// Answer to `GetParam`: the value in force.
+        Read = 4,
     }
 );
 
@@ -205,6 +207,68 @@ wire_enum!(
         EmergencyStop = 3,
         /// Set one reflex parameter.
         SetParam = 4,
+        /// Read one parameter (answered by `ParamAck` with status `Read`).
+        GetParam = 5,
+        /// Store the parameters in force and the encoder zero in flash (answered by
+        /// `CommandAck`).
+        SaveParams = 6,
+        /// Empty the fault history (answered by `CommandAck`).
+        ClearErrors = 7,
+        /// Send `Version`, `Identity` and `BootInfo` now.
+        GetIdentity = 8,
+        /// Send the fault history, newest first (`FaultHistory` frames).
+        GetFaultHistory = 9,
+        /// Take the current encoder reading as ankle angle zero (node disabled, ankle held at
+        /// its zero pose; answered by `CommandAck`; stored by `SaveParams`).
+        CalibrateEncoderZero = 10,
+    }
+);
+
+wire_enum!(
+    /// Why the node's microcontroller last reset.
+    ResetCause {
+        /// No flag was set (or not known, e.g. in simulation).
+        Unknown = 0,
+        /// Power-on or brown-out.
+        PowerOn = 1,
+        /// The reset pin (probe, button).
+        Pin = 2,
+        /// Software reset.
+        Software = 3,
+        /// The independent watchdog: the control loop stopped running on time.
+        IndependentWatchdog = 4,
+        /// The window watchdog.
+        WindowWatchdog = 5,
+        /// Low-power reset.
+        LowPower = 6,
+        /// Option-byte loading.
+        OptionBytes = 7,
+    }
+);
+
+wire_enum!(
+    /// Where the values in force came from at start-up.
+    ConfigSource {
+        /// Built-in defaults (nothing stored).
+        Defaults = 0,
+        /// Read from flash.
+        Flash = 1,
+        /// Flash could not be read; built-in defaults.
+        FlashUnreadable = 2,
+    }
+);
+
+wire_enum!(
+    /// Outcome of a command answered by `CommandAck`.
+    CommandResult {
+        /// Done.
+        Done = 0,
+        /// Tried and failed (e.g. the flash write failed).
+        Failed = 1,
+        /// Refused while the node is enabled.
+        NotWhileEnabled = 2,
+        /// Not possible now (e.g. no good encoder reading to calibrate from).
+        NotAvailable = 3,
     }
 );
 

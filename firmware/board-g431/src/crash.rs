@@ -13,7 +13,11 @@ use crate::power_stage::power_stage_off;
 fn panic(info: &PanicInfo) -> ! {
     power_stage_off();
     compiler_fence(Ordering::SeqCst);
-    defmt::error!("panic: {}", defmt::Display2Format(info));
+    // File and line only: formatting the message would pull core::fmt into the binary.
+    match info.location() {
+        Some(l) => defmt::error!("panic at {}:{}", l.file(), l.line()),
+        None => defmt::error!("panic"),
+    }
     halt()
 }
 

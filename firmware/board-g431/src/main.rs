@@ -24,9 +24,14 @@ mod reset_cause;
 
 use defmt_rtt as _;
 
+// defmt log lines carry the embassy uptime in microseconds.
+defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
+
+use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::Spawner;
 use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::can::{self, OperatingMode, RxBuf, TxBuf};
+use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Input, Level, Output, OutputType, Pull, Speed};
 use embassy_stm32::opamp::{OpAmp, OpAmpSpeed};
 use embassy_stm32::peripherals::{FDCAN1, TIM2};
@@ -41,8 +46,11 @@ use embassy_stm32::{bind_interrupts, rcc, timer, Config};
 use embassy_time::{Duration, Ticker};
 use firmware::drivers::can::CanPort;
 use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
+use firmware::drivers::encoder::AngleSensor;
 use firmware::drivers::pwm_encoder::PwmAngleEncoder;
 use firmware::drivers::spool_motor::{SpoolMotor, SpoolMotorConfig};
+use firmware::node::NodeRequest;
+use firmware::param_store::ParamStore;
 use firmware::runner::AnkleDrivers;
 use firmware::sensors::AngleCalibration;
 use firmware::supervisor::LoopSupervisor;
@@ -75,7 +83,11 @@ const MAX_TICK_US: u64 = 200;
 /// than a flash page erase (SaveParams stalls the core while it erases).
 const WATCHDOG_TIMEOUT_US: u32 = 50_000;
 
-/// Encoder zero: counts at ankle angle 0 (set after mounting the magnet).
+/// Flash kept for parameters and calibration [offsets from the flash base]: the last four
+/// 2 KiB pages of the 128 KiB (the binary is held under 64 KiB by scripts/firmware-tier).
+const PARAM_FLASH: core::ops::Range<u32> = 0x1E000..0x20000;
+
+/// Encoder zero used until one is calibrated and stored (CalibrateEncoderZero, SaveParams).
 const CALIBRATION: AngleCalibration = AngleCalibration {
     zero_counts: 0,
     reversed: false,
@@ -135,6 +147,22 @@ async fn main(_spawner: Spawner) {
     let id = node_id();
     defmt::info!("ankle node {} starting, reset cause {}", id, cause);
 
+    // Parameters and encoder zero from flash (defaults when nothing is stored).
+    let mut store = match ParamStore::new(
+        BlockingAsync::new(Flash::new_blocking(p.FLASH)),
+        PARAM_FLASH,
+    ) {
+        Ok(s) => s,
+        Err(e) => defmt::panic!("parameter flash range: {}", e),
+    };
+    let loaded = store.load(CALIBRATION).await;
+    defmt::info!(
+        "parameters from {}, encoder zero {} from {}",
+        loaded.params_source,
+        loaded.calibration.zero_counts,
+        loaded.calibration_source
+    );
+
     // Power stage: phases U and V as two half-bridges, W held low; off until driven.
     let pwm = ComplementaryPwm::new(
         p.TIM1,
@@ -183,7 +211,7 @@ async fn main(_spawner: Spawner) {
         Pull::Down,
         hz(PWM_CAPTURE_TICK_HZ),
     ));
-    let encoder = PwmAngleEncoder::new(capture, CALIBRATION, ENCODER_PWM_PERIOD_TICKS, 2);
+    let encoder = PwmAngleEncoder::new(capture, loaded.calibration, ENCODER_PWM_PERIOD_TICKS, 2);
 
     // Contact switch: the connector's third pin (PB8, to ground, pull-up), 3 ms debounce.
     let contact = ContactSwitch::new(Input::new(p.PB8, Pull::Up), ActiveLevel::Low, 3);
@@ -218,11 +246,16 @@ async fn main(_spawner: Spawner) {
     defmt::info!("CAN 500 kbit/s, termination {}", term);
 
     let mut config = NodeConfig::nominal(id);
-    config.build_id = 0x0001_0000;
-    let node = match AnkleNode::new(config) {
+    config.build_id = u32::from_str_radix(env!("GIT_HASH"), 16).unwrap_or(0);
+    config.uid = reset_cause::unique_id();
+    config.reset_cause = cause;
+    config.params_source = loaded.params_source;
+    config.calibration_source = loaded.calibration_source;
+    let mut node = match AnkleNode::new(config) {
         Ok(n) => n,
         Err(e) => defmt::panic!("node config: {}", e),
     };
+    node.restore_params(loaded.params);
     let mut drivers = AnkleDrivers::new(
         node,
         encoder,
@@ -253,6 +286,15 @@ async fn main(_spawner: Spawner) {
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(start);
         if supervisor.tick(started, EmbassyClock.now()) {
             watchdog.pet();
+        }
+        // SaveParams: the flash erase stalls the core for milliseconds (the supervisor sees a
+        // late tick; the 50 ms watchdog covers it).
+        if out.request == Some(NodeRequest::SaveParams) {
+            let params = *drivers.node.params();
+            let cal = drivers.encoder.calibration();
+            let ok = store.save(&params, cal).await.is_ok();
+            defmt::info!("parameters saved: {}", ok);
+            drivers.node.storage_done(ok);
         }
         worst = worst.max(cycles);
         n = n.wrapping_add(1);

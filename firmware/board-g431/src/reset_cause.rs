@@ -1,26 +1,7 @@
 //! Why the chip last reset, from RCC_CSR's flags (cleared after reading so that the next
-//! reset reports its own cause).
+//! reset reports its own cause), as the protocol's `ResetCause` (sent in `BootInfo`).
 
-/// Reset causes, as the protocol reports them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
-pub enum ResetCause {
-    /// Power-on or brown-out.
-    PowerOn,
-    /// The reset pin (NRST, the ST-LINK or the button).
-    Pin,
-    /// Software reset (SYSRESETREQ, e.g. after flashing).
-    Software,
-    /// The independent watchdog: the control loop stopped running on time.
-    IndependentWatchdog,
-    /// The window watchdog.
-    WindowWatchdog,
-    /// Low-power reset.
-    LowPower,
-    /// Option-byte loading.
-    OptionBytes,
-    /// No flag set.
-    Unknown,
-}
+use protocol::ResetCause;
 
 /// Read and clear the reset flags.
 pub fn read_and_clear() -> ResetCause {
@@ -46,4 +27,18 @@ pub fn read_and_clear() -> ResetCause {
     };
     rcc.csr().modify(|w| w.set_rmvf(true));
     cause
+}
+
+/// The 96-bit unique ID as three little-endian words (bits 0–31, 32–63, 64–95).
+pub fn unique_id() -> [u32; 3] {
+    let b = embassy_stm32::uid::uid();
+    let word = |k: usize| {
+        u32::from_le_bytes([
+            b.get(4 * k).copied().unwrap_or(0),
+            b.get(4 * k + 1).copied().unwrap_or(0),
+            b.get(4 * k + 2).copied().unwrap_or(0),
+            b.get(4 * k + 3).copied().unwrap_or(0),
+        ])
+    };
+    [word(0), word(1), word(2)]
 }

@@ -52,11 +52,21 @@ pub trait AngleSensor {
     /// # Errors
     /// [`EncoderError`]; the node raises `EncoderComms`.
     fn read_angle(&mut self) -> Result<AngleSample, EncoderError>;
+    /// The calibration in use.
+    fn calibration(&self) -> AngleCalibration;
+    /// Use `zero_counts` as the reading at ankle angle zero from now on.
+    fn set_zero_counts(&mut self, zero_counts: u16);
 }
 
 impl<S: SpiDevice> AngleSensor for MagneticEncoder<S> {
     fn read_angle(&mut self) -> Result<AngleSample, EncoderError> {
         self.read()
+    }
+    fn calibration(&self) -> AngleCalibration {
+        self.calibration
+    }
+    fn set_zero_counts(&mut self, zero_counts: u16) {
+        self.calibration.zero_counts = zero_counts;
     }
 }
 
@@ -70,11 +80,6 @@ impl<S: SpiDevice> MagneticEncoder<S> {
     /// Wrap an SPI device (mode 1, ≤ 10 MHz).
     pub fn new(spi: S, calibration: AngleCalibration) -> Self {
         MagneticEncoder { spi, calibration }
-    }
-
-    /// The calibration in use.
-    pub fn calibration(&self) -> AngleCalibration {
-        self.calibration
     }
 
     /// The SPI device.

@@ -91,14 +91,17 @@ impl<C: PwmCapture> PwmAngleEncoder<C> {
             max_missed,
         }
     }
-
-    /// Replace the calibration (after an encoder-zero calibration).
-    pub fn set_calibration(&mut self, calibration: AngleCalibration) {
-        self.calibration = calibration;
-    }
 }
 
 impl<C: PwmCapture> AngleSensor for PwmAngleEncoder<C> {
+    fn calibration(&self) -> AngleCalibration {
+        self.calibration
+    }
+    fn set_zero_counts(&mut self, zero_counts: u16) {
+        self.calibration.zero_counts = zero_counts;
+        self.last = None;
+    }
+
     fn read_angle(&mut self) -> Result<AngleSample, EncoderError> {
         match self.capture.take_frame() {
             Some(frame) => {
