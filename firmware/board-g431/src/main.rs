@@ -147,22 +147,6 @@ async fn main(_spawner: Spawner) {
     let id = node_id();
     defmt::info!("ankle node {} starting, reset cause {}", id, cause);
 
-    // Parameters and encoder zero from flash (defaults when nothing is stored).
-    let mut store = match ParamStore::new(
-        BlockingAsync::new(Flash::new_blocking(p.FLASH)),
-        PARAM_FLASH,
-    ) {
-        Ok(s) => s,
-        Err(e) => defmt::panic!("parameter flash range: {}", e),
-    };
-    let loaded = store.load(CALIBRATION).await;
-    defmt::info!(
-        "parameters from {}, encoder zero {} from {}",
-        loaded.params_source,
-        loaded.calibration.zero_counts,
-        loaded.calibration_source
-    );
-
     // Power stage: phases U and V as two half-bridges, W held low; off until driven.
     let pwm = ComplementaryPwm::new(
         p.TIM1,
@@ -180,6 +164,22 @@ async fn main(_spawner: Spawner) {
     let bridges = Tim1Bridges::new(pwm);
     let _phase_w_high = Output::new(p.PA10, Level::Low, Speed::Low);
     let _phase_w_low = Output::new(p.PB15, Level::Low, Speed::Low);
+
+    // Parameters and encoder zero from flash (defaults when nothing is stored).
+    let mut store = match ParamStore::new(
+        BlockingAsync::new(Flash::new_blocking(p.FLASH)),
+        PARAM_FLASH,
+    ) {
+        Ok(s) => s,
+        Err(e) => defmt::panic!("parameter flash range: {}", e),
+    };
+    let loaded = store.load(CALIBRATION).await;
+    defmt::info!(
+        "parameters from {}, encoder zero {} from {}",
+        loaded.params_source,
+        loaded.calibration.zero_counts,
+        loaded.calibration_source
+    );
 
     // Current sense: OPAMP1 (phase U shunt) and OPAMP2 (phase V) with the board's external
     // gain networks, read by ADC1 and ADC2.
