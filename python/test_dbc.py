@@ -28,7 +28,8 @@ def vectors():
 
 def test_strict_load_has_every_node_and_message(db):
     assert sorted(n.name for n in db.nodes) == ["HOST", "LEFT_ANKLE", "RIGHT_ANKLE"]
-    assert len(db.messages) == 20
+    # 20 identifiers of v1, plus Identity, BootInfo, CommandAck and FaultHistory per ankle
+    assert len(db.messages) == 28
     for m in db.messages:
         assert not m.is_extended_frame
         assert m.frame_id < 0x800

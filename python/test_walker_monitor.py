@@ -123,3 +123,35 @@ def test_worst_case_bound_and_crc_residue():
         data = bytes(rnd.randrange(256) for _ in range(n))
         bits = wm.frame_bits(rnd.randrange(0x800), data)
         assert 34 + 8 * n + 13 <= bits <= wm.worst_case_bits(n)
+
+
+def _frame(db, name, **signals):
+    m = db.get_message_by_name(name)
+    return can.Message(arbitration_id=m.frame_id, is_extended_id=False,
+                       data=m.encode(signals), timestamp=1.0)
+
+
+def test_identity_and_fault_history_are_decoded_per_node(db):
+    mon = wm.Monitor(db)
+    mon.feed(_frame(db, "Version_LEFT_ANKLE", protocol_version=2, fw_major=0, fw_minor=1,
+                    fw_patch=0, build_id=0x5F69C0E1))
+    mon.feed(_frame(db, "Identity_LEFT_ANKLE", uid_low=0x00340021, uid_mid=0x31385108))
+    mon.feed(_frame(db, "BootInfo_LEFT_ANKLE", uid_high=0x20334E50,
+                    reset_cause="IndependentWatchdog", params_source="Flash",
+                    fault_history_len=2, calibration_source="Defaults"))
+    for k, (code, state) in enumerate((("EncoderStuck", "Safe"), ("CanBus", "Disabled"))):
+        mon.feed(_frame(db, "FaultHistory_LEFT_ANKLE", entry=k, code=code, state_after=state,
+                        detail=-3, uptime=12.345))
+    mon.feed(_frame(db, "CommandAck_LEFT_ANKLE", opcode="SaveParams", result="Done"))
+    left = mon.summary()["nodes"]["LEFT_ANKLE"]
+    ident = left["identity"]
+    assert ident["firmware"] == "0.1.0"
+    assert ident["build_id"] == "5f69c0e1"
+    assert ident["uid"] == "20334e50" "31385108" "00340021"
+    assert ident["reset_cause"] == "IndependentWatchdog"
+    assert ident["params_source"] == "Flash"
+    assert [e["code"] for e in left["fault_history"]] == ["EncoderStuck", "CanBus"]
+    assert left["fault_history"][0]["state_after"] == "Safe"
+    assert left["fault_history"][0]["uptime"] == pytest.approx(12.345)
+    assert left["command_acks"][0]["result"] == "Done"
+    assert mon.summary()["nodes"]["RIGHT_ANKLE"]["identity"] == {}

@@ -13,6 +13,12 @@ frames, undecodable frames) and the bus load; can record what it sees to a candu
     .venv/bin/python python/walker_monitor.py --interface slcan --channel /dev/ttyACM0
     # a log
     .venv/bin/python python/walker_monitor.py --log run.log --json
+    # ask the left ankle for its identity and fault history (Command opcodes 8 and 9)
+    .venv/bin/python python/walker_monitor.py ... --send 042#080000000000 --send 042#090000000000
+
+Each node's `identity` (firmware version, build id, 96-bit chip UID, reset cause, where its
+parameters and encoder zero came from), `fault_history` (newest first: code, the node state
+it left, detail, uptime) and `command_acks` are in the summary.
 
 Bus load = bits on the wire (actual bit stuffing of each frame, CRC-15 included, plus the
 3-bit interframe space, as the Rust simulator counts them) / (bit rate x observed time span).
@@ -46,6 +52,8 @@ DEFAULT_DBC = ROOT / "protocol" / "walker.dbc"
 NODES = ("HOST", "LEFT_ANKLE", "RIGHT_ANKLE")
 #: Malformed log lines quoted in `bad_lines` and on stderr; the rest are only counted.
 MAX_QUOTED_LINES = 5
+#: Fault-history entries and command acknowledgements kept per node.
+MAX_HISTORY_ENTRIES = 32
 #: Fault events kept in `faults.events` (`faults.events_total` counts them all).
 MAX_FAULT_EVENTS = 1000
 #: Distinct unknown identifiers counted one by one (`faults.unknown_ids`); frames with further
@@ -120,6 +128,9 @@ class NodeStatus:
     faults: list = field(default_factory=list)
     uptime_s: Optional[float] = None
     last_seen: Optional[float] = None
+    identity: dict = field(default_factory=dict)
+    fault_history: dict = field(default_factory=dict)
+    acks: list = field(default_factory=list)
 
 
 class Monitor:
@@ -202,6 +213,35 @@ class Monitor:
             self.fault_events_total += 1
             if len(self.fault_events) < MAX_FAULT_EVENTS:
                 self.fault_events.append({"t": ts, "node": sender, **sig})
+        elif kind in ("Version", "Identity", "BootInfo") and sender in self.nodes:
+            ident = self.nodes[sender].identity
+            if kind == "Version":
+                ident["firmware"] = "{}.{}.{}".format(
+                    int(sig["fw_major"]), int(sig["fw_minor"]), int(sig["fw_patch"]))
+                ident["build_id"] = f"{int(sig['build_id']):08x}"
+                ident["protocol_version"] = int(sig["protocol_version"])
+            elif kind == "Identity":
+                ident["uid_low"] = int(sig["uid_low"])
+                ident["uid_mid"] = int(sig["uid_mid"])
+            else:
+                ident["uid_high"] = int(sig["uid_high"])
+                for k in ("reset_cause", "params_source", "calibration_source"):
+                    ident[k] = sig[k]
+                ident["fault_history_len"] = int(sig["fault_history_len"])
+            if all(k in ident for k in ("uid_low", "uid_mid", "uid_high")):
+                # 96-bit unique ID, most significant word first, as ST prints it.
+                ident["uid"] = "{:08x}{:08x}{:08x}".format(
+                    ident["uid_high"], ident["uid_mid"], ident["uid_low"])
+        elif kind == "FaultHistory" and sender in self.nodes:
+            entry = int(sig["entry"])
+            if 0 <= entry < MAX_HISTORY_ENTRIES:
+                self.nodes[sender].fault_history[entry] = {
+                    "code": sig["code"], "state_after": sig["state_after"],
+                    "detail": int(sig["detail"]), "uptime": sig["uptime"]}
+        elif kind == "CommandAck" and sender in self.nodes:
+            acks = self.nodes[sender].acks
+            if len(acks) < MAX_HISTORY_ENTRIES:
+                acks.append({"t": ts, "opcode": sig["opcode"], "result": sig["result"]})
 
     def _count_unknown(self, ident: int) -> None:
         if ident in self.unknown or len(self.unknown) < MAX_UNKNOWN_IDS:
@@ -252,6 +292,10 @@ class Monitor:
                 "fault_flags": n.fault_flags,
                 "faults": n.faults,
                 "uptime_s": n.uptime_s,
+                "identity": n.identity,
+                # newest first, as the node numbers them
+                "fault_history": [n.fault_history[k] for k in sorted(n.fault_history)],
+                "command_acks": n.acks,
             }
         return {
             "span_s": span,

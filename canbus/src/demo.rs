@@ -194,7 +194,8 @@ impl Demo {
                 (CommandKind::Disable, _) => NodeState::Disabled,
                 (CommandKind::Enable, NodeState::EmergencyStop) => NodeState::EmergencyStop,
                 (CommandKind::Enable, _) => NodeState::Enabled,
-                (CommandKind::SetParam { .. }, s) => s,
+                // Parameters, identity, history, storage: no state change.
+                (_, s) => s,
             };
         }
     }

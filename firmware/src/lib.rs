@@ -18,12 +18,16 @@ pub(crate) mod fmt;
 
 pub mod drivers;
 pub mod estimator;
+pub mod fault_report;
+pub mod following;
 pub mod node;
+pub mod param_store;
 pub mod params;
 pub mod reflex;
 pub mod runner;
 pub mod scenarios;
 pub mod sensors;
+pub mod supervisor;
 pub mod time;
 
 pub use node::{AnkleNode, DriverHealth, NodeConfig, TickInputs, TickOutputs};

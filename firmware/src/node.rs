@@ -5,13 +5,16 @@
 
 use heapless::Vec;
 use protocol::{
-    Angle, AngularRate, AnkleState, Command, CommandKind, FaultCode, FaultEvent, FaultFlags,
-    FaultTransition, Heartbeat, HeelStrike, Message, NodeId, NodeState, ParamAck, ParamStatus,
-    ReflexPhase, Version, PROTOCOL_VERSION,
+    Angle, AngularRate, AnkleState, BootInfo, Command, CommandAck, CommandKind, CommandResult,
+    ConfigSource, FaultCode, FaultEvent, FaultFlags, FaultHistoryEntry, FaultTransition, Heartbeat,
+    HeelStrike, Identity, Message, NodeId, NodeState, Opcode, ParamAck, ParamStatus, ReflexPhase,
+    ResetCause, Version, PROTOCOL_VERSION,
 };
 
 use crate::estimator::{AngleEstimator, EstimatorGains};
+use crate::fault_report::FaultReporter;
 use crate::fmt::{log_info, log_warn};
+use crate::following::FollowingErrorMonitor;
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
 use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
@@ -19,9 +22,38 @@ use crate::time::Instant;
 
 /// Messages the node reads per tick at most (bounded work); callers keep the rest queued.
 pub const MAX_RX_PER_TICK: usize = 8;
+/// Fault-history entries kept (the newest; older ones drop out).
+pub const FAULT_HISTORY_LEN: usize = 8;
+
 /// Capacity of the per-tick transmit list: heel strike, every fault code changing at once,
-/// one acknowledgement per received message, state, heartbeat and version.
-pub const MAX_TX_PER_TICK: usize = 1 + 8 + MAX_RX_PER_TICK + 3;
+/// one acknowledgement per received message, state, heartbeat and version, one fault-history
+/// dump and one identity (each answered once per tick however often asked), a deferred
+/// acknowledgement.
+pub const MAX_TX_PER_TICK: usize =
+    1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
+
+/// What the node asks of the layer around it (the board, the driver runner): things it
+/// cannot do itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeRequest {
+    /// Store the parameters in force and the encoder zero in flash, then report with
+    /// [`AnkleNode::storage_done`].
+    SaveParams,
+    /// Use this raw reading as the encoder's zero from now on.
+    SetEncoderZero {
+        /// Counts read at ankle angle zero.
+        zero_counts: u16,
+    },
+}
+
+/// One fault-history record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct HistoryRecord {
+    code: FaultCode,
+    detail: i16,
+    uptime_ms: u32,
+    state_after: NodeState,
+}
 
 /// Firmware version sent in the [`Version`] message.
 pub const FIRMWARE_VERSION: (u8, u8, u8) = (0, 1, 0);
@@ -37,8 +69,17 @@ pub struct NodeConfig {
     pub heartbeat_period_us: u64,
     /// Period of the version message [µs] (nominal 5 000 000; also sent at start).
     pub version_period_us: u64,
-    /// Build identifier sent in the version message.
+    /// Build identifier sent in the version message (the board: the first 8 hex digits of
+    /// the git commit).
     pub build_id: u32,
+    /// Chip unique ID (96 bits), sent in `Identity` and `BootInfo`; zero in simulation.
+    pub uid: [u32; 3],
+    /// Why the chip last reset.
+    pub reset_cause: ResetCause,
+    /// Where the parameters in force came from.
+    pub params_source: ConfigSource,
+    /// Where the encoder zero came from.
+    pub calibration_source: ConfigSource,
     /// Estimator gains.
     pub estimator: EstimatorGains,
 }
@@ -52,6 +93,10 @@ impl NodeConfig {
             heartbeat_period_us: 50_000,
             version_period_us: 5_000_000,
             build_id: 0,
+            uid: [0; 3],
+            reset_cause: ResetCause::Unknown,
+            params_source: ConfigSource::Defaults,
+            calibration_source: ConfigSource::Defaults,
             estimator: EstimatorGains::default(),
         }
     }
@@ -72,8 +117,11 @@ pub enum ConfigError {
 pub struct DriverHealth {
     /// The actuator driver failed to apply the last command.
     pub actuator_error: bool,
-    /// The CAN controller reported an error, or a frame could not be queued.
+    /// A frame could not be queued for transmission (the queue was full).
     pub can_error: bool,
+    /// The CAN controller is bus-off (from its status register; error frames and
+    /// error-passive are not faults).
+    pub can_bus_off: bool,
 }
 
 /// Inputs of one tick.
@@ -100,6 +148,8 @@ pub struct TickOutputs {
     pub state: NodeState,
     /// Reflex phase after the tick.
     pub phase: ReflexPhase,
+    /// A request for the layer around the node, if any.
+    pub request: Option<NodeRequest>,
 }
 
 /// The ankle node.
@@ -122,6 +172,18 @@ pub struct AnkleNode {
     next_heartbeat_at: Instant,
     next_version_at: Instant,
     dropped_tx: u32,
+    following: FollowingErrorMonitor,
+    driven_setpoint: Option<f32>,
+    enabled_at: Option<Instant>,
+    peer_state: Option<(Instant, NodeState)>,
+    reporter: FaultReporter,
+    history: heapless::Deque<HistoryRecord, FAULT_HISTORY_LEN>,
+    raised_this_tick: usize,
+    identity_due: bool,
+    history_due: bool,
+    pending_ack: Option<CommandAck>,
+    request: Option<NodeRequest>,
+    save_in_progress: bool,
 }
 
 /// Accumulates one tick's transmissions, counting what does not fit.
@@ -171,8 +233,21 @@ impl AnkleNode {
             last_peer_heartbeat: None,
             next_state_at: Instant(0),
             next_heartbeat_at: Instant(0),
-            next_version_at: Instant(0),
+            // The first Version goes out with the identity at start-up.
+            next_version_at: Instant(config.version_period_us),
             dropped_tx: 0,
+            following: FollowingErrorMonitor::default(),
+            driven_setpoint: None,
+            enabled_at: None,
+            peer_state: None,
+            reporter: FaultReporter::default(),
+            history: heapless::Deque::new(),
+            raised_this_tick: 0,
+            identity_due: true,
+            history_due: false,
+            pending_ack: None,
+            request: None,
+            save_in_progress: false,
         })
     }
 
@@ -196,6 +271,16 @@ impl AnkleNode {
     pub fn params(&self) -> &ReflexParams {
         &self.params
     }
+    /// Put parameters loaded at start-up (from flash) in force; only before the first tick.
+    /// Returns false (and changes nothing) afterwards.
+    pub fn restore_params(&mut self, params: ReflexParams) -> bool {
+        if self.started_at.is_some() {
+            return false;
+        }
+        self.params = params;
+        true
+    }
+
     /// Messages that did not fit a tick's transmit list (should stay 0).
     pub fn dropped_tx(&self) -> u32 {
         self.dropped_tx
@@ -212,28 +297,127 @@ impl AnkleNode {
         if present == self.faults.contains(code) {
             return;
         }
-        let transition = if present {
+        if present {
             self.faults.insert(code);
             log_warn!("fault raised: {}", code);
-            FaultTransition::Raised
+            if self.history.is_full() {
+                let _ = self.history.pop_back();
+            }
+            let _ = self.history.push_front(HistoryRecord {
+                code,
+                detail: detail.unwrap_or(0),
+                uptime_ms: now.uptime_ms(),
+                state_after: self.state,
+            });
+            self.raised_this_tick = self.raised_this_tick.saturating_add(1);
         } else {
             self.faults.remove(code);
             log_info!("fault cleared: {}", code);
-            FaultTransition::Cleared
-        };
+        }
+        if let Some(r) = self
+            .reporter
+            .changed(now, code, present, detail.unwrap_or(0))
+        {
+            self.send_fault(out, now, r.code, r.transition, r.detail);
+        }
+    }
+
+    fn send_fault(
+        &self,
+        out: &mut Outbox,
+        now: Instant,
+        code: FaultCode,
+        transition: FaultTransition,
+        detail: i16,
+    ) {
         out.push(Message::Fault(FaultEvent {
             node: self.config.node,
             code,
             transition,
-            detail: detail.unwrap_or(0),
+            detail,
             uptime_ms: now.uptime_ms(),
         }));
     }
 
-    fn enter(&mut self, state: NodeState, contact_closed: bool) {
+    /// Report the outcome of a [`NodeRequest::SaveParams`]; acknowledged in the next tick.
+    pub fn storage_done(&mut self, ok: bool) {
+        if self.save_in_progress {
+            self.save_in_progress = false;
+            self.pending_ack = Some(self.ack(
+                Opcode::SaveParams,
+                if ok {
+                    CommandResult::Done
+                } else {
+                    CommandResult::Failed
+                },
+            ));
+        }
+    }
+
+    /// Fault-history entries held (newest first): code, detail, uptime [ms], state after.
+    pub fn fault_history(&self) -> impl Iterator<Item = (FaultCode, i16, u32, NodeState)> + '_ {
+        self.history
+            .iter()
+            .map(|r| (r.code, r.detail, r.uptime_ms, r.state_after))
+    }
+
+    fn ack(&self, opcode: Opcode, result: CommandResult) -> CommandAck {
+        CommandAck {
+            node: self.config.node,
+            opcode,
+            result,
+        }
+    }
+
+    fn send_identity(&self, out: &mut Outbox) {
+        let (major, minor, patch) = FIRMWARE_VERSION;
+        let c = &self.config;
+        out.push(Message::Version(Version {
+            node: c.node,
+            protocol: PROTOCOL_VERSION,
+            major,
+            minor,
+            patch,
+            build: c.build_id,
+        }));
+        out.push(Message::Identity(Identity {
+            node: c.node,
+            uid_low: c.uid[0],
+            uid_mid: c.uid[1],
+        }));
+        out.push(Message::BootInfo(BootInfo {
+            node: c.node,
+            uid_high: c.uid[2],
+            reset_cause: c.reset_cause,
+            params_source: c.params_source,
+            fault_history_len: self.history.len() as u8,
+            calibration_source: c.calibration_source,
+        }));
+    }
+
+    fn send_history(&self, out: &mut Outbox) {
+        for (k, r) in self.history.iter().enumerate() {
+            out.push(Message::FaultHistory(FaultHistoryEntry {
+                node: self.config.node,
+                entry: k as u8,
+                code: r.code,
+                state_after: r.state_after,
+                detail: r.detail,
+                uptime_ms: r.uptime_ms & 0xFF_FFFF,
+            }));
+        }
+    }
+
+    /// Fault changes held back by the inhibit time (see [`crate::fault_report`]).
+    pub fn suppressed_fault_events(&self) -> u32 {
+        self.reporter.suppressed()
+    }
+
+    fn enter(&mut self, now: Instant, state: NodeState, contact_closed: bool) {
         if state == self.state {
             return;
         }
+        self.enabled_at = (state == NodeState::Enabled).then_some(now);
         log_info!("node state {} -> {}", self.state, state);
         self.state = state;
         if state == NodeState::Enabled {
@@ -243,19 +427,26 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, contact_closed: bool) {
+    fn handle_command(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        cmd: &Command,
+        inputs: &TickInputs,
+    ) {
+        let contact_closed = inputs.contact_closed;
         if !cmd.target.addresses(self.config.node) {
             return;
         }
         match cmd.kind {
-            CommandKind::EmergencyStop => self.enter(NodeState::EmergencyStop, contact_closed),
-            CommandKind::Disable => self.enter(NodeState::Disabled, contact_closed),
+            CommandKind::EmergencyStop => self.enter(now, NodeState::EmergencyStop, contact_closed),
+            CommandKind::Disable => self.enter(now, NodeState::Disabled, contact_closed),
             CommandKind::Enable => {
                 // From Disabled or Safe only, and only without a safety-relevant fault;
                 // emergency stop needs a Disable first.
                 let allowed = matches!(self.state, NodeState::Disabled | NodeState::Safe);
                 if allowed && !self.faults.any_safety_relevant() {
-                    self.enter(NodeState::Enabled, contact_closed);
+                    self.enter(now, NodeState::Enabled, contact_closed);
                 }
             }
             CommandKind::SetParam { param, value } => {
@@ -274,6 +465,52 @@ impl AnkleNode {
                     value: self.params.wire_value(param),
                 }));
             }
+            CommandKind::GetParam { param } => out.push(Message::ParamAck(ParamAck {
+                node: self.config.node,
+                param,
+                status: ParamStatus::Read,
+                value: self.params.wire_value(param),
+            })),
+            CommandKind::GetIdentity => self.identity_due = true,
+            CommandKind::GetFaultHistory => self.history_due = true,
+            CommandKind::ClearErrors => {
+                self.history.clear();
+                out.push(Message::CommandAck(
+                    self.ack(Opcode::ClearErrors, CommandResult::Done),
+                ));
+            }
+            CommandKind::SaveParams => {
+                let result = if self.state == NodeState::Enabled {
+                    Some(CommandResult::NotWhileEnabled)
+                } else if self.save_in_progress || self.request.is_some() {
+                    Some(CommandResult::NotAvailable)
+                } else {
+                    self.save_in_progress = true;
+                    self.request = Some(NodeRequest::SaveParams);
+                    None
+                };
+                if let Some(r) = result {
+                    out.push(Message::CommandAck(self.ack(Opcode::SaveParams, r)));
+                }
+            }
+            CommandKind::CalibrateEncoderZero => {
+                let result = match (self.state, inputs.angle) {
+                    (NodeState::Enabled, _) => CommandResult::NotWhileEnabled,
+                    (_, Ok(s)) if self.request.is_none() => {
+                        self.request = Some(NodeRequest::SetEncoderZero {
+                            zero_counts: s.counts,
+                        });
+                        // The estimator restarts on the new zero.
+                        self.estimator.reset();
+                        self.last_sample_at = None;
+                        CommandResult::Done
+                    }
+                    _ => CommandResult::NotAvailable,
+                };
+                out.push(Message::CommandAck(
+                    self.ack(Opcode::CalibrateEncoderZero, result),
+                ));
+            }
         }
     }
 
@@ -286,22 +523,29 @@ impl AnkleNode {
         };
         let started = *self.started_at.get_or_insert(now);
         let contact = inputs.contact_closed;
+        self.raised_this_tick = 0;
+        if let Some(a) = self.pending_ack.take() {
+            out.push(Message::CommandAck(a));
+        }
 
         // 1. Messages: commands to this node, the peer's heartbeat and heel strike.
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(&mut out, c, contact),
+                Message::Command(c) => self.handle_command(&mut out, now, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
+                    self.peer_state = Some((now, h.state));
                 }
                 Message::HeelStrike(h) if h.node == self.peer => peer_heel_strike = true,
                 _ => {}
             }
         }
 
-        // 2. Sensors: plausibility, then the estimator on good samples.
-        let driving = self.reflex.phase() == ReflexPhase::Push;
+        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check runs
+        // in every driven phase (push and hold): a working encoder's reading always moves by
+        // its noise, a frozen one does not.
+        let driving = matches!(self.reflex.phase(), ReflexPhase::Push | ReflexPhase::Hold);
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
@@ -309,6 +553,13 @@ impl AnkleNode {
         self.set_fault(&mut out, now, FaultCode::EncoderRange, found.range);
         self.set_fault(&mut out, now, FaultCode::EncoderRate, found.rate);
         self.set_fault(&mut out, now, FaultCode::EncoderStuck, found.stuck);
+        // Following error against the previous tick's setpoint, on a plausible reading.
+        let measured = match inputs.angle {
+            Ok(s) if found.range.is_none() && found.rate.is_none() => Some(s.angle_rad),
+            _ => None,
+        };
+        let following = self.following.check(now, self.driven_setpoint, measured);
+        self.set_fault(&mut out, now, FaultCode::FollowingError, following);
         match inputs.angle {
             Ok(s) if found.range.is_none() && found.rate.is_none() => {
                 let dt = self
@@ -345,7 +596,13 @@ impl AnkleNode {
             &mut out,
             now,
             FaultCode::CanBus,
-            inputs.drivers.can_error.then_some(0),
+            if inputs.drivers.can_bus_off {
+                Some(2)
+            } else if inputs.drivers.can_error {
+                Some(1)
+            } else {
+                None
+            },
         );
 
         // 4. Contact edges; the own heel strike is announced in every state.
@@ -361,9 +618,25 @@ impl AnkleNode {
             }));
         }
 
-        // 5. Safe state on any safety-relevant fault.
+        // 5. The peer's own state, from heartbeats received since this node was enabled: a
+        // peer in its safe state or emergency stop cannot walk, so neither can this one.
+        let peer_safe = match (self.enabled_at, self.peer_state) {
+            (Some(since), Some((at, st))) if at > since => {
+                matches!(st, NodeState::Safe | NodeState::EmergencyStop)
+            }
+            _ => false,
+        };
+        let peer_detail = self.peer_state.map(|(_, st)| st.raw() as i16);
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::PeerSafe,
+            if peer_safe { peer_detail } else { None },
+        );
+
+        // Safe state on any safety-relevant fault.
         if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
-            self.enter(NodeState::Safe, contact);
+            self.enter(now, NodeState::Safe, contact);
         }
 
         // 6. The reflex.
@@ -389,6 +662,26 @@ impl AnkleNode {
         }
         if self.state != NodeState::Enabled {
             self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+        }
+        self.driven_setpoint = match actuator {
+            ActuatorCommand::Position { ankle_angle_rad } => Some(ankle_angle_rad),
+            ActuatorCommand::Released => None,
+        };
+        // Fault events held back by their inhibit time.
+        let faults = self.faults;
+        for r in self.reporter.due(now, |c| faults.contains(c)) {
+            self.send_fault(&mut out, now, r.code, r.transition, r.detail);
+        }
+        // The history records the state each raise left the node in.
+        let state = self.state;
+        for r in self.history.iter_mut().take(self.raised_this_tick) {
+            r.state_after = state;
+        }
+        if core::mem::take(&mut self.identity_due) {
+            self.send_identity(&mut out);
+        }
+        if core::mem::take(&mut self.history_due) {
+            self.send_history(&mut out);
         }
 
         // 7. Periodic messages.
@@ -448,6 +741,7 @@ impl AnkleNode {
             transmit: out.list,
             state: self.state,
             phase: self.reflex.phase(),
+            request: self.request.take(),
         };
         self.dropped_tx = dropped;
         outputs

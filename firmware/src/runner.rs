@@ -4,22 +4,21 @@
 
 use embedded_can::nb::Can;
 use embedded_hal::digital::InputPin;
-use embedded_hal::spi::SpiDevice;
 use heapless::Vec;
 
 use crate::drivers::actuator::Actuator;
-use crate::drivers::can::CanPort;
+use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
-use crate::drivers::encoder::MagneticEncoder;
-use crate::node::{AnkleNode, DriverHealth, TickInputs, TickOutputs, MAX_RX_PER_TICK};
+use crate::drivers::encoder::AngleSensor;
+use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
 use crate::time::Monotonic;
 
 /// Every driver of one ankle, and its node.
-pub struct AnkleDrivers<S, P, A, C, M> {
+pub struct AnkleDrivers<E, P, A, C, M> {
     /// The node logic.
     pub node: AnkleNode,
-    /// Angle encoder.
-    pub encoder: MagneticEncoder<S>,
+    /// Ankle angle encoder (SPI, or PWM output on the board).
+    pub encoder: E,
     /// Foot contact switch.
     pub contact: ContactSwitch<P>,
     /// String actuator.
@@ -31,18 +30,18 @@ pub struct AnkleDrivers<S, P, A, C, M> {
     health: DriverHealth,
 }
 
-impl<S, P, A, C, M> AnkleDrivers<S, P, A, C, M>
+impl<E, P, A, C, M> AnkleDrivers<E, P, A, C, M>
 where
-    S: SpiDevice,
+    E: AngleSensor,
     P: InputPin,
     A: Actuator,
-    C: Can,
+    C: Can + ControllerHealth,
     M: Monotonic,
 {
     /// Assemble the drivers.
     pub fn new(
         node: AnkleNode,
-        encoder: MagneticEncoder<S>,
+        encoder: E,
         contact: ContactSwitch<P>,
         actuator: A,
         can: CanPort<C>,
@@ -59,28 +58,34 @@ where
         }
     }
 
-    /// One control tick. Bounded: two SPI words, one pin read, at most
+    /// One control tick. Bounded: one encoder read, one pin read, at most
     /// 2 × [`MAX_RX_PER_TICK`] frame reads and a bounded number of frame writes.
     pub fn step(&mut self) -> TickOutputs {
         let now = self.clock.now();
-        let angle = self.encoder.read();
+        let angle = self.encoder.read_angle();
         // A pin error keeps the last debounced state; contact pins on MCUs are infallible.
         let contact_closed = self
             .contact
             .sample()
             .unwrap_or_else(|_| self.contact.closed());
         let mut received: Vec<_, MAX_RX_PER_TICK> = Vec::new();
-        let rx_error = self.can.receive(&mut received);
+        self.can.receive(&mut received);
+        let bus = self.can.poll_status();
         let inputs = TickInputs {
             angle,
             contact_closed,
             received: &received,
             drivers: DriverHealth {
-                can_error: self.health.can_error || rx_error,
+                can_bus_off: bus == BusState::BusOff,
                 ..self.health
             },
         };
         let out = self.node.tick(now, &inputs);
+        // An encoder-zero calibration takes effect at once; a save is the caller's (it needs
+        // the flash), reported back with `AnkleNode::storage_done`.
+        if let Some(NodeRequest::SetEncoderZero { zero_counts }) = out.request {
+            self.encoder.set_zero_counts(zero_counts);
+        }
         let measured = self.node.estimate().map(|(a, _)| a);
         self.health.actuator_error = self.actuator.apply(out.actuator, measured).is_err();
         self.health.can_error = self.can.transmit(&out.transmit);

@@ -22,7 +22,7 @@ use protocol::{
 
 use crate::node::{AnkleNode, ConfigError, DriverHealth, NodeConfig, TickInputs};
 use crate::reflex::ActuatorCommand;
-use crate::sensors::{AngleCalibration, AngleSample, EncoderError};
+use crate::sensors::{with_simulated_noise, AngleCalibration, AngleSample, EncoderError};
 use crate::time::Instant;
 
 /// Control period [µs].
@@ -464,7 +464,7 @@ impl World {
 
     /// The encoder read of the current plant angle, glitches applied.
     pub fn encoder(&mut self, tick: u32) -> Result<AngleSample, EncoderError> {
-        let mut counts = CALIBRATION.counts(self.angle_rad);
+        let mut counts = with_simulated_noise(CALIBRATION.counts(self.angle_rad), tick);
         let mut frozen = false;
         for g in self.scenario.glitches {
             match *g {

@@ -32,15 +32,20 @@ pub enum EncoderError {
         /// The 16-bit word received.
         word: u16,
     },
+    /// No fresh reading arrived in time (a PWM-output encoder whose line went quiet, or a
+    /// frame whose period is not the sensor's).
+    NoSignal,
 }
 
 impl EncoderError {
-    /// A small code for the fault event's `detail` field: 1 bus, 2 parity, 3 error flag.
+    /// A small code for the fault event's `detail` field: 1 bus, 2 parity, 3 error flag,
+    /// 4 no signal.
     pub fn detail(&self) -> i16 {
         match self {
             EncoderError::Bus(_) => 1,
             EncoderError::Parity { .. } => 2,
             EncoderError::ErrorFlag { .. } => 3,
+            EncoderError::NoSignal => 4,
         }
     }
 }
@@ -90,6 +95,20 @@ pub const SIMULATED_CALIBRATION: AngleCalibration = AngleCalibration {
     zero_counts: 4000,
     reversed: false,
 };
+
+/// Output noise of a simulated magnetic encoder at sample `n` [counts]: −1, 0 or +1 from a
+/// fixed integer hash, so that host, QEMU and simulator runs stay bit-identical. A real
+/// AS5047P-class sensor's reading moves by a few counts of noise at 14 bits; a reading that
+/// does not move at all for the stuck timeout is a failed sensor ([`Plausibility`]). Every
+/// simulated encoder (scenarios, host tests, the simulator) adds this to its counts.
+pub fn simulated_noise_counts(n: u32) -> i32 {
+    (n.wrapping_mul(2_654_435_761) >> 30) as i32 % 3 - 1
+}
+
+/// `counts` plus [`simulated_noise_counts`], wrapped to the encoder's range.
+pub fn with_simulated_noise(counts: u16, n: u32) -> u16 {
+    (counts as i32 + simulated_noise_counts(n)).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
+}
 
 /// What the plausibility checks found in one sample; `Some(detail)` when a check fails,
 /// with the offending raw value for the fault event.
@@ -156,7 +175,7 @@ impl Plausibility {
             _ => self.last_change = Some((now, s.counts)),
         }
         if let Some((since, c)) = self.last_change {
-            if driving && now.secs_since(since) > params.stuck_timeout_s() {
+            if driving && now.secs_since(since) >= params.stuck_timeout_s() {
                 self.stuck_at = Some(c);
             }
         }
@@ -265,7 +284,30 @@ mod tests {
                 break;
             }
         }
-        assert_eq!(stuck_at, Some(151), "50 ms stuck timeout");
+        assert_eq!(stuck_at, Some(150), "50 ms stuck timeout");
+    }
+
+    #[test]
+    fn simulated_noise_moves_within_a_count_and_never_sits_still_long() {
+        let mut run = 0;
+        let mut longest = 0;
+        let mut seen = [false; 3];
+        for n in 0..10_000u32 {
+            let d = simulated_noise_counts(n);
+            seen[(d + 1) as usize] = true;
+            run = if n > 0 && d == simulated_noise_counts(n - 1) {
+                run + 1
+            } else {
+                0
+            };
+            longest = longest.max(run);
+        }
+        assert_eq!(seen, [true; 3]);
+        assert!(longest < 20, "longest still run {longest}");
+        assert_eq!(
+            with_simulated_noise(0, 0),
+            16383.min(with_simulated_noise(0, 0))
+        );
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 use firmware::node::{AnkleNode, DriverHealth, NodeConfig, TickInputs, TickOutputs};
 use firmware::scenarios::CALIBRATION;
-use firmware::sensors::{AngleSample, EncoderError};
+use firmware::sensors::{with_simulated_noise, AngleSample, EncoderError};
 use firmware::{ActuatorCommand, Instant};
 use protocol::*;
 
@@ -21,6 +21,8 @@ struct Bench {
     frozen: Option<u16>,
     drivers: DriverHealth,
     heartbeats: bool,
+    peer_state: NodeState,
+    reversed_motor: bool,
 }
 
 fn cmd(kind: CommandKind) -> Message {
@@ -41,6 +43,8 @@ impl Bench {
             frozen: None,
             drivers: DriverHealth::default(),
             heartbeats: true,
+            peer_state: NodeState::Enabled,
+            reversed_motor: false,
         }
     }
 
@@ -49,7 +53,7 @@ impl Bench {
         if self.heartbeats && self.ms.is_multiple_of(50) {
             rx.push(Message::Heartbeat(Heartbeat {
                 node: PEER,
-                state: NodeState::Enabled,
+                state: self.peer_state,
                 faults: FaultFlags::NONE,
                 uptime_ms: self.ms as u32,
             }));
@@ -57,9 +61,9 @@ impl Bench {
         let angle = match self.encoder_error {
             Some(e) => Err(e),
             None => {
-                let counts = self
-                    .frozen
-                    .unwrap_or_else(|| CALIBRATION.counts(self.angle));
+                let counts = self.frozen.unwrap_or_else(|| {
+                    with_simulated_noise(CALIBRATION.counts(self.angle), self.ms as u32)
+                });
                 Ok(AngleSample {
                     counts,
                     angle_rad: CALIBRATION.angle_rad(counts),
@@ -76,9 +80,12 @@ impl Bench {
             },
         );
         self.ms += 1;
-        // The plant: a taut string holds the ankle at or above the setpoint.
+        // The plant: a taut string holds the ankle at or above the setpoint; a reversed
+        // motor pays the string out instead (the ankle sinks at 2 rad/s).
         if let ActuatorCommand::Position { ankle_angle_rad } = out.actuator {
-            if ankle_angle_rad > self.angle {
+            if self.reversed_motor {
+                self.angle -= 0.002;
+            } else if ankle_angle_rad > self.angle {
                 self.angle = ankle_angle_rad;
             }
         }
@@ -162,7 +169,9 @@ fn starts_disabled_and_sends_version_heartbeat_and_state() {
         [
             MessageClass::Heartbeat,
             MessageClass::AnkleState,
-            MessageClass::Version
+            MessageClass::Version,
+            MessageClass::Identity,
+            MessageClass::BootInfo
         ]
     );
     // Over one second: 200 states, 20 heartbeats, one version.
@@ -572,4 +581,248 @@ fn estimator_reports_angle_and_rate_in_telemetry() {
     let s = state.unwrap();
     assert!((s.rate.to_si() + 0.5).abs() < 0.02, "{:?}", s.rate);
     assert!((s.angle.to_si() - (0.1 - 0.5e-3 * 495.0)).abs() < 0.01);
+}
+
+/// Runs an enabled node through its push into Hold.
+fn bench_in_hold() -> Bench {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    for _ in 0..300 {
+        if b.node.phase() == ReflexPhase::Hold {
+            break;
+        }
+        b.tick();
+    }
+    assert_eq!(b.node.phase(), ReflexPhase::Hold);
+    // Hold for a while with a healthy (noisy) encoder: no stuck fault.
+    for _ in 0..200 {
+        assert_eq!(b.tick().state, NodeState::Enabled);
+    }
+    b
+}
+
+#[test]
+fn stuck_encoder_during_hold_releases_within_50_ms() {
+    let mut b = bench_in_hold();
+    b.frozen = Some(CALIBRATION.counts(b.angle));
+    let mut released_after = None;
+    let mut msgs = Vec::new();
+    // Tick k (from 0) runs k ms after the first frozen sample.
+    for k in 0..=60 {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.actuator == ActuatorCommand::Released {
+            assert_eq!(o.state, NodeState::Safe);
+            released_after = Some(k);
+            break;
+        }
+    }
+    let ms = released_after.expect("released");
+    assert!(ms <= 50, "released {ms} ms after the freeze");
+    assert_eq!(
+        fault_events(&msgs, FaultCode::EncoderStuck),
+        [FaultTransition::Raised]
+    );
+}
+
+#[test]
+fn following_error_catches_a_reversed_motor() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.reversed_motor = true;
+    let mut msgs = Vec::new();
+    let mut safe_after = None;
+    for ms in 1..=200 {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.state == NodeState::Safe {
+            assert_eq!(o.actuator, ActuatorCommand::Released);
+            safe_after = Some(ms);
+            break;
+        }
+    }
+    let ms = safe_after.expect("the following error stops a reversed motor");
+    // The setpoint rises while the ankle sinks: 0.05 rad of shortfall within ~10 ms, then
+    // 30 ms of it.
+    assert!(ms <= 60, "{ms} ms");
+    assert_eq!(
+        fault_events(&msgs, FaultCode::FollowingError),
+        [FaultTransition::Raised]
+    );
+    assert!(!b.node.faults().contains(FaultCode::EncoderStuck));
+}
+
+#[test]
+fn a_healthy_push_and_hold_raise_no_following_error() {
+    let b = bench_in_hold();
+    assert!(b.node.faults().is_empty(), "{:?}", b.node.faults());
+}
+
+#[test]
+fn a_peer_in_its_safe_state_makes_this_node_safe_until_enabled_again() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.peer_state = NodeState::Safe;
+    let msgs = b.run(150);
+    assert_eq!(b.node.state(), NodeState::Safe);
+    assert_eq!(
+        fault_events(&msgs, FaultCode::PeerSafe),
+        [FaultTransition::Raised, FaultTransition::Cleared],
+        "raised, then cleared once this node left Enabled"
+    );
+    // Both re-enabled: the peer's heartbeats say Enabled again, and so does this node.
+    b.peer_state = NodeState::Enabled;
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Enable)]).state,
+        NodeState::Enabled
+    );
+    b.run(200);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+    // A peer that is merely disabled is no fault.
+    b.peer_state = NodeState::Disabled;
+    b.run(200);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+}
+
+#[test]
+fn a_flapping_fault_is_reported_at_most_once_per_inhibit_time() {
+    let mut b = Bench::enabled();
+    let mut msgs = Vec::new();
+    for k in 0..200 {
+        b.drivers.actuator_error = k % 2 == 0;
+        msgs.extend(b.tick().transmit);
+    }
+    let events = fault_events(&msgs, FaultCode::Actuator);
+    assert!(
+        (2..=5).contains(&events.len()),
+        "{} events in 200 ms",
+        events.len()
+    );
+    assert!(b.node.suppressed_fault_events() > 100);
+}
+
+#[test]
+fn identity_at_boot_and_on_request() {
+    let mut config = NodeConfig::nominal(ME);
+    config.uid = [0x11, 0x22, 0x33];
+    config.build_id = 0xC0FFEE;
+    config.reset_cause = ResetCause::IndependentWatchdog;
+    let mut b = Bench::new();
+    b.node = AnkleNode::new(config).unwrap();
+    let boot = b.tick().transmit;
+    let versions = boot
+        .iter()
+        .filter(|m| matches!(m, Message::Version(v) if v.build == 0xC0FFEE))
+        .count();
+    assert_eq!(versions, 1, "one Version at boot, with the identity");
+    assert!(boot.contains(&Message::Identity(Identity {
+        node: ME,
+        uid_low: 0x11,
+        uid_mid: 0x22
+    })));
+    assert!(boot.iter().any(|m| matches!(m,
+        Message::BootInfo(i) if i.uid_high == 0x33
+            && i.reset_cause == ResetCause::IndependentWatchdog)));
+    assert!(!b
+        .tick()
+        .transmit
+        .iter()
+        .any(|m| matches!(m, Message::Identity(_))));
+    let again = b.tick_with(&[cmd(CommandKind::GetIdentity), cmd(CommandKind::GetIdentity)]);
+    let n = again
+        .transmit
+        .iter()
+        .filter(|m| matches!(m, Message::Identity(_)))
+        .count();
+    assert_eq!(n, 1, "answered once per tick");
+}
+
+#[test]
+fn get_param_reads_the_value_in_force() {
+    let mut b = Bench::new();
+    b.tick();
+    let o = b.tick_with(&[cmd(CommandKind::GetParam {
+        param: ParamId::ExtendedAngle,
+    })]);
+    assert!(o.transmit.contains(&Message::ParamAck(ParamAck {
+        node: ME,
+        param: ParamId::ExtendedAngle,
+        status: ParamStatus::Read,
+        value: ParamValue(200_000),
+    })));
+}
+
+#[test]
+fn fault_history_says_why_the_node_went_safe_and_clear_errors_empties_it() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.encoder_error = Some(EncoderError::Parity { word: 1 });
+    assert_eq!(b.tick().state, NodeState::Safe);
+    b.encoder_error = None;
+    b.run(10);
+    let o = b.tick_with(&[cmd(CommandKind::GetFaultHistory)]);
+    let entries: Vec<FaultHistoryEntry> = o
+        .transmit
+        .iter()
+        .filter_map(|m| match m {
+            Message::FaultHistory(e) => Some(*e),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    assert_eq!(entries[0].entry, 0);
+    assert_eq!(entries[0].code, FaultCode::EncoderComms);
+    assert_eq!(entries[0].state_after, NodeState::Safe, "the cause of Safe");
+    assert_eq!(entries[0].detail, 2);
+    let o = b.tick_with(&[cmd(CommandKind::ClearErrors)]);
+    assert!(o.transmit.contains(&Message::CommandAck(CommandAck {
+        node: ME,
+        opcode: Opcode::ClearErrors,
+        result: CommandResult::Done,
+    })));
+    assert_eq!(b.node.fault_history().count(), 0);
+}
+
+#[test]
+fn save_params_asks_the_board_and_acknowledges_its_outcome() {
+    let mut b = Bench::new();
+    b.tick();
+    let o = b.tick_with(&[cmd(CommandKind::SaveParams)]);
+    assert_eq!(o.request, Some(firmware::node::NodeRequest::SaveParams));
+    assert!(!o
+        .transmit
+        .iter()
+        .any(|m| matches!(m, Message::CommandAck(_))));
+    b.node.storage_done(false);
+    let o = b.tick();
+    assert!(o.transmit.contains(&Message::CommandAck(CommandAck {
+        node: ME,
+        opcode: Opcode::SaveParams,
+        result: CommandResult::Failed,
+    })));
+    // Not while enabled.
+    let mut b = Bench::enabled();
+    let o = b.tick_with(&[cmd(CommandKind::SaveParams)]);
+    assert_eq!(o.request, None);
+    assert!(o.transmit.iter().any(|m| matches!(m,
+        Message::CommandAck(a) if a.result == CommandResult::NotWhileEnabled)));
+}
+
+#[test]
+fn encoder_zero_calibration_takes_the_current_reading() {
+    let mut b = Bench::new();
+    b.tick();
+    b.angle = 0.3;
+    b.frozen = Some(5000);
+    let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
+    assert_eq!(
+        o.request,
+        Some(firmware::node::NodeRequest::SetEncoderZero { zero_counts: 5000 })
+    );
+    assert!(o.transmit.iter().any(|m| matches!(m,
+        Message::CommandAck(a) if a.opcode == Opcode::CalibrateEncoderZero
+            && a.result == CommandResult::Done)));
+    b.encoder_error = Some(EncoderError::Parity { word: 1 });
+    let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
+    assert_eq!(o.request, None, "no reading, no calibration");
 }

@@ -11,7 +11,7 @@ use std::rc::Rc;
 use embedded_can::{Frame, Id, StandardId};
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use firmware::drivers::actuator::{PwmDirActuator, PwmDirGains};
-use firmware::drivers::can::CanPort;
+use firmware::drivers::can::{BusState, CanPort, ControllerHealth, ControllerStatus};
 use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
 use firmware::drivers::encoder::{read_command, MagneticEncoder, ANGLECOM};
 use firmware::runner::AnkleDrivers;
@@ -30,6 +30,7 @@ struct World {
     tx: RefCell<Vec<TestFrame>>,
     tx_room: Cell<usize>,
     bus_error: Cell<bool>,
+    bus_state: Cell<BusState>,
     now_us: Cell<u64>,
 }
 
@@ -178,6 +179,17 @@ impl embedded_can::nb::Can for Can {
     }
 }
 
+impl ControllerHealth for Can {
+    fn status(&mut self) -> ControllerStatus {
+        ControllerStatus {
+            state: self.0.bus_state.get(),
+            tx_errors: 0,
+            rx_errors: 0,
+            rx_lost: 0,
+        }
+    }
+}
+
 struct Clock(Rc<World>);
 impl Monotonic for Clock {
     fn now(&mut self) -> Instant {
@@ -185,7 +197,7 @@ impl Monotonic for Clock {
     }
 }
 
-type Drivers = AnkleDrivers<Spi, Pin, PwmDirActuator<Pwm, Dir>, Can, Clock>;
+type Drivers = AnkleDrivers<MagneticEncoder<Spi>, Pin, PwmDirActuator<Pwm, Dir>, Can, Clock>;
 
 fn setup() -> (Rc<World>, Drivers) {
     let w = Rc::new(World::default());
@@ -316,13 +328,15 @@ fn full_controller_queues_then_sends_in_order() {
     w.tx_room.set(1000);
     step(&w, &mut d);
     let classes: Vec<_> = sent(&w).iter().map(Message::class).collect();
-    // Tick 0's heartbeat, state and version, then tick 1's (nothing periodic due at 1 ms).
+    // Tick 0's heartbeat, state, version and identity, then tick 1's (nothing periodic due at 1 ms).
     assert_eq!(
         classes,
         [
             MessageClass::Heartbeat,
             MessageClass::AnkleState,
-            MessageClass::Version
+            MessageClass::Version,
+            MessageClass::Identity,
+            MessageClass::BootInfo
         ]
     );
     assert_eq!(d.can.stats().dropped, 0);
@@ -339,10 +353,85 @@ fn encoder_and_bus_errors_become_faults() {
     step(&w, &mut d);
     step(&w, &mut d);
     assert!(!d.node.faults().contains(FaultCode::EncoderComms));
+    // One error frame reported through the receive path: counted, not a fault.
     w.bus_error.set(true);
     step(&w, &mut d);
-    assert!(d.node.faults().contains(FaultCode::CanBus));
+    assert!(!d.node.faults().contains(FaultCode::CanBus));
     assert_eq!(d.can.stats().bus_errors, 1);
+    // Error-passive: reported in the stats, not a fault.
+    w.bus_state.set(BusState::ErrorPassive);
     step(&w, &mut d);
     assert!(!d.node.faults().contains(FaultCode::CanBus));
+    assert_eq!(d.can.stats().status.state, BusState::ErrorPassive);
+    // Bus-off from the status register: a fault.
+    w.bus_state.set(BusState::BusOff);
+    step(&w, &mut d);
+    assert!(d.node.faults().contains(FaultCode::CanBus));
+    assert_eq!(d.can.stats().bus_off_events, 1);
+    w.bus_state.set(BusState::ErrorActive);
+    step(&w, &mut d);
+    assert!(!d.node.faults().contains(FaultCode::CanBus));
+}
+
+fn enable(w: &World, d: &mut Drivers) {
+    send(
+        w,
+        Message::Command(Command {
+            target: Target::Broadcast,
+            kind: CommandKind::Enable,
+        }),
+    );
+    assert_eq!(step(w, d).state, NodeState::Enabled);
+}
+
+#[test]
+fn boot_with_the_foot_down_sends_no_heel_strike() {
+    let (w, mut d) = setup();
+    w.contact_closed.set(true);
+    for _ in 0..100 {
+        step(&w, &mut d);
+    }
+    enable(&w, &mut d);
+    for _ in 0..100 {
+        step(&w, &mut d);
+    }
+    assert!(
+        !sent(&w).iter().any(|m| matches!(m, Message::HeelStrike(_))),
+        "a foot already down at power-up is no heel strike"
+    );
+    // The next real strike is announced.
+    w.contact_closed.set(false);
+    for _ in 0..10 {
+        step(&w, &mut d);
+    }
+    w.contact_closed.set(true);
+    for _ in 0..10 {
+        step(&w, &mut d);
+    }
+    let strikes = sent(&w)
+        .iter()
+        .filter(|m| matches!(m, Message::HeelStrike(_)))
+        .count();
+    assert_eq!(strikes, 1);
+}
+
+#[test]
+fn one_error_frame_is_no_safe_state_but_bus_off_is() {
+    let (w, mut d) = setup();
+    step(&w, &mut d);
+    enable(&w, &mut d);
+    w.bus_error.set(true);
+    for _ in 0..20 {
+        assert_eq!(step(&w, &mut d).state, NodeState::Enabled);
+    }
+    assert_eq!(d.can.stats().bus_errors, 1);
+    w.bus_state.set(BusState::ErrorPassive);
+    for _ in 0..20 {
+        assert_eq!(step(&w, &mut d).state, NodeState::Enabled);
+    }
+    w.bus_state.set(BusState::BusOff);
+    let o = step(&w, &mut d);
+    assert_eq!(o.state, NodeState::Safe);
+    assert_eq!(o.actuator, firmware::ActuatorCommand::Released);
+    assert!(d.node.faults().contains(FaultCode::CanBus));
 }

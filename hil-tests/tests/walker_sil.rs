@@ -137,7 +137,14 @@ fn peer_heartbeat_lost_puts_the_node_in_the_safe_state_and_the_robot_falls() {
         safe > from_s + 0.3 - 0.05 && safe <= from_s + 0.3 + 2.0 * TICK_S,
         "{safe}"
     );
-    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    // The right node follows once the left one's heartbeat reports Safe (PeerSafe): the
+    // right node still receives the left's heartbeats (only 0x063 is dropped).
+    assert_eq!(r.node(Side::Right).unwrap().state, "Safe");
+    let follows = r.first_raise(Side::Right, "PeerSafe").unwrap();
+    assert!(
+        follows > safe && follows <= safe + 0.05 + 2.0 * TICK_S,
+        "{follows}"
+    );
     // Without the left ankle's push-off the walker does not keep going.
     let f = walk.failure.expect("typed failure");
     assert!(f.t_walk_s > safe, "{f:?}");

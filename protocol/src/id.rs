@@ -129,11 +129,19 @@ pub enum MessageClass {
     AnkleState,
     /// Protocol and firmware version.
     Version,
+    /// Chip unique ID, first 64 bits.
+    Identity,
+    /// Chip unique ID, last 32 bits; reset cause; where parameters and calibration came from.
+    BootInfo,
+    /// Answer to a command that has no other answer.
+    CommandAck,
+    /// One entry of the fault history.
+    FaultHistory,
 }
 
 impl MessageClass {
     /// Every class, highest priority first.
-    pub const ALL: [MessageClass; 8] = [
+    pub const ALL: [MessageClass; 12] = [
         MessageClass::EmergencyStop,
         MessageClass::HeelStrike,
         MessageClass::Fault,
@@ -142,6 +150,10 @@ impl MessageClass {
         MessageClass::Heartbeat,
         MessageClass::AnkleState,
         MessageClass::Version,
+        MessageClass::Identity,
+        MessageClass::BootInfo,
+        MessageClass::CommandAck,
+        MessageClass::FaultHistory,
     ];
 
     /// The 7-bit class value.
@@ -155,6 +167,10 @@ impl MessageClass {
             MessageClass::Heartbeat => 0x06,
             MessageClass::AnkleState => 0x07,
             MessageClass::Version => 0x08,
+            MessageClass::Identity => 0x09,
+            MessageClass::BootInfo => 0x0A,
+            MessageClass::CommandAck => 0x0B,
+            MessageClass::FaultHistory => 0x0C,
         }
     }
 
@@ -169,6 +185,10 @@ impl MessageClass {
             0x06 => Some(MessageClass::Heartbeat),
             0x07 => Some(MessageClass::AnkleState),
             0x08 => Some(MessageClass::Version),
+            0x09 => Some(MessageClass::Identity),
+            0x0A => Some(MessageClass::BootInfo),
+            0x0B => Some(MessageClass::CommandAck),
+            0x0C => Some(MessageClass::FaultHistory),
             _ => None,
         }
     }
@@ -218,7 +238,7 @@ impl CanId {
         }
     }
 
-    /// As an embedded-can standard identifier (always valid: at most 0x08F).
+    /// As an embedded-can standard identifier (always valid: at most 0x0CF).
     pub fn standard(self) -> embedded_can::StandardId {
         // Both fields are masked, so the value is < 0x800 and `new` cannot fail; fall back to
         // ZERO rather than panic to keep the no-panic rule provable.
@@ -226,8 +246,39 @@ impl CanId {
     }
 }
 
+/// Identifiers an ankle's acceptance filters let through, and nothing else: emergency stop
+/// and command addressed to it or to every ankle, and the other ankle's heel strike, fault and
+/// heartbeat (the node follows the peer's state). `None` for the host.
+pub const fn accepted_by_ankle(me: NodeId) -> Option<[u16; ACCEPTED_BY_ANKLE]> {
+    let Some(peer) = me.peer() else {
+        return None;
+    };
+    let all = Target::Broadcast.raw();
+    Some([
+        CanId::new(MessageClass::EmergencyStop, me.raw()).raw(),
+        CanId::new(MessageClass::EmergencyStop, all).raw(),
+        CanId::new(MessageClass::HeelStrike, peer.raw()).raw(),
+        CanId::new(MessageClass::Fault, peer.raw()).raw(),
+        CanId::new(MessageClass::Command, me.raw()).raw(),
+        CanId::new(MessageClass::Command, all).raw(),
+        CanId::new(MessageClass::Heartbeat, peer.raw()).raw(),
+    ])
+}
+
+/// Number of identifiers in [`accepted_by_ankle`].
+pub const ACCEPTED_BY_ANKLE: usize = 7;
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn ankle_filters_accept_only_what_the_node_reads() {
+        let left = accepted_by_ankle(NodeId::LeftAnkle).unwrap();
+        assert_eq!(left, [0x012, 0x01F, 0x023, 0x033, 0x042, 0x04F, 0x063]);
+        let right = accepted_by_ankle(NodeId::RightAnkle).unwrap();
+        assert_eq!(right, [0x013, 0x01F, 0x022, 0x032, 0x043, 0x04F, 0x062]);
+        assert!(accepted_by_ankle(NodeId::Host).is_none());
+    }
+
     use super::*;
 
     #[test]

@@ -24,12 +24,13 @@ pub mod values;
 pub mod vectors;
 
 pub use error::{DecodeError, EncodeError, RangeError};
-pub use id::{CanId, MessageClass, NodeId, Target};
+pub use id::{accepted_by_ankle, CanId, MessageClass, NodeId, Target, ACCEPTED_BY_ANKLE};
 pub use messages::{
-    spec, AnkleState, Command, CommandKind, FaultEvent, Heartbeat, HeelStrike, Message, ParamAck,
-    RawFrame, Version, BITRATE_BPS, MESSAGES, PROTOCOL_VERSION,
+    spec, AnkleState, BootInfo, Command, CommandAck, CommandKind, FaultEvent, FaultHistoryEntry,
+    Heartbeat, HeelStrike, Identity, Message, ParamAck, RawFrame, Version, BITRATE_BPS, MESSAGES,
+    PROTOCOL_VERSION,
 };
 pub use values::{
-    Angle, AngularRate, FaultCode, FaultFlags, FaultTransition, NodeState, Opcode, ParamId,
-    ParamStatus, ParamValue, ReflexPhase,
+    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
+    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
 };

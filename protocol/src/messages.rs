@@ -4,12 +4,12 @@ use crate::error::{DecodeError, EncodeError};
 use crate::id::{CanId, MessageClass, NodeId, Target};
 use crate::signal::{Direction, Kind, MessageSpec, SignalSpec};
 use crate::values::{
-    Angle, AngularRate, FaultCode, FaultFlags, FaultTransition, NodeState, Opcode, ParamId,
-    ParamStatus, ParamValue, ReflexPhase,
+    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
+    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
 };
 
 /// Version of this message set, sent in [`Version`]. Bump on any layout change.
-pub const PROTOCOL_VERSION: u8 = 1;
+pub const PROTOCOL_VERSION: u8 = 2;
 
 /// Nominal bus bit rate [bit/s] (classic CAN, FDCAN in classic mode).
 pub const BITRATE_BPS: u32 = 500_000;
@@ -277,6 +277,138 @@ pub mod layout {
         /// Signals in byte order.
         pub const SIGNALS: &[SignalSpec] = &[PROTOCOL, MAJOR, MINOR, PATCH, BUILD];
     }
+
+    /// [`Identity`](super::Identity).
+    pub mod identity {
+        use super::*;
+        /// UID bits 0–31.
+        pub const UID_LOW: SignalSpec = sig(
+            "uid_low",
+            0,
+            Kind::U32,
+            1.0,
+            "",
+            "chip unique ID, bits 0-31 (STM32: UID word at 0x1FFF7590)",
+        );
+        /// UID bits 32–63.
+        pub const UID_MID: SignalSpec = sig(
+            "uid_mid",
+            4,
+            Kind::U32,
+            1.0,
+            "",
+            "chip unique ID, bits 32-63",
+        );
+        /// Signals in byte order.
+        pub const SIGNALS: &[SignalSpec] = &[UID_LOW, UID_MID];
+    }
+
+    /// [`BootInfo`](super::BootInfo).
+    pub mod boot_info {
+        use super::*;
+        /// UID bits 64–95.
+        pub const UID_HIGH: SignalSpec = sig(
+            "uid_high",
+            0,
+            Kind::U32,
+            1.0,
+            "",
+            "chip unique ID, bits 64-95",
+        );
+        /// Reset cause.
+        pub const RESET_CAUSE: SignalSpec = enum_sig(
+            "reset_cause",
+            4,
+            ResetCause::CHOICES,
+            "why the microcontroller last reset",
+        );
+        /// Where the parameters came from.
+        pub const PARAMS_SOURCE: SignalSpec = enum_sig(
+            "params_source",
+            5,
+            ConfigSource::CHOICES,
+            "where the reflex parameters in force came from at start-up",
+        );
+        /// Entries in the fault history.
+        pub const FAULT_HISTORY_LEN: SignalSpec = sig(
+            "fault_history_len",
+            6,
+            Kind::U8,
+            1.0,
+            "",
+            "entries in the fault history (GetFaultHistory reads them)",
+        );
+        /// Where the encoder zero came from.
+        pub const CALIBRATION_SOURCE: SignalSpec = enum_sig(
+            "calibration_source",
+            7,
+            ConfigSource::CHOICES,
+            "where the encoder zero in force came from",
+        );
+        /// Signals in byte order.
+        pub const SIGNALS: &[SignalSpec] = &[
+            UID_HIGH,
+            RESET_CAUSE,
+            PARAMS_SOURCE,
+            FAULT_HISTORY_LEN,
+            CALIBRATION_SOURCE,
+        ];
+    }
+
+    /// [`CommandAck`](super::CommandAck).
+    pub mod command_ack {
+        use super::*;
+        /// The command answered.
+        pub const OPCODE: SignalSpec =
+            enum_sig("opcode", 0, Opcode::CHOICES, "the command answered");
+        /// Outcome.
+        pub const RESULT: SignalSpec = enum_sig(
+            "result",
+            1,
+            CommandResult::CHOICES,
+            "outcome of the command",
+        );
+        /// Signals in byte order.
+        pub const SIGNALS: &[SignalSpec] = &[OPCODE, RESULT];
+    }
+
+    /// [`FaultHistoryEntry`](super::FaultHistoryEntry).
+    pub mod fault_history {
+        use super::*;
+        /// Entry index, 0 = newest.
+        pub const ENTRY: SignalSpec =
+            sig("entry", 0, Kind::U8, 1.0, "", "entry index, 0 = the newest");
+        /// Fault code.
+        pub const CODE: SignalSpec =
+            enum_sig("code", 1, FaultCode::CHOICES, "the fault that was raised");
+        /// Node state after the tick of the raise.
+        pub const STATE_AFTER: SignalSpec = enum_sig(
+            "state_after",
+            2,
+            NodeState::CHOICES,
+            "node state after that tick (Safe: this raise is why the node went safe)",
+        );
+        /// Offending raw value.
+        pub const DETAIL: SignalSpec = sig(
+            "detail",
+            3,
+            Kind::I16,
+            1.0,
+            "",
+            "offending raw value, as in the Fault event",
+        );
+        /// Time of the raise.
+        pub const UPTIME_MS: SignalSpec = sig(
+            "uptime",
+            5,
+            Kind::U24,
+            1.0e-3,
+            "s",
+            "sender's uptime at the raise (1 ms counts, wraps after 4.66 h)",
+        );
+        /// Signals in byte order.
+        pub const SIGNALS: &[SignalSpec] = &[ENTRY, CODE, STATE_AFTER, DETAIL, UPTIME_MS];
+    }
 }
 
 /// Every message's layout, highest priority first. The DBC file, the bus-load figure and the
@@ -355,6 +487,42 @@ pub const MESSAGES: &[MessageSpec] = &[
         nominal_rate_hz: 0.2,
         comment: "protocol and firmware version",
     },
+    MessageSpec {
+        class: MessageClass::Identity,
+        name: "Identity",
+        dlc: 8,
+        signals: layout::identity::SIGNALS,
+        direction: Direction::FromNode(ANKLES),
+        nominal_rate_hz: 0.0,
+        comment: "chip unique ID (first 64 bits); at start-up and on GetIdentity",
+    },
+    MessageSpec {
+        class: MessageClass::BootInfo,
+        name: "BootInfo",
+        dlc: 8,
+        signals: layout::boot_info::SIGNALS,
+        direction: Direction::FromNode(ANKLES),
+        nominal_rate_hz: 0.0,
+        comment: "chip unique ID (last 32 bits), reset cause, parameter and calibration source",
+    },
+    MessageSpec {
+        class: MessageClass::CommandAck,
+        name: "CommandAck",
+        dlc: 2,
+        signals: layout::command_ack::SIGNALS,
+        direction: Direction::FromNode(ANKLES),
+        nominal_rate_hz: 0.0,
+        comment: "answer to SaveParams, ClearErrors, CalibrateEncoderZero",
+    },
+    MessageSpec {
+        class: MessageClass::FaultHistory,
+        name: "FaultHistory",
+        dlc: 8,
+        signals: layout::fault_history::SIGNALS,
+        direction: Direction::FromNode(ANKLES),
+        nominal_rate_hz: 0.0,
+        comment: "one fault-history entry, sent on GetFaultHistory (newest first)",
+    },
 ];
 
 /// The layout of a message class.
@@ -421,6 +589,39 @@ pub enum CommandKind {
         /// New value.
         value: ParamValue,
     },
+    /// Read one parameter (answered by `ParamAck`, status `Read`).
+    GetParam {
+        /// Which parameter.
+        param: ParamId,
+    },
+    /// Store parameters and encoder zero in flash (answered by `CommandAck`).
+    SaveParams,
+    /// Empty the fault history (answered by `CommandAck`).
+    ClearErrors,
+    /// Send `Version`, `Identity` and `BootInfo`.
+    GetIdentity,
+    /// Send the fault history.
+    GetFaultHistory,
+    /// Take the current reading as encoder zero (answered by `CommandAck`).
+    CalibrateEncoderZero,
+}
+
+impl CommandKind {
+    /// The opcode on the wire.
+    pub const fn opcode(&self) -> Opcode {
+        match self {
+            CommandKind::Enable => Opcode::Enable,
+            CommandKind::Disable => Opcode::Disable,
+            CommandKind::EmergencyStop => Opcode::EmergencyStop,
+            CommandKind::SetParam { .. } => Opcode::SetParam,
+            CommandKind::GetParam { .. } => Opcode::GetParam,
+            CommandKind::SaveParams => Opcode::SaveParams,
+            CommandKind::ClearErrors => Opcode::ClearErrors,
+            CommandKind::GetIdentity => Opcode::GetIdentity,
+            CommandKind::GetFaultHistory => Opcode::GetFaultHistory,
+            CommandKind::CalibrateEncoderZero => Opcode::CalibrateEncoderZero,
+        }
+    }
 }
 
 /// A host command to one ankle or to all.
@@ -497,6 +698,66 @@ pub struct Version {
     pub build: u32,
 }
 
+/// Chip unique ID, first 64 bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Identity {
+    /// The sender.
+    pub node: NodeId,
+    /// UID bits 0–31.
+    pub uid_low: u32,
+    /// UID bits 32–63.
+    pub uid_mid: u32,
+}
+
+/// Chip unique ID (last 32 bits), reset cause and where the configuration came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BootInfo {
+    /// The sender.
+    pub node: NodeId,
+    /// UID bits 64–95.
+    pub uid_high: u32,
+    /// Why the microcontroller last reset.
+    pub reset_cause: ResetCause,
+    /// Where the reflex parameters came from.
+    pub params_source: ConfigSource,
+    /// Entries in the fault history.
+    pub fault_history_len: u8,
+    /// Where the encoder zero came from.
+    pub calibration_source: ConfigSource,
+}
+
+/// Answer to a command without another answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CommandAck {
+    /// The answering ankle.
+    pub node: NodeId,
+    /// The command answered.
+    pub opcode: Opcode,
+    /// Outcome.
+    pub result: CommandResult,
+}
+
+/// One fault-history entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FaultHistoryEntry {
+    /// The sender.
+    pub node: NodeId,
+    /// Index, 0 = newest.
+    pub entry: u8,
+    /// The fault raised.
+    pub code: FaultCode,
+    /// Node state after the tick of the raise.
+    pub state_after: NodeState,
+    /// Offending raw value.
+    pub detail: i16,
+    /// Uptime at the raise [ms], 24 bits on the wire (wraps after 4.66 h).
+    pub uptime_ms: u32,
+}
+
 /// Any message of the protocol.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -515,6 +776,14 @@ pub enum Message {
     Fault(FaultEvent),
     /// Version.
     Version(Version),
+    /// Chip unique ID (first part).
+    Identity(Identity),
+    /// Chip unique ID (last part), reset cause, configuration sources.
+    BootInfo(BootInfo),
+    /// Command acknowledgement.
+    CommandAck(CommandAck),
+    /// Fault-history entry.
+    FaultHistory(FaultHistoryEntry),
 }
 
 /// An encoded frame: identifier, length and payload.
@@ -595,6 +864,10 @@ impl Message {
             Message::ParamAck(_) => MessageClass::ParamAck,
             Message::Fault(_) => MessageClass::Fault,
             Message::Version(_) => MessageClass::Version,
+            Message::Identity(_) => MessageClass::Identity,
+            Message::BootInfo(_) => MessageClass::BootInfo,
+            Message::CommandAck(_) => MessageClass::CommandAck,
+            Message::FaultHistory(_) => MessageClass::FaultHistory,
         }
     }
 
@@ -608,6 +881,10 @@ impl Message {
             Message::ParamAck(m) => m.node.raw(),
             Message::Fault(m) => m.node.raw(),
             Message::Version(m) => m.node.raw(),
+            Message::Identity(m) => m.node.raw(),
+            Message::BootInfo(m) => m.node.raw(),
+            Message::CommandAck(m) => m.node.raw(),
+            Message::FaultHistory(m) => m.node.raw(),
         };
         CanId::new(self.class(), node_raw)
     }
@@ -679,6 +956,14 @@ impl Message {
                     command::PARAM_ID.put(&mut b, param.raw() as i64);
                     command::PARAM_VALUE.put(&mut b, value.0 as i64);
                 }
+                CommandKind::GetParam { param } => {
+                    command::OPCODE.put(&mut b, Opcode::GetParam.raw() as i64);
+                    command::PARAM_ID.put(&mut b, param.raw() as i64);
+                }
+                other => {
+                    let op = other.opcode();
+                    command::OPCODE.put(&mut b, op.raw() as i64);
+                }
             },
             Message::ParamAck(m) => {
                 param_ack::PARAM_ID.put(&mut b, m.param.raw() as i64);
@@ -697,6 +982,28 @@ impl Message {
                 version::MINOR.put(&mut b, m.minor as i64);
                 version::PATCH.put(&mut b, m.patch as i64);
                 version::BUILD.put(&mut b, m.build as i64);
+            }
+            Message::Identity(m) => {
+                identity::UID_LOW.put(&mut b, m.uid_low as i64);
+                identity::UID_MID.put(&mut b, m.uid_mid as i64);
+            }
+            Message::BootInfo(m) => {
+                boot_info::UID_HIGH.put(&mut b, m.uid_high as i64);
+                boot_info::RESET_CAUSE.put(&mut b, m.reset_cause.raw() as i64);
+                boot_info::PARAMS_SOURCE.put(&mut b, m.params_source.raw() as i64);
+                boot_info::FAULT_HISTORY_LEN.put(&mut b, m.fault_history_len as i64);
+                boot_info::CALIBRATION_SOURCE.put(&mut b, m.calibration_source.raw() as i64);
+            }
+            Message::CommandAck(m) => {
+                command_ack::OPCODE.put(&mut b, m.opcode.raw() as i64);
+                command_ack::RESULT.put(&mut b, m.result.raw() as i64);
+            }
+            Message::FaultHistory(m) => {
+                fault_history::ENTRY.put(&mut b, m.entry as i64);
+                fault_history::CODE.put(&mut b, m.code.raw() as i64);
+                fault_history::STATE_AFTER.put(&mut b, m.state_after.raw() as i64);
+                fault_history::DETAIL.put(&mut b, m.detail as i64);
+                fault_history::UPTIME_MS.put(&mut b, (m.uptime_ms & 0xFF_FFFF) as i64);
             }
         }
         let n = spec.dlc as usize;
@@ -773,6 +1080,27 @@ impl Message {
                         param: enum_field(&command::PARAM_ID, &b, ParamId::from_raw)?,
                         value: ParamValue(command::PARAM_VALUE.get(&b) as i32),
                     },
+                    Opcode::GetParam => {
+                        zero(&command::PARAM_VALUE)?;
+                        CommandKind::GetParam {
+                            param: enum_field(&command::PARAM_ID, &b, ParamId::from_raw)?,
+                        }
+                    }
+                    op @ (Opcode::SaveParams
+                    | Opcode::ClearErrors
+                    | Opcode::GetIdentity
+                    | Opcode::GetFaultHistory
+                    | Opcode::CalibrateEncoderZero) => {
+                        zero(&command::PARAM_ID)?;
+                        zero(&command::PARAM_VALUE)?;
+                        match op {
+                            Opcode::SaveParams => CommandKind::SaveParams,
+                            Opcode::ClearErrors => CommandKind::ClearErrors,
+                            Opcode::GetIdentity => CommandKind::GetIdentity,
+                            Opcode::GetFaultHistory => CommandKind::GetFaultHistory,
+                            _ => CommandKind::CalibrateEncoderZero,
+                        }
+                    }
                     Opcode::EmergencyStop => {
                         // Emergency stop has its own, higher-priority identifier.
                         return Err(DecodeError::ValueOutOfRange {
@@ -829,6 +1157,36 @@ impl Message {
                 minor: version::MINOR.get(&b) as u8,
                 patch: version::PATCH.get(&b) as u8,
                 build: version::BUILD.get(&b) as u32,
+            }),
+            MessageClass::Identity => Message::Identity(Identity {
+                node: sender(id.class, id.node_raw)?,
+                uid_low: identity::UID_LOW.get(&b) as u32,
+                uid_mid: identity::UID_MID.get(&b) as u32,
+            }),
+            MessageClass::BootInfo => Message::BootInfo(BootInfo {
+                node: sender(id.class, id.node_raw)?,
+                uid_high: boot_info::UID_HIGH.get(&b) as u32,
+                reset_cause: enum_field(&boot_info::RESET_CAUSE, &b, ResetCause::from_raw)?,
+                params_source: enum_field(&boot_info::PARAMS_SOURCE, &b, ConfigSource::from_raw)?,
+                fault_history_len: boot_info::FAULT_HISTORY_LEN.get(&b) as u8,
+                calibration_source: enum_field(
+                    &boot_info::CALIBRATION_SOURCE,
+                    &b,
+                    ConfigSource::from_raw,
+                )?,
+            }),
+            MessageClass::CommandAck => Message::CommandAck(CommandAck {
+                node: sender(id.class, id.node_raw)?,
+                opcode: enum_field(&command_ack::OPCODE, &b, Opcode::from_raw)?,
+                result: enum_field(&command_ack::RESULT, &b, CommandResult::from_raw)?,
+            }),
+            MessageClass::FaultHistory => Message::FaultHistory(FaultHistoryEntry {
+                node: sender(id.class, id.node_raw)?,
+                entry: fault_history::ENTRY.get(&b) as u8,
+                code: enum_field(&fault_history::CODE, &b, FaultCode::from_raw)?,
+                state_after: enum_field(&fault_history::STATE_AFTER, &b, NodeState::from_raw)?,
+                detail: fault_history::DETAIL.get(&b) as i16,
+                uptime_ms: fault_history::UPTIME_MS.get(&b) as u32,
             }),
         };
         Ok(msg)

@@ -12,6 +12,8 @@ pub enum Kind {
     U16,
     /// Signed 16 bits, two's complement.
     I16,
+    /// Unsigned 24 bits.
+    U24,
     /// Unsigned 32 bits.
     U32,
     /// Signed 32 bits, two's complement.
@@ -24,6 +26,7 @@ impl Kind {
         match self {
             Kind::U8 => 1,
             Kind::U16 | Kind::I16 => 2,
+            Kind::U24 => 3,
             Kind::U32 | Kind::I32 => 4,
         }
     }
@@ -34,7 +37,7 @@ impl Kind {
     /// Smallest raw value.
     pub const fn raw_min(self) -> i64 {
         match self {
-            Kind::U8 | Kind::U16 | Kind::U32 => 0,
+            Kind::U8 | Kind::U16 | Kind::U24 | Kind::U32 => 0,
             Kind::I16 => i16::MIN as i64,
             Kind::I32 => i32::MIN as i64,
         }
@@ -45,6 +48,7 @@ impl Kind {
             Kind::U8 => u8::MAX as i64,
             Kind::U16 => u16::MAX as i64,
             Kind::I16 => i16::MAX as i64,
+            Kind::U24 => 0xFF_FFFF,
             Kind::U32 => u32::MAX as i64,
             Kind::I32 => i32::MAX as i64,
         }

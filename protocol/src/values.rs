@@ -134,17 +134,27 @@ wire_enum!(
         EncoderRange = 2,
         /// The angle changed faster than the ankle can move.
         EncoderRate = 3,
-        /// The angle did not change at all for too long while the actuator was driving.
+        /// The angle did not change at all for too long while the actuator was driving (push
+        /// or hold; a working magnetic encoder's output always moves by its noise).
         EncoderStuck = 4,
         /// No heartbeat from the other ankle within the timeout.
         PeerHeartbeatLost = 5,
         /// The actuator driver reported an error.
         Actuator = 6,
-        /// The CAN controller reported an error or the transmit queue overflowed.
+        /// The CAN controller went bus-off (status register), or the transmit queue
+        /// overflowed. Error frames and error-passive are not faults.
         CanBus = 7,
         /// The other foot's heel-strike message did not arrive before the own foot lifted
         /// (the own contact switch released the string). Not safety-relevant.
         PeerHeelStrikeLate = 8,
+        /// The measured ankle angle stayed more than the limit below the actuator's setpoint
+        /// for longer than the allowed time while driving (push or hold): the string is not
+        /// where it is commanded — a reversed or failed motor, a broken string, a frozen
+        /// encoder reading.
+        FollowingError = 9,
+        /// The other ankle reported (in its heartbeat, after this node was enabled) that it is
+        /// in its safe state or emergency stop: one ankle cannot walk alone.
+        PeerSafe = 10,
     }
 );
 
@@ -181,6 +191,8 @@ wire_enum!(
         Inconsistent = 2,
         /// Parameters may only change while the node is disabled; the old value stays.
         NotWhileEnabled = 3,
+        /// Answer to `GetParam`: the value in force.
+        Read = 4,
     }
 );
 
@@ -195,6 +207,68 @@ wire_enum!(
         EmergencyStop = 3,
         /// Set one reflex parameter.
         SetParam = 4,
+        /// Read one parameter (answered by `ParamAck` with status `Read`).
+        GetParam = 5,
+        /// Store the parameters in force and the encoder zero in flash (answered by
+        /// `CommandAck`).
+        SaveParams = 6,
+        /// Empty the fault history (answered by `CommandAck`).
+        ClearErrors = 7,
+        /// Send `Version`, `Identity` and `BootInfo` now.
+        GetIdentity = 8,
+        /// Send the fault history, newest first (`FaultHistory` frames).
+        GetFaultHistory = 9,
+        /// Take the current encoder reading as ankle angle zero (node disabled, ankle held at
+        /// its zero pose; answered by `CommandAck`; stored by `SaveParams`).
+        CalibrateEncoderZero = 10,
+    }
+);
+
+wire_enum!(
+    /// Why the node's microcontroller last reset.
+    ResetCause {
+        /// No flag was set (or not known, e.g. in simulation).
+        Unknown = 0,
+        /// Power-on or brown-out.
+        PowerOn = 1,
+        /// The reset pin (probe, button).
+        Pin = 2,
+        /// Software reset.
+        Software = 3,
+        /// The independent watchdog: the control loop stopped running on time.
+        IndependentWatchdog = 4,
+        /// The window watchdog.
+        WindowWatchdog = 5,
+        /// Low-power reset.
+        LowPower = 6,
+        /// Option-byte loading.
+        OptionBytes = 7,
+    }
+);
+
+wire_enum!(
+    /// Where the values in force came from at start-up.
+    ConfigSource {
+        /// Built-in defaults (nothing stored).
+        Defaults = 0,
+        /// Read from flash.
+        Flash = 1,
+        /// Flash could not be read; built-in defaults.
+        FlashUnreadable = 2,
+    }
+);
+
+wire_enum!(
+    /// Outcome of a command answered by `CommandAck`.
+    CommandResult {
+        /// Done.
+        Done = 0,
+        /// Tried and failed (e.g. the flash write failed).
+        Failed = 1,
+        /// Refused while the node is enabled.
+        NotWhileEnabled = 2,
+        /// Not possible now (e.g. no good encoder reading to calibrate from).
+        NotAvailable = 3,
     }
 );
 

@@ -11,12 +11,12 @@ use core::fmt::Write as _;
 
 use crate::id::{NodeId, Target};
 use crate::messages::{
-    spec, AnkleState, Command, CommandKind, FaultEvent, Heartbeat, HeelStrike, Message, ParamAck,
-    Version,
+    spec, AnkleState, BootInfo, Command, CommandAck, CommandKind, FaultEvent, FaultHistoryEntry,
+    Heartbeat, HeelStrike, Identity, Message, ParamAck, Version,
 };
 use crate::values::{
-    Angle, AngularRate, FaultCode, FaultFlags, FaultTransition, NodeState, ParamId, ParamStatus,
-    ParamValue, ReflexPhase,
+    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
+    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
 };
 
 /// Messages covering every identifier, every enumeration value at least once, and the
@@ -95,6 +95,14 @@ pub fn messages() -> Vec<Message> {
             CommandKind::Enable,
             CommandKind::Disable,
             CommandKind::EmergencyStop,
+            CommandKind::SaveParams,
+            CommandKind::ClearErrors,
+            CommandKind::GetIdentity,
+            CommandKind::GetFaultHistory,
+            CommandKind::CalibrateEncoderZero,
+            CommandKind::GetParam {
+                param: ParamId::StuckTimeout,
+            },
         ] {
             v.push(Message::Command(Command { target, kind }));
         }
@@ -113,6 +121,40 @@ pub fn messages() -> Vec<Message> {
             value: ParamValue(i32::MIN),
         },
     }));
+    for (i, node) in NodeId::ANKLES.into_iter().enumerate() {
+        v.push(Message::Identity(Identity {
+            node,
+            uid_low: 0x0034_0021 + i as u32,
+            uid_mid: u32::MAX,
+        }));
+        for (k, cause) in ResetCause::ALL.iter().enumerate() {
+            v.push(Message::BootInfo(BootInfo {
+                node,
+                uid_high: 0x2020_4E50,
+                reset_cause: *cause,
+                params_source: ConfigSource::ALL[k % ConfigSource::ALL.len()],
+                fault_history_len: (k * 37) as u8,
+                calibration_source: ConfigSource::ALL[(k + 1) % ConfigSource::ALL.len()],
+            }));
+        }
+        for (k, op) in Opcode::ALL.iter().enumerate() {
+            v.push(Message::CommandAck(CommandAck {
+                node,
+                opcode: *op,
+                result: CommandResult::ALL[k % CommandResult::ALL.len()],
+            }));
+        }
+        for (k, code) in FaultCode::ALL.iter().enumerate() {
+            v.push(Message::FaultHistory(FaultHistoryEntry {
+                node,
+                entry: k as u8,
+                code: *code,
+                state_after: NodeState::ALL[k % NodeState::ALL.len()],
+                detail: [i16::MIN, -1, 0, 1, i16::MAX][k % 5],
+                uptime_ms: [0, 1, 123_456, 0xFF_FFFF][k % 4],
+            }));
+        }
+    }
     v
 }
 

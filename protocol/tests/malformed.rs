@@ -129,8 +129,13 @@ fn unknown_identifiers() {
         Err(DecodeError::UnknownId { raw: 0 })
     );
     assert_eq!(
-        Message::decode(0x092, &[0; 8]),
-        Err(DecodeError::UnknownId { raw: 0x092 })
+        Message::decode(0x0D2, &[0; 8]),
+        Err(DecodeError::UnknownId { raw: 0x0D2 })
+    );
+    // Identity from the host: ankles only.
+    assert_eq!(
+        Message::decode(0x091, &[0; 8]),
+        Err(DecodeError::UnknownId { raw: 0x091 })
     );
     // Known class, node field without that message: ankle telemetry "from" the host,
     // a node number that does not exist, a command to the host.
@@ -171,8 +176,9 @@ fn every_undefined_identifier_is_rejected() {
             assert_eq!(r, Err(DecodeError::UnknownId { raw: raw as u32 }));
         }
     }
-    // emergency stop 3, heel strike 2, fault 2, command 3, ack 2, heartbeat 3, state 2, version 3
-    assert_eq!(defined, 20);
+    // emergency stop 3, heel strike 2, fault 2, command 3, ack 2, heartbeat 3, state 2, version 3,
+    // identity 2, boot info 2, command ack 2, fault history 2
+    assert_eq!(defined, 28);
 }
 
 #[test]

@@ -63,6 +63,12 @@ fn message() -> impl Strategy<Value = Message> {
                 Just(CommandKind::Enable),
                 Just(CommandKind::Disable),
                 Just(CommandKind::EmergencyStop),
+                Just(CommandKind::SaveParams),
+                Just(CommandKind::ClearErrors),
+                Just(CommandKind::GetIdentity),
+                Just(CommandKind::GetFaultHistory),
+                Just(CommandKind::CalibrateEncoderZero),
+                pick(ParamId::ALL).prop_map(|param| CommandKind::GetParam { param }),
                 (pick(ParamId::ALL), any::<i32>()).prop_map(|(param, v)| {
                     CommandKind::SetParam {
                         param,
@@ -110,6 +116,56 @@ fn message() -> impl Strategy<Value = Message> {
                 build,
             })
         }),
+        (ankle(), any::<u32>(), any::<u32>()).prop_map(|(node, uid_low, uid_mid)| {
+            Message::Identity(Identity {
+                node,
+                uid_low,
+                uid_mid,
+            })
+        }),
+        (
+            ankle(),
+            any::<u32>(),
+            pick(ResetCause::ALL),
+            pick(ConfigSource::ALL),
+            any::<u8>(),
+            pick(ConfigSource::ALL)
+        )
+            .prop_map(|(node, uid_high, reset_cause, params_source, n, cal)| {
+                Message::BootInfo(BootInfo {
+                    node,
+                    uid_high,
+                    reset_cause,
+                    params_source,
+                    fault_history_len: n,
+                    calibration_source: cal,
+                })
+            }),
+        (ankle(), pick(Opcode::ALL), pick(CommandResult::ALL)).prop_map(
+            |(node, opcode, result)| Message::CommandAck(CommandAck {
+                node,
+                opcode,
+                result,
+            })
+        ),
+        (
+            ankle(),
+            any::<u8>(),
+            pick(FaultCode::ALL),
+            pick(NodeState::ALL),
+            any::<i16>(),
+            0u32..=0xFF_FFFF
+        )
+            .prop_map(|(node, entry, code, state_after, detail, uptime_ms)| {
+                Message::FaultHistory(FaultHistoryEntry {
+                    node,
+                    entry,
+                    code,
+                    state_after,
+                    detail,
+                    uptime_ms,
+                })
+            }),
     ]
 }
 

@@ -1,62 +1,93 @@
-//! The ankle node on ST's B-G431B-ESC1 (STM32G431CB at 170 MHz, FDCAN1 at 500 kbit/s).
+//! The ankle node on ST's B-G431B-ESC1 (STM32G431CB at 170 MHz from the 8 MHz crystal,
+//! FDCAN1 at 500 kbit/s).
 //!
 //! One embassy task runs the control loop at 1 kHz: [`firmware::runner::AnkleDrivers::step`]
-//! reads the encoder (SPI1) and the contact switch, drains the CAN receive buffer, ticks the
-//! node, drives the actuator (TIM1 PWM + direction pin) and queues the node's frames on the
-//! buffered FDCAN driver. The DWT cycle counter measures every step; the worst case is logged
-//! through defmt once a second.
+//! reads the ankle encoder (PWM output on PA15/TIM2) and the contact switch, drains the CAN
+//! receive buffer and reads the controller's status, ticks the node, drives the spool motor
+//! (two half-bridges on TIM1, spool encoder on TIM4, current from the shunt amplifiers) and
+//! queues the node's frames. The independent watchdog is petted only when the tick ran on
+//! time ([`firmware::supervisor::LoopSupervisor`]). Pin map, power-up and fault states:
+//! `docs/firmware.md` ("Board: B-G431B-ESC1").
 //!
 //! Which ankle this is comes from the build: `ANKLE_SIDE=right cargo run --release` for the
-//! right ankle, left otherwise.
-//!
-//! Pin assignment (check against the board's user manual UM2516 and your wiring before
-//! flashing; the inverter pins of the ESC board are reused for a brushed string motor):
-//!
-//! | function | pin |
-//! | --- | --- |
-//! | FDCAN1 RX / TX (on-board transceiver) | PA11 / PB9 |
-//! | encoder SPI1 SCK / MISO / MOSI, chip select | PB3 / PB4 / PB5, PA15 |
-//! | contact switch (to ground, pull-up) | PB6 |
-//! | motor PWM (TIM1_CH1, 20 kHz) / direction | PA8 / PB7 |
+//! right ankle, left otherwise. `CAN_TERMINATION=on` switches the on-board 120 Ω in (the two
+//! nodes at the ends of the bus only).
 #![no_std]
 #![no_main]
 
-use defmt_rtt as _;
-use panic_probe as _;
+mod can_port;
+mod crash;
+mod current_sense;
+mod encoders;
+mod power_stage;
+mod reset_cause;
 
+use defmt_rtt as _;
+
+// defmt log lines carry the embassy uptime in microseconds.
+defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
+
+use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::Spawner;
-use embassy_stm32::can::{
-    self, BufferedCanReceiver, BufferedCanSender, Frame, OperatingMode, RxBuf, TxBuf,
-};
+use embassy_stm32::adc::{Adc, AdcConfig};
+use embassy_stm32::can::{self, OperatingMode, RxBuf, TxBuf};
+use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Input, Level, Output, OutputType, Pull, Speed};
-use embassy_stm32::peripherals::FDCAN1;
-use embassy_stm32::spi::{self, Spi};
-use embassy_stm32::time::{khz, mhz};
+use embassy_stm32::opamp::{OpAmp, OpAmpSpeed};
+use embassy_stm32::peripherals::{FDCAN1, TIM2};
+use embassy_stm32::time::{hz, khz};
+use embassy_stm32::timer::complementary_pwm::{ComplementaryPwm, ComplementaryPwmPin};
 use embassy_stm32::timer::low_level::CountingMode;
-use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm};
-use embassy_stm32::{bind_interrupts, rcc, Config};
+use embassy_stm32::timer::pwm_input::PwmInput;
+use embassy_stm32::timer::qei::{self, Qei};
+use embassy_stm32::timer::simple_pwm::PwmPin;
+use embassy_stm32::wdg::IndependentWatchdog;
+use embassy_stm32::{bind_interrupts, rcc, timer, Config};
 use embassy_time::{Duration, Ticker};
-use embedded_hal_bus::spi::ExclusiveDevice;
-use firmware::drivers::actuator::{PwmDirActuator, PwmDirGains};
 use firmware::drivers::can::CanPort;
 use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
-use firmware::drivers::encoder::MagneticEncoder;
+use firmware::drivers::encoder::AngleSensor;
+use firmware::drivers::pwm_encoder::PwmAngleEncoder;
+use firmware::drivers::spool_motor::{SpoolMotor, SpoolMotorConfig};
+use firmware::node::NodeRequest;
+use firmware::param_store::ParamStore;
 use firmware::runner::AnkleDrivers;
 use firmware::sensors::AngleCalibration;
+use firmware::supervisor::LoopSupervisor;
 use firmware::{AnkleNode, Instant, Monotonic, NodeConfig};
 use protocol::NodeId;
+
+use crate::can_port::{BoardCan, Termination};
+use crate::current_sense::ShuntCurrent;
+use crate::encoders::{AnklePwmCapture, SpoolQei, ENCODER_PWM_PERIOD_TICKS, PWM_CAPTURE_TICK_HZ};
+use crate::power_stage::Tim1Bridges;
 
 bind_interrupts!(struct Irqs {
     FDCAN1_IT0 => can::IT0InterruptHandler<FDCAN1>;
     FDCAN1_IT1 => can::IT1InterruptHandler<FDCAN1>;
+    TIM2 => timer::CaptureCompareInterruptHandler<TIM2>;
 });
 
 /// Core clock [Hz].
 const SYSCLK_HZ: u32 = 170_000_000;
 /// Budget of one control tick [cycles]: 2 % of the core at 1 kHz.
 const TICK_BUDGET_CYCLES: u32 = 3_400;
+/// Control period [µs].
+const PERIOD_US: u64 = 1_000;
+/// A tick may start this late and still count as on time [µs].
+const MAX_LATE_US: u64 = 500;
+/// A tick may last this long and still count as on time [µs] (the budget is 20 µs; the
+/// margin covers the encoder and ADC reads and CAN queueing).
+const MAX_TICK_US: u64 = 200;
+/// Independent watchdog timeout [µs]: 50 ticks without a pet on time reset the chip. Longer
+/// than a flash page erase (SaveParams stalls the core while it erases).
+const WATCHDOG_TIMEOUT_US: u32 = 50_000;
 
-/// Encoder zero: counts at ankle angle 0 (set after mounting the magnet).
+/// Flash kept for parameters and calibration [offsets from the flash base]: the last four
+/// 2 KiB pages of the 128 KiB (the binary is held under 64 KiB by scripts/firmware-tier).
+const PARAM_FLASH: core::ops::Range<u32> = 0x1E000..0x20000;
+
+/// Encoder zero used until one is calibrated and stored (CalibrateEncoderZero, SaveParams).
 const CALIBRATION: AngleCalibration = AngleCalibration {
     zero_counts: 0,
     reversed: false,
@@ -69,6 +100,13 @@ fn node_id() -> NodeId {
     }
 }
 
+fn termination() -> Termination {
+    match option_env!("CAN_TERMINATION") {
+        Some("on") => Termination::OnBoard,
+        _ => Termination::External,
+    }
+}
+
 /// embassy-time as the node's monotonic clock.
 struct EmbassyClock;
 
@@ -78,51 +116,16 @@ impl Monotonic for EmbassyClock {
     }
 }
 
-/// Errors of the buffered FDCAN adapter.
-#[derive(Debug, Clone, Copy)]
-enum BoardCanError {
-    /// The controller reported a bus error (stuff, form, ACK, CRC, bus-off ...).
-    Bus,
-}
-
-impl embedded_can::Error for BoardCanError {
-    fn kind(&self) -> embedded_can::ErrorKind {
-        embedded_can::ErrorKind::Other
-    }
-}
-
-/// embassy's buffered FDCAN seen as a non-blocking `embedded_can::nb::Can`.
-struct BoardCan {
-    tx: BufferedCanSender,
-    rx: BufferedCanReceiver,
-}
-
-impl embedded_can::nb::Can for BoardCan {
-    type Frame = Frame;
-    type Error = BoardCanError;
-
-    fn transmit(&mut self, frame: &Frame) -> nb::Result<Option<Frame>, BoardCanError> {
-        match self.tx.try_write(*frame) {
-            Ok(()) => Ok(None),
-            Err(_) => Err(nb::Error::WouldBlock),
-        }
-    }
-
-    fn receive(&mut self) -> nb::Result<Frame, BoardCanError> {
-        match self.rx.try_receive() {
-            Ok(Ok(envelope)) => Ok(envelope.frame),
-            Ok(Err(_)) => Err(nb::Error::Other(BoardCanError::Bus)),
-            Err(_) => Err(nb::Error::WouldBlock),
-        }
-    }
-}
-
+/// 8 MHz crystal → PLL (÷2 × 85 ÷ 2) → 170 MHz, boost mode; FDCAN from the crystal itself.
 fn clocks() -> Config {
     let mut config = Config::default();
-    // HSI 16 MHz / 4 × 85 / 2 = 170 MHz, boost mode.
+    config.rcc.hse = Some(rcc::Hse {
+        freq: embassy_stm32::time::mhz(8),
+        mode: rcc::HseMode::Oscillator,
+    });
     config.rcc.pll = Some(rcc::Pll {
-        source: rcc::PllSource::HSI,
-        prediv: rcc::PllPreDiv::DIV4,
+        source: rcc::PllSource::HSE,
+        prediv: rcc::PllPreDiv::DIV2,
         mul: rcc::PllMul::MUL85,
         divp: None,
         divq: None,
@@ -130,23 +133,108 @@ fn clocks() -> Config {
     });
     config.rcc.sys = rcc::Sysclk::PLL1_R;
     config.rcc.boost = true;
-    config.rcc.mux.fdcansel = rcc::mux::Fdcansel::PCLK1;
+    config.rcc.mux.fdcansel = rcc::mux::Fdcansel::HSE;
+    config.rcc.mux.adc12sel = rcc::mux::Adcsel::SYS;
     config
 }
 
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
+    // Before anything else: the power stage's pins are inputs at reset; TIM1 is configured
+    // with its main output disabled below, before any other peripheral.
     let p = embassy_stm32::init(clocks());
+    let cause = reset_cause::read_and_clear();
     let id = node_id();
-    defmt::info!("ankle node {} starting", id);
+    defmt::info!("ankle node {} starting, reset cause {}", id, cause);
 
-    // CAN: 500 kbit/s classic, buffered.
+    // Power stage: phases U and V as two half-bridges, W held low; off until driven.
+    let pwm = ComplementaryPwm::new(
+        p.TIM1,
+        Some(PwmPin::new(p.PA8, OutputType::PushPull)),
+        Some(ComplementaryPwmPin::new(p.PC13, OutputType::PushPull)),
+        Some(PwmPin::new(p.PA9, OutputType::PushPull)),
+        Some(ComplementaryPwmPin::new(p.PA12, OutputType::PushPull)),
+        None,
+        None,
+        None,
+        None,
+        khz(20),
+        CountingMode::CenterAlignedBothInterrupts,
+    );
+    let bridges = Tim1Bridges::new(pwm);
+    let _phase_w_high = Output::new(p.PA10, Level::Low, Speed::Low);
+    let _phase_w_low = Output::new(p.PB15, Level::Low, Speed::Low);
+
+    // Parameters and encoder zero from flash (defaults when nothing is stored).
+    let mut store = match ParamStore::new(
+        BlockingAsync::new(Flash::new_blocking(p.FLASH)),
+        PARAM_FLASH,
+    ) {
+        Ok(s) => s,
+        Err(e) => defmt::panic!("parameter flash range: {}", e),
+    };
+    let loaded = store.load(CALIBRATION).await;
+    defmt::info!(
+        "parameters from {}, encoder zero {} from {}",
+        loaded.params_source,
+        loaded.calibration.zero_counts,
+        loaded.calibration_source
+    );
+
+    // Current sense: OPAMP1 (phase U shunt) and OPAMP2 (phase V) with the board's external
+    // gain networks, read by ADC1 and ADC2.
+    let mut op1 = OpAmp::new(p.OPAMP1, OpAmpSpeed::Normal);
+    let mut op2 = OpAmp::new(p.OPAMP2, OpAmpSpeed::Normal);
+    let out1 = op1.standalone_ext(p.PA1, p.PA3, p.PA2);
+    let out2 = op2.standalone_ext(p.PA7, p.PA5, p.PA6);
+    let current = ShuntCurrent::new(
+        Adc::new(p.ADC1, AdcConfig::default()),
+        Adc::new(p.ADC2, AdcConfig::default()),
+        out1,
+        out2,
+    );
+    let (ou, ov) = current.offsets();
+    defmt::info!("current-sense offsets {} / {} counts", ou, ov);
+
+    // Spool encoder: TIM4 in encoder mode on the Hall/encoder connector (PB6, PB7).
+    let mut qei_cfg = qei::Config::default();
+    qei_cfg.ch1_pull = Pull::Up;
+    qei_cfg.ch2_pull = Pull::Up;
+    let spool = SpoolQei::new(Qei::new(p.TIM4, p.PB6, p.PB7, qei_cfg));
+    let actuator = SpoolMotor::new(bridges, spool, current, SpoolMotorConfig::default());
+
+    // Ankle encoder: PWM output on the PWM pad (PA15, TIM2_CH1).
+    let capture = AnklePwmCapture::new(PwmInput::new_ch1(
+        p.TIM2,
+        p.PA15,
+        Irqs,
+        Pull::Down,
+        hz(PWM_CAPTURE_TICK_HZ),
+    ));
+    let encoder = PwmAngleEncoder::new(capture, loaded.calibration, ENCODER_PWM_PERIOD_TICKS, 2);
+
+    // Contact switch: the connector's third pin (PB8, to ground, pull-up), 3 ms debounce.
+    let contact = ContactSwitch::new(Input::new(p.PB8, Pull::Up), ActiveLevel::Low, 3);
+
+    // CAN: transceiver enabled (PC11 low), termination as built, crystal-clocked timing,
+    // filters for this node's identifiers only.
+    let _can_shutdown = Output::new(p.PC11, Level::Low, Speed::Low);
+    let term = termination();
+    let _can_term = Output::new(
+        p.PC14,
+        if term == Termination::OnBoard {
+            Level::High
+        } else {
+            Level::Low
+        },
+        Speed::Low,
+    );
     let mut cfg = can::CanConfigurator::new(p.FDCAN1, p.PA11, p.PB9, Irqs);
-    cfg.set_bitrate(protocol::BITRATE_BPS);
+    can_port::configure(&mut cfg, id);
     let can = cfg.start(OperatingMode::NormalOperationMode);
     let (Some(tx_buf), Some(rx_buf)) = (
         cortex_m::singleton!(: TxBuf<32> = TxBuf::<32>::new()),
-        cortex_m::singleton!(: RxBuf<16> = RxBuf::<16>::new()),
+        cortex_m::singleton!(: RxBuf<64> = RxBuf::<64>::new()),
     ) else {
         defmt::panic!("CAN buffers taken twice");
     };
@@ -155,41 +243,19 @@ async fn main(_spawner: Spawner) {
         tx: buffered.writer(),
         rx: buffered.reader(),
     };
-
-    // Encoder on SPI1 (mode 1, 10 MHz: the AS5047P maximum).
-    let mut spi_cfg = spi::Config::default();
-    spi_cfg.frequency = mhz(10);
-    spi_cfg.mode = spi::MODE_1;
-    let spi_bus = Spi::new_blocking(p.SPI1, p.PB3, p.PB5, p.PB4, spi_cfg);
-    let cs = Output::new(p.PA15, Level::High, Speed::VeryHigh);
-    // Infallible: the chip-select pin cannot fail.
-    let Ok(spi_dev) = ExclusiveDevice::new_no_delay(spi_bus, cs);
-    let encoder = MagneticEncoder::new(spi_dev, CALIBRATION);
-
-    // Contact switch: to ground, internal pull-up, 3 ms debounce.
-    let contact = ContactSwitch::new(Input::new(p.PB6, Pull::Up), ActiveLevel::Low, 3);
-
-    // Actuator: TIM1_CH1 PWM at 20 kHz + direction pin.
-    let pwm = SimplePwm::new(
-        p.TIM1,
-        Some(PwmPin::new(p.PA8, OutputType::PushPull)),
-        None,
-        None,
-        None,
-        khz(20),
-        CountingMode::EdgeAlignedUp,
-    );
-    let mut channels = pwm.split();
-    channels.ch1.enable();
-    let dir = Output::new(p.PB7, Level::Low, Speed::Low);
-    let actuator = PwmDirActuator::new(channels.ch1, dir, PwmDirGains::default());
+    defmt::info!("CAN 500 kbit/s, termination {}", term);
 
     let mut config = NodeConfig::nominal(id);
-    config.build_id = 0x0001_0000;
-    let node = match AnkleNode::new(config) {
+    config.build_id = u32::from_str_radix(env!("GIT_HASH"), 16).unwrap_or(0);
+    config.uid = reset_cause::unique_id();
+    config.reset_cause = cause;
+    config.params_source = loaded.params_source;
+    config.calibration_source = loaded.calibration_source;
+    let mut node = match AnkleNode::new(config) {
         Ok(n) => n,
         Err(e) => defmt::panic!("node config: {}", e),
     };
+    node.restore_params(loaded.params);
     let mut drivers = AnkleDrivers::new(
         node,
         encoder,
@@ -206,24 +272,48 @@ async fn main(_spawner: Spawner) {
     core.DCB.enable_trace();
     core.DWT.enable_cycle_counter();
 
+    let mut watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US);
+    watchdog.unleash();
+    let mut supervisor = LoopSupervisor::new(PERIOD_US, MAX_LATE_US, MAX_TICK_US);
+
     let mut ticker = Ticker::every(Duration::from_hz(1_000));
     let mut worst: u32 = 0;
     let mut n: u32 = 0;
     loop {
+        let started = EmbassyClock.now();
         let start = cortex_m::peripheral::DWT::cycle_count();
         let out = drivers.step();
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(start);
+        if supervisor.tick(started, EmbassyClock.now()) {
+            watchdog.pet();
+        }
+        // SaveParams: the flash erase stalls the core for milliseconds (the supervisor sees a
+        // late tick; the 50 ms watchdog covers it).
+        if out.request == Some(NodeRequest::SaveParams) {
+            let params = *drivers.node.params();
+            let cal = drivers.encoder.calibration();
+            let ok = store.save(&params, cal).await.is_ok();
+            defmt::info!("parameters saved: {}", ok);
+            drivers.node.storage_done(ok);
+        }
         worst = worst.max(cycles);
         n = n.wrapping_add(1);
         if n % 1_000 == 0 {
+            let stats = drivers.can.stats();
             defmt::info!(
-                "state {} phase {} faults {:#06x}; worst tick {} cycles (budget {}, {} MHz)",
+                "state {} phase {} faults {:#06x}; worst tick {} cycles (budget {}, {} MHz); late ticks {}; CAN {} TEC {} REC {} lost {} errors {}",
                 out.state,
                 out.phase,
                 drivers.node.faults().bits(),
                 worst,
                 TICK_BUDGET_CYCLES,
-                SYSCLK_HZ / 1_000_000
+                SYSCLK_HZ / 1_000_000,
+                supervisor.late_ticks(),
+                stats.status.state,
+                stats.status.tx_errors,
+                stats.status.rx_errors,
+                stats.rx_lost,
+                stats.bus_errors
             );
             worst = 0;
         }

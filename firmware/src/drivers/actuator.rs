@@ -1,4 +1,5 @@
-//! The string actuator: a DC motor through PWM and a direction pin, or a position servo.
+//! The string actuator: a DC motor through PWM and a direction pin, or a position servo (the
+//! B-G431B-ESC1's two half-bridges are in [`crate::drivers::spool_motor`]).
 
 use embedded_hal::digital::{Error as _, ErrorKind as PinErrorKind, OutputPin};
 use embedded_hal::pwm::{Error as _, ErrorKind as PwmErrorKind, SetDutyCycle};
@@ -15,6 +16,16 @@ pub enum ActuatorError {
     Pin(PinErrorKind),
     /// A position command without a valid angle measurement (closed loop impossible).
     NoFeedback,
+    /// The motor current stayed over the limit; the power stage is latched off.
+    OverCurrent,
+    /// The motor-current measurement failed.
+    CurrentSense,
+    /// The spool position could not be read.
+    SpoolSensor,
+    /// The power stage refused a setting.
+    Bridge,
+    /// Paying out the slack on release did not finish in time (jammed spool?).
+    ReleaseTimeout,
 }
 
 /// Anything that can hold the string at an ankle angle or release it.

@@ -8,6 +8,43 @@ use protocol::{DecodeError, Message, RawFrame};
 
 use crate::node::MAX_RX_PER_TICK;
 
+/// The controller's fault-confinement state (ISO 11898-1), read from its status register.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BusState {
+    /// Both error counters below 128: the node takes part normally.
+    #[default]
+    ErrorActive,
+    /// An error counter at 128 or more: the node still sends and receives, but signals errors
+    /// passively. Reported, not a fault.
+    ErrorPassive,
+    /// Transmit error counter past 255: the controller has left the bus.
+    BusOff,
+}
+
+/// What the controller reports about its health, as the real driver does: the error
+/// counters and the confinement state from the status registers (not the last error code),
+/// and the frames lost because the receive FIFO was full.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ControllerStatus {
+    /// Fault-confinement state.
+    pub state: BusState,
+    /// Transmit error counter (TEC).
+    pub tx_errors: u8,
+    /// Receive error counter (REC).
+    pub rx_errors: u8,
+    /// Frames lost to a full receive FIFO since the last call.
+    pub rx_lost: u32,
+}
+
+/// A controller that can report its status (implemented by the board's FDCAN adapter and the
+/// simulator's bus).
+pub trait ControllerHealth {
+    /// The current status; `rx_lost` counts since the previous call.
+    fn status(&mut self) -> ControllerStatus;
+}
+
 /// Frames the port holds while the controller's mailboxes are full.
 pub const TX_QUEUE_LEN: usize = 32;
 
@@ -25,8 +62,14 @@ pub struct CanStats {
     pub sent: u32,
     /// Frames dropped because the queue was full or could not be built.
     pub dropped: u32,
-    /// Controller errors reported.
+    /// Error frames and other protocol errors the driver reported (counted, not faults).
     pub bus_errors: u32,
+    /// Frames lost because the receive FIFO was full.
+    pub rx_lost: u32,
+    /// Last status read from the controller.
+    pub status: ControllerStatus,
+    /// Times the controller went bus-off.
+    pub bus_off_events: u32,
 }
 
 /// A CAN controller with a transmit queue.
@@ -34,6 +77,20 @@ pub struct CanPort<C> {
     can: C,
     queue: Deque<RawFrame, TX_QUEUE_LEN>,
     stats: CanStats,
+}
+
+impl<C: Can + ControllerHealth> CanPort<C> {
+    /// Read the controller's status; counts lost frames and bus-off entries. Returns the
+    /// state.
+    pub fn poll_status(&mut self) -> BusState {
+        let st = self.can.status();
+        self.stats.rx_lost = self.stats.rx_lost.wrapping_add(st.rx_lost);
+        if st.state == BusState::BusOff && self.stats.status.state != BusState::BusOff {
+            self.stats.bus_off_events = self.stats.bus_off_events.wrapping_add(1);
+        }
+        self.stats.status = st;
+        st.state
+    }
 }
 
 impl<C: Can> CanPort<C> {
@@ -56,10 +113,11 @@ impl<C: Can> CanPort<C> {
         &mut self.can
     }
 
-    /// Read up to [`MAX_RX_PER_TICK`] frames; malformed ones are counted and skipped.
-    /// Returns true when the controller reported an error.
-    pub fn receive(&mut self, out: &mut Vec<Message, MAX_RX_PER_TICK>) -> bool {
-        let mut error = false;
+    /// Read up to [`MAX_RX_PER_TICK`] frames; malformed ones are counted and skipped, and so
+    /// are the protocol errors the driver reports through the receive path (an error frame
+    /// on the bus is normal CAN life, not a fault: the error counters decide, see
+    /// [`Self::poll_status`]).
+    pub fn receive(&mut self, out: &mut Vec<Message, MAX_RX_PER_TICK>) {
         // Bounded: at most twice the capacity of reads (malformed frames included).
         for _ in 0..2 * MAX_RX_PER_TICK {
             if out.is_full() {
@@ -80,16 +138,15 @@ impl<C: Can> CanPort<C> {
                 Err(nb::Error::Other(e)) => {
                     let _ = e.kind();
                     self.stats.bus_errors = self.stats.bus_errors.wrapping_add(1);
-                    error = true;
                     break;
                 }
             }
         }
-        error
     }
 
     /// Queue `messages` and hand the controller as many queued frames as it takes.
-    /// Returns true when a frame was dropped or the controller reported an error.
+    /// Returns true when a frame was dropped (the queue was full: the node cannot say what it
+    /// must). A controller error on a write keeps the frame queued and is only counted.
     pub fn transmit(&mut self, messages: &[Message]) -> bool {
         let mut error = false;
         for m in messages {
@@ -133,7 +190,6 @@ impl<C: Can> CanPort<C> {
                 Err(nb::Error::Other(_)) => {
                     let _ = self.queue.push_front(raw);
                     self.stats.bus_errors = self.stats.bus_errors.wrapping_add(1);
-                    error = true;
                     break;
                 }
             }

@@ -17,16 +17,20 @@ pub enum ActiveLevel {
 pub struct ContactSwitch<P> {
     pin: P,
     level: ActiveLevel,
-    debouncer: Debouncer,
+    samples: u8,
+    debouncer: Option<Debouncer>,
 }
 
 impl<P: InputPin> ContactSwitch<P> {
-    /// Debounce over `samples` consecutive ticks (3 at 1 kHz: 3 ms), starting open.
+    /// Debounce over `samples` consecutive ticks (3 at 1 kHz: 3 ms). The debounced state
+    /// starts from the first reading (a foot already on the floor at power-up is no heel
+    /// strike); until then it reads open.
     pub fn new(pin: P, level: ActiveLevel, samples: u8) -> Self {
         ContactSwitch {
             pin,
             level,
-            debouncer: Debouncer::new(false, samples),
+            samples,
+            debouncer: None,
         }
     }
 
@@ -40,12 +44,16 @@ impl<P: InputPin> ContactSwitch<P> {
             ActiveLevel::High => high,
             ActiveLevel::Low => !high,
         };
-        Ok(self.debouncer.update(closed))
+        let samples = self.samples;
+        Ok(self
+            .debouncer
+            .get_or_insert_with(|| Debouncer::new(closed, samples))
+            .update(closed))
     }
 
-    /// The debounced state.
+    /// The debounced state (open before the first reading).
     pub fn closed(&self) -> bool {
-        self.debouncer.state()
+        self.debouncer.is_some_and(|d| d.state())
     }
 }
 
@@ -74,8 +82,21 @@ mod tests {
     fn active_low_switch_is_debounced() {
         let levels = [true, false, true, false, false, false, true];
         let mut c = ContactSwitch::new(Pin(&levels, 0), ActiveLevel::Low, 3);
+        assert!(!c.closed(), "open before the first reading");
         let got: [bool; 7] = core::array::from_fn(|_| c.sample().unwrap());
         assert_eq!(got, [false, false, false, false, false, true, true]);
         assert!(c.closed());
+    }
+
+    #[test]
+    fn a_foot_down_at_power_up_reads_closed_from_the_first_sample() {
+        let levels = [false, false, true, false];
+        let mut c = ContactSwitch::new(Pin(&levels, 0), ActiveLevel::Low, 3);
+        let got: [bool; 4] = core::array::from_fn(|_| c.sample().unwrap());
+        assert_eq!(
+            got,
+            [true, true, true, true],
+            "no open-to-closed edge at boot"
+        );
     }
 }

@@ -43,6 +43,33 @@ pub fn parse_answer(word: u16) -> Result<u16, EncoderError> {
     Ok(word & 0x3FFF)
 }
 
+/// Anything that reads the ankle angle once per control tick: the SPI encoder here, or the
+/// PWM-output encoder of [`crate::drivers::pwm_encoder`] (the B-G431B-ESC1 has no free SPI
+/// pins).
+pub trait AngleSensor {
+    /// Read the ankle angle.
+    ///
+    /// # Errors
+    /// [`EncoderError`]; the node raises `EncoderComms`.
+    fn read_angle(&mut self) -> Result<AngleSample, EncoderError>;
+    /// The calibration in use.
+    fn calibration(&self) -> AngleCalibration;
+    /// Use `zero_counts` as the reading at ankle angle zero from now on.
+    fn set_zero_counts(&mut self, zero_counts: u16);
+}
+
+impl<S: SpiDevice> AngleSensor for MagneticEncoder<S> {
+    fn read_angle(&mut self) -> Result<AngleSample, EncoderError> {
+        self.read()
+    }
+    fn calibration(&self) -> AngleCalibration {
+        self.calibration
+    }
+    fn set_zero_counts(&mut self, zero_counts: u16) {
+        self.calibration.zero_counts = zero_counts;
+    }
+}
+
 /// The encoder on an SPI device.
 pub struct MagneticEncoder<S> {
     spi: S,
@@ -55,9 +82,9 @@ impl<S: SpiDevice> MagneticEncoder<S> {
         MagneticEncoder { spi, calibration }
     }
 
-    /// The calibration in use.
-    pub fn calibration(&self) -> AngleCalibration {
-        self.calibration
+    /// The SPI device.
+    pub fn device(&self) -> &S {
+        &self.spi
     }
 
     /// Give the SPI device back.

@@ -4,3 +4,5 @@ pub mod actuator;
 pub mod can;
 pub mod contact;
 pub mod encoder;
+pub mod pwm_encoder;
+pub mod spool_motor;

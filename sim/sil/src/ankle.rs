@@ -30,7 +30,8 @@ use crate::side::Side;
 use crate::tick::TickTime;
 
 /// The board's drivers over the simulator's hardware.
-type SimDrivers = AnkleDrivers<SimSpi, SimContactPin, SimActuator, SimCan, SimClock>;
+type SimDrivers =
+    AnkleDrivers<MagneticEncoder<SimSpi>, SimContactPin, SimActuator, SimCan, SimClock>;
 
 /// The orchestrator's ends of one ankle's hardware (shared with the drivers' ends).
 struct Wiring {
@@ -48,6 +49,8 @@ pub(crate) struct BusAccess {
     pub tx_room: usize,
     /// The node is bus-off.
     pub bus_off: bool,
+    /// The node's fault-confinement state and transmit error counter.
+    pub error_state: (canbus::ErrorState, u16),
 }
 
 /// What one step of an ankle's firmware did, for the records.
@@ -77,9 +80,6 @@ pub(crate) struct Ankle {
     handle: NodeHandle,
     drivers: SimDrivers,
     wiring: Wiring,
-    debounce_samples: u8,
-    /// The contact switch has been sampled for the debounce length before the first tick.
-    settled: bool,
 }
 
 impl Ankle {
@@ -128,8 +128,6 @@ impl Ankle {
             handle,
             drivers,
             wiring,
-            debounce_samples: config.debounce_samples,
-            settled: false,
         })
     }
 
@@ -154,25 +152,19 @@ impl Ankle {
     pub fn step(&mut self, t: TickTime, scene: &AnkleScene, access: BusAccess) -> AnkleStep {
         let w = &self.wiring;
         w.shaft.set(t.t_s, scene.angle_rad);
+        w.shaft.set_phase(self.drivers.node.phase());
         w.contact.set_closed(scene.contact_closed);
         w.clock.set(Instant::from_micros(t.t_ns / 1000));
         {
             let mut can = w.can.borrow_mut();
             can.set_tx_room(access.tx_room);
             can.set_bus_off(access.bus_off);
+            can.set_error_state(access.error_state.0, access.error_state.1);
         }
         // The string's torque acts on the stance ankle's servo only.
         w.actuator
             .borrow_mut()
             .set_tick(t.t_s, t.t_end_s, scene.angle_rad, scene.string_load_n_m);
-        if !self.settled {
-            // Power-up: the switch is sampled for the debounce length before the first tick,
-            // so that the firmware's debounced state (which starts open) is the foot's.
-            self.settled = true;
-            for _ in 0..self.debounce_samples {
-                let _ = self.drivers.contact.sample();
-            }
-        }
         // The firmware, as on the board.
         let outputs = self.drivers.step();
         let peer = self.side.other().node();
@@ -225,6 +217,11 @@ impl Ankle {
             .borrow_mut()
             .take_segment()
             .ok_or_else(|| control_error("the firmware applied no actuator command"))
+    }
+
+    /// The injected encoder faults that took effect at this ankle.
+    pub fn sensor_faults_applied(&self) -> &[crate::sensors::AppliedSensorFault] {
+        self.drivers.encoder.device().encoder().applied()
     }
 
     /// Fill in what the firmware, its CAN port, the controller and the actuator counted.

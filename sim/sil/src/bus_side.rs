@@ -158,6 +158,14 @@ impl BusSide {
         )
     }
 
+    /// `node`'s fault-confinement state and transmit error counter, as its controller's
+    /// status register would show them (error-active and 0 for an unknown node).
+    pub fn error_state(&self, node: NodeHandle) -> (canbus::ErrorState, u16) {
+        self.bus
+            .node_error_state(node)
+            .unwrap_or((canbus::ErrorState::ErrorActive, 0))
+    }
+
     /// Room left in `node`'s transmit queue [frames].
     pub fn tx_room(&self, node: NodeHandle) -> usize {
         self.bus

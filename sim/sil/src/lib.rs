@@ -57,6 +57,8 @@ pub use report::{
     FaultRecord, HistoryElided, HostReport, Landing, NodeReport, PhaseChange, SilReport,
     SocketcandReport, StateChange,
 };
-pub use sensors::{SensorFault, SensorFaultParseError, SimEncoder};
+pub use sensors::{
+    AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,
+};
 pub use side::Side;
 pub use swing::{SwingAnkle, SwingAnkleModel};

@@ -132,6 +132,11 @@ impl FirmwareInTheLoop {
             bus: self.bus.bus().stats(),
             host: self.host.report(),
             socketcand: self.bus.socketcand_report(),
+            sensor_faults_applied: self
+                .ankles
+                .iter()
+                .flat_map(|a| a.sensor_faults_applied().iter().cloned())
+                .collect(),
         }
     }
 
@@ -190,6 +195,7 @@ impl FirmwareInTheLoop {
         let access = BusAccess {
             tx_room: self.bus.tx_room(ankle.handle()),
             bus_off: self.bus.is_bus_off(ankle.handle()),
+            error_state: self.bus.error_state(ankle.handle()),
         };
         let step = ankle.step(t, &scene, access);
         self.records.observe(t.t_s, side, scene.stance, &step);

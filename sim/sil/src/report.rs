@@ -217,6 +217,8 @@ pub struct SilReport {
     pub host: HostReport,
     /// The socketcand server, if one ran.
     pub socketcand: Option<SocketcandReport>,
+    /// Injected encoder faults that took effect: side, kind, walk time.
+    pub sensor_faults_applied: Vec<crate::sensors::AppliedSensorFault>,
 }
 
 impl SilReport {

@@ -281,7 +281,10 @@ fn dropped_peer_heartbeats_put_the_node_in_the_safe_state() {
     let ticks = run(&mut c, 0.8, &[]);
     let r = c.report();
     check_heartbeat_bound(&r, 0.15);
-    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    // The right node follows into its safe state when the left one's heartbeat reports Safe
+    // (PeerSafe): one ankle cannot walk alone.
+    assert_eq!(r.node(Side::Right).unwrap().state, "Safe");
+    assert!(r.first_raise(Side::Right, "PeerSafe").is_some());
     let safe = r.first_state_at_or_after(Side::Left, "Safe", 0.0).unwrap();
     // 0.451 s: the left node was pushing; the string is released at once.
     assert!(ticks.iter().any(|t| t.t_s < safe && !t.seg.released));
@@ -306,14 +309,17 @@ fn an_encoder_glitch_raises_a_rate_fault() {
         r.first_state_at_or_after(Side::Left, "Safe", 0.0),
         Some(0.1)
     );
-    // Cleared two samples later, but the node stays safe until the host enables it again.
+    // Cleared two samples later; the clear event waits for the fault's inhibit time (50 ms,
+    // as CANopen's EMCY); the node stays safe until the host enables it again.
     assert!(r
         .faults
         .iter()
-        .any(|f| f.code == "EncoderRate" && !f.raised && f.t_s <= 0.103));
+        .any(|f| f.code == "EncoderRate" && !f.raised && f.t_s <= 0.151));
     assert_eq!(r.node(Side::Left).unwrap().state, "Safe");
     assert!(ticks.iter().all(|t| t.seg.released));
-    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    // The right node follows (PeerSafe) once the left one's heartbeat says Safe.
+    assert_eq!(r.node(Side::Right).unwrap().state, "Safe");
+    assert!(r.first_raise(Side::Right, "PeerSafe").is_some());
 }
 
 #[test]
@@ -525,7 +531,9 @@ fn spi_failures_and_parity_errors_raise_the_encoder_comms_fault() {
     );
     let comms = r.faults.iter().find(|f| f.code == "EncoderComms").unwrap();
     assert_eq!(comms.detail, 1, "bus error");
-    assert_eq!(r.node(Side::Right).unwrap().state, "Enabled");
+    // The right node follows (PeerSafe) once the left one's heartbeat says Safe.
+    assert_eq!(r.node(Side::Right).unwrap().state, "Safe");
+    assert!(r.first_raise(Side::Right, "PeerSafe").unwrap() >= 0.1);
     let config = SilConfig::default().with_sensor_fault(SensorFault::Parity {
         side: Side::Right,
         at_s: 0.05,
@@ -538,7 +546,12 @@ fn spi_failures_and_parity_errors_raise_the_encoder_comms_fault() {
         (comms.side, comms.t_s, comms.detail),
         (Side::Right, 0.05, 2)
     );
-    assert_eq!(r.node(Side::Left).unwrap().state, "Enabled");
+    assert_eq!(
+        r.node(Side::Left).unwrap().state,
+        "Safe",
+        "follows its peer"
+    );
+    assert!(r.first_raise(Side::Left, "PeerSafe").is_some());
 }
 
 #[test]
@@ -585,4 +598,59 @@ fn histories_are_bounded_and_count_what_they_leave_out() {
         bounded.history_elided.landings,
         full.landings.len().saturating_sub(6) as u64
     );
+}
+
+#[test]
+fn a_stuck_encoder_during_hold_releases_the_string_within_50_ms() {
+    let config = SilConfig::default().with_sensor_fault(SensorFault::StuckInPhase {
+        side: Side::Left,
+        phase: crate::DrivenPhase::Hold,
+    });
+    let mut c = sil(config);
+    let ticks = run(&mut c, 0.9, &[]);
+    let r = c.report();
+    let hold = first_phase(&r, Side::Left, "Hold", 0.0).expect("the left node reaches Hold");
+    let applied = &r.sensor_faults_applied;
+    assert_eq!(applied.len(), 1, "{applied:?}");
+    assert_eq!((applied[0].side, applied[0].kind), (Side::Left, "stuck"));
+    // Frozen at the first read of a tick that starts in Hold: the tick after the one that
+    // entered it.
+    let frozen_at = applied[0].t_s;
+    assert!(
+        frozen_at > hold && frozen_at <= hold + 0.001 + 1e-9,
+        "{hold} {frozen_at}"
+    );
+    let stuck = r.first_raise(Side::Left, "EncoderStuck").expect("caught");
+    let safe = r.first_state_at_or_after(Side::Left, "Safe", 0.0).unwrap();
+    assert!(
+        safe - frozen_at <= 0.050 + 1e-9,
+        "frozen {frozen_at}, fault {stuck}, safe {safe}"
+    );
+    assert!(ticks
+        .iter()
+        .filter(|t| t.t_s >= safe)
+        .all(|t| t.seg.released));
+}
+
+#[test]
+fn no_heel_strike_is_announced_for_the_foot_down_at_power_up() {
+    let mut c = sil(SilConfig::default());
+    // Long enough for the stance node to push, not long enough for the swing foot to land.
+    run(&mut c, 0.3, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        assert_eq!(r.node(side).unwrap().state, "Enabled", "{side:?}");
+    }
+    assert!(
+        r.faults.is_empty(),
+        "a healthy start raises no fault: {:?}",
+        r.faults
+    );
+    assert_eq!(
+        r.host.per_class.get("HeelStrike"),
+        None,
+        "no HeelStrike frame before any foot landed: {:?}",
+        r.host.per_class
+    );
+    assert!(r.host.per_class.get("Heartbeat").is_some_and(|n| *n > 0));
 }

@@ -32,6 +32,7 @@ pub struct SilArgs {
     pub faults: Vec<String>,
     /// An encoder fault (repeatable; docs/sil.md):
     /// `glitch:side=left,at_ms=500[,delta_rad=0.1]`, `stuck:side=left,from_ms=500`,
+    /// `stuck:side=left,state=hold` (frozen from the first tick that node is in Hold),
     /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
@@ -83,6 +84,8 @@ struct SilWalkReport<'a, Bus: Serialize> {
     frames: u64,
     /// The step summaries kept (`--keep-steps`).
     steps: &'a [StepSummary],
+    /// Injected encoder faults that took effect: `[{side, kind, t_s}]`.
+    sensor_faults_applied: &'a [sil::AppliedSensorFault],
 }
 
 /// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
@@ -227,6 +230,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         bus: &firmware.bus,
         frames: firmware.frames_delivered,
         steps: steps_kept,
+        sensor_faults_applied: &firmware.sensor_faults_applied,
     };
     if common.json {
         print_json(&report)?;

@@ -22,6 +22,7 @@ use std::collections::VecDeque;
 use std::rc::Rc;
 
 use embedded_can::{ErrorKind, Id, StandardId};
+use firmware::drivers::can::{BusState, ControllerHealth, ControllerStatus};
 
 /// A standard data frame of the simulated bus as an `embedded_can::Frame`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +86,8 @@ pub struct CanLink {
     tx: Vec<canbus::Frame>,
     tx_room: usize,
     bus_off: bool,
+    error_state: (canbus::ErrorState, u16),
+    rx_overflows_reported: u64,
     refused_full: u64,
     refused_bus_off: u64,
 }
@@ -100,6 +103,8 @@ impl CanLink {
             tx: Vec::new(),
             tx_room: 0,
             bus_off: false,
+            error_state: (canbus::ErrorState::ErrorActive, 0),
+            rx_overflows_reported: 0,
             refused_full: 0,
             refused_bus_off: 0,
         }
@@ -135,6 +140,12 @@ impl CanLink {
         self.bus_off = bus_off;
     }
 
+    /// The bus node's fault-confinement state and transmit error counter, which the
+    /// controller reports as the FDCAN's status (PSR) and error counter (ECR) registers do.
+    pub fn set_error_state(&mut self, state: canbus::ErrorState, tec: u16) {
+        self.error_state = (state, tec);
+    }
+
     /// Frames the controller accepted since the last call, in order.
     pub fn take_tx(&mut self) -> std::vec::Drain<'_, canbus::Frame> {
         self.tx.drain(..)
@@ -164,6 +175,28 @@ impl SimCan {
     /// A controller on `link`.
     pub fn new(link: Rc<RefCell<CanLink>>) -> Self {
         SimCan(link)
+    }
+}
+
+impl ControllerHealth for SimCan {
+    /// As the board's driver reports it: the state from the status register, TEC saturated
+    /// to the register's 8 bits, REC 0 (the bus model keeps no receive counter), and the
+    /// frames lost to a full FIFO since the last call.
+    fn status(&mut self) -> ControllerStatus {
+        let mut l = self.0.borrow_mut();
+        let lost = l.rx_overflows - l.rx_overflows_reported;
+        l.rx_overflows_reported = l.rx_overflows;
+        let (state, tec) = l.error_state;
+        ControllerStatus {
+            state: match state {
+                canbus::ErrorState::ErrorActive => BusState::ErrorActive,
+                canbus::ErrorState::ErrorPassive => BusState::ErrorPassive,
+                canbus::ErrorState::BusOff => BusState::BusOff,
+            },
+            tx_errors: u8::try_from(tec).unwrap_or(u8::MAX),
+            rx_errors: 0,
+            rx_lost: u32::try_from(lost).unwrap_or(u32::MAX),
+        }
     }
 }
 
@@ -260,12 +293,20 @@ mod tests {
             .deliver(canbus::Frame::from(heartbeat(9).encode().unwrap()));
         link.borrow_mut().set_tx_room(8);
         link.borrow_mut().set_bus_off(true);
-        assert!(port.transmit(&[heartbeat(1)]), "error reported");
+        assert!(
+            !port.transmit(&[heartbeat(1)]),
+            "a refused write is counted, the frame kept: the status decides"
+        );
         assert_eq!(link.borrow().refused_bus_off(), 1);
         let mut rx = heapless::Vec::new();
-        assert!(port.receive(&mut rx), "error reported");
+        port.receive(&mut rx);
         assert!(rx.is_empty());
         assert_eq!(port.stats().bus_errors, 2);
+        link.borrow_mut()
+            .set_error_state(canbus::ErrorState::BusOff, 256);
+        assert_eq!(port.poll_status(), BusState::BusOff);
+        assert_eq!(port.stats().status.tx_errors, 255);
+        assert_eq!(port.stats().bus_off_events, 1);
     }
 
     #[test]
@@ -280,8 +321,12 @@ mod tests {
         assert_eq!(l.rx_overflows(), 1);
         drop(l);
         let mut rx = heapless::Vec::new();
-        assert!(!port.receive(&mut rx));
+        port.receive(&mut rx);
         assert_eq!(rx.as_slice(), &[heartbeat(5)]);
+        assert_eq!(port.poll_status(), BusState::ErrorActive);
+        assert_eq!(port.stats().rx_lost, 1, "the lost frame is reported once");
+        assert_eq!(port.poll_status(), BusState::ErrorActive);
+        assert_eq!(port.stats().rx_lost, 1);
         assert_eq!(port.stats().malformed, 2);
         assert_eq!(link.borrow_mut().take_read().count(), 3);
         assert_eq!(link.borrow().rx_backlog(), 0);

@@ -19,6 +19,7 @@ use std::rc::Rc;
 
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use firmware::drivers::encoder::{even_parity, ANGLECOM};
+use protocol::ReflexPhase;
 
 use crate::sensors::SimEncoder;
 
@@ -33,8 +34,14 @@ const PARERR: u16 = 0x0004;
 
 /// The true state of the ankle's shaft, set by the orchestrator before each tick: time [s] and
 /// angle [rad]. Shared with a [`SimSpi`].
-#[derive(Clone, Debug, Default)]
-pub struct Shaft(Rc<Cell<(f64, f64)>>);
+#[derive(Clone, Debug)]
+pub struct Shaft(Rc<Cell<(f64, f64)>>, Rc<Cell<ReflexPhase>>);
+
+impl Default for Shaft {
+    fn default() -> Self {
+        Shaft(Rc::default(), Rc::new(Cell::new(ReflexPhase::Inactive)))
+    }
+}
 
 impl Shaft {
     /// A shaft at angle 0 at time 0.
@@ -50,6 +57,17 @@ impl Shaft {
     /// Time [s] and true angle [rad].
     pub fn get(&self) -> (f64, f64) {
         self.0.get()
+    }
+
+    /// The node's reflex phase at the start of the tick (after the previous one), which a
+    /// state-triggered fault ([`crate::SensorFault::StuckInPhase`]) waits for.
+    pub fn set_phase(&self, phase: ReflexPhase) {
+        self.1.set(phase);
+    }
+
+    /// The phase set last.
+    pub fn phase(&self) -> ReflexPhase {
+        self.1.get()
     }
 }
 
@@ -97,6 +115,11 @@ impl SimSpi {
         }
     }
 
+    /// The encoder chip (its applied faults).
+    pub fn encoder(&self) -> &SimEncoder {
+        &self.encoder
+    }
+
     /// Transactions served (failed ones included).
     pub fn transactions(&self) -> u64 {
         self.transactions
@@ -115,7 +138,7 @@ impl SimSpi {
             ANGLECOM | ANGLEUNC => {
                 let counts = self
                     .encoder
-                    .read(t_s, angle_rad)
+                    .read(t_s, angle_rad, self.shaft.phase())
                     .map_or(0, |s| s.counts & 0x3FFF);
                 let word = with_parity(counts);
                 if corrupt {
@@ -192,6 +215,7 @@ mod tests {
     use crate::sensors::SensorFault;
     use crate::side::Side;
     use firmware::drivers::encoder::{parse_answer, read_command, MagneticEncoder, NOP};
+    use firmware::sensors::with_simulated_noise;
     use firmware::sensors::EncoderError;
     use firmware::sensors::SIMULATED_CALIBRATION as CALIBRATION;
 
@@ -215,18 +239,20 @@ mod tests {
         let w = word(&mut spi, read_command(NOP));
         assert!(even_parity(w), "{w:#06x}");
         assert_eq!(w & 0x4000, 0, "no error flag");
-        assert_eq!(parse_answer(w), Ok(CALIBRATION.counts(a1 as f32)));
+        // Read n of the chip carries the sensor's noise for n (firmware::sensors).
+        let noisy = |a: f64, n| with_simulated_noise(CALIBRATION.counts(a as f32), n);
+        assert_eq!(parse_answer(w), Ok(noisy(a1, 0)));
         // A NOP's own answer is 0; ANGLECOM twice: the second frame carries the first's angle.
         assert_eq!(word(&mut spi, read_command(ANGLECOM)), 0);
         let w = word(&mut spi, read_command(ANGLECOM));
-        assert_eq!(parse_answer(w), Ok(CALIBRATION.counts(a2 as f32)));
+        assert_eq!(parse_answer(w), Ok(noisy(a2, 1)));
         // Every answer the chip can give has even parity.
-        for a in [-0.3, -0.1, 0.0, 0.05, 0.3] {
+        for (n, a) in [-0.3, -0.1, 0.0, 0.05, 0.3].into_iter().enumerate() {
             shaft.set(0.002, a);
             word(&mut spi, read_command(ANGLECOM));
             let w = word(&mut spi, read_command(NOP));
             assert!(even_parity(w));
-            assert_eq!(parse_answer(w), Ok(CALIBRATION.counts(a as f32)));
+            assert_eq!(parse_answer(w), Ok(noisy(a, n as u32 + 3)));
         }
     }
 
@@ -239,8 +265,11 @@ mod tests {
         for (k, a) in [-0.2, -0.0801, 0.0, 0.123_456].into_iter().enumerate() {
             shaft.set(k as f64 * 1e-3, a);
             let s = enc.read().unwrap();
-            assert_eq!(s.counts, CALIBRATION.counts(a as f32));
-            assert!((f64::from(s.angle_rad) - a).abs() <= 0.5 * lsb + 1e-6);
+            assert_eq!(
+                s.counts,
+                with_simulated_noise(CALIBRATION.counts(a as f32), k as u32)
+            );
+            assert!((f64::from(s.angle_rad) - a).abs() <= 1.5 * lsb + 1e-6);
         }
         assert_eq!(enc.release().transactions(), 8, "two frames per read");
     }

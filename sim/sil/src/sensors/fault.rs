@@ -25,6 +25,14 @@ pub enum SensorFault {
         /// From when [s].
         from_s: f64,
     },
+    /// From the first tick its node is in `phase` on, the counts stay frozen at the last
+    /// reading before it.
+    StuckInPhase {
+        /// Which ankle.
+        side: Side,
+        /// The reflex phase that triggers it.
+        phase: DrivenPhase,
+    },
     /// Every SPI transaction in `[from_s, until_s)` fails (the driver's `EncoderError::Bus`).
     SpiFailure {
         /// Which ankle.
@@ -44,12 +52,43 @@ pub enum SensorFault {
     },
 }
 
+/// A reflex phase in which the actuator drives, as a trigger of [`SensorFault::StuckInPhase`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DrivenPhase {
+    /// The extension profile.
+    Push,
+    /// Holding the extended angle.
+    Hold,
+}
+
+impl DrivenPhase {
+    /// The firmware's phase.
+    pub fn reflex_phase(self) -> protocol::ReflexPhase {
+        match self {
+            DrivenPhase::Push => protocol::ReflexPhase::Push,
+            DrivenPhase::Hold => protocol::ReflexPhase::Hold,
+        }
+    }
+}
+
 impl SensorFault {
+    /// The kind's name in the text form (`glitch`, `stuck`, `spi`, `parity`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SensorFault::Glitch { .. } => "glitch",
+            SensorFault::Stuck { .. } | SensorFault::StuckInPhase { .. } => "stuck",
+            SensorFault::SpiFailure { .. } => "spi",
+            SensorFault::Parity { .. } => "parity",
+        }
+    }
+
     /// The ankle it affects.
     pub fn side(&self) -> Side {
         match self {
             SensorFault::Glitch { side, .. }
             | SensorFault::Stuck { side, .. }
+            | SensorFault::StuckInPhase { side, .. }
             | SensorFault::SpiFailure { side, .. }
             | SensorFault::Parity { side, .. } => *side,
         }
@@ -123,6 +162,8 @@ impl std::str::FromStr for SensorFault {
     /// * `glitch:side=left,at_ms=500[,delta_rad=0.1]` — [`SensorFault::Glitch`] (default
     ///   jump 0.1 rad);
     /// * `stuck:side=left,from_ms=500` — [`SensorFault::Stuck`];
+    /// * `stuck:side=left,state=hold` (or `state=push`) — [`SensorFault::StuckInPhase`]: frozen
+    ///   from the first tick that node is in that reflex phase;
     /// * `spi:side=right,from_ms=500[,until_ms=700]` — [`SensorFault::SpiFailure`] (until the
     ///   end of the run without `until_ms`);
     /// * `parity:side=right,at_ms=500` — [`SensorFault::Parity`].
@@ -146,9 +187,26 @@ impl std::str::FromStr for SensorFault {
                     })?
                     .unwrap_or(0.1),
             },
-            "stuck" => SensorFault::Stuck {
-                side,
-                from_s: spec.required("from_ms", ms, seconds)?,
+            "stuck" => match spec.get("state") {
+                Some(_) => {
+                    if let Some(v) = spec.get("from_ms") {
+                        return Err(spec
+                            .bad("from_ms", v, "either from_ms or state, not both")
+                            .into());
+                    }
+                    SensorFault::StuckInPhase {
+                        side,
+                        phase: spec.required("state", "push or hold", |v| match v {
+                            "push" => Some(DrivenPhase::Push),
+                            "hold" => Some(DrivenPhase::Hold),
+                            _ => None,
+                        })?,
+                    }
+                }
+                None => SensorFault::Stuck {
+                    side,
+                    from_s: spec.required("from_ms", ms, seconds)?,
+                },
             },
             "spi" => {
                 let from_s = spec.required("from_ms", ms, seconds)?;
@@ -177,7 +235,7 @@ impl std::str::FromStr for SensorFault {
 fn allowed_keys(kind: &str) -> Option<&'static str> {
     Some(match kind {
         "glitch" => "side, at_ms, delta_rad",
-        "stuck" => "side, from_ms",
+        "stuck" => "side, from_ms, state",
         "spi" => "side, from_ms, until_ms",
         "parity" => "side, at_ms",
         _ => return None,
@@ -211,6 +269,23 @@ impl From<SpecError> for SensorFaultParseError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn stuck_by_state_parses_and_refuses_both_triggers() {
+        let ok = |t: &str| t.parse::<SensorFault>().unwrap();
+        assert_eq!(
+            ok("stuck:side=left,state=hold"),
+            SensorFault::StuckInPhase {
+                side: Side::Left,
+                phase: DrivenPhase::Hold
+            }
+        );
+        assert_eq!(ok("stuck:side=right,state=push").kind(), "stuck");
+        let bad = |t: &str| t.parse::<SensorFault>().unwrap_err().to_string();
+        assert!(bad("stuck:side=left,state=swing").contains("push or hold"));
+        assert!(bad("stuck:side=left,state=hold,from_ms=5").contains("not both"));
+        assert!(bad("stuck:side=left").contains("from_ms"));
+    }
 
     #[test]
     fn text_forms_parse_and_bad_parts_are_named() {

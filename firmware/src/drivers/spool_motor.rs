@@ -1,0 +1,469 @@
+//! The string actuator as the B-G431B-ESC1's power stage can drive it: a brushed DC gear
+//! motor winding the string on a spool, across two of the board's three half-bridges (phase
+//! U and V; W stays off), with the spool's position from a quadrature encoder on the motor
+//! and the motor current from the board's low-side shunt amplifiers.
+//!
+//! Drive scheme (sign–magnitude, "slow decay"): for a positive duty, leg A switches at the
+//! duty with complementary low-side switching and dead time, leg B keeps its low side on; for
+//! a negative duty the legs swap. The leg held low carries the whole motor current through its
+//! shunt in both halves of the PWM period (on: high A → motor → low B; off: freewheeling
+//! through low A and low B), so one amplifier reading per tick is the motor current whatever
+//! the PWM phase.
+//!
+//! What each command does:
+//! * `Position { ankle_angle_rad }` — proportional loop from the measured ankle angle to the
+//!   duty (the string is taut while held), duty clamped to `max_duty`. The spool position of
+//!   every such tick is remembered.
+//! * `Released` — a geared motor is not back-drivable: duty 0 would leave the string as it
+//!   was. So the spool pays out `slack_counts` from where it last held the string (a bounded
+//!   move at `release_max_duty`), then the power stage switches off. Without a previous hold
+//!   (power-up) there is nothing to pay out: off.
+//! * Over-current: above `current_limit_a` the bridge is off for that tick (chopping); for
+//!   `overcurrent_ticks` ticks in a row the actuator latches off and reports `OverCurrent`
+//!   until it has been commanded `Released` for `overcurrent_cooldown_ticks` ticks.
+//! * A failed spool or current reading, a bridge error, or a pay-out that does not reach its
+//!   target in `release_timeout_ticks`: off and an error (the node raises `Actuator` and goes
+//!   `Safe`).
+
+use crate::drivers::actuator::{Actuator, ActuatorError};
+use crate::reflex::ActuatorCommand;
+
+/// A peripheral that failed (timer, ADC, encoder timer).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HardwareError;
+
+/// Two half-bridges of a three-phase power stage.
+pub trait HalfBridges {
+    /// Drive with a signed duty in [−1, 1] (positive: wind the string in); enables the
+    /// outputs when they were off.
+    ///
+    /// # Errors
+    /// [`HardwareError`] when the timer refused the setting.
+    fn drive(&mut self, signed_duty: f32) -> Result<(), HardwareError>;
+    /// Every switch off (on the STM32: main output enable cleared, outputs at their idle level).
+    fn off(&mut self);
+}
+
+/// The spool's position sensor (a quadrature encoder on the motor shaft).
+pub trait SpoolEncoder {
+    /// Spool position [counts], growing as the string winds in.
+    ///
+    /// # Errors
+    /// [`HardwareError`] when the position cannot be read.
+    fn spool_counts(&mut self) -> Result<i32, HardwareError>;
+}
+
+/// The motor-current measurement.
+pub trait CurrentSense {
+    /// Magnitude of the motor current [A].
+    ///
+    /// # Errors
+    /// [`HardwareError`] when the converter failed.
+    fn motor_current_a(&mut self) -> Result<f32, HardwareError>;
+}
+
+/// Gains and limits of the spool motor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpoolMotorConfig {
+    /// Duty per radian of ankle-angle error while holding [1/rad].
+    pub kp_per_rad: f32,
+    /// Largest duty while holding (0..1].
+    pub max_duty: f32,
+    /// Current limit [A].
+    pub current_limit_a: f32,
+    /// Ticks in a row over the limit before the actuator latches off.
+    pub overcurrent_ticks: u16,
+    /// Ticks of `Released` that clear the over-current latch.
+    pub overcurrent_cooldown_ticks: u16,
+    /// Spool counts paid out on release.
+    pub slack_counts: i32,
+    /// Duty per count of pay-out error.
+    pub release_kp_per_count: f32,
+    /// Largest duty while paying out (0..1].
+    pub release_max_duty: f32,
+    /// Pay-out done within this many counts.
+    pub release_tolerance_counts: i32,
+    /// Pay-out must finish within this many ticks.
+    pub release_timeout_ticks: u16,
+}
+
+impl Default for SpoolMotorConfig {
+    /// 10 /rad up to 80 % duty; 4 A limit (5 ticks to latch, 0.5 s to clear at 1 kHz);
+    /// release pays out 2000 counts at up to 30 % duty within 0.3 s.
+    fn default() -> Self {
+        SpoolMotorConfig {
+            kp_per_rad: 10.0,
+            max_duty: 0.8,
+            current_limit_a: 4.0,
+            overcurrent_ticks: 5,
+            overcurrent_cooldown_ticks: 500,
+            slack_counts: 2000,
+            release_kp_per_count: 0.001,
+            release_max_duty: 0.3,
+            release_tolerance_counts: 50,
+            release_timeout_ticks: 300,
+        }
+    }
+}
+
+/// What the power stage did in the last tick (for logs and tests).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StageOutput {
+    /// Switches off.
+    Off,
+    /// Driving at this signed duty.
+    Duty(f32),
+}
+
+/// The DC gear motor on two half-bridges.
+pub struct SpoolMotor<B, E, I> {
+    bridge: B,
+    encoder: E,
+    current: I,
+    config: SpoolMotorConfig,
+    held_at: Option<i32>,
+    release_target: Option<i32>,
+    release_ticks: u16,
+    over_ticks: u16,
+    latched: bool,
+    cooldown: u16,
+    output: StageOutput,
+}
+
+impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
+    /// Wrap the power stage and its sensors; the stage is switched off now.
+    pub fn new(mut bridge: B, encoder: E, current: I, config: SpoolMotorConfig) -> Self {
+        bridge.off();
+        SpoolMotor {
+            bridge,
+            encoder,
+            current,
+            config,
+            held_at: None,
+            release_target: None,
+            release_ticks: 0,
+            over_ticks: 0,
+            latched: false,
+            cooldown: 0,
+            output: StageOutput::Off,
+        }
+    }
+
+    /// What the stage did in the last tick.
+    pub fn output(&self) -> StageOutput {
+        self.output
+    }
+
+    /// True while the over-current latch holds the stage off.
+    pub fn overcurrent_latched(&self) -> bool {
+        self.latched
+    }
+
+    /// The power stage.
+    pub fn bridge(&self) -> &B {
+        &self.bridge
+    }
+
+    fn off(&mut self) {
+        self.bridge.off();
+        self.output = StageOutput::Off;
+    }
+
+    fn drive(&mut self, duty: f32) -> Result<(), ActuatorError> {
+        match self.bridge.drive(duty) {
+            Ok(()) => {
+                self.output = StageOutput::Duty(duty);
+                Ok(())
+            }
+            Err(HardwareError) => {
+                self.off();
+                Err(ActuatorError::Bridge)
+            }
+        }
+    }
+
+    fn fail(&mut self, e: ActuatorError) -> Result<(), ActuatorError> {
+        self.off();
+        Err(e)
+    }
+
+    fn release(&mut self, spool: i32) -> Result<(), ActuatorError> {
+        if let Some(h) = self.held_at.take() {
+            self.release_target = Some(h.saturating_sub(self.config.slack_counts));
+            self.release_ticks = 0;
+        }
+        let Some(target) = self.release_target else {
+            self.off();
+            return Ok(());
+        };
+        let error = target.saturating_sub(spool);
+        if error.abs() <= self.config.release_tolerance_counts {
+            self.release_target = None;
+            self.off();
+            return Ok(());
+        }
+        self.release_ticks = self.release_ticks.saturating_add(1);
+        if self.release_ticks > self.config.release_timeout_ticks {
+            self.release_target = None;
+            return self.fail(ActuatorError::ReleaseTimeout);
+        }
+        let m = self.config.release_max_duty;
+        let d = (self.config.release_kp_per_count * error as f32).clamp(-m, m);
+        self.drive(d)
+    }
+}
+
+impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B, E, I> {
+    fn apply(
+        &mut self,
+        command: ActuatorCommand,
+        measured_angle_rad: Option<f32>,
+    ) -> Result<(), ActuatorError> {
+        let released = command == ActuatorCommand::Released;
+        if self.latched {
+            self.off();
+            self.cooldown = if released {
+                self.cooldown.saturating_add(1)
+            } else {
+                0
+            };
+            if self.cooldown < self.config.overcurrent_cooldown_ticks {
+                return Err(ActuatorError::OverCurrent);
+            }
+            self.latched = false;
+            self.over_ticks = 0;
+            // The string's state is unknown after the latch: nothing to pay out from.
+            self.held_at = None;
+            self.release_target = None;
+        }
+        let Ok(amps) = self.current.motor_current_a() else {
+            return self.fail(ActuatorError::CurrentSense);
+        };
+        if amps.is_nan() || amps.abs() > self.config.current_limit_a {
+            // Over the limit (or NaN): off for this tick, latched after a run of them.
+            self.over_ticks = self.over_ticks.saturating_add(1);
+            self.off();
+            if self.over_ticks >= self.config.overcurrent_ticks {
+                self.latched = true;
+                self.cooldown = 0;
+                return Err(ActuatorError::OverCurrent);
+            }
+            return Ok(());
+        }
+        self.over_ticks = 0;
+        let Ok(spool) = self.encoder.spool_counts() else {
+            return self.fail(ActuatorError::SpoolSensor);
+        };
+        match command {
+            ActuatorCommand::Released => self.release(spool),
+            ActuatorCommand::Position { ankle_angle_rad } => {
+                self.release_target = None;
+                let Some(m) = measured_angle_rad else {
+                    return self.fail(ActuatorError::NoFeedback);
+                };
+                let limit = self.config.max_duty;
+                let d = (self.config.kp_per_rad * (ankle_angle_rad - m)).clamp(-limit, limit);
+                if d.is_nan() {
+                    return self.fail(ActuatorError::NoFeedback);
+                }
+                self.held_at = Some(spool);
+                self.drive(d)
+            }
+        }
+    }
+}
+
+/// Extends a 16-bit hardware counter (a timer in encoder mode) to 32 bits, assuming less
+/// than half a wrap (32,768 counts) between two reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CounterUnwrap {
+    last: Option<u16>,
+    total: i32,
+}
+
+impl CounterUnwrap {
+    /// Feed the counter's value, get the extended position.
+    pub fn update(&mut self, raw: u16) -> i32 {
+        if let Some(prev) = self.last {
+            let step = raw.wrapping_sub(prev) as i16;
+            self.total = self.total.wrapping_add(step as i32);
+        } else {
+            self.total = raw as i32;
+        }
+        self.last = Some(raw);
+        self.total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::cell::Cell;
+
+    #[derive(Default)]
+    struct Bridge {
+        duty: Option<f32>,
+        offs: u32,
+        fail: bool,
+    }
+    impl HalfBridges for &mut Bridge {
+        fn drive(&mut self, d: f32) -> Result<(), HardwareError> {
+            if self.fail {
+                return Err(HardwareError);
+            }
+            self.duty = Some(d);
+            Ok(())
+        }
+        fn off(&mut self) {
+            self.duty = None;
+            self.offs += 1;
+        }
+    }
+    struct Spool<'a>(&'a Cell<Option<i32>>);
+    impl SpoolEncoder for Spool<'_> {
+        fn spool_counts(&mut self) -> Result<i32, HardwareError> {
+            self.0.get().ok_or(HardwareError)
+        }
+    }
+    struct Amps<'a>(&'a Cell<Option<f32>>);
+    impl CurrentSense for Amps<'_> {
+        fn motor_current_a(&mut self) -> Result<f32, HardwareError> {
+            self.0.get().ok_or(HardwareError)
+        }
+    }
+
+    const HOLD: ActuatorCommand = ActuatorCommand::Position {
+        ankle_angle_rad: 0.2,
+    };
+
+    #[test]
+    fn off_at_power_up_and_when_released_without_a_hold() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(0));
+        let amps = Cell::new(Some(0.0));
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
+        assert_eq!(m.output(), StageOutput::Off);
+        m.apply(ActuatorCommand::Released, Some(0.0)).unwrap();
+        assert_eq!(m.output(), StageOutput::Off);
+        assert!(m.bridge().offs >= 2 && m.bridge().duty.is_none());
+    }
+
+    #[test]
+    fn holds_with_a_clamped_p_loop_then_pays_out_the_slack_and_switches_off() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(10_000));
+        let amps = Cell::new(Some(1.0));
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
+        m.apply(HOLD, Some(0.15)).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(10.0 * (0.2 - 0.15)));
+        m.apply(HOLD, Some(-0.5)).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(0.8), "clamped to max_duty");
+        // Release: pays out 2000 counts (negative duty) from 10 000, at most 30 %.
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(-0.3));
+        spool.set(Some(7_900));
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        let StageOutput::Duty(d) = m.output() else {
+            panic!("still paying out")
+        };
+        assert!(
+            (d - 0.1).abs() < 1e-6,
+            "overshoot corrected proportionally: {d}"
+        );
+        spool.set(Some(8_030));
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(m.output(), StageOutput::Off, "within tolerance: off");
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(m.output(), StageOutput::Off, "stays off");
+    }
+
+    #[test]
+    fn a_jammed_pay_out_times_out_off() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(0));
+        let amps = Cell::new(Some(0.5));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        m.apply(HOLD, Some(0.2)).unwrap();
+        let mut result = Ok(());
+        for _ in 0..=cfg.release_timeout_ticks {
+            result = m.apply(ActuatorCommand::Released, None);
+        }
+        assert_eq!(result, Err(ActuatorError::ReleaseTimeout));
+        assert_eq!(m.output(), StageOutput::Off);
+        assert_eq!(m.apply(ActuatorCommand::Released, None), Ok(()));
+        assert_eq!(m.output(), StageOutput::Off);
+    }
+
+    #[test]
+    fn over_current_chops_then_latches_until_released_long_enough() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(0));
+        let amps = Cell::new(Some(4.5));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        for _ in 1..cfg.overcurrent_ticks {
+            assert_eq!(m.apply(HOLD, Some(0.0)), Ok(()));
+            assert_eq!(m.output(), StageOutput::Off, "chopped");
+        }
+        assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::OverCurrent));
+        assert!(m.overcurrent_latched());
+        amps.set(Some(0.0));
+        // Holding keeps the latch; only Released for the cool-down clears it.
+        for _ in 0..1000 {
+            assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::OverCurrent));
+        }
+        for _ in 1..cfg.overcurrent_cooldown_ticks {
+            assert_eq!(
+                m.apply(ActuatorCommand::Released, None),
+                Err(ActuatorError::OverCurrent)
+            );
+            assert_eq!(m.output(), StageOutput::Off);
+        }
+        assert_eq!(m.apply(ActuatorCommand::Released, None), Ok(()));
+        assert!(!m.overcurrent_latched());
+        assert_eq!(
+            m.output(),
+            StageOutput::Off,
+            "nothing to pay out after a latch"
+        );
+        amps.set(Some(f32::NAN));
+        for _ in 0..cfg.overcurrent_ticks {
+            let _ = m.apply(HOLD, Some(0.0));
+        }
+        assert!(
+            m.overcurrent_latched(),
+            "NaN current counts as over the limit"
+        );
+    }
+
+    #[test]
+    fn failed_sensors_and_bridge_switch_off() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(0));
+        let amps = Cell::new(None);
+        {
+            let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
+            assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::CurrentSense));
+            amps.set(Some(0.0));
+            spool.set(None);
+            assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::SpoolSensor));
+            spool.set(Some(0));
+            assert_eq!(m.apply(HOLD, None), Err(ActuatorError::NoFeedback));
+            assert_eq!(m.output(), StageOutput::Off);
+        }
+        b.fail = true;
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
+        assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::Bridge));
+        assert_eq!(m.output(), StageOutput::Off);
+    }
+
+    #[test]
+    fn counter_unwrap_follows_wraps_both_ways() {
+        let mut u = CounterUnwrap::default();
+        assert_eq!(u.update(65_000), 65_000);
+        assert_eq!(u.update(100), 65_000 + 636);
+        assert_eq!(u.update(65_500), 65_000 + 636 - 136);
+    }
+}
