@@ -1,6 +1,7 @@
 //! Motor current from the board's low-side shunts: phase U's shunt amplified by OPAMP1
 //! (inputs PA1/PA3, output PA2 = ADC1_IN3), phase V's by OPAMP2 (PA7/PA5, output PA6 =
-//! ADC2_IN3), each with the board's external gain network.
+//! ADC2_IN3), each an internal PGA (gain 16, biased through VINM0) behind the board's input
+//! divider.
 //!
 //! Scale (from the SimpleFOC B_G431B_ESC1 example's `LowsideCurrentSense(0.003f, -64.0f/7.0f,
 //! ...)`; UM2516's schematic was not read here): 3 mΩ shunt, amplifier gain −64/7, 12-bit ADC

@@ -33,7 +33,7 @@ use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::can::{self, OperatingMode, RxBuf, TxBuf};
 use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Input, Level, Output, OutputType, Pull, Speed};
-use embassy_stm32::opamp::{OpAmp, OpAmpSpeed};
+use embassy_stm32::opamp::{OpAmp, OpAmpGain, OpAmpSpeed};
 use embassy_stm32::peripherals::{FDCAN1, TIM2};
 use embassy_stm32::time::{hz, khz};
 use embassy_stm32::timer::complementary_pwm::{ComplementaryPwm, ComplementaryPwmPin};
@@ -181,12 +181,14 @@ async fn main(_spawner: Spawner) {
         loaded.calibration_source
     );
 
-    // Current sense: OPAMP1 (phase U shunt) and OPAMP2 (phase V) with the board's external
-    // gain networks, read by ADC1 and ADC2.
+    // Current sense: OPAMP1 (phase U shunt) and OPAMP2 (phase V) as internal PGAs with gain
+    // 16, the gain network's ground on the VINM0 bias pins (PA3, PA5), after the board's input
+    // divider (4/7): 64/7 in all, as SimpleFOC's B-G431B-ESC1 driver programs them. The board
+    // has no external feedback network, so standalone mode would run open loop.
     let mut op1 = OpAmp::new(p.OPAMP1, OpAmpSpeed::Normal);
     let mut op2 = OpAmp::new(p.OPAMP2, OpAmpSpeed::Normal);
-    let out1 = op1.standalone_ext(p.PA1, p.PA3, p.PA2);
-    let out2 = op2.standalone_ext(p.PA7, p.PA5, p.PA6);
+    let out1 = op1.pga_biased_ext(p.PA1, p.PA3, p.PA2, OpAmpGain::Mul16);
+    let out2 = op2.pga_biased_ext(p.PA7, p.PA5, p.PA6, OpAmpGain::Mul16);
     let current = ShuntCurrent::new(
         Adc::new(p.ADC1, AdcConfig::default()),
         Adc::new(p.ADC2, AdcConfig::default()),
