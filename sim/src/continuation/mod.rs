@@ -1,0 +1,244 @@
+//! Following gaits while a scene parameter moves: branches of stride-map fixed points, their
+//! bifurcations, their ends, and the period-doubled branches born on them
+//! (docs/bifurcations.md).
+//!
+//! By concept:
+//! - `natural`: the natural-parameter sweep [`sweep`] (one Newton solve per grid value, secant
+//!   predictor), kept for callers that fill grids row by row;
+//! - `family`: [`Family`], the stride maps `Sᵏ(v; p)` of a scene in one parameter: the walker
+//!   rebuilt at `p`, orbits, monodromy matrices, `∂Sᵏ/∂p`, event sequences;
+//! - `arclength`: pseudo-arclength predictor and corrector, [`BranchPoint`], [`StepControl`];
+//! - `bifurcation`: test functions, [`Bifurcation`] and its location;
+//! - `branch_end`: [`BranchEnd`], non-smooth ends located by bisection;
+//! - `branch`: [`Branch`], following one branch across a [`Grid`];
+//! - `period2`: switching to the period-doubled branch at a period doubling.
+//!
+//! [`continuation`] puts them together: the branch through the gait at `from`, followed to
+//! `to`, and the period-2, 4, … branches born on it.
+
+mod arclength;
+mod bifurcation;
+mod branch;
+mod branch_end;
+mod family;
+mod natural;
+mod period2;
+
+pub use arclength::{BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl};
+pub use bifurcation::{
+    complex_outside, fold_test, neimark_sacker_test, period_doubling_test, Bifurcation,
+    BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
+};
+pub use branch::{Branch, Grid, GridPoint};
+pub use branch_end::{BranchEnd, BranchEndKind};
+pub use family::{EvalError, EventSignature, Family, Orbit};
+pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
+pub use period2::{flip_vector, SwitchError};
+
+use crate::limit_cycle::{GaitSearch, NewtonSettings};
+use crate::scene::Scene;
+use nalgebra::DVector;
+use std::collections::VecDeque;
+
+/// Settings of a continuation beyond the Newton ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContinuationSettings {
+    /// Largest period followed (1, 2, 4, …): branches of period up to this are followed,
+    /// and the period doublings on them located.
+    pub max_period: usize,
+    /// Steps allowed per branch.
+    pub steps_per_branch: usize,
+    /// Branches allowed in all.
+    pub max_branches: usize,
+    /// Smallest step as a fraction of the largest.
+    pub min_step_fraction: f64,
+    /// Corrector iteration budget.
+    pub corrector_iterations: usize,
+}
+
+impl Default for ContinuationSettings {
+    fn default() -> Self {
+        Self {
+            max_period: 8,
+            steps_per_branch: 400,
+            max_branches: 8,
+            min_step_fraction: 1e-4,
+            corrector_iterations: 10,
+        }
+    }
+}
+
+/// The branches of a continuation over a grid.
+#[derive(Clone, Debug)]
+pub struct Continuation {
+    /// The grid.
+    pub grid: Grid,
+    /// The branches: `[0]` through the first gait found, then the period-doubled ones.
+    pub branches: Vec<Branch>,
+    /// The grid values where no gait was found to start from, with the reason, before the
+    /// first start (`branches[0]` starts at the next value).
+    pub no_start: Vec<(f64, String)>,
+    /// Period doublings whose doubled branch could not be started: value and why.
+    pub switch_failures: Vec<(f64, String)>,
+}
+
+impl Continuation {
+    /// The grid values branch 0 did not reach, with the reason (`param`: the parameter's
+    /// name, for the text).
+    pub fn unreached(&self, param: &str) -> Vec<(f64, String)> {
+        let mut out: Vec<(f64, String)> = self
+            .no_start
+            .iter()
+            .map(|(v, e)| (*v, format!("no gait to start from: {e}")))
+            .collect();
+        let Some(b) = self.branches.first() else {
+            return out;
+        };
+        let reason = match &b.end {
+            Some(e) => format!(
+                "the branch ends at {param} = {}: {} ({})",
+                e.value,
+                e.kind.name(),
+                e.detail
+            ),
+            None => "not reached by the branch".into(),
+        };
+        for &g in &self.grid.values {
+            let hit = b.grid.iter().any(|p| p.value == g);
+            let before = self.no_start.iter().any(|(v, _)| *v == g);
+            if !hit && !before {
+                out.push((g, reason.clone()));
+            }
+        }
+        out
+    }
+}
+
+/// Pseudo-arclength continuation of `scene`'s gait in `param` from `from` to `to`: the gait
+/// at `from` (from the scene's guess; if none, the next grid value's), followed with the
+/// grid spacing `|to − from|/(points − 1)` as the largest step; its points at the grid values,
+/// bifurcations and end; then the period-doubled branches. `progress` is called with the
+/// fraction done.
+///
+/// # Errors
+/// [`SweepError`]: a bad parameter name or value, fewer than two points.
+pub fn continuation(
+    scene: &Scene,
+    param: &str,
+    (from, to, points): (f64, f64, usize),
+    newton: &NewtonSettings,
+    settings: &ContinuationSettings,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<Continuation, SweepError> {
+    if points < 2 {
+        return Err(SweepError::TooFewPoints(points));
+    }
+    let family = Family::new(scene, param, newton)?;
+    family.scene_at(from)?;
+    family.scene_at(to)?;
+    let grid = Grid::new(from, to, points);
+    let spacing = grid.spacing().max(1e-12);
+    let steps = StepControl {
+        initial: 0.5 * spacing,
+        max: spacing,
+        min: spacing * settings.min_step_fraction,
+        max_iterations: settings.corrector_iterations,
+    };
+    let mut out = Continuation {
+        grid: grid.clone(),
+        branches: Vec::new(),
+        no_start: Vec::new(),
+        switch_failures: Vec::new(),
+    };
+    let cont = Continuer {
+        family: &family,
+        period: 1,
+        steps,
+    };
+    // The first gait, at the first grid value that has one.
+    let mut start = None;
+    for &g in &grid.values {
+        let setup = family.setup_at(g)?;
+        match GaitSearch::new(&setup.walker, &setup.settings, newton).find_from_guess(&setup.guess)
+        {
+            Ok(gait) => {
+                let n = gait.fixed_point.len();
+                let x = DVector::from_fn(n + 1, |i, _| {
+                    if i < n {
+                        gait.fixed_point[i]
+                    } else {
+                        g
+                    }
+                });
+                let mut c = DVector::zeros(n + 1);
+                c[n] = 1.0;
+                let along = &c * (to - from).signum();
+                let constraint = arclength::Constraint { c, b: g };
+                match cont.correct(&x, &constraint, None, &along, true) {
+                    Ok(s) => {
+                        start = Some(s);
+                        break;
+                    }
+                    Err(e) => out.no_start.push((g, format!("the corrector at the gait failed: {e}"))),
+                }
+            }
+            Err(e) => out.no_start.push((g, e.to_string())),
+        }
+    }
+    let Some(start) = start else {
+        return Ok(out);
+    };
+    let share = 1.0 / (1.0 + settings.max_period.max(1).ilog2() as f64);
+    let main = branch::follow(
+        &cont,
+        0,
+        None,
+        start,
+        &grid,
+        settings.steps_per_branch,
+        &|f| progress(f * share),
+    );
+    // Period doublings to switch at: (parent id, the bifurcation, parent period).
+    let mut queue: VecDeque<(usize, Bifurcation, usize)> = VecDeque::new();
+    let enqueue = |b: &Branch, queue: &mut VecDeque<(usize, Bifurcation, usize)>| {
+        for bif in &b.bifurcations {
+            if bif.kind == BifurcationKind::PeriodDoubling && 2 * b.period_strides <= settings.max_period {
+                queue.push_back((b.id, bif.clone(), b.period_strides));
+            }
+        }
+    };
+    enqueue(&main, &mut queue);
+    out.branches.push(main);
+    while let Some((parent, pd, k)) = queue.pop_front() {
+        if out.branches.len() >= settings.max_branches {
+            out.switch_failures
+                .push((pd.value, "branch budget reached".into()));
+            continue;
+        }
+        let doubled = Continuer {
+            family: &family,
+            period: 2 * k,
+            steps,
+        };
+        match period2::switch(&doubled, &pd, steps.initial) {
+            Ok(first) => {
+                let id = out.branches.len();
+                let done = share * (1.0 + (2 * k).ilog2() as f64 - 1.0);
+                let b = branch::follow(
+                    &doubled,
+                    id,
+                    Some((parent, pd.value)),
+                    first,
+                    &grid,
+                    settings.steps_per_branch,
+                    &|f| progress((done + f * share).min(1.0)),
+                );
+                enqueue(&b, &mut queue);
+                out.branches.push(b);
+            }
+            Err(e) => out.switch_failures.push((pd.value, e.to_string())),
+        }
+    }
+    progress(1.0);
+    Ok(out)
+}
