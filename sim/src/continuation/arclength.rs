@@ -8,9 +8,11 @@
 //! normal to the tangent), with `c = e_p, b = g` a point at the parameter value `g`. A fold is
 //! regular for the augmented system, so the branch passes it.
 //!
-//! Step control: the step grows by 1.5 after a corrector that took at most 3 iterations,
-//! halves after one that took more than 6, and halves on a failed corrector, between
-//! [`StepControl::min`] and [`StepControl::max`].
+//! Step control: the step grows by 1.5 after a corrector that took at most 5 iterations (most
+//! of them chord iterations, which cost one orbit each), halves after one that took more
+//! than 8, and halves on a failed corrector, between
+//! [`StepControl::min`] and [`StepControl::max`]; it moves the parameter by at most
+//! [`StepControl::max_dp`] (the grid spacing).
 
 use super::family::{EvalError, EventSignature, Family};
 use crate::limit_cycle::JacobianMethod;
@@ -92,8 +94,11 @@ pub enum CorrectorError {
 pub struct StepControl {
     /// First step.
     pub initial: f64,
-    /// Largest step.
+    /// Largest step (arclength).
     pub max: f64,
+    /// Largest change of the parameter in one step (the grid spacing): the step is at most
+    /// `max_dp / |dp/ds|`.
+    pub max_dp: f64,
     /// Smallest step: a corrector failing at this step ends the branch.
     pub min: f64,
     /// Corrector iteration budget.
@@ -101,11 +106,21 @@ pub struct StepControl {
 }
 
 impl StepControl {
+    /// `h` capped so that the parameter moves at most `max_dp` along `tangent`.
+    pub fn capped(&self, h: f64, tangent: &DVector<f64>) -> f64 {
+        let tp = tangent[tangent.len() - 1].abs();
+        if tp > 0.0 {
+            h.min(self.max_dp / tp)
+        } else {
+            h
+        }
+    }
+
     /// The step after a corrector that converged in `iterations`.
     pub fn adapt(&self, h: f64, iterations: usize) -> f64 {
-        if iterations <= 3 {
+        if iterations <= 5 {
             (h * 1.5).min(self.max)
-        } else if iterations > 6 {
+        } else if iterations > 8 {
             (h * 0.5).max(self.min)
         } else {
             h
@@ -197,7 +212,10 @@ impl<'a> Continuer<'a> {
         full: bool,
     ) -> Result<(BranchPoint, Linearisation), CorrectorError> {
         let n = x0.len() - 1;
-        let tol = self.family.newton.tolerance;
+        // Rounding in `Sᵏ` grows with `k` and with the size of its Jacobian: so does the
+        // tolerance on the correction.
+        let base_tol = self.family.newton.tolerance * self.period as f64;
+        let mut tol = base_tol;
         let mut x = x0.clone();
         let mut lin: Option<Linearisation> = kept.cloned();
         let mut lin_at_x = false;
@@ -272,6 +290,7 @@ impl<'a> Continuer<'a> {
             }
             last_step = dx.amax();
             x += dx;
+            tol = base_tol * l.monodromy.amax().max(1.0);
             lin_at_x = lin_at_x && last_step < tol;
             lin = Some(l);
         }

@@ -96,6 +96,19 @@ fn between(a: f64, b: f64, g: f64) -> bool {
     (a < g && g <= b) || (b <= g && g < a)
 }
 
+/// Whether the step `h` from `a` to `b` is taken: the corrector moved the point by at most
+/// `h` from the prediction and the tangent turned by less than 60° (more says the step
+/// skipped over structure, or jumped to another branch), and a period-`k` cycle (`k > 1`) has
+/// not collapsed onto the period-`k/2` one (its two halves at least 1e-7 apart).
+fn acceptable(a: &BranchPoint, b: &BranchPoint, h: f64) -> bool {
+    let predicted = a.x() + &a.tangent * h;
+    if (b.x() - predicted).norm() > h || a.tangent.dot(&b.tangent) < 0.5 {
+        return false;
+    }
+    let k = b.period_strides();
+    k == 1 || (&b.orbit[k / 2] - &b.orbit[0]).amax() > 1e-7
+}
+
 /// Follows the branch from `start` across `grid` with at most `budget` steps, calling
 /// `progress` with the fraction of the range covered.
 pub fn follow(
@@ -126,12 +139,18 @@ pub fn follow(
     }
     let mut cur = start;
     let mut h = cont.steps.initial;
-    let n = cur.0.tangent.len() - 1;
     let mut furthest = grid.fraction(cur.0.value);
     let mut steps = 0;
     while steps < budget {
+        h = cont.steps.capped(h, &cur.0.tangent);
         let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
+        if std::env::var("CONT_DEBUG").is_ok() {
+            eprintln!("k {} p {:.8} h {:.3e} tp {:.3e} -> {:?}", cont.period, cur.0.value, h, cur.0.tangent[cur.0.tangent.len()-1], trial.as_ref().map(|t| (t.0.value, t.0.iterations)).map_err(|e| e.to_string()));
+        }
         match trial {
+            Ok((p, _)) if h > cont.steps.min && !acceptable(&cur.0, &p, h) => {
+                h = (h * 0.5).max(cont.steps.min);
+            }
             Ok((p, l)) if p.signature == cur.0.signature => {
                 steps += 1;
                 for kind in bifurcation::crossings(&cur.0, &p) {
@@ -188,11 +207,6 @@ pub fn follow(
                     break;
                 }
                 h = cont.steps.adapt(h, p.iterations);
-                // A tangent that turned by more than 60° says the step skipped structure.
-                if p.tangent.dot(&cur.0.tangent) < 0.5 {
-                    h = (h * 0.5).max(cont.steps.min);
-                }
-                let _ = n;
                 cur = (p, l);
             }
             other => {

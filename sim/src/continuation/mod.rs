@@ -50,7 +50,10 @@ pub struct ContinuationSettings {
     pub steps_per_branch: usize,
     /// Branches allowed in all.
     pub max_branches: usize,
-    /// Smallest step as a fraction of the largest.
+    /// Largest arclength step in grid spacings (the parameter moves at most one spacing per
+    /// step in any case; the state may move more).
+    pub max_arclength_steps: f64,
+    /// Smallest step as a fraction of the grid spacing.
     pub min_step_fraction: f64,
     /// Corrector iteration budget.
     pub corrector_iterations: usize,
@@ -62,8 +65,9 @@ impl Default for ContinuationSettings {
             max_period: 8,
             steps_per_branch: 400,
             max_branches: 8,
+            max_arclength_steps: 10.0,
             min_step_fraction: 1e-4,
-            corrector_iterations: 10,
+            corrector_iterations: 12,
         }
     }
 }
@@ -140,7 +144,8 @@ pub fn continuation(
     let spacing = grid.spacing().max(1e-12);
     let steps = StepControl {
         initial: 0.5 * spacing,
-        max: spacing,
+        max: settings.max_arclength_steps * spacing,
+        max_dp: spacing,
         min: spacing * settings.min_step_fraction,
         max_iterations: settings.corrector_iterations,
     };

@@ -40,7 +40,8 @@ pub enum SwitchError {
 }
 
 /// The first point of the period-`2k` branch born at `pd` (of a period-`k` branch), at
-/// distance `h` along the flip eigenvector; `doubled` continues `S²ᵏ`.
+/// distance `h` along the flip eigenvector (retried at `h/8`, the other way, `h/64`);
+/// `doubled` continues `S²ᵏ`.
 ///
 /// # Errors
 /// [`SwitchError`].
@@ -52,17 +53,27 @@ pub fn switch(
     let e = flip_vector(&pd.point.monodromy).ok_or(SwitchError::NoEigenvector)?;
     let x_star = pd.point.x();
     let n = e.len();
-    let t0 = DVector::from_fn(n + 1, |i, _| if i < n { e[i] } else { 0.0 });
-    let pred = &x_star + &t0 * h;
-    let constraint = Constraint {
-        c: t0.clone(),
-        b: t0.dot(&pred),
-    };
-    let (p, l) = doubled.correct(&pred, &constraint, None, &t0, true)?;
     let k = pd.point.period_strides();
-    let half = &p.orbit[k] - &p.orbit[0];
-    if half.amax() < 1e-3 * h {
-        return Err(SwitchError::NotDoubled(k));
+    let mut last = SwitchError::NotDoubled(k);
+    // Smaller distances first fail less often onto the period-k branch (which the hyperplane
+    // also cuts); both orientations of `e` give the same cycle.
+    for (h, sign) in [(h, 1.0), (h / 8.0, 1.0), (h / 8.0, -1.0), (h / 64.0, 1.0)] {
+        let t0 = DVector::from_fn(n + 1, |i, _| if i < n { sign * e[i] } else { 0.0 });
+        let pred = &x_star + &t0 * h;
+        let constraint = Constraint {
+            c: t0.clone(),
+            b: t0.dot(&pred),
+        };
+        match doubled.correct(&pred, &constraint, None, &t0, true) {
+            Ok((p, l)) => {
+                let half = &p.orbit[k] - &p.orbit[0];
+                if half.amax() >= 1e-3 * h {
+                    return Ok((p, l));
+                }
+                last = SwitchError::NotDoubled(k);
+            }
+            Err(e) => last = e.into(),
+        }
     }
-    Ok((p, l))
+    Err(last)
 }
