@@ -144,9 +144,6 @@ pub fn follow(
     while steps < budget {
         h = cont.steps.capped(h, &cur.0.tangent);
         let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
-        if std::env::var("CONT_DEBUG").is_ok() {
-            eprintln!("k {} p {:.8} h {:.3e} tp {:.3e} -> {:?}", cont.period, cur.0.value, h, cur.0.tangent[cur.0.tangent.len()-1], trial.as_ref().map(|t| (t.0.value, t.0.iterations)).map_err(|e| e.to_string()));
-        }
         match trial {
             Ok((p, _)) if h > cont.steps.min && !acceptable(&cur.0, &p, h) => {
                 h = (h * 0.5).max(cont.steps.min);

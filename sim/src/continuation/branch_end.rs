@@ -60,15 +60,16 @@ pub struct BranchEnd {
 /// What a trial past the end gave: a stride failure or another event sequence.
 fn describe(from: &BranchPoint, trial: &Result<(BranchPoint, Linearisation), CorrectorError>) -> Option<(String, String)> {
     match trial {
-        Ok((p, _)) if p.signature != from.signature => Some((
-            p.signature.difference(&from.signature),
-            format!(
-                "the stride's event sequence changes: {} (from `{}` to `{}`)",
-                from.signature.difference(&p.signature),
-                from.signature,
-                p.signature
-            ),
-        )),
+        Ok((p, _)) if p.signature != from.signature => {
+            let (event, change) = from.signature.difference(&p.signature);
+            Some((
+                event,
+                format!(
+                    "the stride's event sequence changes: {change} (from `{}` to `{}`)",
+                    from.signature, p.signature
+                ),
+            ))
+        }
         Err(CorrectorError::Eval(EvalError::Stride(f))) => Some((
             serde_json::to_value(f.kind)
                 .ok()

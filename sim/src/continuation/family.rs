@@ -41,16 +41,16 @@ impl EventSignature {
         Self(names)
     }
 
-    /// The first event where `self` and `other` differ, described (`string_engaged` lost,
-    /// `heel_down` new, ...).
-    pub fn difference(&self, other: &Self) -> String {
+    /// Where `other` (the new sequence) first differs from `self`: the event that now comes
+    /// there (or the one that no longer occurs), and the change in words.
+    pub fn difference(&self, other: &Self) -> (String, String) {
         let (a, b) = (&self.0, &other.0);
         let i = a.iter().zip(b).take_while(|(x, y)| x == y).count();
         match (a.get(i), b.get(i)) {
-            (Some(x), Some(y)) => format!("{y} instead of {x}"),
-            (Some(x), None) => format!("{x} no longer occurs"),
-            (None, Some(y)) => format!("{y} now occurs"),
-            (None, None) => "none".into(),
+            (Some(x), Some(y)) => (y.clone(), format!("{y} comes before {x}")),
+            (Some(x), None) => (x.clone(), format!("{x} no longer occurs")),
+            (None, Some(y)) => (y.clone(), format!("{y} now occurs")),
+            (None, None) => (String::new(), "no change".into()),
         }
     }
 }
