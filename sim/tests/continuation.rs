@@ -225,3 +225,63 @@ fn the_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
     let beyond = events_at(end.value + 1e-7);
     assert!(beyond.as_ref().map_or(true, |e| e != &before), "{beyond:?}");
 }
+
+/// The stride Jacobian's error at located points (docs/bifurcations.md, "The stride map and its
+/// Jacobian"): the simplest walker's has no variational Jacobian (infinitesimal feet) and is
+/// compared with central differences on frozen step sizes; the wisse2d one with the
+/// variational Jacobian. The located values must not move by more than 1e-9 between methods.
+#[test]
+fn the_stride_jacobian_error_at_the_located_points_is_small() {
+    use sim::limit_cycle::JacobianMethod;
+    let cases = [
+        ("simplest", "slope", (0.009, 0.017, 5), BifurcationKind::PeriodDoubling, true),
+        ("wisse2d", "ankle_engage_rad", (-0.055, -0.06, 3), BifurcationKind::Fold, false),
+    ];
+    for (name, param, range, kind, frozen) in cases {
+        let scene = Scene::load(name).unwrap();
+        let settings = ContinuationSettings {
+            max_period: 1,
+            ..ContinuationSettings::default()
+        };
+        let reference_newton = NewtonSettings {
+            frozen_steps: frozen,
+            jacobian: if frozen {
+                JacobianMethod::CentralDifferences
+            } else {
+                JacobianMethod::Variational
+            },
+            ..NewtonSettings::default()
+        };
+        let located = |newton: &NewtonSettings| {
+            let c = continuation(&scene, param, range, newton, &settings, &|_| {}).unwrap();
+            c.branches[0]
+                .bifurcations
+                .iter()
+                .find(|b| b.kind == kind)
+                .cloned()
+                .unwrap()
+        };
+        let ours = located(&NewtonSettings::default());
+        let reference = located(&reference_newton);
+        println!(
+            "{name}: {kind:?} at {:.12} (central, h = 1e-6) and {:.12} (reference)",
+            ours.value, reference.value
+        );
+        assert!((ours.value - reference.value).abs() < 1e-9);
+        let mut s = scene.clone();
+        s.set(param, ours.value).unwrap();
+        let setup = s.setup().unwrap();
+        let v = &ours.point.orbit[0];
+        let jacobian = |newton: &NewtonSettings| {
+            let search = GaitSearch::new(&setup.walker, &setup.settings, newton);
+            let sv = search.stride_map(v).unwrap().0;
+            search.stride_jacobian_by(v, &sv).unwrap()
+        };
+        let (j, _) = jacobian(&NewtonSettings::default());
+        let (r, method) = jacobian(&reference_newton);
+        assert_eq!(method, reference_newton.jacobian);
+        let error = (&j - &r).amax();
+        println!("{name}: max |J − J_reference| = {error:e}");
+        assert!(error < 1e-7, "{error}");
+    }
+}
