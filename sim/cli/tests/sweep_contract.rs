@@ -9,7 +9,6 @@ use std::process::Output;
 
 mod common;
 #[path = "../../tests/garcia/mod.rs"]
-#[allow(dead_code)]
 mod garcia;
 use common::walker;
 
@@ -23,8 +22,18 @@ fn json(out: &Output) -> Value {
 }
 
 const SIMPLEST: [&str; 12] = [
-    "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.009", "--to", "0.017",
-    "--points", "5", "--max-period",
+    "sweep",
+    "--scene",
+    "simplest",
+    "--param",
+    "slope",
+    "--from",
+    "0.009",
+    "--to",
+    "0.017",
+    "--points",
+    "5",
+    "--max-period",
 ];
 
 #[test]
@@ -50,8 +59,14 @@ fn the_simplest_sweep_reports_branches_periods_orbits_and_the_period_doubling() 
         let orbit = p["orbit"].as_array().unwrap();
         assert_eq!(orbit.len(), 2);
         assert_eq!(orbit[0], p["fixed_point"]);
-        let (a, b) = (orbit[0]["theta"].as_f64().unwrap(), orbit[1]["theta"].as_f64().unwrap());
-        assert!((a - b).abs() > 1e-4, "a period-2 cycle has two distinct states: {orbit:?}");
+        let (a, b) = (
+            orbit[0]["theta"].as_f64().unwrap(),
+            orbit[1]["theta"].as_f64().unwrap(),
+        );
+        assert!(
+            (a - b).abs() > 1e-4,
+            "a period-2 cycle has two distinct states: {orbit:?}"
+        );
     }
     let branches = v["branches"].as_array().unwrap();
     assert_eq!(branches[1]["parent"], 0);

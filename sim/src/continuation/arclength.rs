@@ -51,12 +51,18 @@ impl BranchPoint {
     /// `x = (v₀, p)`.
     pub fn x(&self) -> DVector<f64> {
         let n = self.orbit[0].len();
-        DVector::from_fn(n + 1, |i, _| if i < n { self.orbit[0][i] } else { self.value })
+        DVector::from_fn(
+            n + 1,
+            |i, _| if i < n { self.orbit[0][i] } else { self.value },
+        )
     }
 
     /// Largest multiplier modulus.
     pub fn max_abs_multiplier(&self) -> f64 {
-        self.multipliers.iter().map(|z| z.norm()).fold(0.0, f64::max)
+        self.multipliers
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max)
     }
 
     /// All multipliers strictly inside the unit circle.
@@ -77,7 +83,9 @@ pub enum CorrectorError {
     #[error(transparent)]
     Eval(#[from] EvalError),
     /// The iteration budget ran out.
-    #[error("the corrector did not converge in {iterations} iterations (last |Δx| = {last_step:e})")]
+    #[error(
+        "the corrector did not converge in {iterations} iterations (last |Δx| = {last_step:e})"
+    )]
     NotConverged {
         /// Iterations used.
         iterations: usize,
@@ -243,7 +251,12 @@ impl<'a> Continuer<'a> {
                 };
                 let (multipliers, tangent) = if full {
                     let t = Self::tangent(&lin.top, along).ok_or(CorrectorError::Singular)?;
-                    let m: Vec<Complex<f64>> = lin.monodromy.complex_eigenvalues().iter().copied().collect();
+                    let m: Vec<Complex<f64>> = lin
+                        .monodromy
+                        .complex_eigenvalues()
+                        .iter()
+                        .copied()
+                        .collect();
                     (m, t)
                 } else {
                     (Vec::new(), DVector::zeros(0))

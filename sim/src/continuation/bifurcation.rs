@@ -70,7 +70,9 @@ pub struct Bifurcation {
 }
 
 fn product(m: &[Complex<f64>], f: impl Fn(Complex<f64>) -> Complex<f64>) -> f64 {
-    m.iter().fold(Complex::new(1.0, 0.0), |acc, &z| acc * f(z)).re
+    m.iter()
+        .fold(Complex::new(1.0, 0.0), |acc, &z| acc * f(z))
+        .re
 }
 
 /// `det(M − I)` from the multipliers.

@@ -131,7 +131,11 @@ pub fn follow(
         steps: 0,
     };
     let slack = 1e-12 * (1.0 + grid.from.abs().max(grid.to.abs()));
-    if let Some(&g) = grid.values.iter().find(|&&g| (g - start.0.value).abs() <= slack) {
+    if let Some(&g) = grid
+        .values
+        .iter()
+        .find(|&&g| (g - start.0.value).abs() <= slack)
+    {
         branch.grid.push(GridPoint {
             value: g,
             point: start.0.clone(),
@@ -207,10 +211,8 @@ pub fn follow(
                 cur = (p, l);
             }
             other => {
-                let stride_failed = matches!(
-                    other,
-                    Err(CorrectorError::Eval(EvalError::Stride(_)))
-                );
+                let stride_failed =
+                    matches!(other, Err(CorrectorError::Eval(EvalError::Stride(_))));
                 let changed = branch_end::is_event_change(&cur.0, &other);
                 if (stride_failed || !changed) && h > cont.steps.min {
                     h = (h * 0.5).max(cont.steps.min);

@@ -58,7 +58,10 @@ pub struct BranchEnd {
 }
 
 /// What a trial past the end gave: a stride failure or another event sequence.
-fn describe(from: &BranchPoint, trial: &Result<(BranchPoint, Linearisation), CorrectorError>) -> Option<(String, String)> {
+fn describe(
+    from: &BranchPoint,
+    trial: &Result<(BranchPoint, Linearisation), CorrectorError>,
+) -> Option<(String, String)> {
     match trial {
         Ok((p, _)) if p.signature != from.signature => {
             let (event, change) = from.signature.difference(&p.signature);

@@ -24,7 +24,9 @@ mod family;
 mod natural;
 mod period2;
 
-pub use arclength::{BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl};
+pub use arclength::{
+    BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
+};
 pub use bifurcation::{
     complex_outside, fold_test, neimark_sacker_test, period_doubling_test, Bifurcation,
     BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
@@ -168,13 +170,7 @@ pub fn continuation(
         {
             Ok(gait) => {
                 let n = gait.fixed_point.len();
-                let x = DVector::from_fn(n + 1, |i, _| {
-                    if i < n {
-                        gait.fixed_point[i]
-                    } else {
-                        g
-                    }
-                });
+                let x = DVector::from_fn(n + 1, |i, _| if i < n { gait.fixed_point[i] } else { g });
                 let mut c = DVector::zeros(n + 1);
                 c[n] = 1.0;
                 let along = &c * (to - from).signum();
@@ -184,7 +180,9 @@ pub fn continuation(
                         start = Some(s);
                         break;
                     }
-                    Err(e) => out.no_start.push((g, format!("the corrector at the gait failed: {e}"))),
+                    Err(e) => out
+                        .no_start
+                        .push((g, format!("the corrector at the gait failed: {e}"))),
                 }
             }
             Err(e) => out.no_start.push((g, e.to_string())),
@@ -207,7 +205,9 @@ pub fn continuation(
     let mut queue: VecDeque<(usize, Bifurcation, usize)> = VecDeque::new();
     let enqueue = |b: &Branch, queue: &mut VecDeque<(usize, Bifurcation, usize)>| {
         for bif in &b.bifurcations {
-            if bif.kind == BifurcationKind::PeriodDoubling && 2 * b.period_strides <= settings.max_period {
+            if bif.kind == BifurcationKind::PeriodDoubling
+                && 2 * b.period_strides <= settings.max_period
+            {
                 queue.push_back((b.id, bif.clone(), b.period_strides));
             }
         }
