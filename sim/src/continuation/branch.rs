@@ -78,6 +78,8 @@ pub struct Branch {
     pub bifurcations: Vec<Bifurcation>,
     /// Bifurcations detected but not located (a corrector failed during location).
     pub unlocated: Vec<(BifurcationKind, f64, String)>,
+    /// Grid values the branch crossed where the corrector at that value failed, with why.
+    pub missed: Vec<(f64, String)>,
     /// Where and why it ended (`None`: it left the range).
     pub end: Option<BranchEnd>,
     /// Continuation points computed (steps accepted).
@@ -127,6 +129,7 @@ pub fn follow(
         grid: Vec::new(),
         bifurcations: Vec::new(),
         unlocated: Vec::new(),
+        missed: Vec::new(),
         end: None,
         steps: 0,
     };
@@ -170,11 +173,12 @@ pub fn follow(
                     crossed.reverse();
                 }
                 for g in crossed {
-                    if let Ok((gp, _)) = cont.at_value(&cur.0, &p, &l, g) {
-                        branch.grid.push(GridPoint {
+                    match cont.at_value(&cur.0, &p, &l, g) {
+                        Ok((gp, _)) => branch.grid.push(GridPoint {
                             value: g,
                             point: gp,
-                        });
+                        }),
+                        Err(e) => branch.missed.push((g, e.to_string())),
                     }
                 }
                 furthest = furthest.max(grid.fraction(p.value));

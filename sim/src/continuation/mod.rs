@@ -109,8 +109,11 @@ impl Continuation {
             ),
             None => "not reached by the branch".into(),
         };
+        for (g, why) in &b.missed {
+            out.push((*g, format!("the corrector at this value failed: {why}")));
+        }
         for &g in &self.grid.values {
-            let hit = b.grid.iter().any(|p| p.value == g);
+            let hit = b.grid.iter().any(|p| p.value == g) || b.missed.iter().any(|m| m.0 == g);
             let before = self.no_start.iter().any(|(v, _)| *v == g);
             if !hit && !before {
                 out.push((g, reason.clone()));

@@ -128,6 +128,8 @@ pub struct FailedPoint {
     pub reason: String,
     /// The branch that did not reach this value (0).
     pub branch: usize,
+    /// Strides per cycle of that branch (1).
+    pub period_strides: usize,
 }
 
 /// A change of stability.
@@ -187,6 +189,7 @@ impl SweepReport {
                     error: e.to_string(),
                     reason: e.to_string(),
                     branch: 0,
+                    period_strides: 1,
                 }),
             })
             .collect();
@@ -235,6 +238,7 @@ impl SweepReport {
                         error: reason.clone(),
                         reason,
                         branch: 0,
+                        period_strides: 1,
                     }));
                 }
             }
@@ -251,6 +255,7 @@ impl SweepReport {
                     error: reason.clone(),
                     reason,
                     branch: 0,
+                    period_strides: 1,
                 }));
             }
         }
