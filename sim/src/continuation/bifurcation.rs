@@ -203,3 +203,44 @@ pub fn locate(
         point: best,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn polar(r: f64, angle: f64) -> [Complex<f64>; 2] {
+        [
+            Complex::from_polar(r, angle),
+            Complex::from_polar(r, -angle),
+        ]
+    }
+
+    #[test]
+    fn a_complex_pair_through_the_circle_is_a_neimark_sacker_crossing_and_a_real_one_is_not() {
+        let inside = [polar(0.99, 2.0).as_slice(), &[Complex::new(0.3, 0.0)]].concat();
+        let outside = [polar(1.01, 2.0).as_slice(), &[Complex::new(0.3, 0.0)]].concat();
+        assert_eq!(complex_outside(&inside), 0);
+        assert_eq!(complex_outside(&outside), 2);
+        let t = |m: &[Complex<f64>]| neimark_sacker_test(m).unwrap();
+        assert!(t(&inside) < 0.0 && t(&outside) > 0.0);
+        // The fold and period-doubling functions keep their signs through it.
+        assert_eq!(fold_test(&inside).signum(), fold_test(&outside).signum());
+        assert_eq!(
+            period_doubling_test(&inside).signum(),
+            period_doubling_test(&outside).signum()
+        );
+        // A real multiplier through −1 is a period doubling, not a Neimark–Sacker crossing.
+        let before = [Complex::new(-0.99, 0.0), Complex::new(0.5, 0.0)];
+        let after = [Complex::new(-1.01, 0.0), Complex::new(0.5, 0.0)];
+        assert_ne!(
+            period_doubling_test(&before).signum(),
+            period_doubling_test(&after).signum()
+        );
+        assert_eq!(complex_outside(&before), complex_outside(&after));
+        assert!(neimark_sacker_test(&after).is_none());
+        // Through +1: the fold function changes sign.
+        let before = [Complex::new(0.99, 0.0)];
+        let after = [Complex::new(1.01, 0.0)];
+        assert_ne!(fold_test(&before).signum(), fold_test(&after).signum());
+    }
+}
