@@ -207,7 +207,8 @@ impl<'a> Continuer<'a> {
     /// Newton's method on `F(x) = 0, c·x = b` from `x0`; the first iterations reuse `kept`
     /// (a chord iteration) while the residual falls fourfold per iteration. With `full`, the
     /// converged point gets its monodromy matrix, multipliers and tangent (oriented along
-    /// `along`); without, only its orbit and signature (the rest left empty).
+    /// `along`); without, only its orbit and signature (the rest left empty), and the
+    /// iteration stays a chord iteration on `kept` (no perturbed strides).
     ///
     /// # Errors
     /// [`CorrectorError`].
@@ -231,7 +232,13 @@ impl<'a> Continuer<'a> {
         let mut last_step = f64::INFINITY;
         let mut setup_p = f64::NAN;
         let mut setup: Option<Setup> = None;
-        for it in 0..=self.steps.max_iterations {
+        // Chord iterations only (without `full`) converge linearly: a larger budget.
+        let budget = if full {
+            self.steps.max_iterations
+        } else {
+            3 * self.steps.max_iterations
+        };
+        for it in 0..=budget {
             if setup.is_none() || setup_p != x[n] {
                 setup = Some(self.family.setup_at(x[n]).map_err(EvalError::from)?);
                 setup_p = x[n];
@@ -276,15 +283,22 @@ impl<'a> Continuer<'a> {
                 };
                 return Ok((point, lin));
             }
-            if it == self.steps.max_iterations {
+            if it == budget {
                 break;
             }
             let mut r = DVector::zeros(n + 1);
             r.rows_mut(0, n).copy_from(&f);
             r[n] = constraint.c.dot(&x) - constraint.b;
             let r_norm = r.amax();
+            // Without `full` (locating a branch end) the kept matrix is never replaced: a
+            // fresh one perturbs the state and the parameter, and a perturbed stride failing
+            // near the end would count as the point failing.
             let l = match lin.take() {
-                Some(l) if r_norm <= 0.25 * last_residual || (it == 0 && kept.is_some()) => {
+                Some(l)
+                    if !full
+                        || r_norm <= 0.25 * last_residual
+                        || (it == 0 && kept.is_some()) =>
+                {
                     lin_at_x = false;
                     l
                 }
@@ -308,7 +322,7 @@ impl<'a> Continuer<'a> {
             lin = Some(l);
         }
         Err(CorrectorError::NotConverged {
-            iterations: self.steps.max_iterations,
+            iterations: budget,
             last_step,
         })
     }
@@ -325,14 +339,30 @@ impl<'a> Continuer<'a> {
         s: f64,
         full: bool,
     ) -> Result<(BranchPoint, Linearisation), CorrectorError> {
-        let x0 = from.x();
+        let pred = from.x() + &from.tangent * s;
+        self.at_arclength_from(from, from_lin, s, &pred, full)
+    }
+
+    /// As [`Self::at_arclength`], the corrector starting from `x0` instead of the prediction
+    /// (a point found nearer, e.g. the last good point of a bisection moved onto the
+    /// hyperplane).
+    ///
+    /// # Errors
+    /// As [`Self::correct`].
+    pub fn at_arclength_from(
+        &self,
+        from: &BranchPoint,
+        from_lin: &Linearisation,
+        s: f64,
+        x0: &DVector<f64>,
+        full: bool,
+    ) -> Result<(BranchPoint, Linearisation), CorrectorError> {
         let t = &from.tangent;
-        let pred = &x0 + t * s;
         let constraint = Constraint {
             c: t.clone(),
-            b: t.dot(&pred),
+            b: t.dot(&from.x()) + s,
         };
-        self.correct(&pred, &constraint, Some(from_lin), t, full)
+        self.correct(x0, &constraint, Some(from_lin), t, full)
     }
 
     /// The point at the parameter value `g` between `a` and `b` (linear interpolation as the

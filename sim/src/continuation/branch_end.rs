@@ -5,8 +5,9 @@
 //! engages, a heel lands, a knee locks elsewhere), or a stride fails (a scuff becomes a
 //! contact, heel strike before knee lock, the old stance foot does not lift, a fall), the
 //! branch ends there. The end is located by bisection on the arclength from the last good
-//! point, with the corrector at every trial, until the bracket is below
-//! [`LOCATION_TOLERANCE`]: the value reported is the last point with the old sequence.
+//! point, with the corrector at every trial (started from the last good point, so that its
+//! iterates stay within the bracket), until the bracket is below [`LOCATION_TOLERANCE`]: the
+//! value reported is the last point with the old sequence.
 
 use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
 use super::bifurcation::{LOCATION_BUDGET, LOCATION_TOLERANCE};
@@ -108,7 +109,11 @@ pub fn locate(
             break;
         }
         let mid = 0.5 * (lo + hi);
-        let trial = cont.at_arclength(a, a_lin, mid, false);
+        // Start from the last good point moved onto the trial's hyperplane: the corrector's
+        // iterates stay within about the bracket of it, so a stride failing at an iterate
+        // says the branch fails within the bracket (not at a far Newton excursion).
+        let x0 = good.x() + &a.tangent * (mid - lo);
+        let trial = cont.at_arclength_from(a, a_lin, mid, &x0, false);
         match &trial {
             Ok((p, _)) if p.signature == a.signature => {
                 good = p.clone();
