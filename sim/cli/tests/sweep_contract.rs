@@ -158,3 +158,20 @@ fn a_bad_max_period_is_named() {
     assert_eq!(out.status.code(), Some(2));
     assert!(common::stderr(&out).contains("--max-period"));
 }
+
+#[test]
+fn the_command_lines_integrator_applies_at_every_value() {
+    // RK4 with a 0.1 s step moves the period doubling by about 1e-8 from the scene's DOP853:
+    // the sweep must use it (at every rebuilt parameter value), not the scene's integrator.
+    let pd = |extra: &[&str]| {
+        let mut args = SIMPLEST.to_vec();
+        args.extend(["1", "--json"]);
+        args.extend(extra);
+        let v = json(&walker(&args));
+        v["stability_boundaries"][0]["value"].as_f64().unwrap()
+    };
+    let scene = pd(&[]);
+    let rk4 = pd(&["--integrator", "rk4", "--step-s", "0.1"]);
+    assert!((rk4 - scene).abs() > 1e-9, "{rk4} vs {scene}");
+    assert!((rk4 - scene).abs() < 1e-6, "{rk4} vs {scene}");
+}

@@ -295,9 +295,7 @@ impl<'a> Continuer<'a> {
             // near the end would count as the point failing.
             let l = match lin.take() {
                 Some(l)
-                    if !full
-                        || r_norm <= 0.25 * last_residual
-                        || (it == 0 && kept.is_some()) =>
+                    if !full || r_norm <= 0.25 * last_residual || (it == 0 && kept.is_some()) =>
                 {
                     lin_at_x = false;
                     l

@@ -7,7 +7,7 @@
 
 use crate::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
 use crate::scene::{Scene, SceneError, Setup};
-use crate::stride::{StrideFailure, StrideResult};
+use crate::stride::{StrideFailure, StrideResult, StrideSettings};
 use nalgebra::{DMatrix, DVector};
 
 /// Why a stride map of the family could not be evaluated.
@@ -83,6 +83,10 @@ pub struct Family {
     pub newton: NewtonSettings,
     /// Central-difference step of `∂S/∂p` (in the parameter's unit).
     pub dp: f64,
+    /// Stride settings used at every parameter value instead of the scene's (e.g. the
+    /// command line's `--integrator`, `--rtol`, `--step-s`); `None`: the scene's own at each
+    /// value.
+    pub stride_settings: Option<StrideSettings>,
 }
 
 impl Family {
@@ -104,6 +108,7 @@ impl Family {
             param: param.to_string(),
             newton: *newton,
             dp: newton.perturbation,
+            stride_settings: None,
         })
     }
 
@@ -114,7 +119,11 @@ impl Family {
     pub fn setup_at(&self, p: f64) -> Result<Setup, SceneError> {
         let mut s = self.scene.clone();
         s.set(&self.param, p)?;
-        s.setup()
+        let mut setup = s.setup()?;
+        if let Some(settings) = &self.stride_settings {
+            setup.settings = settings.clone();
+        }
+        Ok(setup)
     }
 
     /// The scene with `p` set (to name fixed points in reports).

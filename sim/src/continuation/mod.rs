@@ -43,7 +43,7 @@ use nalgebra::DVector;
 use std::collections::VecDeque;
 
 /// Settings of a continuation beyond the Newton ones.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ContinuationSettings {
     /// Largest period followed (1, 2, 4, …): branches of period up to this are followed,
     /// and the period doublings on them located.
@@ -59,6 +59,9 @@ pub struct ContinuationSettings {
     pub min_step_fraction: f64,
     /// Corrector iteration budget.
     pub corrector_iterations: usize,
+    /// Stride settings for every parameter value instead of the scene's (`None`: the
+    /// scene's own at each value).
+    pub stride_settings: Option<crate::stride::StrideSettings>,
 }
 
 impl Default for ContinuationSettings {
@@ -70,6 +73,7 @@ impl Default for ContinuationSettings {
             max_arclength_steps: 10.0,
             min_step_fraction: 1e-4,
             corrector_iterations: 12,
+            stride_settings: None,
         }
     }
 }
@@ -142,7 +146,8 @@ pub fn continuation(
     if points < 2 {
         return Err(SweepError::TooFewPoints(points));
     }
-    let family = Family::new(scene, param, newton)?;
+    let mut family = Family::new(scene, param, newton)?;
+    family.stride_settings = settings.stride_settings.clone();
     family.scene_at(from)?;
     family.scene_at(to)?;
     let grid = Grid::new(from, to, points);

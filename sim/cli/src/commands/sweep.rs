@@ -49,22 +49,27 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         max_period,
     } = args;
     let scene = common.scene()?;
-    common.setup(&scene)?;
+    let base = common.setup(&scene)?;
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let max_period = limits::count("--max-period", max_period, 1, 64)?;
     let newton = common.newton();
+    // The command line's integrator choices apply at every parameter value.
+    let overridden =
+        common.integrator.is_some() || common.rtol.is_some() || common.step_s.is_some();
     let settings = ContinuationSettings {
         max_period,
+        stride_settings: overridden.then_some(base.settings),
         ..ContinuationSettings::default()
     };
     let scene_error = |e: SweepError| match e {
         SweepError::Scene(s) => InputError::Scene(s),
         other => InputError::Other(other.to_string()),
     };
-    let family = Family::new(&scene, &param, &newton).map_err(InputError::Scene)?;
+    let mut family = Family::new(&scene, &param, &newton).map_err(InputError::Scene)?;
+    family.stride_settings = settings.stride_settings.clone();
     let result = continuation(
         &scene,
         &param,
