@@ -332,3 +332,53 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
         assert!(error < 1e-7, "{error}");
     }
 }
+
+#[test]
+fn the_kneed_walkers_smallest_slope_is_a_fold_found_from_either_side() {
+    // No gait from the scene's guess at slopes 0.01–0.03: the branch starts at 0.04 and is
+    // followed both ways; downhill it turns at a fold (the smallest slope it walks on).
+    let c = run("kneed2d", "slope_rad", (0.01, 0.08, 8), 1);
+    assert_eq!(c.no_start.len(), 3, "{:?}", c.no_start);
+    let main = &c.branches[0];
+    let end = main.end_before.as_ref().expect("an end below the start");
+    assert_eq!(end.kind, BranchEndKind::Fold);
+    let fold = main
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::Fold)
+        .expect("the fold");
+    assert_eq!(fold.value, end.value);
+    assert!(fold.value > 0.03 && fold.value < 0.035, "{}", fold.value);
+    // The same fold, reached from 0.04 going down.
+    let down = run("kneed2d", "slope_rad", (0.04, 0.01, 7), 1);
+    let other = down.branches[0]
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::Fold)
+        .expect("the fold going down");
+    assert!(
+        (other.value - fold.value).abs() < 1e-9,
+        "{} vs {}",
+        other.value,
+        fold.value
+    );
+    // The grid values in arclength order: 0.04 on the unstable side, then the stable one up.
+    let values: Vec<f64> = main.grid.iter().map(|g| g.value).collect();
+    let expected = [0.04, 0.04, 0.05, 0.06, 0.07, 0.08];
+    assert_eq!(values.len(), expected.len(), "{values:?}");
+    for (v, e) in values.iter().zip(expected) {
+        assert!((v - e).abs() < 1e-15, "{values:?}");
+    }
+    assert!(!main.grid[0].point.stable() && main.grid[1].point.stable());
+    // Newton at single values from the fold's state: converges above it, not below.
+    let scene = Scene::load("kneed2d").unwrap();
+    let newton = NewtonSettings::default();
+    let solve = |p: f64| {
+        let mut s = scene.clone();
+        s.set("slope_rad", p).unwrap();
+        let setup = s.setup().unwrap();
+        GaitSearch::new(&setup.walker, &setup.settings, &newton).find(&fold.point.orbit[0])
+    };
+    assert!(solve(fold.value + 1e-5).is_ok());
+    assert!(solve(fold.value - 1e-5).is_err());
+}

@@ -80,6 +80,9 @@ pub struct Branch {
     pub unlocated: Vec<(BifurcationKind, f64, String)>,
     /// Grid values the branch crossed where the corrector at that value failed, with why.
     pub missed: Vec<(f64, String)>,
+    /// Where and why it ends on the `from` side, when it started after `from` (no gait at the
+    /// first grid values) and was followed backward from its start too.
+    pub end_before: Option<BranchEnd>,
     /// Where and why it ended (`None`: it left the range).
     pub end: Option<BranchEnd>,
     /// Continuation points computed (steps accepted).
@@ -96,6 +99,30 @@ impl Branch {
 fn between(a: f64, b: f64, g: f64) -> bool {
     // (a, b] in either direction.
     (a < g && g <= b) || (b <= g && g < a)
+}
+
+/// Joins `back` (the same branch followed backward from its start) in front of `forward`:
+/// its grid points and bifurcations in reverse (stability before and after swapped), its end
+/// as `end_before`.
+pub fn prepend(forward: &mut Branch, back: Branch) {
+    let mut grid: Vec<GridPoint> = back.grid.into_iter().skip(1).rev().collect();
+    grid.append(&mut forward.grid);
+    forward.grid = grid;
+    let mut bifurcations: Vec<Bifurcation> = back
+        .bifurcations
+        .into_iter()
+        .rev()
+        .map(|mut b| {
+            std::mem::swap(&mut b.stable_before, &mut b.stable_after);
+            b
+        })
+        .collect();
+    bifurcations.append(&mut forward.bifurcations);
+    forward.bifurcations = bifurcations;
+    forward.unlocated.extend(back.unlocated);
+    forward.missed.extend(back.missed);
+    forward.steps += back.steps;
+    forward.end_before = back.end;
 }
 
 /// Whether the step `h` from `a` to `b` is taken: the corrector moved the point by at most
@@ -130,6 +157,7 @@ pub fn follow(
         bifurcations: Vec::new(),
         unlocated: Vec::new(),
         missed: Vec::new(),
+        end_before: None,
         end: None,
         steps: 0,
     };

@@ -96,15 +96,14 @@ impl Continuation {
     /// The grid values branch 0 did not reach, with the reason (`param`: the parameter's
     /// name, for the text).
     pub fn unreached(&self, param: &str) -> Vec<(f64, String)> {
-        let mut out: Vec<(f64, String)> = self
-            .no_start
-            .iter()
-            .map(|(v, e)| (*v, format!("no gait to start from: {e}")))
-            .collect();
         let Some(b) = self.branches.first() else {
-            return out;
+            return self
+                .no_start
+                .iter()
+                .map(|(v, e)| (*v, format!("no gait to start from: {e}")))
+                .collect();
         };
-        let reason = match &b.end {
+        let describe = |e: &Option<BranchEnd>| match e {
             Some(e) => format!(
                 "the branch ends at {param} = {}: {} ({})",
                 e.value,
@@ -113,15 +112,24 @@ impl Continuation {
             ),
             None => "not reached by the branch".into(),
         };
-        for (g, why) in &b.missed {
-            out.push((*g, format!("the corrector at this value failed: {why}")));
-        }
+        let mut out: Vec<(f64, String)> = b
+            .missed
+            .iter()
+            .map(|(g, why)| (*g, format!("the corrector at this value failed: {why}")))
+            .collect();
         for &g in &self.grid.values {
             let hit = b.grid.iter().any(|p| p.value == g) || b.missed.iter().any(|m| m.0 == g);
-            let before = self.no_start.iter().any(|(v, _)| *v == g);
-            if !hit && !before {
-                out.push((g, reason.clone()));
+            if hit {
+                continue;
             }
+            let reason = match self.no_start.iter().find(|(v, _)| *v == g) {
+                Some((_, e)) => match &b.end_before {
+                    Some(_) => format!("{}; no gait to start from: {e}", describe(&b.end_before)),
+                    None => format!("no gait to start from: {e}"),
+                },
+                None => describe(&b.end),
+            };
+            out.push((g, reason));
         }
         out
     }
@@ -200,7 +208,27 @@ pub fn continuation(
         return Ok(out);
     };
     let share = 1.0 / (1.0 + settings.max_period.max(1).ilog2() as f64);
-    let main = branch::follow(
+    // A start after `from`: the branch is also followed backward from it, toward `from`.
+    let i0 = out.no_start.len();
+    let back = (i0 > 0).then(|| {
+        let back_grid = Grid {
+            from: grid.values[i0],
+            to: grid.from,
+            values: grid.values[..=i0].iter().rev().copied().collect(),
+        };
+        let mut reversed = start.clone();
+        reversed.0.tangent = -&reversed.0.tangent;
+        branch::follow(
+            &cont,
+            0,
+            None,
+            reversed,
+            &back_grid,
+            settings.steps_per_branch,
+            &|_| {},
+        )
+    });
+    let mut main = branch::follow(
         &cont,
         0,
         None,
@@ -209,6 +237,9 @@ pub fn continuation(
         settings.steps_per_branch,
         &|f| progress(f * share),
     );
+    if let Some(back) = back {
+        branch::prepend(&mut main, back);
+    }
     // Period doublings to switch at: (parent id, the bifurcation, parent period).
     let mut queue: VecDeque<(usize, Bifurcation, usize)> = VecDeque::new();
     let enqueue = |b: &Branch, queue: &mut VecDeque<(usize, Bifurcation, usize)>| {

@@ -287,16 +287,19 @@ impl SweepReport {
             branch_ends: c
                 .branches
                 .iter()
-                .filter_map(|br| {
-                    br.end.as_ref().map(|e| BranchEndRecord {
-                        branch: br.id,
-                        period_strides: br.period_strides,
-                        value: e.value,
-                        kind: e.kind.name(),
-                        event: e.event.clone(),
-                        detail: e.detail.clone(),
-                        bracket: e.bracket,
-                    })
+                .flat_map(|br| {
+                    [&br.end_before, &br.end]
+                        .into_iter()
+                        .flatten()
+                        .map(|e| BranchEndRecord {
+                            branch: br.id,
+                            period_strides: br.period_strides,
+                            value: e.value,
+                            kind: e.kind.name(),
+                            event: e.event.clone(),
+                            detail: e.detail.clone(),
+                            bracket: e.bracket,
+                        })
                 })
                 .collect(),
             branches: c
