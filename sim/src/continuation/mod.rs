@@ -62,6 +62,8 @@ pub struct ContinuationSettings {
     /// Stride settings for every parameter value instead of the scene's (`None`: the
     /// scene's own at each value).
     pub stride_settings: Option<crate::stride::StrideSettings>,
+    /// Grid values tried (from `from` on) for a first gait from the scene's guess.
+    pub start_attempts: usize,
 }
 
 impl Default for ContinuationSettings {
@@ -74,6 +76,7 @@ impl Default for ContinuationSettings {
             min_step_fraction: 1e-4,
             corrector_iterations: 12,
             stride_settings: None,
+            start_attempts: 32,
         }
     }
 }
@@ -97,10 +100,19 @@ impl Continuation {
     /// name, for the text).
     pub fn unreached(&self, param: &str) -> Vec<(f64, String)> {
         let Some(b) = self.branches.first() else {
+            let tried = self.no_start.len();
             return self
-                .no_start
+                .grid
+                .values
                 .iter()
-                .map(|(v, e)| (*v, format!("no gait to start from: {e}")))
+                .enumerate()
+                .map(|(i, v)| match self.no_start.get(i) {
+                    Some((_, e)) => (*v, format!("no gait to start from: {e}")),
+                    None => (
+                        *v,
+                        format!("no gait found to start from at the first {tried} values"),
+                    ),
+                })
                 .collect();
         };
         let describe = |e: &Option<BranchEnd>| match e {
@@ -178,9 +190,9 @@ pub fn continuation(
         period: 1,
         steps,
     };
-    // The first gait, at the first grid value that has one.
+    // The first gait, at the first grid value that has one (of at most `start_attempts`).
     let mut start = None;
-    for &g in &grid.values {
+    for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
         let setup = family.setup_at(g)?;
         match GaitSearch::new(&setup.walker, &setup.settings, newton).find_from_guess(&setup.guess)
         {
