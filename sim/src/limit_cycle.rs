@@ -11,6 +11,7 @@ use crate::stride::{
 use crate::variational::VariationalError;
 use crate::walker::Walker;
 use nalgebra::{Complex, DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Settings of the fixed-point search.
@@ -234,20 +235,27 @@ impl<'a> GaitSearch<'a> {
                 Ok(self.stride_map(x)?.0)
             }
         };
-        let mut j = DMatrix::zeros(n, n);
-        for k in 0..n {
+        // The columns are independent strides: computed in parallel (rayon), each with the
+        // same arithmetic as a sequential loop, so the Jacobian is bit-identical to it. The
+        // first failure in column order is reported, as a sequential loop would.
+        let column = |k: usize| -> Result<DVector<f64>, StrideFailure> {
             let mut vp = v.clone();
             vp[k] += d;
             let sp = map(&vp)?;
-            let col = if settings.central {
+            Ok(if settings.central {
                 let mut vm = v.clone();
                 vm[k] -= d;
                 let sm = map(&vm)?;
                 (sp - sm) / (2.0 * d)
             } else {
                 (sp - s_v) / d
-            };
-            j.set_column(k, &col);
+            })
+        };
+        let columns: Vec<Result<DVector<f64>, StrideFailure>> =
+            (0..n).into_par_iter().map(column).collect();
+        let mut j = DMatrix::zeros(n, n);
+        for (k, col) in columns.into_iter().enumerate() {
+            j.set_column(k, &col?);
         }
         Ok(j)
     }

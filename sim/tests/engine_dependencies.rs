@@ -2,6 +2,18 @@
 //! the engine, never the other way round; docs/engine.md).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+/// Every dependency the engine may have: the numerics, serialisation, errors, and rayon for
+/// parallel stride evaluations (independent Jacobian columns, parameter sides).
+const ALLOWED: [&str; 7] = [
+    "nalgebra",
+    "num-dual",
+    "serde",
+    "serde_json",
+    "toml",
+    "thiserror",
+    "rayon",
+];
+
 const FORBIDDEN: [&str; 12] = [
     "firmware",
     "protocol",
@@ -30,6 +42,13 @@ fn the_engine_depends_on_no_firmware_can_or_cli_crate() {
         assert!(
             !deps.contains_key(name),
             "the engine depends on `{name}` ({})",
+            path.display()
+        );
+    }
+    for name in deps.keys() {
+        assert!(
+            ALLOWED.contains(&name.as_str()),
+            "the engine depends on `{name}`, which is not on the allowed list ({})",
             path.display()
         );
     }

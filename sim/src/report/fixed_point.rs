@@ -3,6 +3,7 @@
 use crate::limit_cycle::Gait;
 use crate::scene::Scene;
 use crate::walker::Walker;
+use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -16,12 +17,17 @@ pub struct FixedPoint(pub BTreeMap<String, f64>);
 impl FixedPoint {
     /// The fixed point of `gait`, named by `walker`'s stride map and `scene`'s conventions.
     pub fn of(scene: &Scene, walker: &Walker, gait: &Gait) -> Self {
+        Self::of_state(scene, walker, &gait.fixed_point)
+    }
+
+    /// The stride-map vector `v` (a state just after heel strike) named the same way.
+    pub fn of_state(scene: &Scene, walker: &Walker, v: &DVector<f64>) -> Self {
         let mut m: BTreeMap<String, f64> = walker
             .map_names()
             .into_iter()
-            .zip(gait.fixed_point.iter().copied())
+            .zip(v.iter().copied())
             .collect();
-        let (q, qd) = walker.unpack(&gait.fixed_point);
+        let (q, qd) = walker.unpack(v);
         if let Ok(extra) = scene.convention_outputs(walker, &q, &qd) {
             m.extend(extra);
         }

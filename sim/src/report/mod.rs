@@ -32,7 +32,10 @@ pub use fixed_point::FixedPoint;
 pub use gait::{ActuatorFigures, ContactFigures, FoundGait, GaitNotFound, GaitOutcome, GaitReport};
 pub use ideal_gait::IdealGaitRecord;
 pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
-pub use sweep::{BoundaryRecord, ConvergedPoint, FailedPoint, SweepPointRecord, SweepReport};
+pub use sweep::{
+    BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, SweepPointRecord,
+    SweepReport,
+};
 pub use walk::WalkReport;
 pub use walk_gait::WalkGaitRecord;
 

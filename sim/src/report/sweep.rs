@@ -1,7 +1,11 @@
-//! The `walker sweep` report: the gait at each parameter value and where stability changes.
+//! The `walker sweep` report: the gait at each parameter value and where stability changes;
+//! from a pseudo-arclength continuation ([`SweepReport::from_continuation`]) also each point's
+//! branch and period, the bifurcations by kind, and where and why branches end.
 
 use super::{eigenvalue_pairs, FixedPoint};
-use crate::continuation::{StabilityBoundary, SweepPoint};
+use crate::continuation::{
+    Bifurcation, BranchPoint, Continuation, Family, StabilityBoundary, SweepPoint,
+};
 use crate::scene::Scene;
 use crate::walker::Walker;
 use serde::Serialize;
@@ -15,8 +19,49 @@ pub struct SweepReport {
     pub param: String,
     /// One record per parameter value, in sweep order.
     pub points: Vec<SweepPointRecord>,
-    /// Changes of stability between successive converged points.
+    /// Changes of stability between successive converged points; from a continuation, every
+    /// located bifurcation (with its `kind`).
     pub stability_boundaries: Vec<BoundaryRecord>,
+    /// Where and why branches end (empty for the natural-parameter sweep).
+    pub branch_ends: Vec<BranchEndRecord>,
+    /// The branches followed (empty for the natural-parameter sweep).
+    pub branches: Vec<BranchRecord>,
+}
+
+/// Where a branch ends.
+#[derive(Clone, Debug, Serialize)]
+pub struct BranchEndRecord {
+    /// The branch.
+    pub branch: usize,
+    /// Strides per cycle on it.
+    pub period_strides: usize,
+    /// The parameter value of the branch's last point.
+    pub value: f64,
+    /// `event_change`, `fold`, `not_converged` or `budget`.
+    pub kind: &'static str,
+    /// The event that appears, disappears or fails (e.g. `scuffed`), when there is one.
+    pub event: Option<String>,
+    /// What happens there, in words.
+    pub detail: String,
+    /// Width of the arclength bracket of its location (an upper bound on the parameter's).
+    pub bracket: f64,
+}
+
+/// A branch of the continuation.
+#[derive(Clone, Debug, Serialize)]
+pub struct BranchRecord {
+    /// Its id, as the points' `branch`.
+    pub branch: usize,
+    /// Strides per cycle.
+    pub period_strides: usize,
+    /// The branch it was switched from, at its period doubling (`null` for branch 0).
+    pub parent: Option<usize>,
+    /// The parameter value of that period doubling.
+    pub born_at: Option<f64>,
+    /// Continuation steps taken.
+    pub steps: usize,
+    /// The stride event sequence along it (`|` between strides of a cycle).
+    pub events: Vec<String>,
 }
 
 /// One point of a sweep.
@@ -46,10 +91,19 @@ pub struct ConvergedPoint {
     pub eigenvalues: Vec<[f64; 2]>,
     /// The fixed point (`null` if the walker of this value could not be rebuilt to name it).
     pub fixed_point: Option<FixedPoint>,
-    /// Step period [s].
+    /// Step period [s] (of the first stride of the cycle).
     pub step_period_s: f64,
-    /// Distance between the contacts of a step [m].
+    /// Distance between the contacts of a step [m] (of the first stride of the cycle).
     pub step_length_m: f64,
+    /// Strides per cycle (1, 2, 4, …).
+    pub period_strides: usize,
+    /// The branch (`branches[..].branch`); 0 for the natural-parameter sweep.
+    pub branch: usize,
+    /// For period > 1: the cycle's states, each like `fixed_point` (the first is it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orbit: Option<Vec<Option<FixedPoint>>>,
+    /// How the stride Jacobians were taken (`central_differences`, `variational`).
+    pub jacobian_method: crate::limit_cycle::JacobianMethod,
 }
 
 /// A sweep point without a gait.
@@ -69,6 +123,13 @@ pub struct FailedPoint {
     pub fixed_point: Option<FixedPoint>,
     /// Why no gait was found.
     pub error: String,
+    /// Why no gait was found (as `error`): the Newton failure, or where and why the branch
+    /// ended before this value.
+    pub reason: String,
+    /// The branch that did not reach this value (0).
+    pub branch: usize,
+    /// Strides per cycle of that branch (1).
+    pub period_strides: usize,
 }
 
 /// A change of stability.
@@ -76,8 +137,18 @@ pub struct FailedPoint {
 pub struct BoundaryRecord {
     /// Estimated parameter value where `max |λ| = 1`.
     pub value: f64,
-    /// `lost` or `gained` (with increasing point index).
+    /// `lost` or `gained` (with increasing point index; from a continuation, along the
+    /// branch), `none` when the crossing keeps the point unstable.
     pub change: &'static str,
+    /// `fold`, `branch_point`, `period_doubling`, `neimark_sacker`; `stability_change` for the
+    /// natural-parameter sweep (interpolated, not located).
+    pub kind: &'static str,
+    /// The branch (0 for the natural-parameter sweep).
+    pub branch: usize,
+    /// Strides per cycle on the branch.
+    pub period_strides: usize,
+    /// The multipliers at the located point, `[re, im]` (empty for the natural sweep).
+    pub multipliers: Vec<[f64; 2]>,
 }
 
 impl SweepReport {
@@ -103,6 +174,10 @@ impl SweepReport {
                     fixed_point: walker_for(p.value).map(|(s, w)| FixedPoint::of(&s, &w, g)),
                     step_period_s: g.stride.duration_s,
                     step_length_m: g.stride.step_m.norm(),
+                    period_strides: 1,
+                    branch: 0,
+                    orbit: None,
+                    jacobian_method: g.jacobian_method,
                 })),
                 Err(e) => SweepPointRecord::Failed(FailedPoint {
                     parameter: param.to_string(),
@@ -112,6 +187,9 @@ impl SweepReport {
                     stable: false,
                     fixed_point: None,
                     error: e.to_string(),
+                    reason: e.to_string(),
+                    branch: 0,
+                    period_strides: 1,
                 }),
             })
             .collect();
@@ -124,8 +202,147 @@ impl SweepReport {
                 .map(|b| BoundaryRecord {
                     value: b.value,
                     change: b.change,
+                    kind: "stability_change",
+                    branch: 0,
+                    period_strides: 1,
+                    multipliers: Vec::new(),
+                })
+                .collect(),
+            branch_ends: Vec::new(),
+            branches: Vec::new(),
+        }
+    }
+
+    /// The report of a pseudo-arclength continuation of `family`'s parameter: each branch's
+    /// points at the grid values in arclength order (branch 0 first, then the grid values it
+    /// did not reach, with the reason; then the period-doubled branches), every located
+    /// bifurcation, and the branches' ends.
+    pub fn from_continuation(family: &Family, c: &Continuation) -> Self {
+        let param = family.param.clone();
+        let mut points = Vec::new();
+        for b in &c.branches {
+            for g in &b.grid {
+                points.push(SweepPointRecord::Converged(Box::new(converged(
+                    family, &param, b.id, &g.point,
+                ))));
+            }
+            if b.id == 0 {
+                for (value, reason) in c.unreached(&param) {
+                    points.push(SweepPointRecord::Failed(FailedPoint {
+                        parameter: param.clone(),
+                        value,
+                        converged: false,
+                        max_abs_eigenvalue: None,
+                        stable: false,
+                        fixed_point: None,
+                        error: reason.clone(),
+                        reason,
+                        branch: 0,
+                        period_strides: 1,
+                    }));
+                }
+            }
+        }
+        if c.branches.is_empty() {
+            for (value, reason) in c.unreached(&param) {
+                points.push(SweepPointRecord::Failed(FailedPoint {
+                    parameter: param.clone(),
+                    value,
+                    converged: false,
+                    max_abs_eigenvalue: None,
+                    stable: false,
+                    fixed_point: None,
+                    error: reason.clone(),
+                    reason,
+                    branch: 0,
+                    period_strides: 1,
+                }));
+            }
+        }
+        let boundary = |id: usize, k: usize, b: &Bifurcation| BoundaryRecord {
+            value: b.value,
+            change: match (b.stable_before, b.stable_after) {
+                (true, false) => "lost",
+                (false, true) => "gained",
+                _ => "none",
+            },
+            kind: b.kind.name(),
+            branch: id,
+            period_strides: k,
+            multipliers: eigenvalue_pairs(&b.multipliers),
+        };
+        Self {
+            scene: family.scene.name().to_string(),
+            param: param.clone(),
+            points,
+            stability_boundaries: c
+                .branches
+                .iter()
+                .flat_map(|br| {
+                    br.bifurcations
+                        .iter()
+                        .map(move |b| boundary(br.id, br.period_strides, b))
+                })
+                .collect(),
+            branch_ends: c
+                .branches
+                .iter()
+                .flat_map(|br| {
+                    [&br.end_before, &br.end]
+                        .into_iter()
+                        .flatten()
+                        .map(|e| BranchEndRecord {
+                            branch: br.id,
+                            period_strides: br.period_strides,
+                            value: e.value,
+                            kind: e.kind.name(),
+                            event: e.event.clone(),
+                            detail: e.detail.clone(),
+                            bracket: e.bracket,
+                        })
+                })
+                .collect(),
+            branches: c
+                .branches
+                .iter()
+                .map(|br| BranchRecord {
+                    branch: br.id,
+                    period_strides: br.period_strides,
+                    parent: br.parent.map(|p| p.0),
+                    born_at: br.parent.map(|p| p.1),
+                    steps: br.steps,
+                    events: br
+                        .grid
+                        .first()
+                        .map(|g| g.point.signature.0.clone())
+                        .unwrap_or_default(),
                 })
                 .collect(),
         }
+    }
+}
+
+/// The record of a continuation point on branch `id`.
+fn converged(family: &Family, param: &str, id: usize, p: &BranchPoint) -> ConvergedPoint {
+    let named = family
+        .scene_at(p.value)
+        .ok()
+        .and_then(|s| s.setup().ok().map(|setup| (s, setup.walker)));
+    let name = |v| named.as_ref().map(|(s, w)| FixedPoint::of_state(s, w, v));
+    let first = &p.strides[0];
+    ConvergedPoint {
+        parameter: param.to_string(),
+        value: p.value,
+        converged: true,
+        max_abs_eigenvalue: p.max_abs_multiplier(),
+        stable: p.stable(),
+        eigenvalues: eigenvalue_pairs(&p.multipliers),
+        fixed_point: name(&p.orbit[0]),
+        step_period_s: first.duration_s,
+        step_length_m: first.step_m.norm(),
+        period_strides: p.period_strides(),
+        branch: id,
+        orbit: (p.period_strides() > 1).then(|| p.orbit.iter().map(name).collect()),
+        jacobian_method: p.jacobian_method,
     }
 }

@@ -1,4 +1,6 @@
-//! `walker sweep`: continuation, following the gait while one parameter changes.
+//! `walker sweep`: pseudo-arclength continuation of the gait while one parameter changes,
+//! through folds, with its bifurcations located, its end named, and the period-doubled
+//! branches (docs/bifurcations.md).
 
 use super::print_json;
 use crate::input_error::InputError;
@@ -7,7 +9,7 @@ use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use clap::Args;
-use sim::continuation::sweep;
+use sim::continuation::{continuation, ContinuationSettings, Family, SweepError};
 use sim::report::{SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;
@@ -26,9 +28,14 @@ pub struct SweepArgs {
     /// Last value.
     #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
-    /// Number of points (2 to 10,000).
+    /// Number of grid values reported (2 to 10,000); their spacing is the largest
+    /// continuation step.
     #[arg(long)]
     pub points: usize,
+    /// Longest cycle followed, in strides (1: the period-1 branch only; 2, 4, … follow the
+    /// period-doubled branches up to this).
+    #[arg(long, default_value_t = 8)]
+    pub max_period: usize,
 }
 
 /// Runs `walker sweep`.
@@ -39,25 +46,40 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         from,
         to,
         points,
+        max_period,
     } = args;
     let scene = common.scene()?;
-    common.setup(&scene)?;
+    let base = common.setup(&scene)?;
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
-    let (pts, bounds) =
-        sweep(&scene, &param, from, to, points, &common.newton()).map_err(|e| match e {
-            sim::continuation::SweepError::Scene(s) => InputError::Scene(s),
-            other => InputError::Other(other.to_string()),
-        })?;
-    let walker_for = |value: f64| {
-        let mut s = scene.clone();
-        s.set(&param, value).ok()?;
-        let w = s.build().ok()?;
-        Some((s, w))
+    let max_period = limits::count("--max-period", max_period, 1, 64)?;
+    let newton = common.newton();
+    // The command line's integrator choices apply at every parameter value.
+    let overridden =
+        common.integrator.is_some() || common.rtol.is_some() || common.step_s.is_some();
+    let settings = ContinuationSettings {
+        max_period,
+        stride_settings: overridden.then_some(base.settings),
+        ..ContinuationSettings::default()
     };
-    let report = SweepReport::new(&scene, &walker_for, &param, &pts, &bounds);
+    let scene_error = |e: SweepError| match e {
+        SweepError::Scene(s) => InputError::Scene(s),
+        other => InputError::Other(other.to_string()),
+    };
+    let mut family = Family::new(&scene, &param, &newton).map_err(InputError::Scene)?;
+    family.stride_settings = settings.stride_settings.clone();
+    let result = continuation(
+        &scene,
+        &param,
+        (from, to, points),
+        &newton,
+        &settings,
+        &|_fraction| {},
+    )
+    .map_err(scene_error)?;
+    let report = SweepReport::from_continuation(&family, &result);
     if common.json {
         print_json(&report)?;
     } else {
@@ -68,21 +90,60 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
 
 fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
     let param = &r.param;
-    writeln!(out, "{:>14} {:>10} {:>8}", param, "max|λ|", "stable")?;
+    writeln!(
+        out,
+        "{:>14} {:>7} {:>7} {:>10} {:>8}",
+        param, "branch", "period", "max|λ|", "stable"
+    )?;
     for p in &r.points {
         match p {
             SweepPointRecord::Converged(g) => writeln!(
                 out,
-                "{:>14.6} {:>10.6} {:>8}",
-                g.value, g.max_abs_eigenvalue, g.stable
+                "{:>14.6} {:>7} {:>7} {:>10.6} {:>8}",
+                g.value, g.branch, g.period_strides, g.max_abs_eigenvalue, g.stable
             )?,
-            SweepPointRecord::Failed(e) => {
-                writeln!(out, "{:>14.6} {:>10} {:>8}  {}", e.value, "-", "-", e.error)?
-            }
+            SweepPointRecord::Failed(e) => writeln!(
+                out,
+                "{:>14.6} {:>7} {:>7} {:>10} {:>8}  {}",
+                e.value, e.branch, "-", "-", "-", e.reason
+            )?,
         }
     }
     for b in &r.stability_boundaries {
-        writeln!(out, "stability {} at {} ≈ {:.6}", b.change, param, b.value)?;
+        let m: Vec<String> = b
+            .multipliers
+            .iter()
+            .map(|[re, im]| {
+                if *im == 0.0 {
+                    format!("{re:.6}")
+                } else {
+                    format!("{re:.6}{im:+.6}i")
+                }
+            })
+            .collect();
+        writeln!(
+            out,
+            "{} on branch {} (period {}) at {} = {:.10} (stability {}); multipliers {}",
+            b.kind.replace('_', " "),
+            b.branch,
+            b.period_strides,
+            param,
+            b.value,
+            b.change,
+            m.join(", ")
+        )?;
+    }
+    for e in &r.branch_ends {
+        writeln!(
+            out,
+            "branch {} (period {}) ends at {} = {:.10}: {} — {}",
+            e.branch,
+            e.period_strides,
+            param,
+            e.value,
+            e.kind.replace('_', " "),
+            e.detail
+        )?;
     }
     Ok(())
 }

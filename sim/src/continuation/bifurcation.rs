@@ -1,0 +1,246 @@
+//! Bifurcations of a branch: where a Floquet multiplier crosses the unit circle.
+//!
+//! Test functions of the monodromy matrix `M` (from its multipliers `λᵢ`):
+//! - fold (a real multiplier through +1): `det(M − I) = Π(λᵢ − 1)`; a fold proper is where
+//!   the branch also turns (`dp/ds` changes sign); otherwise the crossing is a branch point;
+//! - period doubling (a real multiplier through −1): `det(M + I) = Π(λᵢ + 1)`;
+//! - Neimark–Sacker (a complex pair through the unit circle): the number of complex
+//!   multipliers outside the circle changes; located on `|λ_c| − 1` of the complex pair
+//!   nearest the circle.
+//!
+//! Between two points whose test function has opposite signs the zero is located on the
+//! arclength by the Illinois variant of regula falsi, with the corrector at every trial,
+//! until the arclength bracket is below [`LOCATION_TOLERANCE`] (the parameter moves at most
+//! as much as the arclength, so the parameter is located at least as well).
+
+use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
+use nalgebra::Complex;
+use serde::Serialize;
+
+/// Width of the arclength bracket at which a bifurcation or branch end is located (so the
+/// parameter is known to this at least).
+pub const LOCATION_TOLERANCE: f64 = 1e-9;
+
+/// Trial budget of one location.
+pub const LOCATION_BUDGET: usize = 80;
+
+/// What kind of bifurcation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BifurcationKind {
+    /// A real multiplier through +1 where the branch turns back in the parameter.
+    Fold,
+    /// A real multiplier through +1 where the branch does not turn (another branch crosses).
+    BranchPoint,
+    /// A real multiplier through −1.
+    PeriodDoubling,
+    /// A complex pair of multipliers through the unit circle.
+    NeimarkSacker,
+}
+
+impl BifurcationKind {
+    /// The JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fold => "fold",
+            Self::BranchPoint => "branch_point",
+            Self::PeriodDoubling => "period_doubling",
+            Self::NeimarkSacker => "neimark_sacker",
+        }
+    }
+}
+
+/// A located bifurcation.
+#[derive(Clone, Debug)]
+pub struct Bifurcation {
+    /// Its kind.
+    pub kind: BifurcationKind,
+    /// The parameter value.
+    pub value: f64,
+    /// The multipliers there.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Stable before it (in the branch's arclength order).
+    pub stable_before: bool,
+    /// Stable after it.
+    pub stable_after: bool,
+    /// The point itself (for branch switching).
+    pub point: BranchPoint,
+    /// Width of the final parameter bracket.
+    pub bracket: f64,
+}
+
+fn product(m: &[Complex<f64>], f: impl Fn(Complex<f64>) -> Complex<f64>) -> f64 {
+    m.iter()
+        .fold(Complex::new(1.0, 0.0), |acc, &z| acc * f(z))
+        .re
+}
+
+/// `det(M − I)` from the multipliers.
+pub fn fold_test(m: &[Complex<f64>]) -> f64 {
+    product(m, |z| z - 1.0)
+}
+
+/// `det(M + I)` from the multipliers.
+pub fn period_doubling_test(m: &[Complex<f64>]) -> f64 {
+    product(m, |z| z + 1.0)
+}
+
+fn is_complex(z: &Complex<f64>) -> bool {
+    z.im.abs() > 1e-9 * z.norm().max(1e-300)
+}
+
+/// Complex multipliers outside the unit circle.
+pub fn complex_outside(m: &[Complex<f64>]) -> usize {
+    m.iter().filter(|z| is_complex(z) && z.norm() > 1.0).count()
+}
+
+/// `|λ| − 1` of the complex multiplier nearest the unit circle (`None` without one).
+pub fn neimark_sacker_test(m: &[Complex<f64>]) -> Option<f64> {
+    m.iter()
+        .filter(|z| is_complex(z))
+        .map(|z| z.norm() - 1.0)
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+}
+
+/// The bifurcations between two successive points `a` (with its linearisation) and `b`:
+/// which test functions changed sign.
+pub fn crossings(a: &BranchPoint, b: &BranchPoint) -> Vec<BifurcationKind> {
+    let (ma, mb) = (&a.multipliers, &b.multipliers);
+    let mut kinds = Vec::new();
+    if fold_test(ma).signum() != fold_test(mb).signum() {
+        let n = a.tangent.len() - 1;
+        kinds.push(if a.tangent[n].signum() != b.tangent[n].signum() {
+            BifurcationKind::Fold
+        } else {
+            BifurcationKind::BranchPoint
+        });
+    }
+    if period_doubling_test(ma).signum() != period_doubling_test(mb).signum() {
+        kinds.push(BifurcationKind::PeriodDoubling);
+    }
+    if complex_outside(ma) != complex_outside(mb) {
+        kinds.push(BifurcationKind::NeimarkSacker);
+    }
+    kinds
+}
+
+/// The test function of `kind` at `p`.
+fn test(kind: BifurcationKind, p: &BranchPoint) -> f64 {
+    let m = &p.multipliers;
+    match kind {
+        BifurcationKind::Fold | BifurcationKind::BranchPoint => fold_test(m),
+        BifurcationKind::PeriodDoubling => period_doubling_test(m),
+        BifurcationKind::NeimarkSacker => neimark_sacker_test(m).unwrap_or(f64::NAN),
+    }
+}
+
+/// Locates the bifurcation `kind` between `a` and `b` (`b` at arclength `s_b` from `a`
+/// along `a`'s tangent).
+///
+/// # Errors
+/// A corrector failure at a trial.
+pub fn locate(
+    cont: &Continuer,
+    kind: BifurcationKind,
+    (a, a_lin): (&BranchPoint, &Linearisation),
+    b: &BranchPoint,
+) -> Result<Bifurcation, CorrectorError> {
+    let s_b = a.tangent.dot(&(b.x() - a.x()));
+    let (mut s_lo, mut f_lo) = (0.0, test(kind, a));
+    let (mut s_hi, mut f_hi) = (s_b, test(kind, b));
+    let mut best = b.clone();
+    let mut best_f = f_hi;
+    let mut side = 0i8;
+    for _ in 0..LOCATION_BUDGET {
+        if (s_hi - s_lo).abs() < LOCATION_TOLERANCE {
+            break;
+        }
+        let mut s = if f_lo.is_finite() && f_hi.is_finite() && f_hi != f_lo {
+            s_lo - f_lo * (s_hi - s_lo) / (f_hi - f_lo)
+        } else {
+            0.5 * (s_lo + s_hi)
+        };
+        // Keep the trial strictly inside the bracket (bisect when regula falsi would not).
+        let (lo, hi) = (s_lo.min(s_hi), s_lo.max(s_hi));
+        let margin = 0.01 * (hi - lo);
+        if !(s > lo + margin && s < hi - margin) {
+            s = 0.5 * (s_lo + s_hi);
+        }
+        let (p, _) = cont.at_arclength(a, a_lin, s, true)?;
+        let f = test(kind, &p);
+        if f.abs() < best_f.abs() || !best_f.is_finite() {
+            best = p.clone();
+            best_f = f;
+        }
+        if f == 0.0 {
+            s_lo = s;
+            s_hi = s;
+            break;
+        }
+        if f.signum() == f_lo.signum() {
+            s_lo = s;
+            f_lo = f;
+            if side == -1 {
+                f_hi *= 0.5;
+            }
+            side = -1;
+        } else {
+            s_hi = s;
+            f_hi = f;
+            if side == 1 {
+                f_lo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok(Bifurcation {
+        kind,
+        value: best.value,
+        multipliers: best.multipliers.clone(),
+        stable_before: a.stable(),
+        stable_after: b.stable(),
+        bracket: (s_hi - s_lo).abs(),
+        point: best,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn polar(r: f64, angle: f64) -> [Complex<f64>; 2] {
+        [
+            Complex::from_polar(r, angle),
+            Complex::from_polar(r, -angle),
+        ]
+    }
+
+    #[test]
+    fn a_complex_pair_through_the_circle_is_a_neimark_sacker_crossing_and_a_real_one_is_not() {
+        let inside = [polar(0.99, 2.0).as_slice(), &[Complex::new(0.3, 0.0)]].concat();
+        let outside = [polar(1.01, 2.0).as_slice(), &[Complex::new(0.3, 0.0)]].concat();
+        assert_eq!(complex_outside(&inside), 0);
+        assert_eq!(complex_outside(&outside), 2);
+        let t = |m: &[Complex<f64>]| neimark_sacker_test(m).unwrap();
+        assert!(t(&inside) < 0.0 && t(&outside) > 0.0);
+        // The fold and period-doubling functions keep their signs through it.
+        assert_eq!(fold_test(&inside).signum(), fold_test(&outside).signum());
+        assert_eq!(
+            period_doubling_test(&inside).signum(),
+            period_doubling_test(&outside).signum()
+        );
+        // A real multiplier through −1 is a period doubling, not a Neimark–Sacker crossing.
+        let before = [Complex::new(-0.99, 0.0), Complex::new(0.5, 0.0)];
+        let after = [Complex::new(-1.01, 0.0), Complex::new(0.5, 0.0)];
+        assert_ne!(
+            period_doubling_test(&before).signum(),
+            period_doubling_test(&after).signum()
+        );
+        assert_eq!(complex_outside(&before), complex_outside(&after));
+        assert!(neimark_sacker_test(&after).is_none());
+        // Through +1: the fold function changes sign.
+        let before = [Complex::new(0.99, 0.0)];
+        let after = [Complex::new(1.01, 0.0)];
+        assert_ne!(fold_test(&before).signum(), fold_test(&after).signum());
+    }
+}

@@ -1,0 +1,284 @@
+//! Following one branch across a parameter range: predictor–corrector steps with step
+//! control, bifurcations located between steps, the points at the grid values hit exactly,
+//! and the branch's end.
+
+use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
+use super::bifurcation::{self, Bifurcation, BifurcationKind};
+use super::branch_end::{self, BranchEnd, BranchEndKind};
+use super::family::EvalError;
+
+/// The parameter range of a sweep and its grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// The grid values, `from` to `to`.
+    pub values: Vec<f64>,
+}
+
+impl Grid {
+    /// `points` values from `from` to `to`, evenly spaced.
+    pub fn new(from: f64, to: f64, points: usize) -> Self {
+        let n = points.max(2);
+        let values = (0..n)
+            .map(|i| {
+                if i + 1 == n {
+                    to
+                } else {
+                    from + (to - from) * i as f64 / (n - 1) as f64
+                }
+            })
+            .collect();
+        Self { from, to, values }
+    }
+
+    /// The grid spacing.
+    pub fn spacing(&self) -> f64 {
+        (self.to - self.from).abs() / (self.values.len() - 1) as f64
+    }
+
+    fn contains(&self, p: f64) -> bool {
+        let slack = 1e-12 * (1.0 + self.from.abs().max(self.to.abs()));
+        p >= self.from.min(self.to) - slack && p <= self.from.max(self.to) + slack
+    }
+
+    /// Fraction of the way from `from` to `to` at `p`, in [0, 1].
+    pub fn fraction(&self, p: f64) -> f64 {
+        if self.to == self.from {
+            return 1.0;
+        }
+        ((p - self.from) / (self.to - self.from)).clamp(0.0, 1.0)
+    }
+}
+
+/// A point of a branch at a grid value.
+#[derive(Clone, Debug)]
+pub struct GridPoint {
+    /// The grid value.
+    pub value: f64,
+    /// The branch's point there.
+    pub point: BranchPoint,
+}
+
+/// One branch, followed.
+#[derive(Clone, Debug)]
+pub struct Branch {
+    /// Its id (0: the period-1 branch the sweep starts on; then in order of creation).
+    pub id: usize,
+    /// Strides per cycle.
+    pub period_strides: usize,
+    /// The branch and bifurcation it was switched from (`None` for the first).
+    pub parent: Option<(usize, f64)>,
+    /// Its points at the grid values, in arclength order (past a fold a value can appear
+    /// twice).
+    pub grid: Vec<GridPoint>,
+    /// Bifurcations, in arclength order.
+    pub bifurcations: Vec<Bifurcation>,
+    /// Bifurcations detected but not located (a corrector failed during location).
+    pub unlocated: Vec<(BifurcationKind, f64, String)>,
+    /// Grid values the branch crossed where the corrector at that value failed, with why.
+    pub missed: Vec<(f64, String)>,
+    /// Where and why it ends on the `from` side, when it started after `from` (no gait at the
+    /// first grid values) and was followed backward from its start too.
+    pub end_before: Option<BranchEnd>,
+    /// Where and why it ended (`None`: it left the range).
+    pub end: Option<BranchEnd>,
+    /// Continuation points computed (steps accepted).
+    pub steps: usize,
+}
+
+impl Branch {
+    /// The last parameter value the branch reached before leaving the range or ending.
+    pub fn reached(&self) -> Option<f64> {
+        self.end.as_ref().map(|e| e.value)
+    }
+}
+
+fn between(a: f64, b: f64, g: f64) -> bool {
+    // (a, b] in either direction.
+    (a < g && g <= b) || (b <= g && g < a)
+}
+
+/// Joins `back` (the same branch followed backward from its start) in front of `forward`:
+/// its grid points and bifurcations in reverse (stability before and after swapped), its end
+/// as `end_before`.
+pub fn prepend(forward: &mut Branch, back: Branch) {
+    let mut grid: Vec<GridPoint> = back.grid.into_iter().skip(1).rev().collect();
+    grid.append(&mut forward.grid);
+    forward.grid = grid;
+    let mut bifurcations: Vec<Bifurcation> = back
+        .bifurcations
+        .into_iter()
+        .rev()
+        .map(|mut b| {
+            std::mem::swap(&mut b.stable_before, &mut b.stable_after);
+            b
+        })
+        .collect();
+    bifurcations.append(&mut forward.bifurcations);
+    forward.bifurcations = bifurcations;
+    forward.unlocated.extend(back.unlocated);
+    forward.missed.extend(back.missed);
+    forward.steps += back.steps;
+    forward.end_before = back.end;
+}
+
+/// Whether the step `h` from `a` to `b` is taken: the corrector moved the point by at most
+/// `h` from the prediction and the tangent turned by less than 60° (more says the step
+/// skipped over structure, or jumped to another branch), and a period-`k` cycle (`k > 1`) has
+/// not collapsed onto the period-`k/2` one (its two halves at least 1e-7 apart).
+fn acceptable(a: &BranchPoint, b: &BranchPoint, h: f64) -> bool {
+    let predicted = a.x() + &a.tangent * h;
+    if (b.x() - predicted).norm() > h || a.tangent.dot(&b.tangent) < 0.5 {
+        return false;
+    }
+    let k = b.period_strides();
+    k == 1 || (&b.orbit[k / 2] - &b.orbit[0]).amax() > 1e-7
+}
+
+/// Follows the branch from `start` across `grid` with at most `budget` steps, calling
+/// `progress` with the fraction of the range covered.
+pub fn follow(
+    cont: &Continuer,
+    id: usize,
+    parent: Option<(usize, f64)>,
+    start: (BranchPoint, Linearisation),
+    grid: &Grid,
+    budget: usize,
+    progress: &dyn Fn(f64),
+) -> Branch {
+    let mut branch = Branch {
+        id,
+        period_strides: cont.period,
+        parent,
+        grid: Vec::new(),
+        bifurcations: Vec::new(),
+        unlocated: Vec::new(),
+        missed: Vec::new(),
+        end_before: None,
+        end: None,
+        steps: 0,
+    };
+    let slack = 1e-12 * (1.0 + grid.from.abs().max(grid.to.abs()));
+    if let Some(&g) = grid
+        .values
+        .iter()
+        .find(|&&g| (g - start.0.value).abs() <= slack)
+    {
+        branch.grid.push(GridPoint {
+            value: g,
+            point: start.0.clone(),
+        });
+    }
+    let mut cur = start;
+    let mut h = cont.steps.initial;
+    let mut furthest = grid.fraction(cur.0.value);
+    let mut steps = 0;
+    while steps < budget {
+        h = cont.steps.capped(h, &cur.0.tangent);
+        let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
+        match trial {
+            Ok((p, _)) if h > cont.steps.min && !acceptable(&cur.0, &p, h) => {
+                h = (h * 0.5).max(cont.steps.min);
+            }
+            Ok((p, l)) if p.signature == cur.0.signature => {
+                steps += 1;
+                for kind in bifurcation::crossings(&cur.0, &p) {
+                    match bifurcation::locate(cont, kind, (&cur.0, &cur.1), &p) {
+                        Ok(b) => branch.bifurcations.push(b),
+                        Err(e) => branch.unlocated.push((kind, p.value, e.to_string())),
+                    }
+                }
+                let mut crossed: Vec<f64> = grid
+                    .values
+                    .iter()
+                    .copied()
+                    .filter(|&g| between(cur.0.value, p.value, g))
+                    .collect();
+                if p.value < cur.0.value {
+                    crossed.reverse();
+                }
+                for g in crossed {
+                    match cont.at_value(&cur.0, &p, &l, g) {
+                        Ok((gp, _)) => branch.grid.push(GridPoint {
+                            value: g,
+                            point: gp,
+                        }),
+                        Err(e) => branch.missed.push((g, e.to_string())),
+                    }
+                }
+                furthest = furthest.max(grid.fraction(p.value));
+                progress(furthest);
+                if !grid.contains(p.value) {
+                    let towards_to = (p.value - grid.from) * (grid.to - grid.from) > 0.0;
+                    if !towards_to {
+                        let fold = branch
+                            .bifurcations
+                            .iter()
+                            .rev()
+                            .find(|b| b.kind == BifurcationKind::Fold);
+                        let (value, detail) = match fold {
+                            Some(f) => (
+                                f.value,
+                                format!(
+                                    "the branch turns back at a fold at {} and returns to {}",
+                                    f.value, grid.from
+                                ),
+                            ),
+                            None => (p.value, format!("the branch returns to {}", grid.from)),
+                        };
+                        branch.end = Some(BranchEnd {
+                            kind: BranchEndKind::Fold,
+                            value,
+                            event: None,
+                            detail,
+                            bracket: 0.0,
+                        });
+                    }
+                    break;
+                }
+                h = cont.steps.adapt(h, p.iterations);
+                cur = (p, l);
+            }
+            other => {
+                let stride_failed =
+                    matches!(other, Err(CorrectorError::Eval(EvalError::Stride(_))));
+                let changed = branch_end::is_event_change(&cur.0, &other);
+                if (stride_failed || !changed) && h > cont.steps.min {
+                    h = (h * 0.5).max(cont.steps.min);
+                    continue;
+                }
+                steps += 1;
+                branch.end = Some(if changed {
+                    branch_end::locate(cont, (&cur.0, &cur.1), h, other)
+                } else {
+                    BranchEnd {
+                        kind: BranchEndKind::NotConverged,
+                        value: cur.0.value,
+                        event: None,
+                        detail: match other {
+                            Err(e) => format!("no point beyond: {e}"),
+                            Ok(_) => "no point beyond".into(),
+                        },
+                        bracket: h,
+                    }
+                });
+                break;
+            }
+        }
+    }
+    if steps >= budget && branch.end.is_none() {
+        branch.end = Some(BranchEnd {
+            kind: BranchEndKind::Budget,
+            value: cur.0.value,
+            event: None,
+            detail: format!("the point budget of {budget} steps ran out"),
+            bracket: 0.0,
+        });
+    }
+    branch.steps = steps;
+    progress(1.0);
+    branch
+}

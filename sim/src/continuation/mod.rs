@@ -1,0 +1,300 @@
+//! Following gaits while a scene parameter moves: branches of stride-map fixed points, their
+//! bifurcations, their ends, and the period-doubled branches born on them
+//! (docs/bifurcations.md).
+//!
+//! By concept:
+//! - `natural`: the natural-parameter sweep [`sweep`] (one Newton solve per grid value, secant
+//!   predictor), kept for callers that fill grids row by row;
+//! - `family`: [`Family`], the stride maps `Sᵏ(v; p)` of a scene in one parameter: the walker
+//!   rebuilt at `p`, orbits, monodromy matrices, `∂Sᵏ/∂p`, event sequences;
+//! - `arclength`: pseudo-arclength predictor and corrector, [`BranchPoint`], [`StepControl`];
+//! - `bifurcation`: test functions, [`Bifurcation`] and its location;
+//! - `branch_end`: [`BranchEnd`], non-smooth ends located by bisection;
+//! - `branch`: [`Branch`], following one branch across a [`Grid`];
+//! - `period2`: switching to the period-doubled branch at a period doubling.
+//!
+//! [`continuation`] puts them together: the branch through the gait at `from`, followed to
+//! `to`, and the period-2, 4, … branches born on it.
+
+mod arclength;
+mod bifurcation;
+mod branch;
+mod branch_end;
+mod family;
+mod natural;
+mod period2;
+
+pub use arclength::{
+    BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
+};
+pub use bifurcation::{
+    complex_outside, fold_test, neimark_sacker_test, period_doubling_test, Bifurcation,
+    BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
+};
+pub use branch::{Branch, Grid, GridPoint};
+pub use branch_end::{BranchEnd, BranchEndKind};
+pub use family::{EvalError, EventSignature, Family, Orbit};
+pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
+pub use period2::{flip_vector, SwitchError};
+
+use crate::limit_cycle::{GaitSearch, NewtonSettings};
+use crate::scene::Scene;
+use nalgebra::DVector;
+use std::collections::VecDeque;
+
+/// Settings of a continuation beyond the Newton ones.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContinuationSettings {
+    /// Largest period followed (1, 2, 4, …): branches of period up to this are followed,
+    /// and the period doublings on them located.
+    pub max_period: usize,
+    /// Steps allowed per branch.
+    pub steps_per_branch: usize,
+    /// Branches allowed in all.
+    pub max_branches: usize,
+    /// Largest arclength step in grid spacings (the parameter moves at most one spacing per
+    /// step in any case; the state may move more).
+    pub max_arclength_steps: f64,
+    /// Smallest step as a fraction of the grid spacing.
+    pub min_step_fraction: f64,
+    /// Corrector iteration budget.
+    pub corrector_iterations: usize,
+    /// Stride settings for every parameter value instead of the scene's (`None`: the
+    /// scene's own at each value).
+    pub stride_settings: Option<crate::stride::StrideSettings>,
+    /// Grid values tried (from `from` on) for a first gait from the scene's guess.
+    pub start_attempts: usize,
+}
+
+impl Default for ContinuationSettings {
+    fn default() -> Self {
+        Self {
+            max_period: 8,
+            steps_per_branch: 400,
+            max_branches: 8,
+            max_arclength_steps: 10.0,
+            min_step_fraction: 1e-4,
+            corrector_iterations: 12,
+            stride_settings: None,
+            start_attempts: 32,
+        }
+    }
+}
+
+/// The branches of a continuation over a grid.
+#[derive(Clone, Debug)]
+pub struct Continuation {
+    /// The grid.
+    pub grid: Grid,
+    /// The branches: `[0]` through the first gait found, then the period-doubled ones.
+    pub branches: Vec<Branch>,
+    /// The grid values where no gait was found to start from, with the reason, before the
+    /// first start (`branches[0]` starts at the next value).
+    pub no_start: Vec<(f64, String)>,
+    /// Period doublings whose doubled branch could not be started: value and why.
+    pub switch_failures: Vec<(f64, String)>,
+}
+
+impl Continuation {
+    /// The grid values branch 0 did not reach, with the reason (`param`: the parameter's
+    /// name, for the text).
+    pub fn unreached(&self, param: &str) -> Vec<(f64, String)> {
+        let Some(b) = self.branches.first() else {
+            let tried = self.no_start.len();
+            return self
+                .grid
+                .values
+                .iter()
+                .enumerate()
+                .map(|(i, v)| match self.no_start.get(i) {
+                    Some((_, e)) => (*v, format!("no gait to start from: {e}")),
+                    None => (
+                        *v,
+                        format!("no gait found to start from at the first {tried} values"),
+                    ),
+                })
+                .collect();
+        };
+        let describe = |e: &Option<BranchEnd>| match e {
+            Some(e) => format!(
+                "the branch ends at {param} = {}: {} ({})",
+                e.value,
+                e.kind.name(),
+                e.detail
+            ),
+            None => "not reached by the branch".into(),
+        };
+        let mut out: Vec<(f64, String)> = b
+            .missed
+            .iter()
+            .map(|(g, why)| (*g, format!("the corrector at this value failed: {why}")))
+            .collect();
+        for &g in &self.grid.values {
+            let hit = b.grid.iter().any(|p| p.value == g) || b.missed.iter().any(|m| m.0 == g);
+            if hit {
+                continue;
+            }
+            let reason = match self.no_start.iter().find(|(v, _)| *v == g) {
+                Some((_, e)) => match &b.end_before {
+                    Some(_) => format!("{}; no gait to start from: {e}", describe(&b.end_before)),
+                    None => format!("no gait to start from: {e}"),
+                },
+                None => describe(&b.end),
+            };
+            out.push((g, reason));
+        }
+        out
+    }
+}
+
+/// Pseudo-arclength continuation of `scene`'s gait in `param` from `from` to `to`: the gait
+/// at `from` (from the scene's guess; if none, the next grid value's), followed with the
+/// grid spacing `|to − from|/(points − 1)` as the largest step; its points at the grid values,
+/// bifurcations and end; then the period-doubled branches. `progress` is called with the
+/// fraction done.
+///
+/// # Errors
+/// [`SweepError`]: a bad parameter name or value, fewer than two points.
+pub fn continuation(
+    scene: &Scene,
+    param: &str,
+    (from, to, points): (f64, f64, usize),
+    newton: &NewtonSettings,
+    settings: &ContinuationSettings,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<Continuation, SweepError> {
+    if points < 2 {
+        return Err(SweepError::TooFewPoints(points));
+    }
+    let mut family = Family::new(scene, param, newton)?;
+    family.stride_settings = settings.stride_settings.clone();
+    family.scene_at(from)?;
+    family.scene_at(to)?;
+    let grid = Grid::new(from, to, points);
+    let spacing = grid.spacing().max(1e-12);
+    let steps = StepControl {
+        initial: 0.5 * spacing,
+        max: settings.max_arclength_steps * spacing,
+        max_dp: spacing,
+        min: spacing * settings.min_step_fraction,
+        max_iterations: settings.corrector_iterations,
+    };
+    let mut out = Continuation {
+        grid: grid.clone(),
+        branches: Vec::new(),
+        no_start: Vec::new(),
+        switch_failures: Vec::new(),
+    };
+    let cont = Continuer {
+        family: &family,
+        period: 1,
+        steps,
+    };
+    // The first gait, at the first grid value that has one (of at most `start_attempts`).
+    let mut start = None;
+    for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
+        let setup = family.setup_at(g)?;
+        match GaitSearch::new(&setup.walker, &setup.settings, newton).find_from_guess(&setup.guess)
+        {
+            Ok(gait) => {
+                let n = gait.fixed_point.len();
+                let x = DVector::from_fn(n + 1, |i, _| if i < n { gait.fixed_point[i] } else { g });
+                let mut c = DVector::zeros(n + 1);
+                c[n] = 1.0;
+                let along = &c * (to - from).signum();
+                let constraint = arclength::Constraint { c, b: g };
+                match cont.correct(&x, &constraint, None, &along, true) {
+                    Ok(s) => {
+                        start = Some(s);
+                        break;
+                    }
+                    Err(e) => out
+                        .no_start
+                        .push((g, format!("the corrector at the gait failed: {e}"))),
+                }
+            }
+            Err(e) => out.no_start.push((g, e.to_string())),
+        }
+    }
+    let Some(start) = start else {
+        return Ok(out);
+    };
+    let share = 1.0 / (1.0 + settings.max_period.max(1).ilog2() as f64);
+    // A start after `from`: the branch is also followed backward from it, toward `from`.
+    let i0 = out.no_start.len();
+    let back = (i0 > 0).then(|| {
+        let back_grid = Grid {
+            from: grid.values[i0],
+            to: grid.from,
+            values: grid.values[..=i0].iter().rev().copied().collect(),
+        };
+        let mut reversed = start.clone();
+        reversed.0.tangent = -&reversed.0.tangent;
+        branch::follow(
+            &cont,
+            0,
+            None,
+            reversed,
+            &back_grid,
+            settings.steps_per_branch,
+            &|_| {},
+        )
+    });
+    let mut main = branch::follow(
+        &cont,
+        0,
+        None,
+        start,
+        &grid,
+        settings.steps_per_branch,
+        &|f| progress(f * share),
+    );
+    if let Some(back) = back {
+        branch::prepend(&mut main, back);
+    }
+    // Period doublings to switch at: (parent id, the bifurcation, parent period).
+    let mut queue: VecDeque<(usize, Bifurcation, usize)> = VecDeque::new();
+    let enqueue = |b: &Branch, queue: &mut VecDeque<(usize, Bifurcation, usize)>| {
+        for bif in &b.bifurcations {
+            if bif.kind == BifurcationKind::PeriodDoubling
+                && 2 * b.period_strides <= settings.max_period
+            {
+                queue.push_back((b.id, bif.clone(), b.period_strides));
+            }
+        }
+    };
+    enqueue(&main, &mut queue);
+    out.branches.push(main);
+    while let Some((parent, pd, k)) = queue.pop_front() {
+        if out.branches.len() >= settings.max_branches {
+            out.switch_failures
+                .push((pd.value, "branch budget reached".into()));
+            continue;
+        }
+        let doubled = Continuer {
+            family: &family,
+            period: 2 * k,
+            steps,
+        };
+        match period2::switch(&doubled, &pd, steps.initial) {
+            Ok(first) => {
+                let id = out.branches.len();
+                let done = share * (1.0 + (2 * k).ilog2() as f64 - 1.0);
+                let b = branch::follow(
+                    &doubled,
+                    id,
+                    Some((parent, pd.value)),
+                    first,
+                    &grid,
+                    settings.steps_per_branch,
+                    &|f| progress((done + f * share).min(1.0)),
+                );
+                enqueue(&b, &mut queue);
+                out.branches.push(b);
+            }
+            Err(e) => out.switch_failures.push((pd.value, e.to_string())),
+        }
+    }
+    progress(1.0);
+    Ok(out)
+}

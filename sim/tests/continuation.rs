@@ -1,0 +1,384 @@
+//! Pseudo-arclength continuation (`sim::continuation`), checked against the hand-written Garcia
+//! model of the simplest walker (tests/garcia, no code shared with the engine) and against
+//! the engine's own Newton solves at single parameter values.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod garcia;
+
+use garcia::State;
+use nalgebra::DVector;
+use sim::continuation::{
+    continuation, BifurcationKind, BranchEndKind, BranchPoint, Continuation, ContinuationSettings,
+    LOCATION_TOLERANCE,
+};
+use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::scene::Scene;
+
+const GUESS_LONG: State = State {
+    theta: 0.2,
+    theta_dot: -0.2,
+};
+
+fn run(scene: &str, param: &str, range: (f64, f64, usize), max_period: usize) -> Continuation {
+    let scene = Scene::load(scene).unwrap();
+    let settings = ContinuationSettings {
+        max_period,
+        ..ContinuationSettings::default()
+    };
+    continuation(
+        &scene,
+        param,
+        range,
+        &NewtonSettings::default(),
+        &settings,
+        &|_| {},
+    )
+    .unwrap()
+}
+
+/// The simplest walker's state `v` in Garcia's variables (θ = stance_leg, θ̇ = stance_leg_dot).
+fn garcia_state(v: &DVector<f64>) -> State {
+    let w = Scene::load("simplest").unwrap().build().unwrap();
+    let names = w.map_names();
+    let at = |n: &str| v[names.iter().position(|m| m == n).unwrap()];
+    // After heel strike the swing leg is at −2θ: the engine's state is on Garcia's section.
+    assert!((at("swing_leg") + 2.0 * at("stance_leg")).abs() < 1e-9);
+    State {
+        theta: at("stance_leg"),
+        theta_dot: at("stance_leg_dot"),
+    }
+}
+
+fn close(a: State, b: State) -> f64 {
+    (a.theta - b.theta)
+        .abs()
+        .max((a.theta_dot - b.theta_dot).abs())
+}
+
+#[test]
+fn the_simplest_walkers_period_doubling_matches_the_hand_written_model_to_1e_8() {
+    let c = run("simplest", "slope", (0.009, 0.017, 5), 1);
+    let main = &c.branches[0];
+    let pd: Vec<_> = main
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::PeriodDoubling)
+        .collect();
+    assert_eq!(pd.len(), 1, "{:?}", main.bifurcations);
+    let reference = garcia::period_doubling_slope(0.009, 0.017, GUESS_LONG).unwrap();
+    let ours = pd[0].value;
+    println!(
+        "period doubling: ours {ours:.12}, reference {reference:.12}, difference {:e}",
+        ours - reference
+    );
+    assert!(
+        (ours - reference).abs() < 1e-8,
+        "ours {ours}, reference {reference}, difference {:e}",
+        ours - reference
+    );
+    assert!(pd[0].bracket < LOCATION_TOLERANCE);
+    // A multiplier −1 there, and the gait stable before and unstable after.
+    let m = &pd[0].multipliers;
+    let nearest = m.iter().map(|z| (z + 1.0).norm()).fold(f64::MAX, f64::min);
+    assert!(nearest < 1e-7, "{m:?}");
+    assert!(pd[0].stable_before && !pd[0].stable_after);
+    // The located point is the hand-written model's gait at that slope.
+    let g = garcia::continued(0.009, ours, GUESS_LONG, 60).unwrap();
+    assert!(close(garcia_state(&pd[0].point.orbit[0]), g.state) < 1e-8);
+}
+
+#[test]
+fn the_period_two_branch_beyond_the_doubling_matches_the_hand_written_model() {
+    let c = run("simplest", "slope", (0.009, 0.017, 9), 2);
+    assert_eq!(c.branches.len(), 2, "{:?}", c.switch_failures);
+    let two = &c.branches[1];
+    assert_eq!(two.period_strides, 2);
+    let values: Vec<f64> = two.grid.iter().map(|g| g.value).collect();
+    assert!(
+        values.contains(&0.016) && values.contains(&0.017),
+        "{values:?}"
+    );
+    for gp in &two.grid {
+        let gamma = gp.value;
+        let p1 = garcia::continued(0.009, gamma, GUESS_LONG, 80).unwrap();
+        let cycle = garcia::period2_near(gamma, &p1).unwrap();
+        let ours = [
+            garcia_state(&gp.point.orbit[0]),
+            garcia_state(&gp.point.orbit[1]),
+        ];
+        // The same cycle, whichever state each starts from.
+        let d = close(ours[0], cycle[0])
+            .max(close(ours[1], cycle[1]))
+            .min(close(ours[0], cycle[1]).max(close(ours[1], cycle[0])));
+        assert!(
+            d < 1e-7,
+            "slope {gamma}: ours {ours:?}, reference {cycle:?}"
+        );
+        // Its multipliers (the engine's two nonzero ones) match the reference's.
+        let reference = garcia::period2_eigenvalues(gamma, cycle[0]).unwrap();
+        let mut ours_m: Vec<f64> = gp
+            .point
+            .multipliers
+            .iter()
+            .filter(|z| z.norm() > 1e-6)
+            .map(|z| z.re)
+            .collect();
+        let mut theirs: Vec<f64> = reference.iter().map(|z| z.0).collect();
+        ours_m.sort_by(f64::total_cmp);
+        theirs.sort_by(f64::total_cmp);
+        assert_eq!(ours_m.len(), 2, "{:?}", gp.point.multipliers);
+        for (a, b) in ours_m.iter().zip(&theirs) {
+            assert!(
+                (a - b).abs() < 1e-5,
+                "slope {gamma}: {ours_m:?} vs {theirs:?}"
+            );
+        }
+        // A genuine period-2 cycle: the two states differ.
+        assert!(close(ours[0], ours[1]) > 1e-4);
+    }
+}
+
+#[test]
+fn a_coarse_sweep_stays_on_the_long_period_branch() {
+    // Two grid steps of 0.0035 from 0.009 to 0.016: each point must be the long-period gait
+    // the hand-written model continues in fine steps, not the short-period one.
+    let c = run("simplest", "slope", (0.009, 0.016, 3), 1);
+    let main = &c.branches[0];
+    assert_eq!(main.grid.len(), 3);
+    for gp in &main.grid {
+        let reference = garcia::continued(0.009, gp.value, GUESS_LONG, 100).unwrap();
+        let d = close(garcia_state(&gp.point.orbit[0]), reference.state);
+        assert!(
+            d < 1e-8,
+            "slope {}: off the long-period branch by {d}",
+            gp.value
+        );
+    }
+}
+
+fn fold_test(p: &BranchPoint) -> f64 {
+    sim::continuation::fold_test(&p.multipliers)
+}
+
+#[test]
+fn the_wisse2d_branch_turns_at_a_fold_and_the_gait_does_not_exist_beyond_it() {
+    let c = run("wisse2d", "ankle_engage_rad", (-0.055, -0.06, 3), 1);
+    let main = &c.branches[0];
+    let folds: Vec<_> = main
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::Fold)
+        .collect();
+    assert_eq!(folds.len(), 1, "{:?}", main.bifurcations);
+    let fold = folds[0];
+    assert!(fold.value < -0.055 && fold.value > -0.06, "{}", fold.value);
+    // A multiplier +1 at the fold, where the branch's tangent has no parameter component.
+    let t = &fold.point.tangent;
+    assert!(t[t.len() - 1].abs() < 1e-4, "dp/ds = {}", t[t.len() - 1]);
+    assert!(fold_test(&fold.point).abs() < 1e-6);
+    let end = main.end.as_ref().unwrap();
+    assert_eq!(end.kind, BranchEndKind::Fold);
+    // The branch came back to the start value: two gaits there, one stable, one not.
+    let at_start: Vec<_> = main.grid.iter().filter(|g| g.value == -0.055).collect();
+    assert_eq!(at_start.len(), 2);
+    assert!(at_start[0].point.stable() && !at_start[1].point.stable());
+    // Independently, Newton at single values: just before the fold it converges from the
+    // fold's state; just beyond it, it does not.
+    let scene = Scene::load("wisse2d").unwrap();
+    let newton = NewtonSettings::default();
+    let solve = |p: f64| {
+        let mut s = scene.clone();
+        s.set("ankle_engage_rad", p).unwrap();
+        let setup = s.setup().unwrap();
+        GaitSearch::new(&setup.walker, &setup.settings, &newton).find(&fold.point.orbit[0])
+    };
+    assert!(solve(fold.value + 1e-4).is_ok());
+    assert!(solve(fold.value - 1e-4).is_err());
+}
+
+#[test]
+fn the_parallel_stride_jacobian_is_bit_identical_to_the_sequential_columns() {
+    let scene = Scene::load("simplest").unwrap();
+    let setup = scene.setup().unwrap();
+    let newton = NewtonSettings::default();
+    let search = GaitSearch::new(&setup.walker, &setup.settings, &newton);
+    let g = setup.find_gait(&newton).unwrap();
+    let v = &g.fixed_point;
+    let s = search.stride_map(v).unwrap().0;
+    let j = search.stride_jacobian(v, &s).unwrap();
+    let d = newton.perturbation;
+    for k in 0..v.len() {
+        let (mut vp, mut vm) = (v.clone(), v.clone());
+        vp[k] += d;
+        vm[k] -= d;
+        let col =
+            (search.stride_map(&vp).unwrap().0 - search.stride_map(&vm).unwrap().0) / (2.0 * d);
+        for i in 0..v.len() {
+            assert_eq!(j[(i, k)].to_bits(), col[i].to_bits(), "({i}, {k})");
+        }
+    }
+}
+
+#[test]
+fn the_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
+    let c = run("wisse2d", "slope_rad", (0.0, 0.05, 6), 1);
+    let main = &c.branches[0];
+    let end = main.end.as_ref().expect("the branch ends");
+    assert_eq!(end.kind, BranchEndKind::EventChange, "{end:?}");
+    assert_eq!(
+        end.event.as_deref(),
+        Some("knee_lock:swing_knee"),
+        "{end:?}"
+    );
+    assert!(end.value > 0.04 && end.value < 0.05, "{}", end.value);
+    assert!(end.bracket < 1e-8, "{end:?}");
+    // Independently, Newton at single values from the branch's last grid point: 1e-7 before
+    // the end the gait keeps the old order (string, then knee); 1e-7 beyond it there is no
+    // gait with that order.
+    let last = &main.grid.last().unwrap().point;
+    let scene = Scene::load("wisse2d").unwrap();
+    let newton = NewtonSettings::default();
+    let events_at = |p: f64| {
+        let mut s = scene.clone();
+        s.set("slope_rad", p).unwrap();
+        let setup = s.setup().unwrap();
+        GaitSearch::new(&setup.walker, &setup.settings, &newton)
+            .find(&last.orbit[0])
+            .map(|g| {
+                g.stride
+                    .events
+                    .iter()
+                    .map(|e| e.name.clone())
+                    .collect::<Vec<_>>()
+            })
+    };
+    let before = events_at(end.value - 1e-7).unwrap();
+    assert_eq!(
+        before,
+        ["string_engaged", "knee_lock:swing_knee", "heel_strike"]
+    );
+    let beyond = events_at(end.value + 1e-7);
+    assert!(beyond.as_ref() != Ok(&before), "{beyond:?}");
+}
+
+/// The stride Jacobian's error at located points (docs/bifurcations.md, "The stride map and its
+/// Jacobian"): the simplest walker's has no variational Jacobian (infinitesimal feet) and is
+/// compared with central differences on frozen step sizes; the wisse2d one with the
+/// variational Jacobian. The located values must not move by more than 1e-9 between methods.
+#[test]
+fn the_stride_jacobian_error_at_the_located_points_is_small() {
+    use sim::limit_cycle::JacobianMethod;
+    let cases = [
+        (
+            "simplest",
+            "slope",
+            (0.009, 0.017, 5),
+            BifurcationKind::PeriodDoubling,
+            true,
+        ),
+        (
+            "wisse2d",
+            "ankle_engage_rad",
+            (-0.055, -0.06, 3),
+            BifurcationKind::Fold,
+            false,
+        ),
+    ];
+    for (name, param, range, kind, frozen) in cases {
+        let scene = Scene::load(name).unwrap();
+        let settings = ContinuationSettings {
+            max_period: 1,
+            ..ContinuationSettings::default()
+        };
+        let reference_newton = NewtonSettings {
+            frozen_steps: frozen,
+            jacobian: if frozen {
+                JacobianMethod::CentralDifferences
+            } else {
+                JacobianMethod::Variational
+            },
+            ..NewtonSettings::default()
+        };
+        let located = |newton: &NewtonSettings| {
+            let c = continuation(&scene, param, range, newton, &settings, &|_| {}).unwrap();
+            c.branches[0]
+                .bifurcations
+                .iter()
+                .find(|b| b.kind == kind)
+                .cloned()
+                .unwrap()
+        };
+        let ours = located(&NewtonSettings::default());
+        let reference = located(&reference_newton);
+        println!(
+            "{name}: {kind:?} at {:.12} (central, h = 1e-6) and {:.12} (reference)",
+            ours.value, reference.value
+        );
+        assert!((ours.value - reference.value).abs() < 1e-9);
+        let mut s = scene.clone();
+        s.set(param, ours.value).unwrap();
+        let setup = s.setup().unwrap();
+        let v = &ours.point.orbit[0];
+        let jacobian = |newton: &NewtonSettings| {
+            let search = GaitSearch::new(&setup.walker, &setup.settings, newton);
+            let sv = search.stride_map(v).unwrap().0;
+            search.stride_jacobian_by(v, &sv).unwrap()
+        };
+        let (j, _) = jacobian(&NewtonSettings::default());
+        let (r, method) = jacobian(&reference_newton);
+        assert_eq!(method, reference_newton.jacobian);
+        let error = (&j - &r).amax();
+        println!("{name}: max |J − J_reference| = {error:e}");
+        assert!(error < 1e-7, "{error}");
+    }
+}
+
+#[test]
+fn the_kneed_walkers_smallest_slope_is_a_fold_found_from_either_side() {
+    // No gait from the scene's guess at slopes 0.01–0.03: the branch starts at 0.04 and is
+    // followed both ways; downhill it turns at a fold (the smallest slope it walks on).
+    let c = run("kneed2d", "slope_rad", (0.01, 0.08, 8), 1);
+    assert_eq!(c.no_start.len(), 3, "{:?}", c.no_start);
+    let main = &c.branches[0];
+    let end = main.end_before.as_ref().expect("an end below the start");
+    assert_eq!(end.kind, BranchEndKind::Fold);
+    let fold = main
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::Fold)
+        .expect("the fold");
+    assert_eq!(fold.value, end.value);
+    assert!(fold.value > 0.03 && fold.value < 0.035, "{}", fold.value);
+    // The same fold, reached from 0.04 going down.
+    let down = run("kneed2d", "slope_rad", (0.04, 0.01, 7), 1);
+    let other = down.branches[0]
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::Fold)
+        .expect("the fold going down");
+    assert!(
+        (other.value - fold.value).abs() < 1e-9,
+        "{} vs {}",
+        other.value,
+        fold.value
+    );
+    // The grid values in arclength order: 0.04 on the unstable side, then the stable one up.
+    let values: Vec<f64> = main.grid.iter().map(|g| g.value).collect();
+    let expected = [0.04, 0.04, 0.05, 0.06, 0.07, 0.08];
+    assert_eq!(values.len(), expected.len(), "{values:?}");
+    for (v, e) in values.iter().zip(expected) {
+        assert!((v - e).abs() < 1e-15, "{values:?}");
+    }
+    assert!(!main.grid[0].point.stable() && main.grid[1].point.stable());
+    // Newton at single values from the fold's state: converges above it, not below.
+    let scene = Scene::load("kneed2d").unwrap();
+    let newton = NewtonSettings::default();
+    let solve = |p: f64| {
+        let mut s = scene.clone();
+        s.set("slope_rad", p).unwrap();
+        let setup = s.setup().unwrap();
+        GaitSearch::new(&setup.walker, &setup.settings, &newton).find(&fold.point.orbit[0])
+    };
+    assert!(solve(fold.value + 1e-5).is_ok());
+    assert!(solve(fold.value - 1e-5).is_err());
+}
