@@ -4,6 +4,7 @@
 
 pub mod accuracy;
 pub mod actuator;
+pub mod census;
 pub mod contact;
 pub mod continuation;
 pub mod control;
@@ -17,6 +18,7 @@ pub mod kinematics;
 pub mod limit_cycle;
 pub mod math;
 pub mod model;
+pub mod orbit_diagram;
 pub mod relabel;
 pub mod report;
 pub mod scene;

@@ -13,10 +13,11 @@ mod limits;
 mod options;
 mod output;
 mod plot;
+mod progress;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use commands::{accuracy, gait, scenes, sil, sweep, tune, walk};
+use commands::{accuracy, gait, gaits, orbit_diagram, scenes, sil, sweep, tune, walk};
 use input_error::InputError;
 use sim::scene::SceneError;
 use std::process::ExitCode;
@@ -39,11 +40,17 @@ struct Cli {
 enum Command {
     /// Find the periodic gait of a scene and its stability.
     Gait(gait::GaitArgs),
+    /// Census: every distinct period-1 gait found (Newton from the guess, continuation from
+    /// the defaults, multi-start), longest step period first.
+    Gaits(gaits::GaitsArgs),
     /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
     #[command(after_help = WALK_EXIT_CODES)]
     Walk(walk::WalkArgs),
     /// Continuation: follow the gait while one parameter changes.
     Sweep(sweep::SweepArgs),
+    /// Orbit diagram: the attractor (periodic, chaotic or a fall) at each value of one
+    /// parameter, from the previous value's attractor.
+    OrbitDiagram(orbit_diagram::OrbitDiagramArgs),
     /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
     Tune(tune::TuneArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
@@ -70,8 +77,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Scenes { json } => scenes::run(json),
         Command::Gait(args) => gait::run(args),
+        Command::Gaits(args) => gaits::run(args),
         Command::Walk(args) => walk::run(args),
         Command::Sweep(args) => sweep::run(args),
+        Command::OrbitDiagram(args) => orbit_diagram::run(args),
         Command::Tune(args) => tune::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),

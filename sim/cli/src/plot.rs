@@ -13,6 +13,8 @@ pub enum Style {
     Circle,
     /// Stars at the points.
     Star,
+    /// Small filled dots at the points (a scatter of many points, as in an orbit diagram).
+    Dot,
 }
 
 /// One data series.
@@ -226,6 +228,17 @@ impl Plot {
                         );
                     }
                 }
+                Style::Dot => {
+                    for &(x, y) in &pts {
+                        let _ = writeln!(
+                            o,
+                            r#"<circle cx="{:.1}" cy="{:.1}" r="1.3" fill="{}"/>"#,
+                            px(x),
+                            py(y),
+                            s.color
+                        );
+                    }
+                }
                 Style::Star => {
                     for &(x, y) in &pts {
                         let _ = writeln!(
@@ -278,6 +291,12 @@ impl Plot {
                 ),
                 Style::Circle => format!(
                     r#"<circle cx="{:.1}" cy="{:.1}" r="4.5" fill="none" stroke="{}" stroke-width="1.8"/>"#,
+                    lx + 17.0,
+                    y - 4.0,
+                    s.color
+                ),
+                Style::Dot => format!(
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#,
                     lx + 17.0,
                     y - 4.0,
                     s.color

@@ -3,6 +3,8 @@
 
 pub mod accuracy;
 pub mod gait;
+pub mod gaits;
+pub mod orbit_diagram;
 pub mod scenes;
 pub mod sil;
 pub mod sweep;
