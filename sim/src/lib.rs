@@ -24,6 +24,7 @@ pub mod report;
 pub mod scene;
 pub mod singular_limit;
 pub mod stability;
+pub mod stability_map;
 pub mod stride;
 pub mod tune;
 pub mod variational;

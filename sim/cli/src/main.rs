@@ -8,6 +8,7 @@
 
 mod commands;
 mod figures;
+mod heatmap;
 mod input_error;
 mod limits;
 mod options;
@@ -17,7 +18,9 @@ mod progress;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use commands::{accuracy, gait, gaits, orbit_diagram, scenes, sil, sweep, tune, walk};
+use commands::{
+    accuracy, gait, gaits, orbit_diagram, scenes, sil, stability_map, sweep, tune, walk,
+};
 use input_error::InputError;
 use sim::scene::SceneError;
 use std::process::ExitCode;
@@ -51,6 +54,9 @@ enum Command {
     /// Orbit diagram: the attractor (periodic, chaotic or a fall) at each value of one
     /// parameter, from the previous value's attractor.
     OrbitDiagram(orbit_diagram::OrbitDiagramArgs),
+    /// Stability map: max |λ| of the long-period gait over a grid of two parameters, filled
+    /// by continuation along rows.
+    StabilityMap(stability_map::StabilityMapArgs),
     /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
     Tune(tune::TuneArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
@@ -81,6 +87,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Walk(args) => walk::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::OrbitDiagram(args) => orbit_diagram::run(args),
+        Command::StabilityMap(args) => stability_map::run(args),
         Command::Tune(args) => tune::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),

@@ -52,7 +52,7 @@ pub const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 
-fn nice_step(span: f64, target: usize) -> f64 {
+pub(crate) fn nice_step(span: f64, target: usize) -> f64 {
     let raw = span / target as f64;
     let mag = 10f64.powf(raw.log10().floor());
     let f = raw / mag;
@@ -68,7 +68,7 @@ fn nice_step(span: f64, target: usize) -> f64 {
     nice * mag
 }
 
-fn fmt_tick(v: f64, step: f64) -> String {
+pub(crate) fn fmt_tick(v: f64, step: f64) -> String {
     let decimals = (-step.log10().floor()).max(0.0) as usize;
     let s = format!("{v:.decimals$}");
     if s == "-0" || s.chars().all(|c| c == '0' || c == '.' || c == '-') && s.starts_with('-') {
@@ -78,7 +78,7 @@ fn fmt_tick(v: f64, step: f64) -> String {
     }
 }
 
-fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")

@@ -7,6 +7,7 @@ pub mod gaits;
 pub mod orbit_diagram;
 pub mod scenes;
 pub mod sil;
+pub mod stability_map;
 pub mod sweep;
 pub mod tune;
 pub mod walk;
