@@ -59,6 +59,7 @@ pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
     } = args;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
+    let param = scene.parameter_name(&param).map_err(InputError::Scene)?;
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
