@@ -53,6 +53,20 @@ pub struct HomotopySettings {
     pub max_period_change: f64,
     /// Newton searches allowed along one path.
     pub max_solves: usize,
+    /// Newton iterations allowed in one step (at most the caller's own budget): from a good
+    /// predictor Newton converges in a few; more means the step is too long, and halving it
+    /// is cheaper than iterating on (a failing search of the 3D walker costs seconds).
+    pub max_corrector_iterations: usize,
+}
+
+impl HomotopySettings {
+    /// `newton` with its iteration budget cut to [`Self::max_corrector_iterations`].
+    pub fn corrector(&self, newton: &NewtonSettings) -> NewtonSettings {
+        NewtonSettings {
+            max_iterations: newton.max_iterations.min(self.max_corrector_iterations),
+            ..*newton
+        }
+    }
 }
 
 impl Default for HomotopySettings {
@@ -63,6 +77,7 @@ impl Default for HomotopySettings {
             max_correction: 0.1,
             max_period_change: 0.1,
             max_solves: 24,
+            max_corrector_iterations: 12,
         }
     }
 }
@@ -148,6 +163,7 @@ pub fn follow(
     newton: &NewtonSettings,
     settings: &HomotopySettings,
 ) -> (Result<Gait, NewtonError>, usize) {
+    let newton = &settings.corrector(newton);
     let v0 = &start.fixed_point;
     let mut period = start.stride.duration_s;
     let mut s = 0.0;

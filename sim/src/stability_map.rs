@@ -11,8 +11,10 @@
 //! cell has no gait when both fail.
 //!
 //! Rows are independent and run in parallel (rayon); the results do not depend on the
-//! number of threads. Budget per cell: one continuation search, and at most
-//! `2 + HomotopySettings::max_solves` searches when seeded.
+//! number of threads. Budget per cell: one continuation search of at most
+//! [`HomotopySettings::max_corrector_iterations`] Newton iterations, and when seeded two
+//! searches with the caller's Newton budget and at most [`HomotopySettings::max_solves`]
+//! corrector searches along the path from the defaults.
 
 use crate::census::{long_period_gait, HomotopySettings, SetupFor};
 use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
@@ -72,6 +74,7 @@ fn row(
     homotopy: &HomotopySettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<Result<MapCell, NewtonError>>, SceneError> {
+    let corrector = &homotopy.corrector(newton);
     let mut scene = scene.clone();
     let mut out = Vec::with_capacity(x.values.len());
     let mut history: Vec<(f64, DVector<f64>, f64)> = Vec::new();
@@ -84,7 +87,7 @@ fn row(
         }
         .map(|(predictor, period)| -> Result<Option<Gait>, SceneError> {
             let setup = setup_for(&scene)?;
-            let g = GaitSearch::new(&setup.walker, &setup.settings, newton).find(&predictor);
+            let g = GaitSearch::new(&setup.walker, &setup.settings, corrector).find(&predictor);
             Ok(g.ok().filter(|g| {
                 (g.stride.duration_s - period).abs() <= homotopy.max_period_change * period
             }))
