@@ -64,7 +64,8 @@ pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
     let points = limits::count("--points", points, 2, limits::MAX_ORBIT_POINTS)?;
-    let chunk_points = limits::count("--chunk-points", chunk_points, 1, points)?;
+    let chunk_points =
+        limits::count("--chunk-points", chunk_points, 1, limits::MAX_ORBIT_POINTS)?.min(points);
     let names = setup.walker.map_names();
     let conventions: Vec<String> = scene
         .convention_outputs(&setup.walker, &setup.guess.q, &setup.guess.qd)
