@@ -40,7 +40,6 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     let walker = &setup.walker;
     let homotopy = HomotopySettings {
         first_step: 1.0,
-        max_solves: 8,
         ..HomotopySettings::default()
     };
     let result = long_period_gait(&scene, &common.setup_for(), &common.newton(), &homotopy)?;

@@ -93,7 +93,6 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     let progress = Progress::new(cells, "stability map", !common.json);
     let homotopy = HomotopySettings {
         first_step: 1.0,
-        max_solves: 8,
         ..HomotopySettings::default()
     };
     let map = stability_map(
