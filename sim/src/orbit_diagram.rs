@@ -7,7 +7,9 @@
 //! fills: the attractor is **periodic** with the smallest period `p ≤`
 //! [`OrbitSettings::max_period`] for which every state of the window repeats after `p`
 //! strides to [`OrbitSettings::period_tolerance`] (relative, ∞-norm of the stride-map
-//! vector); **chaotic** when no such `p` is found within [`OrbitSettings::max_strides`]
+//! vector), and [`OrbitSettings::cycle_contrast`] times better than after any shorter period
+//! dividing `p` (so that a transient still decaying along a multiplier near −1 is not taken
+//! for a period-2 cycle); **chaotic** when no such `p` is found within [`OrbitSettings::max_strides`]
 //! strides (this also covers a quasi-periodic attractor, a period above the bound, or a
 //! transient slower than the budget); **fell** when a stride fails (its kind and the stride's
 //! number from the start of that value).
@@ -50,6 +52,9 @@ pub struct OrbitSettings {
     pub max_period: usize,
     /// States repeat when they agree to this, relative (`|Δv|∞ ≤ tol (1 + |v|∞)`).
     pub period_tolerance: f64,
+    /// A period `p` counts only when the states repeat after `p` strides this many times
+    /// better than after every shorter period dividing `p` (see [`period_of`]).
+    pub cycle_contrast: f64,
     /// Consecutive values computed in sequence from one seed.
     pub chunk_points: usize,
     /// Relative nudge of an unstable seed gait's first stride-map entry.
@@ -64,6 +69,7 @@ impl Default for OrbitSettings {
             max_strides: 2000,
             max_period: 32,
             period_tolerance: 1e-7,
+            cycle_contrast: 1e-3,
             chunk_points: 8,
             seed_nudge: 1e-6,
         }
@@ -135,17 +141,40 @@ impl OrbitSettings {
         if !(self.period_tolerance.is_finite() && self.period_tolerance > 0.0) {
             return bad("the period tolerance must be positive");
         }
+        if !(self.cycle_contrast > 0.0 && self.cycle_contrast <= 1.0) {
+            return bad("the cycle contrast must be in (0, 1]");
+        }
         Ok(())
     }
 }
 
-/// The smallest period `p ≤ max_period` with which every state of `window` repeats.
-fn period_of(window: &VecDeque<DVector<f64>>, max_period: usize, tol: f64) -> Option<usize> {
-    (1..=max_period.min(window.len() / 2)).find(|&p| {
-        (p..window.len()).all(|i| {
+/// The largest change of the states of `window` over `p` strides, relative
+/// (`|v_i − v_{i−p}|∞ / (1 + |v_i|∞)`).
+fn repeat_error(window: &VecDeque<DVector<f64>>, p: usize) -> f64 {
+    (p..window.len())
+        .map(|i| {
             let (a, b) = (&window[i], &window[i - p]);
-            (a - b).amax() <= tol * (1.0 + a.amax())
+            (a - b).amax() / (1.0 + a.amax())
         })
+        .fold(0.0, f64::max)
+}
+
+/// The smallest period `p ≤ max_period` with which every state of `window` repeats to `tol`
+/// while repeating `contrast` times better than after any shorter period that divides `p`
+/// (a transient decaying slowly along a multiplier near −1 repeats nearly after two strides,
+/// but not `contrast` times better than after one).
+fn period_of(
+    window: &VecDeque<DVector<f64>>,
+    max_period: usize,
+    tol: f64,
+    contrast: f64,
+) -> Option<usize> {
+    let errors: Vec<f64> = (1..=max_period.min(window.len() / 2))
+        .map(|p| repeat_error(window, p))
+        .collect();
+    (1..=errors.len()).find(|&p| {
+        let e = errors[p - 1];
+        e <= tol && (1..p).filter(|d| p % d == 0).all(|d| e <= contrast * errors[d - 1])
     })
 }
 
@@ -178,8 +207,12 @@ fn settle(
         if window.len() == settings.window_strides
             && (k - settings.transient_strides) % settings.window_strides == 0
         {
-            if let Some(p) = period_of(&window, settings.max_period, settings.period_tolerance)
-            {
+            if let Some(p) = period_of(
+                &window,
+                settings.max_period,
+                settings.period_tolerance,
+                settings.cycle_contrast,
+            ) {
                 let cycle = window.iter().skip(window.len() - p).cloned().collect();
                 return Ok((Attractor::Periodic { period: p }, cycle, k));
             }
@@ -282,5 +315,30 @@ pub fn linspace(from: f64, to: f64, points: usize) -> Vec<f64> {
         n => (0..n)
             .map(|i| from + (to - from) * i as f64 / (n - 1) as f64)
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn window(states: impl Iterator<Item = [f64; 2]>) -> VecDeque<DVector<f64>> {
+        states.map(|s| DVector::from_row_slice(&s)).collect()
+    }
+
+    #[test]
+    fn a_decaying_flip_is_no_period_two_cycle_but_a_converged_one_is() {
+        // Period 1 approached along a multiplier −0.99 from an amplitude of 1e-6: it repeats
+        // after two strides to 4e-8, within the tolerance, but only 50 times better than
+        // after one.
+        let flip = window((0..64).map(|k| [0.2 + 1e-6 * (-0.99f64).powi(k), -0.2]));
+        assert_eq!(period_of(&flip, 32, 1e-7, 1e-3), None);
+        assert_eq!(period_of(&flip, 32, 1e-7, 1.0), Some(2), "without the contrast");
+        let cycle = window((0..64).map(|k| [0.2 + 1e-3 * (-1f64).powi(k), -0.2]));
+        assert_eq!(period_of(&cycle, 32, 1e-7, 1e-3), Some(2));
+        let fixed = window((0..64).map(|_| [0.2, -0.2]));
+        assert_eq!(period_of(&fixed, 32, 1e-7, 1e-3), Some(1));
+        let four = window((0..64).map(|k| [0.2 + 1e-3 * [0.0, 1.0, 0.3, 0.7][k % 4], -0.2]));
+        assert_eq!(period_of(&four, 32, 1e-7, 1e-3), Some(4));
     }
 }

@@ -126,6 +126,7 @@ const WINDOW: usize = 64;
 const MAX_STRIDES: usize = 2000;
 const MAX_PERIOD: usize = 32;
 const TOLERANCE: f64 = 1e-7;
+const CONTRAST: f64 = 1e-3;
 
 /// The reference orbit diagram, one value after the other from the previous attractor (the
 /// purely sequential method), after the first from the reference gait.
@@ -162,14 +163,24 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
                 window.remove(0);
             }
             if window.len() == WINDOW && (k - TRANSIENT) % WINDOW == 0 {
-                let repeats = |p: usize| {
-                    (p..WINDOW).all(|i| {
-                        let (a, b) = (window[i], window[i - p]);
-                        let d = (a.theta - b.theta).abs().max((a.theta_dot - b.theta_dot).abs());
-                        d <= TOLERANCE * (1.0 + a.theta.abs().max(a.theta_dot.abs()))
-                    })
+                let error = |p: usize| {
+                    (p..WINDOW)
+                        .map(|i| {
+                            let (a, b) = (window[i], window[i - p]);
+                            let d = (a.theta - b.theta).abs().max((a.theta_dot - b.theta_dot).abs());
+                            d / (1.0 + a.theta.abs().max(a.theta_dot.abs()))
+                        })
+                        .fold(0.0, f64::max)
                 };
-                if let Some(p) = (1..=MAX_PERIOD).find(|&p| repeats(p)) {
+                let errors: Vec<f64> = (1..=MAX_PERIOD).map(error).collect();
+                let cycle = |p: usize| {
+                    let e = errors[p - 1];
+                    e <= TOLERANCE
+                        && (1..p)
+                            .filter(|d| p % d == 0)
+                            .all(|d| e <= CONTRAST * errors[d - 1])
+                };
+                if let Some(p) = (1..=MAX_PERIOD).find(|&p| cycle(p)) {
                     kind = Kind::Periodic(p);
                     break;
                 }
