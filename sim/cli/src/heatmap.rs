@@ -22,8 +22,9 @@ pub struct HeatMap {
     pub y: Vec<f64>,
     /// Values, one row per y.
     pub z: Vec<Vec<Option<f64>>>,
-    /// The colour scale runs from 0 (blue) through `level` (white) to `2 level` and above
-    /// (red); the contour is drawn at `level`.
+    /// The colour scale runs from `level − span` (blue) through `level` (white) to
+    /// `level + span` (red), `span` the largest distance of a value from `level`; the contour
+    /// is drawn at `level`.
     pub level: f64,
     /// Legend text of the contour.
     pub contour_label: String,
@@ -50,9 +51,9 @@ fn edges(c: &[f64]) -> Vec<f64> {
     }
 }
 
-/// Blue (0) → white (`level`) → red (`2 level` and above).
-fn colour(v: f64, level: f64) -> String {
-    let t = (v / (2.0 * level)).clamp(0.0, 1.0);
+/// Blue (`level − span` and below) → white (`level`) → red (`level + span` and above).
+fn colour(v: f64, level: f64, span: f64) -> String {
+    let t = (0.5 + 0.5 * (v - level) / span).clamp(0.0, 1.0);
     let (blue, red) = ((33.0, 102.0, 172.0), (178.0, 24.0, 43.0));
     let (a, b, s) = if t < 0.5 {
         (blue, (247.0, 247.0, 247.0), t / 0.5)
@@ -114,6 +115,14 @@ impl HeatMap {
     /// Renders the map as an SVG document of `width` × `height` pixels.
     pub fn to_svg(&self, width: f64, height: f64) -> String {
         let (ml, mr, mt, mb) = (86.0, 120.0, 64.0, 62.0);
+        let colour_span = self
+            .z
+            .iter()
+            .flatten()
+            .flatten()
+            .filter(|v| v.is_finite())
+            .map(|v| (v - self.level).abs())
+            .fold(1e-6 * self.level.abs().max(1.0), f64::max);
         let (pw, ph) = (width - ml - mr, height - mt - mb);
         let (ex, ey) = (edges(&self.x), edges(&self.y));
         let span = |e: &[f64]| {
@@ -160,7 +169,7 @@ impl HeatMap {
                 let (l, r) = (px(*xa).min(px(*xb)), px(*xa).max(px(*xb)));
                 let (t, b) = (py(*ya).min(py(*yb)), py(*ya).max(py(*yb)));
                 let fill = match v {
-                    Some(v) if v.is_finite() => colour(*v, self.level),
+                    Some(v) if v.is_finite() => colour(*v, self.level, colour_span),
                     _ => "url(#nogait)".to_string(),
                 };
                 let _ = writeln!(
@@ -222,27 +231,25 @@ impl HeatMap {
             mt + ph / 2.0,
             escape(&self.y_label)
         );
-        // Colour bar: 0 to 2 level, the top meaning "at least".
+        // Colour bar: level − span to level + span.
         let (bx, bw) = (ml + pw + 24.0, 18.0);
         let steps = 40;
+        let bar = |f: f64| self.level - colour_span + 2.0 * colour_span * f;
         for k in 0..steps {
-            let v = 2.0 * self.level * (k as f64 + 0.5) / steps as f64;
+            let v = bar((k as f64 + 0.5) / steps as f64);
             let y = mt + ph - ph * (k + 1) as f64 / steps as f64;
             let _ = writeln!(
                 o,
                 r#"<rect x="{bx:.1}" y="{y:.2}" width="{bw}" height="{:.2}" fill="{}"/>"#,
                 ph / steps as f64 + 0.3,
-                colour(v, self.level)
+                colour(v, self.level, colour_span)
             );
         }
+        let tick = nice_step(colour_span, 2) / 10.0;
         for k in 0..=4 {
-            let v = 2.0 * self.level * k as f64 / 4.0;
+            let v = bar(k as f64 / 4.0);
             let y = mt + ph - ph * k as f64 / 4.0;
-            let text = if k == 4 {
-                format!("≥ {}", fmt_tick(v, 0.1))
-            } else {
-                fmt_tick(v, 0.1)
-            };
+            let text = fmt_tick(v, tick);
             let _ = writeln!(
                 o,
                 r##"<line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}">{text}</text>"##,
