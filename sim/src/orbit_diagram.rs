@@ -9,9 +9,12 @@
 //! strides to [`OrbitSettings::period_tolerance`] (relative, ∞-norm of the stride-map
 //! vector), and [`OrbitSettings::cycle_contrast`] times better than after any shorter period
 //! dividing `p` (so that a transient still decaying along a multiplier near −1 is not taken
-//! for a period-2 cycle); **chaotic** when no such `p` is found within [`OrbitSettings::max_strides`]
-//! strides (this also covers a quasi-periodic attractor, a period above the bound, or a
-//! transient slower than the budget); **fell** when a stride fails (its kind and the stride's
+//! for a period-2 cycle); **chaotic** when no such `p` is found within
+//! [`OrbitSettings::max_strides`] strides, or within [`OrbitSettings::max_strides_converging`]
+//! while the window's smallest repeat error keeps shrinking by the
+//! [`OrbitSettings::converging_factor`] (a slow transient near a bifurcation); this also
+//! covers a quasi-periodic attractor, a period above the bound, or a transient slower than
+//! the budget; **fell** when a stride fails (its kind and the stride's
 //! number from the start of that value).
 //!
 //! # Parallel chunks
@@ -46,8 +49,13 @@ pub struct OrbitSettings {
     pub transient_strides: usize,
     /// States examined at a time (the samples of a chaotic attractor).
     pub window_strides: usize,
-    /// The stride budget of one value, transient included.
+    /// The stride budget of one value, transient included (checked at each full window).
     pub max_strides: usize,
+    /// A transient still converging (the smallest repeat error of the window below
+    /// `converging_factor` times that of the window before) may run on to this many strides.
+    pub max_strides_converging: usize,
+    /// See [`Self::max_strides_converging`].
+    pub converging_factor: f64,
     /// Largest period looked for (at most half the window).
     pub max_period: usize,
     /// States repeat when they agree to this, relative (`|Δv|∞ ≤ tol (1 + |v|∞)`).
@@ -67,6 +75,8 @@ impl Default for OrbitSettings {
             transient_strides: 200,
             window_strides: 64,
             max_strides: 2000,
+            max_strides_converging: 10_000,
+            converging_factor: 0.95,
             max_period: 32,
             period_tolerance: 1e-7,
             cycle_contrast: 1e-3,
@@ -132,8 +142,13 @@ impl OrbitSettings {
         if self.max_period == 0 || self.window_strides < 2 * self.max_period {
             return bad("the window must hold at least two cycles of the largest period");
         }
-        if self.max_strides < self.transient_strides + self.window_strides {
-            return bad("the stride budget must cover the transient and one window");
+        if self.max_strides < self.transient_strides + self.window_strides
+            || self.max_strides_converging < self.max_strides
+        {
+            return bad("the stride budgets must cover the transient and one window, in order");
+        }
+        if !(self.converging_factor > 0.0 && self.converging_factor <= 1.0) {
+            return bad("the converging factor must be in (0, 1]");
         }
         if self.chunk_points == 0 {
             return bad("a chunk holds at least one value");
@@ -162,20 +177,23 @@ fn repeat_error(window: &VecDeque<DVector<f64>>, p: usize) -> f64 {
 /// The smallest period `p ≤ max_period` with which every state of `window` repeats to `tol`
 /// while repeating `contrast` times better than after any shorter period that divides `p`
 /// (a transient decaying slowly along a multiplier near −1 repeats nearly after two strides,
-/// but not `contrast` times better than after one).
+/// but not `contrast` times better than after one); else the smallest repeat error of any
+/// period, to tell a transient still converging.
 fn period_of(
     window: &VecDeque<DVector<f64>>,
     max_period: usize,
     tol: f64,
     contrast: f64,
-) -> Option<usize> {
+) -> Result<usize, f64> {
     let errors: Vec<f64> = (1..=max_period.min(window.len() / 2))
         .map(|p| repeat_error(window, p))
         .collect();
-    (1..=errors.len()).find(|&p| {
-        let e = errors[p - 1];
-        e <= tol && (1..p).filter(|d| p % d == 0).all(|d| e <= contrast * errors[d - 1])
-    })
+    (1..=errors.len())
+        .find(|&p| {
+            let e = errors[p - 1];
+            e <= tol && (1..p).filter(|d| p % d == 0).all(|d| e <= contrast * errors[d - 1])
+        })
+        .ok_or_else(|| errors.iter().copied().fold(f64::INFINITY, f64::min))
 }
 
 /// Iterates the stride map of `scene` from `v` and classifies the attractor.
@@ -190,7 +208,10 @@ fn settle(
     let search = GaitSearch::new(&setup.walker, &setup.settings, newton);
     let mut v = v;
     let mut window: VecDeque<DVector<f64>> = VecDeque::with_capacity(settings.window_strides);
-    for k in 1..=settings.max_strides {
+    let mut last_best = f64::INFINITY;
+    let mut k = 0;
+    while k < settings.max_strides_converging {
+        k += 1;
         v = match search.stride_map(&v) {
             Ok((next, _)) => next,
             Err(failure) => {
@@ -207,18 +228,27 @@ fn settle(
         if window.len() == settings.window_strides
             && (k - settings.transient_strides) % settings.window_strides == 0
         {
-            if let Some(p) = period_of(
+            match period_of(
                 &window,
                 settings.max_period,
                 settings.period_tolerance,
                 settings.cycle_contrast,
             ) {
-                let cycle = window.iter().skip(window.len() - p).cloned().collect();
-                return Ok((Attractor::Periodic { period: p }, cycle, k));
+                Ok(p) => {
+                    let cycle = window.iter().skip(window.len() - p).cloned().collect();
+                    return Ok((Attractor::Periodic { period: p }, cycle, k));
+                }
+                Err(best) => {
+                    let converging = best < settings.converging_factor * last_best;
+                    last_best = best;
+                    if k >= settings.max_strides && !converging {
+                        break;
+                    }
+                }
             }
         }
     }
-    Ok((Attractor::Chaotic, window.into(), settings.max_strides))
+    Ok((Attractor::Chaotic, window.into(), k))
 }
 
 /// The starting state of a seeded value: the long-period gait (nudged if unstable), else the
@@ -332,13 +362,13 @@ mod tests {
         // after two strides to 4e-8, within the tolerance, but only 50 times better than
         // after one.
         let flip = window((0..64).map(|k| [0.2 + 1e-6 * (-0.99f64).powi(k), -0.2]));
-        assert_eq!(period_of(&flip, 32, 1e-7, 1e-3), None);
-        assert_eq!(period_of(&flip, 32, 1e-7, 1.0), Some(2), "without the contrast");
+        assert!(period_of(&flip, 32, 1e-7, 1e-3).is_err());
+        assert_eq!(period_of(&flip, 32, 1e-7, 1.0), Ok(2), "without the contrast");
         let cycle = window((0..64).map(|k| [0.2 + 1e-3 * (-1f64).powi(k), -0.2]));
-        assert_eq!(period_of(&cycle, 32, 1e-7, 1e-3), Some(2));
+        assert_eq!(period_of(&cycle, 32, 1e-7, 1e-3), Ok(2));
         let fixed = window((0..64).map(|_| [0.2, -0.2]));
-        assert_eq!(period_of(&fixed, 32, 1e-7, 1e-3), Some(1));
+        assert_eq!(period_of(&fixed, 32, 1e-7, 1e-3), Ok(1));
         let four = window((0..64).map(|k| [0.2 + 1e-3 * [0.0, 1.0, 0.3, 0.7][k % 4], -0.2]));
-        assert_eq!(period_of(&four, 32, 1e-7, 1e-3), Some(4));
+        assert_eq!(period_of(&four, 32, 1e-7, 1e-3), Ok(4));
     }
 }

@@ -43,6 +43,14 @@ fn orbit_settings_that_cannot_classify_are_refused() {
             cycle_contrast: 0.0,
             ..ok
         },
+        OrbitSettings {
+            max_strides_converging: ok.max_strides - 1,
+            ..ok
+        },
+        OrbitSettings {
+            converging_factor: 1.5,
+            ..ok
+        },
     ] {
         assert!(matches!(bad.validate(), Err(OrbitError::Settings(_))), "{bad:?}");
     }

@@ -124,6 +124,8 @@ enum Kind {
 const TRANSIENT: usize = 200;
 const WINDOW: usize = 64;
 const MAX_STRIDES: usize = 2000;
+const MAX_STRIDES_CONVERGING: usize = 10_000;
+const CONVERGING_FACTOR: f64 = 0.95;
 const MAX_PERIOD: usize = 32;
 const TOLERANCE: f64 = 1e-7;
 const CONTRAST: f64 = 1e-3;
@@ -147,7 +149,8 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
         let mut s = s0;
         let mut window: Vec<State> = Vec::new();
         let mut kind = Kind::Chaotic;
-        for k in 1..=MAX_STRIDES {
+        let mut last_best = f64::INFINITY;
+        for k in 1..=MAX_STRIDES_CONVERGING {
             match garcia::stride(gamma, s) {
                 Some((next, _)) => s = next,
                 None => {
@@ -182,6 +185,12 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
                 };
                 if let Some(p) = (1..=MAX_PERIOD).find(|&p| cycle(p)) {
                     kind = Kind::Periodic(p);
+                    break;
+                }
+                let best = errors.iter().copied().fold(f64::INFINITY, f64::min);
+                let converging = best < CONVERGING_FACTOR * last_best;
+                last_best = best;
+                if k >= MAX_STRIDES && !converging {
                     break;
                 }
             }
