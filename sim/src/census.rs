@@ -223,12 +223,7 @@ fn starts(setup: &Setup, settings: &CensusSettings) -> Vec<DVector<f64>> {
     let g = &setup.guess;
     let pack = |q: DVector<f64>, qd: DVector<f64>| setup.walker.pack(&q, &qd);
     let mut v = vec![pack(g.q.clone(), g.qd.clone())];
-    v.extend(
-        settings
-            .scales
-            .iter()
-            .map(|&k| pack(&g.q * k, &g.qd * k)),
-    );
+    v.extend(settings.scales.iter().map(|&k| pack(&g.q * k, &g.qd * k)));
     v.extend(
         settings
             .rate_scales
@@ -297,16 +292,7 @@ pub fn census(
         }
         let followed: Vec<(Result<Gait, NewtonError>, usize)> = origins
             .par_iter()
-            .map(|g| {
-                follow(
-                    &defaults,
-                    scene,
-                    setup_for,
-                    g,
-                    newton,
-                    &settings.homotopy,
-                )
-            })
+            .map(|g| follow(&defaults, scene, setup_for, g, newton, &settings.homotopy))
             .collect();
         for (g, n) in followed {
             searches += n;

@@ -191,7 +191,10 @@ fn period_of(
     (1..=errors.len())
         .find(|&p| {
             let e = errors[p - 1];
-            e <= tol && (1..p).filter(|d| p % d == 0).all(|d| e <= contrast * errors[d - 1])
+            e <= tol
+                && (1..p)
+                    .filter(|d| p % d == 0)
+                    .all(|d| e <= contrast * errors[d - 1])
         })
         .ok_or_else(|| errors.iter().copied().fold(f64::INFINITY, f64::min))
 }
@@ -363,7 +366,11 @@ mod tests {
         // after one.
         let flip = window((0..64).map(|k| [0.2 + 1e-6 * (-0.99f64).powi(k), -0.2]));
         assert!(period_of(&flip, 32, 1e-7, 1e-3).is_err());
-        assert_eq!(period_of(&flip, 32, 1e-7, 1.0), Ok(2), "without the contrast");
+        assert_eq!(
+            period_of(&flip, 32, 1e-7, 1.0),
+            Ok(2),
+            "without the contrast"
+        );
         let cycle = window((0..64).map(|k| [0.2 + 1e-3 * (-1f64).powi(k), -0.2]));
         assert_eq!(period_of(&cycle, 32, 1e-7, 1e-3), Ok(2));
         let fixed = window((0..64).map(|_| [0.2, -0.2]));

@@ -82,7 +82,9 @@ fn row(
         scene.set(&x.name, xv)?;
         let continued = match history.as_slice() {
             [] => None,
-            [.., (x0, v0, _), (x1, v1, t1)] => Some((v1 + (v1 - v0) * ((xv - x1) / (x1 - x0)), *t1)),
+            [.., (x0, v0, _), (x1, v1, t1)] => {
+                Some((v1 + (v1 - v0) * ((xv - x1) / (x1 - x0)), *t1))
+            }
             [.., (_, v, t)] => Some((v.clone(), *t)),
         }
         .map(|(predictor, period)| -> Result<Option<Gait>, SceneError> {

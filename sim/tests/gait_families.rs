@@ -52,7 +52,10 @@ fn orbit_settings_that_cannot_classify_are_refused() {
             ..ok
         },
     ] {
-        assert!(matches!(bad.validate(), Err(OrbitError::Settings(_))), "{bad:?}");
+        assert!(
+            matches!(bad.validate(), Err(OrbitError::Settings(_))),
+            "{bad:?}"
+        );
     }
     assert_eq!(linspace(1.0, 2.0, 3), vec![1.0, 1.5, 2.0]);
     assert_eq!(linspace(1.0, 2.0, 1), vec![1.0]);
@@ -64,10 +67,32 @@ fn an_unknown_parameter_or_a_value_out_of_range_is_refused_before_any_work() {
     let f: &SetupFor<'_> = &setup;
     let newton = NewtonSettings::default();
     let never = || panic!("no value may be computed");
-    let e = orbit_diagram(&scene, f, "nope", &[0.01], &newton, &OrbitSettings::default(), &never);
-    assert!(matches!(e, Err(OrbitError::Scene(SceneError::UnknownParameter { .. }))));
-    let e = orbit_diagram(&scene, f, "slope", &[0.01, 0.9], &newton, &OrbitSettings::default(), &never);
-    assert!(matches!(e, Err(OrbitError::Scene(SceneError::OutOfRange { .. }))));
+    let e = orbit_diagram(
+        &scene,
+        f,
+        "nope",
+        &[0.01],
+        &newton,
+        &OrbitSettings::default(),
+        &never,
+    );
+    assert!(matches!(
+        e,
+        Err(OrbitError::Scene(SceneError::UnknownParameter { .. }))
+    ));
+    let e = orbit_diagram(
+        &scene,
+        f,
+        "slope",
+        &[0.01, 0.9],
+        &newton,
+        &OrbitSettings::default(),
+        &never,
+    );
+    assert!(matches!(
+        e,
+        Err(OrbitError::Scene(SceneError::OutOfRange { .. }))
+    ));
     let x = Axis {
         name: "slope".into(),
         values: vec![0.01],
@@ -120,7 +145,13 @@ fn the_parallel_orbit_diagram_is_the_sequential_one_on_any_number_of_threads() {
         let lo = |p: &sim::orbit_diagram::OrbitPoint| {
             p.states.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min)
         };
-        assert!((lo(a) - lo(b)).abs() < 1e-6, "{} {} {}", a.value, lo(a), lo(b));
+        assert!(
+            (lo(a) - lo(b)).abs() < 1e-6,
+            "{} {} {}",
+            a.value,
+            lo(a),
+            lo(b)
+        );
     }
     assert!(chunked_1.iter().step_by(2).all(|p| p.seeded));
 }

@@ -82,7 +82,12 @@ pub fn contour(x: &[f64], y: &[f64], z: &[Vec<Option<f64>>], level: f64) -> Vec<
                 continue;
             };
             // Corners counter-clockwise: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
-            let corners = [(x[i], y[j], a), (x[i + 1], y[j], b), (x[i + 1], y[j + 1], c), (x[i], y[j + 1], d)];
+            let corners = [
+                (x[i], y[j], a),
+                (x[i + 1], y[j], b),
+                (x[i + 1], y[j + 1], c),
+                (x[i], y[j + 1], d),
+            ];
             let mut cross = Vec::with_capacity(4);
             for k in 0..4 {
                 let (p, q) = (corners[k], corners[(k + 1) % 4]);
@@ -314,7 +319,11 @@ mod tests {
         };
         let svg = h.to_svg(700.0, 500.0);
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
-        assert_eq!(svg.matches(r#"fill="url(#nogait)""#).count(), 2, "legend + one cell");
+        assert_eq!(
+            svg.matches(r#"fill="url(#nogait)""#).count(),
+            2,
+            "legend + one cell"
+        );
         assert!(svg.contains(r#"stroke="black" stroke-width="2.5" stroke-linecap="round""#));
     }
 }

@@ -4,9 +4,9 @@
 //! the stable and no-gait regions of the map.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
 #[path = "../../tests/garcia/mod.rs"]
 mod garcia;
-mod common;
 
 use common::{stderr, walker};
 use garcia::{Period1, State};
@@ -38,20 +38,33 @@ fn assert_matches(gait: &Value, r: &Period1, what: &str) {
     let theta = fp["stance_leg"].as_f64().unwrap();
     let theta_dot = fp["stance_leg_dot"].as_f64().unwrap();
     let swing = fp["swing_leg"].as_f64().unwrap();
-    assert!((theta - r.state.theta).abs() < 1e-8, "{what}: θ {theta} vs {r:?}");
+    assert!(
+        (theta - r.state.theta).abs() < 1e-8,
+        "{what}: θ {theta} vs {r:?}"
+    );
     assert!(
         (theta_dot - r.state.theta_dot).abs() < 1e-8,
         "{what}: θ̇ {theta_dot} vs {r:?}"
     );
-    assert!((swing + 2.0 * r.state.theta).abs() < 1e-8, "{what}: swing {swing}");
+    assert!(
+        (swing + 2.0 * r.state.theta).abs() < 1e-8,
+        "{what}: swing {swing}"
+    );
     let period = gait["step_period_s"].as_f64().unwrap();
-    assert!((period - r.period).abs() < 1e-7, "{what}: period {period} vs {r:?}");
+    assert!(
+        (period - r.period).abs() < 1e-7,
+        "{what}: period {period} vs {r:?}"
+    );
     let m = gait["max_abs_eigenvalue"].as_f64().unwrap();
     assert!(
         (m - r.max_abs_eigenvalue()).abs() < 1e-5,
         "{what}: max|λ| {m} vs {r:?}"
     );
-    assert_eq!(gait["stable"].as_bool().unwrap(), r.max_abs_eigenvalue() < 1.0, "{what}");
+    assert_eq!(
+        gait["stable"].as_bool().unwrap(),
+        r.max_abs_eigenvalue() < 1.0,
+        "{what}"
+    );
 }
 
 #[test]
@@ -59,7 +72,10 @@ fn gaits_finds_both_period_one_gaits_wherever_the_reference_has_both() {
     for gamma in [0.001, 0.004, 0.009, 0.015, 0.018, 0.022] {
         let long = reference(gamma, LONG).expect("reference long-period gait");
         let short = reference(gamma, SHORT).expect("reference short-period gait");
-        assert!(long.period > short.period + 0.5, "{gamma}: two distinct gaits");
+        assert!(
+            long.period > short.period + 0.5,
+            "{gamma}: two distinct gaits"
+        );
         let v = json(&[
             "gaits",
             "--scene",
@@ -91,7 +107,10 @@ fn gaits_lists_each_gait_exactly_as_walker_gait_reports_it() {
     }
     let (a, b) = (&first["fixed_point"], &one["fixed_point"]);
     for (k, x) in a.as_object().unwrap() {
-        assert!((x.as_f64().unwrap() - b[k].as_f64().unwrap()).abs() < 1e-9, "{k}");
+        assert!(
+            (x.as_f64().unwrap() - b[k].as_f64().unwrap()).abs() < 1e-9,
+            "{k}"
+        );
     }
 }
 
@@ -170,7 +189,9 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
                     (p..WINDOW)
                         .map(|i| {
                             let (a, b) = (window[i], window[i - p]);
-                            let d = (a.theta - b.theta).abs().max((a.theta_dot - b.theta_dot).abs());
+                            let d = (a.theta - b.theta)
+                                .abs()
+                                .max((a.theta_dot - b.theta_dot).abs());
                             d / (1.0 + a.theta.abs().max(a.theta_dot.abs()))
                         })
                         .fold(0.0, f64::max)
@@ -275,14 +296,27 @@ fn orbit_diagram_shows_the_cascade_to_chaos_and_the_end_of_walking_as_the_refere
     for &i in &mismatches {
         let near_change = (i > 0 && reference[i - 1] != reference[i])
             || (i + 1 < n && reference[i + 1] != reference[i]);
-        assert!(near_change, "mismatch at {} away from a bifurcation", values[i]);
+        assert!(
+            near_change,
+            "mismatch at {} away from a bifurcation",
+            values[i]
+        );
     }
     // The end of walking: the first slope where the walker falls, to one step of the grid.
     let first_fall = |k: &[Kind]| k.iter().position(|k| *k == Kind::Fell).unwrap();
     let (fe, fr) = (first_fall(&engine), first_fall(&reference));
-    assert!(fe.abs_diff(fr) <= 1, "falls from {} vs {}", values[fe], values[fr]);
+    assert!(
+        fe.abs_diff(fr) <= 1,
+        "falls from {} vs {}",
+        values[fe],
+        values[fr]
+    );
     // Garcia et al. (1998): chaotic walking before γ ≈ 0.019, no walking beyond.
-    assert!((0.0185..=0.0195).contains(&values[fe]), "falls from {}", values[fe]);
+    assert!(
+        (0.0185..=0.0195).contains(&values[fe]),
+        "falls from {}",
+        values[fe]
+    );
 }
 
 #[test]
@@ -321,8 +355,13 @@ fn stability_map_agrees_with_the_reference_on_stable_and_no_gait_cells() {
                     seen.0 += 1;
                 }
                 Some(r) => {
-                    let e = m[row][i].as_f64().unwrap_or_else(|| panic!("gait at {gamma}"));
-                    assert!((e - r.max_abs_eigenvalue()).abs() < 1e-5, "{gamma}: {e} {r:?}");
+                    let e = m[row][i]
+                        .as_f64()
+                        .unwrap_or_else(|| panic!("gait at {gamma}"));
+                    assert!(
+                        (e - r.max_abs_eigenvalue()).abs() < 1e-5,
+                        "{gamma}: {e} {r:?}"
+                    );
                     let s = r.max_abs_eigenvalue() < 1.0;
                     assert_eq!(stable[row][i].as_bool().unwrap(), s, "{gamma}");
                     if s {

@@ -57,22 +57,52 @@ fn bad_orbit_diagram_and_stability_map_options_are_named_and_exit_2() {
         (od(&["--to", "inf"]), vec!["--to"]),
         (od(&["--to", "0.9"]), vec!["slope_rad", "0.9"]),
         (od(&["--chunk-points", "0"]), vec!["--chunk-points", "0"]),
-        (od(&["--coordinate", "knee"]), vec!["--coordinate", "knee", "stance_leg"]),
+        (
+            od(&["--coordinate", "knee"]),
+            vec!["--coordinate", "knee", "stance_leg"],
+        ),
         (map("slope_rad", "leg_mass_kg=1:2:2"), vec!["--x", "="]),
-        (map("slope=0.01:0.02", "leg_mass_kg=1:2:2"), vec!["--x", "three"]),
-        (map("slope=0.01:x:3", "leg_mass_kg=1:2:2"), vec!["--x", "TO", "x"]),
-        (map("slope=0.01:0.02:0", "leg_mass_kg=1:2:2"), vec!["--x N", "0"]),
-        (map("slope=0.01:0.02:501", "leg_mass_kg=1:2:2"), vec!["--x N", "501"]),
+        (
+            map("slope=0.01:0.02", "leg_mass_kg=1:2:2"),
+            vec!["--x", "three"],
+        ),
+        (
+            map("slope=0.01:x:3", "leg_mass_kg=1:2:2"),
+            vec!["--x", "TO", "x"],
+        ),
+        (
+            map("slope=0.01:0.02:0", "leg_mass_kg=1:2:2"),
+            vec!["--x N", "0"],
+        ),
+        (
+            map("slope=0.01:0.02:501", "leg_mass_kg=1:2:2"),
+            vec!["--x N", "501"],
+        ),
         (
             map("slope=0.01:0.02:18446744073709551616", "leg_mass_kg=1:2:2"),
             vec!["--x", "18446744073709551616"],
         ),
         (map("slope=0.01:0.02:3", "nope=1:2:2"), vec!["nope"]),
-        (map("slope=0.01:0.02:3", "slope_rad=0.01:0.03:2"), vec!["slope_rad", "--y"]),
-        (map("slope=0.01:0.01:3", "leg_mass_kg=1:2:2"), vec!["FROM and TO"]),
-        (map("slope=0.01:0.02:300", "leg_mass_kg=1:2:300"), vec!["90000"]),
-        (map("slope=0.01:0.9:3", "leg_mass_kg=1:2:2"), vec!["slope_rad", "0.9"]),
-        (map("slope=0.01:NaN:3", "leg_mass_kg=1:2:2"), vec!["--x", "NaN"]),
+        (
+            map("slope=0.01:0.02:3", "slope_rad=0.01:0.03:2"),
+            vec!["slope_rad", "--y"],
+        ),
+        (
+            map("slope=0.01:0.01:3", "leg_mass_kg=1:2:2"),
+            vec!["FROM and TO"],
+        ),
+        (
+            map("slope=0.01:0.02:300", "leg_mass_kg=1:2:300"),
+            vec!["90000"],
+        ),
+        (
+            map("slope=0.01:0.9:3", "leg_mass_kg=1:2:2"),
+            vec!["slope_rad", "0.9"],
+        ),
+        (
+            map("slope=0.01:NaN:3", "leg_mass_kg=1:2:2"),
+            vec!["--x", "NaN"],
+        ),
         (
             ["gaits", "--scene", "compass", "--set", "leg_mass_kg=-1"]
                 .iter()

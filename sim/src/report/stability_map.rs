@@ -59,7 +59,11 @@ impl StabilityMapReport {
             stable: map
                 .rows
                 .iter()
-                .map(|r| r.iter().map(|c| c.as_ref().ok().map(|c| c.stable)).collect())
+                .map(|r| {
+                    r.iter()
+                        .map(|c| c.as_ref().ok().map(|c| c.stable))
+                        .collect()
+                })
                 .collect(),
             step_period_s: grid(&|c| c.step_period_s),
             no_gait_reason: map

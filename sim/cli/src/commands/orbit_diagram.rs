@@ -129,7 +129,11 @@ pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_text(out: &mut dyn Write, r: &OrbitDiagramReport, coordinate: &str) -> std::io::Result<()> {
+fn print_text(
+    out: &mut dyn Write,
+    r: &OrbitDiagramReport,
+    coordinate: &str,
+) -> std::io::Result<()> {
     writeln!(
         out,
         "{:>14} {:>10} {:>7} {:>8}  {coordinate} at heel strike (or how it fell)",
@@ -140,9 +144,11 @@ fn print_text(out: &mut dyn Write, r: &OrbitDiagramReport, coordinate: &str) -> 
             Some(f) => format!("{:?} in stride {}", f.kind, f.stride),
             None => {
                 let ys = p.samples.get(coordinate).map_or(&[][..], Vec::as_slice);
-                let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                    (a.min(y), b.max(y))
-                });
+                let (lo, hi) = ys
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+                        (a.min(y), b.max(y))
+                    });
                 if p.period_strides == Some(1) {
                     format!("{lo:.8}")
                 } else {

@@ -69,12 +69,7 @@ fn axis(flag: &str, spec: &str, scene: &Scene) -> Result<Axis, InputError> {
 
 /// Runs `walker stability-map`.
 pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
-    let StabilityMapArgs {
-        common,
-        x,
-        y,
-        plot,
-    } = args;
+    let StabilityMapArgs { common, x, y, plot } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
     let (x, y) = (axis("--x", &x, &scene)?, axis("--y", &y, &scene)?);
