@@ -229,7 +229,7 @@ fn settle(
         }
         window.push_back(v.clone());
         if window.len() == settings.window_strides
-            && (k - settings.transient_strides) % settings.window_strides == 0
+            && (k - settings.transient_strides).is_multiple_of(settings.window_strides)
         {
             match period_of(
                 &window,
@@ -266,7 +266,7 @@ fn seed(
     match long_period_gait(scene, setup_for, newton, &homotopy)? {
         Ok(g) => {
             let mut v = g.fixed_point.clone();
-            if !g.stable() && v.len() > 0 {
+            if !g.stable() && !v.is_empty() {
                 v[0] += settings.seed_nudge * (1.0 + v[0].abs());
             }
             Ok(v)

@@ -184,7 +184,7 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
             if window.len() > WINDOW {
                 window.remove(0);
             }
-            if window.len() == WINDOW && (k - TRANSIENT) % WINDOW == 0 {
+            if window.len() == WINDOW && (k - TRANSIENT).is_multiple_of(WINDOW) {
                 let error = |p: usize| {
                     (p..WINDOW)
                         .map(|i| {
@@ -201,7 +201,7 @@ fn reference_diagram(values: &[f64]) -> Vec<Kind> {
                     let e = errors[p - 1];
                     e <= TOLERANCE
                         && (1..p)
-                            .filter(|d| p % d == 0)
+                            .filter(|d| p.is_multiple_of(*d))
                             .all(|d| e <= CONTRAST * errors[d - 1])
                 };
                 if let Some(p) = (1..=MAX_PERIOD).find(|&p| cycle(p)) {
