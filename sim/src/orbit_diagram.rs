@@ -80,7 +80,7 @@ impl Default for OrbitSettings {
             max_period: 32,
             period_tolerance: 1e-7,
             cycle_contrast: 1e-3,
-            chunk_points: 8,
+            chunk_points: 4,
             seed_nudge: 1e-6,
         }
     }
@@ -331,6 +331,9 @@ pub fn orbit_diagram(
     }
     let chunks: Vec<Result<Vec<OrbitPoint>, SceneError>> = values
         .par_chunks(settings.chunk_points)
+        // One task per chunk: the costly (chaotic) values cluster, so leave the balancing to
+        // work stealing rather than to halving the range.
+        .with_max_len(1)
         .map(|c| chunk(scene, setup_for, param, c, newton, settings, progress))
         .collect();
     let mut out = Vec::with_capacity(values.len());
