@@ -4,6 +4,7 @@
 
 pub mod accuracy;
 pub mod actuator;
+pub mod census;
 pub mod contact;
 pub mod continuation;
 pub mod control;
@@ -17,11 +18,13 @@ pub mod kinematics;
 pub mod limit_cycle;
 pub mod math;
 pub mod model;
+pub mod orbit_diagram;
 pub mod relabel;
 pub mod report;
 pub mod scene;
 pub mod singular_limit;
 pub mod stability;
+pub mod stability_map;
 pub mod stride;
 pub mod tune;
 pub mod variational;

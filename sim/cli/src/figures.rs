@@ -145,3 +145,54 @@ pub fn accuracy(
         unit_circle: false,
     }
 }
+
+/// The orbit diagram: `coordinate` at heel strike on the attractor against the parameter,
+/// periodic and chaotic attractors apart; values where the walker fell are marked along the
+/// bottom.
+pub fn orbit_diagram(r: &sim::report::OrbitDiagramReport, coordinate: &str) -> Plot {
+    let mut periodic = Vec::new();
+    let mut chaotic = Vec::new();
+    let mut fell_at = Vec::new();
+    for p in &r.points {
+        let ys = p.samples.get(coordinate).map_or(&[][..], Vec::as_slice);
+        match p.attractor {
+            "periodic" => periodic.extend(ys.iter().map(|&y| (p.value, y))),
+            "chaotic" => chaotic.extend(ys.iter().map(|&y| (p.value, y))),
+            _ => fell_at.push(p.value),
+        }
+    }
+    let bottom = periodic
+        .iter()
+        .chain(&chaotic)
+        .map(|p| p.1)
+        .fold(f64::INFINITY, f64::min);
+    let bottom = if bottom.is_finite() { bottom } else { 0.0 };
+    let series = vec![
+        Series {
+            label: "periodic".into(),
+            points: periodic,
+            style: Style::Dot,
+            color: PALETTE[0],
+        },
+        Series {
+            label: "chaotic (no period up to the bound)".into(),
+            points: chaotic,
+            style: Style::Dot,
+            color: PALETTE[1],
+        },
+        Series {
+            label: "fell".into(),
+            points: fell_at.into_iter().map(|x| (x, bottom)).collect(),
+            style: Style::Star,
+            color: "#555555",
+        },
+    ];
+    Plot {
+        title: format!("{}: orbit diagram over {}", r.scene, r.param),
+        x_label: r.param.clone(),
+        y_label: format!("{coordinate} at heel strike"),
+        series,
+        equal_aspect: false,
+        unit_circle: false,
+    }
+}

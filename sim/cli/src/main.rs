@@ -8,15 +8,19 @@
 
 mod commands;
 mod figures;
+mod heatmap;
 mod input_error;
 mod limits;
 mod options;
 mod output;
 mod plot;
+mod progress;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
-use commands::{accuracy, gait, scenes, sil, sweep, tune, walk};
+use commands::{
+    accuracy, gait, gaits, orbit_diagram, scenes, sil, stability_map, sweep, tune, walk,
+};
 use input_error::InputError;
 use sim::scene::SceneError;
 use std::process::ExitCode;
@@ -39,11 +43,20 @@ struct Cli {
 enum Command {
     /// Find the periodic gait of a scene and its stability.
     Gait(gait::GaitArgs),
+    /// Census: every distinct period-1 gait found (Newton from the guess, continuation from
+    /// the defaults, multi-start), longest step period first.
+    Gaits(gaits::GaitsArgs),
     /// Simulate N steps from the gait (or the scene's guess), optionally perturbed.
     #[command(after_help = WALK_EXIT_CODES)]
     Walk(walk::WalkArgs),
     /// Continuation: follow the gait while one parameter changes.
     Sweep(sweep::SweepArgs),
+    /// Orbit diagram: the attractor (periodic, chaotic or a fall) at each value of one
+    /// parameter, from the previous value's attractor.
+    OrbitDiagram(orbit_diagram::OrbitDiagramArgs),
+    /// Stability map: max |λ| of the long-period gait over a grid of two parameters, filled
+    /// by continuation along rows.
+    StabilityMap(stability_map::StabilityMapArgs),
     /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
     Tune(tune::TuneArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
@@ -70,8 +83,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Scenes { json } => scenes::run(json),
         Command::Gait(args) => gait::run(args),
+        Command::Gaits(args) => gaits::run(args),
         Command::Walk(args) => walk::run(args),
         Command::Sweep(args) => sweep::run(args),
+        Command::OrbitDiagram(args) => orbit_diagram::run(args),
+        Command::StabilityMap(args) => stability_map::run(args),
         Command::Tune(args) => tune::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),

@@ -4,7 +4,8 @@ use crate::input_error::InputError;
 use clap::Args;
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::{JacobianMethod, NewtonSettings};
-use sim::scene::{Scene, Setup};
+use sim::scene::{Scene, SceneError, Setup};
+use sim::stride::StrideSettings;
 
 /// Scene, parameters, output form, integrator and gait-search options.
 #[derive(Args)]
@@ -60,6 +61,25 @@ impl Common {
     /// The walker of `scene` with the integrator options applied; checks every numeric option.
     pub fn setup(&self, scene: &Scene) -> Result<Setup, InputError> {
         let mut w = scene.setup()?;
+        self.configure(&mut w.settings)?;
+        Ok(w)
+    }
+
+    /// [`Self::setup`] as the engine's studies build a scene at other parameter values
+    /// ([`sim::census::SetupFor`]); an option error (already refused by [`Self::setup`] before
+    /// any study starts) comes back as [`SceneError::Invalid`].
+    pub fn setup_for(&self) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
+        move |scene: &Scene| {
+            let mut w = scene.setup()?;
+            self.configure(&mut w.settings)
+                .map_err(|e| SceneError::Invalid(e.to_string()))?;
+            Ok(w)
+        }
+    }
+
+    /// Applies the integrator options to a scene's stride settings; checks every numeric
+    /// option.
+    fn configure(&self, settings: &mut StrideSettings) -> Result<(), InputError> {
         let positive = |name: &str, v: Option<f64>| match v {
             Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
                 "--{name} must be a positive number, got {x}"
@@ -77,7 +97,7 @@ impl Common {
             )));
         }
         if let Some(kind) = &self.integrator {
-            w.settings.integrator =
+            settings.integrator =
                 IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None).ok_or_else(
                     || {
                         InputError::Other(format!(
@@ -86,16 +106,14 @@ impl Common {
                     },
                 )?;
         } else {
-            w.settings.integrator = w
-                .settings
+            settings.integrator = settings
                 .integrator
                 .with_tolerance_or_step(self.rtol, self.step_s);
         }
         // A step too small for the stride's budgets would only run out of them, slowly.
-        w.settings
+        settings
             .validate()
-            .map_err(|e| InputError::Other(e.to_string()))?;
-        Ok(w)
+            .map_err(|e| InputError::Other(e.to_string()))
     }
 
     /// The gait search's settings.

@@ -13,6 +13,8 @@ pub enum Style {
     Circle,
     /// Stars at the points.
     Star,
+    /// Small filled dots at the points (a scatter of many points, as in an orbit diagram).
+    Dot,
 }
 
 /// One data series.
@@ -50,7 +52,7 @@ pub const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 
-fn nice_step(span: f64, target: usize) -> f64 {
+pub(crate) fn nice_step(span: f64, target: usize) -> f64 {
     let raw = span / target as f64;
     let mag = 10f64.powf(raw.log10().floor());
     let f = raw / mag;
@@ -66,7 +68,7 @@ fn nice_step(span: f64, target: usize) -> f64 {
     nice * mag
 }
 
-fn fmt_tick(v: f64, step: f64) -> String {
+pub(crate) fn fmt_tick(v: f64, step: f64) -> String {
     let decimals = (-step.log10().floor()).max(0.0) as usize;
     let s = format!("{v:.decimals$}");
     if s == "-0" || s.chars().all(|c| c == '0' || c == '.' || c == '-') && s.starts_with('-') {
@@ -76,7 +78,7 @@ fn fmt_tick(v: f64, step: f64) -> String {
     }
 }
 
-fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
@@ -226,6 +228,17 @@ impl Plot {
                         );
                     }
                 }
+                Style::Dot => {
+                    for &(x, y) in &pts {
+                        let _ = writeln!(
+                            o,
+                            r#"<circle cx="{:.1}" cy="{:.1}" r="1.3" fill="{}"/>"#,
+                            px(x),
+                            py(y),
+                            s.color
+                        );
+                    }
+                }
                 Style::Star => {
                     for &(x, y) in &pts {
                         let _ = writeln!(
@@ -278,6 +291,12 @@ impl Plot {
                 ),
                 Style::Circle => format!(
                     r#"<circle cx="{:.1}" cy="{:.1}" r="4.5" fill="none" stroke="{}" stroke-width="1.8"/>"#,
+                    lx + 17.0,
+                    y - 4.0,
+                    s.color
+                ),
+                Style::Dot => format!(
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#,
                     lx + 17.0,
                     y - 4.0,
                     s.color

@@ -21,8 +21,11 @@
 mod cost_of_transport;
 mod fixed_point;
 mod gait;
+mod gaits;
 mod ideal_gait;
+mod orbit_diagram;
 mod scenes;
+mod stability_map;
 mod sweep;
 mod walk;
 mod walk_gait;
@@ -30,8 +33,11 @@ mod walk_gait;
 pub use cost_of_transport::CostOfTransport;
 pub use fixed_point::FixedPoint;
 pub use gait::{ActuatorFigures, ContactFigures, FoundGait, GaitNotFound, GaitOutcome, GaitReport};
+pub use gaits::GaitsReport;
 pub use ideal_gait::IdealGaitRecord;
+pub use orbit_diagram::{FellRecord, OrbitDiagramReport, OrbitPointRecord};
 pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
+pub use stability_map::{AxisRecord, StabilityMapReport};
 pub use sweep::{
     BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, SweepPointRecord,
     SweepReport,

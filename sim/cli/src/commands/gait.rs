@@ -1,4 +1,8 @@
 //! `walker gait`: find the periodic gait of a scene and its stability.
+//!
+//! At the scene's default values, Newton from its guess; elsewhere the longer-period of that
+//! and the defaults' gait followed to the requested values ([`long_period_gait`]), so the
+//! long-period gait comes back wherever its branch reaches (`walker gaits` lists them all).
 
 use super::{print_json, shown};
 use crate::figures;
@@ -6,8 +10,11 @@ use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use clap::Args;
+use sim::census::{long_period_gait, HomotopySettings};
+use sim::limit_cycle::{Gait, NewtonError};
 use sim::report::{GaitOutcome, GaitReport};
-use sim::stride::{StrideOptions, StrideRequest};
+use sim::scene::{Scene, Setup};
+use sim::stride::{StrideOptions, StrideRequest, StrideResult};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -31,29 +38,12 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
         output::create_dir("--plot", dir)?;
     }
     let walker = &setup.walker;
-    let result = setup.find_gait(&common.newton());
-    // One more stride from the fixed point: the report's contact figures and, for the
-    // joint-angle figure, its samples.
-    let figures_stride = result.as_ref().ok().and_then(|g| {
-        let (q, qd) = walker.unpack(&g.fixed_point);
-        walker
-            .stride(
-                &q,
-                &qd,
-                StrideRequest::new(&setup.settings).options(StrideOptions {
-                    record: plot.is_some(),
-                    contact: true,
-                }),
-            )
-            .ok()
-    });
-    let report = GaitReport::new(
-        &scene,
-        walker,
-        &setup.settings.integrator,
-        &result,
-        figures_stride.as_ref().map(|r| &r.contact),
-    );
+    let homotopy = HomotopySettings {
+        first_step: 1.0,
+        ..HomotopySettings::default()
+    };
+    let result = long_period_gait(&scene, &common.setup_for(), &common.newton(), &homotopy)?;
+    let (report, figures_stride) = report(&scene, &setup, &result, plot.is_some());
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let name = scene.name();
         let eig = figures::eigenvalues(
@@ -90,6 +80,41 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// The report of a gait search `result` at `scene`'s values (built as `setup`), with the
+/// stride from its fixed point that gives the contact figures (recorded when `record`, for
+/// the joint-angle figure). `walker gaits` reports each of its gaits so.
+pub fn report(
+    scene: &Scene,
+    setup: &Setup,
+    result: &Result<Gait, NewtonError>,
+    record: bool,
+) -> (GaitReport, Option<StrideResult>) {
+    let walker = &setup.walker;
+    // One more stride from the fixed point: the report's contact figures and, for the
+    // joint-angle figure, its samples.
+    let figures_stride = result.as_ref().ok().and_then(|g| {
+        let (q, qd) = walker.unpack(&g.fixed_point);
+        walker
+            .stride(
+                &q,
+                &qd,
+                StrideRequest::new(&setup.settings).options(StrideOptions {
+                    record,
+                    contact: true,
+                }),
+            )
+            .ok()
+    });
+    let report = GaitReport::new(
+        scene,
+        walker,
+        &setup.settings.integrator,
+        result,
+        figures_stride.as_ref().map(|r| &r.contact),
+    );
+    (report, figures_stride)
 }
 
 fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {

@@ -3,8 +3,11 @@
 
 pub mod accuracy;
 pub mod gait;
+pub mod gaits;
+pub mod orbit_diagram;
 pub mod scenes;
 pub mod sil;
+pub mod stability_map;
 pub mod sweep;
 pub mod tune;
 pub mod walk;

@@ -1,0 +1,169 @@
+//! `walker orbit-diagram`: the attractor of the stride map at each value of one parameter
+//! ([`sim::orbit_diagram`]), as text, JSON or the classic figure.
+
+use super::print_json;
+use crate::figures;
+use crate::input_error::InputError;
+use crate::limits;
+use crate::options::Common;
+use crate::output;
+use crate::progress::Progress;
+use anyhow::Result;
+use clap::Args;
+use sim::orbit_diagram::{linspace, orbit_diagram, OrbitError, OrbitSettings};
+use sim::report::OrbitDiagramReport;
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Options of `walker orbit-diagram`.
+#[derive(Args)]
+pub struct OrbitDiagramArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Parameter to vary.
+    #[arg(long)]
+    pub param: String,
+    /// First value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    /// Last value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    /// Number of values (2 to 5,000).
+    #[arg(long)]
+    pub points: usize,
+    /// Consecutive values computed in sequence from one seed gait (the chunks run in
+    /// parallel; as many as --points gives the purely sequential diagram).
+    #[arg(long, default_value_t = OrbitSettings::default().chunk_points)]
+    pub chunk_points: usize,
+    /// The coordinate the figure plots (a stride-map entry or a convention output; default:
+    /// the first stride-map entry).
+    #[arg(long)]
+    pub coordinate: Option<String>,
+    /// Write the figure (orbit_diagram.svg) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
+/// Runs `walker orbit-diagram`.
+pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
+    let OrbitDiagramArgs {
+        common,
+        param,
+        from,
+        to,
+        points,
+        chunk_points,
+        coordinate,
+        plot,
+    } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let param = scene.parameter_name(&param).map_err(InputError::Scene)?;
+    if !(from.is_finite() && to.is_finite()) {
+        return Err(InputError::Other("--from and --to must be finite".into()).into());
+    }
+    let points = limits::count("--points", points, 2, limits::MAX_ORBIT_POINTS)?;
+    let chunk_points =
+        limits::count("--chunk-points", chunk_points, 1, limits::MAX_ORBIT_POINTS)?.min(points);
+    let names = setup.walker.map_names();
+    let conventions: Vec<String> = scene
+        .convention_outputs(&setup.walker, &setup.guess.q, &setup.guess.qd)
+        .map_err(InputError::Scene)?
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect();
+    let coordinate = match coordinate {
+        None => names.first().cloned().unwrap_or_default(),
+        Some(c) if names.contains(&c) || conventions.contains(&c) => c,
+        Some(c) => {
+            return Err(InputError::Other(format!(
+                "--coordinate `{c}`: expected one of {}",
+                names
+                    .iter()
+                    .chain(&conventions)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+            .into())
+        }
+    };
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
+    let settings = OrbitSettings {
+        chunk_points,
+        ..OrbitSettings::default()
+    };
+    let values = linspace(from, to, points);
+    let progress = Progress::new(points, "orbit diagram", !common.json);
+    let found = orbit_diagram(
+        &scene,
+        &common.setup_for(),
+        &param,
+        &values,
+        &common.newton(),
+        &settings,
+        &|| progress.tick(),
+    )
+    .map_err(|e| match e {
+        OrbitError::Scene(s) => InputError::Scene(s),
+        other => InputError::Other(other.to_string()),
+    })?;
+    progress.finish();
+    let report = OrbitDiagramReport::new(&scene, &setup.walker, &param, &found, &settings);
+    if let Some(dir) = &plot {
+        let fig = figures::orbit_diagram(&report, &coordinate);
+        output::write_file(
+            "--plot",
+            &dir.join("orbit_diagram.svg"),
+            &fig.to_svg(900.0, 560.0),
+        )?;
+    }
+    if common.json {
+        print_json(&report)?;
+    } else {
+        output::text(|out| print_text(out, &report, &coordinate))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_text(
+    out: &mut dyn Write,
+    r: &OrbitDiagramReport,
+    coordinate: &str,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{:>14} {:>10} {:>7} {:>8}  {coordinate} at heel strike (or how it fell)",
+        r.param, "attractor", "period", "strides"
+    )?;
+    for p in &r.points {
+        let detail = match &p.failure {
+            Some(f) => format!("{:?} in stride {}", f.kind, f.stride),
+            None => {
+                let ys = p.samples.get(coordinate).map_or(&[][..], Vec::as_slice);
+                let (lo, hi) = ys
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+                        (a.min(y), b.max(y))
+                    });
+                if p.period_strides == Some(1) {
+                    format!("{lo:.8}")
+                } else {
+                    format!("{lo:.8} .. {hi:.8} ({} samples)", ys.len())
+                }
+            }
+        };
+        writeln!(
+            out,
+            "{:>14.8} {:>10} {:>7} {:>8}  {detail}",
+            p.value,
+            p.attractor,
+            p.period_strides.map_or("-".to_string(), |n| n.to_string()),
+            p.strides
+        )?;
+    }
+    Ok(())
+}

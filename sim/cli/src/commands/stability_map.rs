@@ -1,0 +1,154 @@
+//! `walker stability-map`: the largest |eigenvalue| of the long-period gait over a grid of
+//! two parameters ([`sim::stability_map`]), as text, JSON or a heat map.
+
+use super::print_json;
+use crate::heatmap::HeatMap;
+use crate::input_error::InputError;
+use crate::limits;
+use crate::options::Common;
+use crate::output;
+use crate::progress::Progress;
+use anyhow::Result;
+use clap::Args;
+use sim::census::HomotopySettings;
+use sim::orbit_diagram::linspace;
+use sim::report::StabilityMapReport;
+use sim::scene::Scene;
+use sim::stability_map::{stability_map, Axis};
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Options of `walker stability-map`.
+#[derive(Args)]
+pub struct StabilityMapArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// The x axis: `PARAM=FROM:TO:N` (N values from FROM to TO, 1 to 500).
+    #[arg(long, value_name = "PARAM=FROM:TO:N", allow_hyphen_values = true)]
+    pub x: String,
+    /// The y axis: `PARAM=FROM:TO:N` (at most 40,000 cells in all).
+    #[arg(long, value_name = "PARAM=FROM:TO:N", allow_hyphen_values = true)]
+    pub y: String,
+    /// Write the heat map (stability_map.svg) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
+/// Parses `PARAM=FROM:TO:N` for option `flag` of `scene` (the parameter by its canonical name).
+fn axis(flag: &str, spec: &str, scene: &Scene) -> Result<Axis, InputError> {
+    let bad = |why: &str| {
+        InputError::Other(format!(
+            "{flag} `{spec}`: {why} (expected PARAM=FROM:TO:N, e.g. slope_rad=0.01:0.02:11)"
+        ))
+    };
+    let (name, range) = spec.split_once('=').ok_or_else(|| bad("no `=`"))?;
+    let name = scene.parameter_name(name.trim())?;
+    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
+    let [from, to, n] = parts.as_slice() else {
+        return Err(bad("expected three fields after `=`"));
+    };
+    let number = |what: &str, s: &str| -> Result<f64, InputError> {
+        s.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(&format!("{what} `{s}` is not a finite number")))
+    };
+    let (from, to) = (number("FROM", from)?, number("TO", to)?);
+    let n: usize = n
+        .parse()
+        .map_err(|_| bad(&format!("N `{n}` is not a count")))?;
+    let n = limits::count(&format!("{flag} N"), n, 1, limits::MAX_MAP_AXIS_POINTS)?;
+    if n > 1 && from == to {
+        return Err(bad("FROM and TO are equal"));
+    }
+    Ok(Axis {
+        name,
+        values: linspace(from, to, n),
+    })
+}
+
+/// Runs `walker stability-map`.
+pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
+    let StabilityMapArgs { common, x, y, plot } = args;
+    let scene = common.scene()?;
+    common.setup(&scene)?;
+    let (x, y) = (axis("--x", &x, &scene)?, axis("--y", &y, &scene)?);
+    if x.name == y.name {
+        return Err(InputError::Other(format!(
+            "--x and --y both vary `{}`: give two different parameters",
+            x.name
+        ))
+        .into());
+    }
+    let cells = x.values.len() * y.values.len();
+    limits::count("--x N × --y N", cells, 1, limits::MAX_MAP_CELLS)?;
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
+    let progress = Progress::new(cells, "stability map", !common.json);
+    let homotopy = HomotopySettings {
+        first_step: 1.0,
+        ..HomotopySettings::default()
+    };
+    let map = stability_map(
+        &scene,
+        &common.setup_for(),
+        &x,
+        &y,
+        &common.newton(),
+        &homotopy,
+        &|| progress.tick(),
+    )
+    .map_err(InputError::Scene)?;
+    progress.finish();
+    let report = StabilityMapReport::new(scene.name(), &x, &y, &map);
+    if let Some(dir) = &plot {
+        let fig = HeatMap {
+            title: format!("{}: stability map of the long-period gait", scene.name()),
+            x_label: x.name.clone(),
+            y_label: y.name.clone(),
+            z_label: "max |λ| of the stride Jacobian".into(),
+            x: x.values.clone(),
+            y: y.values.clone(),
+            z: report.max_abs_eigenvalue.clone(),
+            level: 1.0,
+            contour_label: "|λ| = 1: stability boundary".into(),
+            missing_label: "no gait found".into(),
+        };
+        output::write_file(
+            "--plot",
+            &dir.join("stability_map.svg"),
+            &fig.to_svg(820.0, 620.0),
+        )?;
+    }
+    if common.json {
+        print_json(&report)?;
+    } else {
+        output::text(|out| print_text(out, &report))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_text(out: &mut dyn Write, r: &StabilityMapReport) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "max |λ| of the long-period gait ('-': no gait), rows {} (down), columns {} (across)",
+        r.y.name, r.x.name
+    )?;
+    write!(out, "{:>12}", "")?;
+    for x in &r.x.values {
+        write!(out, " {x:>9.4}")?;
+    }
+    writeln!(out)?;
+    for (y, row) in r.y.values.iter().zip(&r.max_abs_eigenvalue) {
+        write!(out, "{y:>12.5}")?;
+        for v in row {
+            match v {
+                Some(v) => write!(out, " {v:>9.4}")?,
+                None => write!(out, " {:>9}", "-")?,
+            }
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}

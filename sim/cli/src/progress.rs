@@ -1,0 +1,67 @@
+//! Progress of a long study on a terminal: a bar on standard error with a label, the count
+//! done out of a length, the time taken and the time left. Silent when the output is JSON or
+//! standard error is not a terminal (a pipe, a file, a test), so it never mixes into what
+//! another tool reads. Generic: any command that knows how many pieces of work it has (points,
+//! grid cells, values) can show one.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+
+/// A progress bar (or nothing, when silent). Shared between threads: [`Self::tick`] may be
+/// called from any of them.
+pub struct Progress {
+    bar: ProgressBar,
+}
+
+impl Progress {
+    /// A bar of `len` pieces labelled `label`, shown only when `visible` and standard error is
+    /// a terminal (pass `!json`).
+    pub fn new(len: usize, label: &str, visible: bool) -> Self {
+        let len = u64::try_from(len).unwrap_or(u64::MAX);
+        let bar = if visible && std::io::stderr().is_terminal() {
+            let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+            if let Ok(style) = ProgressStyle::with_template(
+                "{msg} [{bar:32}] {pos}/{len} ({elapsed} taken, about {eta} left)",
+            ) {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar.set_message(label.to_string());
+            bar
+        } else {
+            ProgressBar::hidden()
+        };
+        Self { bar }
+    }
+
+    /// One more piece done.
+    pub fn tick(&self) {
+        self.bar.inc(1);
+    }
+
+    /// Removes the bar from the terminal.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_hidden_bar_counts_without_drawing() {
+        let p = Progress::new(3, "test", false);
+        for _ in 0..5 {
+            p.tick();
+        }
+        assert!(p.bar.is_hidden());
+        assert_eq!(p.bar.position(), 5);
+        p.finish();
+    }
+}
