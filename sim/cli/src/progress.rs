@@ -38,6 +38,16 @@ impl Progress {
         self.bar.inc(1);
     }
 
+    /// Sets the count done to `fraction` (0 to 1) of the length, for work that reports a
+    /// fraction rather than pieces; it never moves the bar back.
+    pub fn set_fraction(&self, fraction: f64) {
+        let len = self.bar.length().unwrap_or(0);
+        let pos = (fraction.clamp(0.0, 1.0) * len as f64).round() as u64;
+        if pos > self.bar.position() {
+            self.bar.set_position(pos);
+        }
+    }
+
     /// Removes the bar from the terminal.
     pub fn finish(&self) {
         self.bar.finish_and_clear();
@@ -63,5 +73,18 @@ mod tests {
         assert!(p.bar.is_hidden());
         assert_eq!(p.bar.position(), 5);
         p.finish();
+    }
+
+    #[test]
+    fn a_fraction_sets_the_position_and_never_moves_back() {
+        let p = Progress::new(1000, "test", false);
+        p.set_fraction(0.25);
+        assert_eq!(p.bar.position(), 250);
+        p.set_fraction(0.1);
+        assert_eq!(p.bar.position(), 250);
+        p.set_fraction(7.0);
+        assert_eq!(p.bar.position(), 1000);
+        p.set_fraction(f64::NAN);
+        assert_eq!(p.bar.position(), 1000);
     }
 }

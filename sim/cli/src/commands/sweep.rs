@@ -7,12 +7,16 @@ use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::continuation::{continuation, ContinuationSettings, Family, SweepError};
 use sim::report::{SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;
+
+/// Resolution of the sweep's progress bar (the continuation reports a fraction done).
+const PROGRESS_STEPS: usize = 1000;
 
 /// Options of `walker sweep`.
 #[derive(Args)]
@@ -70,15 +74,17 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     };
     let mut family = Family::new(&scene, &param, &newton).map_err(InputError::Scene)?;
     family.stride_settings = settings.stride_settings.clone();
+    let progress = Progress::new(PROGRESS_STEPS, "sweep", !common.json);
     let result = continuation(
         &scene,
         &param,
         (from, to, points),
         &newton,
         &settings,
-        &|_fraction| {},
+        &|fraction| progress.set_fraction(fraction),
     )
     .map_err(scene_error)?;
+    progress.finish();
     let report = SweepReport::from_continuation(&family, &result);
     if common.json {
         print_json(&report)?;
