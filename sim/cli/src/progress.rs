@@ -11,6 +11,7 @@ use std::io::IsTerminal;
 /// called from any of them.
 pub struct Progress {
     bar: ProgressBar,
+    len: u64,
 }
 
 impl Progress {
@@ -30,7 +31,7 @@ impl Progress {
         } else {
             ProgressBar::hidden()
         };
-        Self { bar }
+        Self { bar, len }
     }
 
     /// One more piece done.
@@ -41,8 +42,7 @@ impl Progress {
     /// Sets the count done to `fraction` (0 to 1) of the length, for work that reports a
     /// fraction rather than pieces; it never moves the bar back.
     pub fn set_fraction(&self, fraction: f64) {
-        let len = self.bar.length().unwrap_or(0);
-        let pos = (fraction.clamp(0.0, 1.0) * len as f64).round() as u64;
+        let pos = (fraction.clamp(0.0, 1.0) * self.len as f64).round() as u64;
         if pos > self.bar.position() {
             self.bar.set_position(pos);
         }
