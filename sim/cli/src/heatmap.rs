@@ -2,7 +2,7 @@
 //! line (linear interpolation, marching squares over the cell centres), hatched cells where
 //! there is no value, a colour bar and labelled axes.
 
-use crate::plot::{escape, fmt_tick, nice_step};
+use crate::plot::{escape, fmt_tick, frame, nice_step, Rect};
 use std::fmt::Write as _;
 
 /// A heat map: `z[j][i]` at `(x[i], y[j])`, `None` where there is no value.
@@ -224,17 +224,12 @@ impl HeatMap {
             );
             t += ystep;
         }
-        let _ = write!(
-            o,
-            r##"<rect x="{ml}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>
-<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>
-<text transform="translate(18,{:.1}) rotate(-90)" text-anchor="middle">{}</text>
-"##,
-            ml + pw / 2.0,
-            height - 16.0,
-            escape(&self.x_label),
-            mt + ph / 2.0,
-            escape(&self.y_label)
+        frame(
+            &mut o,
+            Rect { ml, mt, pw, ph },
+            height,
+            &self.x_label,
+            &self.y_label,
         );
         // Colour bar: level − span to level + span.
         let (bx, bw) = (ml + pw + 24.0, 18.0);

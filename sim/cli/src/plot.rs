@@ -78,6 +78,31 @@ pub(crate) fn fmt_tick(v: f64, step: f64) -> String {
     }
 }
 
+/// A plot area: left and top margins, width and height [px].
+pub(crate) struct Rect {
+    pub ml: f64,
+    pub mt: f64,
+    pub pw: f64,
+    pub ph: f64,
+}
+
+/// The plot area's frame and the two axis labels, for every figure.
+pub(crate) fn frame(o: &mut String, r: Rect, height: f64, x_label: &str, y_label: &str) {
+    let Rect { ml, mt, pw, ph } = r;
+    let _ = write!(
+        o,
+        r##"<rect x="{ml}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>
+<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>
+<text transform="translate(18,{:.1}) rotate(-90)" text-anchor="middle">{}</text>
+"##,
+        ml + pw / 2.0,
+        height - 16.0,
+        escape(x_label),
+        mt + ph / 2.0,
+        escape(y_label)
+    );
+}
+
 pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -169,17 +194,12 @@ impl Plot {
             );
             t += ystep;
         }
-        let _ = write!(
-            o,
-            r##"<rect x="{ml}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>
-<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>
-<text transform="translate(18,{:.1}) rotate(-90)" text-anchor="middle">{}</text>
-"##,
-            ml + pw / 2.0,
-            height - 16.0,
-            escape(&self.x_label),
-            mt + ph / 2.0,
-            escape(&self.y_label)
+        frame(
+            &mut o,
+            Rect { ml, mt, pw, ph },
+            height,
+            &self.x_label,
+            &self.y_label,
         );
         let _ = writeln!(o, r#"<g clip-path="url(#plotarea)">"#);
         if self.unit_circle {
