@@ -11,6 +11,7 @@ use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
 use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
+use protocol::NodeState;
 use crate::time::Monotonic;
 
 /// Every driver of one ankle, and its node.
@@ -87,7 +88,13 @@ where
             self.encoder.set_zero_counts(zero_counts);
         }
         let measured = self.node.estimate().map(|(a, _)| a);
-        self.health.actuator_error = self.actuator.apply(out.actuator, measured).is_err();
+        // Emergency stop: the actuator off at once (no pay-out sequence).
+        let result = if out.state == NodeState::EmergencyStop {
+            self.actuator.stop()
+        } else {
+            self.actuator.apply(out.actuator, measured)
+        };
+        self.health.actuator_error = result.is_err();
         self.health.can_error = self.can.transmit(&out.transmit);
         out
     }
