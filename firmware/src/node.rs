@@ -122,6 +122,9 @@ pub struct DriverHealth {
     /// The CAN controller is bus-off (from its status register; error frames and
     /// error-passive are not faults).
     pub can_bus_off: bool,
+    /// The actuator moved the string in the last tick (`Actuator::string_moving`: the spool
+    /// encoder turned); cross-checked against the ankle angle by the stuck check in hold.
+    pub string_moving: bool,
 }
 
 /// Inputs of one tick.
@@ -174,8 +177,10 @@ pub struct AnkleNode {
     dropped_tx: u32,
     following: FollowingErrorMonitor,
     driven_setpoint: Option<f32>,
-    enabled_at: Option<Instant>,
     peer_state: Option<(Instant, NodeState)>,
+    /// The peer's state when it dropped out of `Enabled` (to `Safe` or `EmergencyStop`) while
+    /// this node was enabled; cleared when this node leaves `Enabled` or the peer is enabled.
+    peer_dropped_out: Option<NodeState>,
     reporter: FaultReporter,
     history: heapless::Deque<HistoryRecord, FAULT_HISTORY_LEN>,
     raised_this_tick: usize,
@@ -238,8 +243,8 @@ impl AnkleNode {
             dropped_tx: 0,
             following: FollowingErrorMonitor::default(),
             driven_setpoint: None,
-            enabled_at: None,
             peer_state: None,
+            peer_dropped_out: None,
             reporter: FaultReporter::default(),
             history: heapless::Deque::new(),
             raised_this_tick: 0,
@@ -417,7 +422,6 @@ impl AnkleNode {
         if state == self.state {
             return;
         }
-        self.enabled_at = (state == NodeState::Enabled).then_some(now);
         log_info!("node state {} -> {}", self.state, state);
         self.state = state;
         if state == NodeState::Enabled {
@@ -535,17 +539,35 @@ impl AnkleNode {
                 Message::Command(c) => self.handle_command(&mut out, now, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
+                    let before = self.peer_state.map(|(_, st)| st);
                     self.peer_state = Some((now, h.state));
+                    // The edge, not the level: a peer still `Safe` from an earlier event
+                    // must not stop this node from being enabled first.
+                    let dropped = matches!(h.state, NodeState::Safe | NodeState::EmergencyStop);
+                    if before == Some(NodeState::Enabled)
+                        && dropped
+                        && self.state == NodeState::Enabled
+                    {
+                        self.peer_dropped_out = Some(h.state);
+                    } else if h.state == NodeState::Enabled {
+                        self.peer_dropped_out = None;
+                    }
                 }
                 Message::HeelStrike(h) if h.node == self.peer => peer_heel_strike = true,
                 _ => {}
             }
         }
 
-        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check runs
-        // in every driven phase (push and hold): a working encoder's reading always moves by
-        // its noise, a frozen one does not.
-        let driving = matches!(self.reflex.phase(), ReflexPhase::Push | ReflexPhase::Hold);
+        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check counts
+        // ticks where the actuator moves the ankle: the whole push (the setpoint profile moves
+        // it), and hold ticks in which the spool turned (`DriverHealth::string_moving`). A
+        // still ankle with a still spool in hold is no fault: a healthy encoder may sit on one
+        // code then.
+        let driving = match self.reflex.phase() {
+            ReflexPhase::Push => true,
+            ReflexPhase::Hold => inputs.drivers.string_moving,
+            _ => false,
+        };
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
@@ -618,21 +640,15 @@ impl AnkleNode {
             }));
         }
 
-        // 5. The peer's own state, from heartbeats received since this node was enabled: a
-        // peer in its safe state or emergency stop cannot walk, so neither can this one.
-        let peer_safe = match (self.enabled_at, self.peer_state) {
-            (Some(since), Some((at, st))) if at > since => {
-                matches!(st, NodeState::Safe | NodeState::EmergencyStop)
-            }
-            _ => false,
-        };
-        let peer_detail = self.peer_state.map(|(_, st)| st.raw() as i16);
-        self.set_fault(
-            &mut out,
-            now,
-            FaultCode::PeerSafe,
-            if peer_safe { peer_detail } else { None },
-        );
+        // 5. The peer's own state: a peer that dropped from `Enabled` to its safe state or
+        // emergency stop while this node walked cannot walk, so neither can this one. Only
+        // that transition counts (not the level), so after a safe event the ankles can be
+        // enabled one at a time.
+        if self.state != NodeState::Enabled {
+            self.peer_dropped_out = None;
+        }
+        let peer_detail = self.peer_dropped_out.map(|st| st.raw() as i16);
+        self.set_fault(&mut out, now, FaultCode::PeerSafe, peer_detail);
 
         // Safe state on any safety-relevant fault.
         if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {

@@ -11,8 +11,8 @@ use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
 use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
-use protocol::NodeState;
 use crate::time::Monotonic;
+use protocol::NodeState;
 
 /// Every driver of one ankle, and its node.
 pub struct AnkleDrivers<E, P, A, C, M> {
@@ -95,6 +95,7 @@ where
             self.actuator.apply(out.actuator, measured)
         };
         self.health.actuator_error = result.is_err();
+        self.health.string_moving = self.actuator.string_moving();
         self.health.can_error = self.can.transmit(&out.transmit);
         out
     }

@@ -43,6 +43,13 @@ pub trait Actuator {
         measured_angle_rad: Option<f32>,
     ) -> Result<(), ActuatorError>;
 
+    /// True when the actuator moved the string in the last [`Actuator::apply`] (a spool
+    /// sensor saw it turn). The default, for actuators without such a sensor: false (the
+    /// node then has no evidence that a hold moves the ankle).
+    fn string_moving(&self) -> bool {
+        false
+    }
+
     /// Emergency stop: the actuator off at once, without a release sequence. The default
     /// applies `Released` (for actuators whose release is already immediate).
     ///
@@ -59,6 +66,9 @@ impl<T: Actuator + ?Sized> Actuator for &mut T {
     }
     fn stop(&mut self) -> Result<(), ActuatorError> {
         T::stop(self)
+    }
+    fn string_moving(&self) -> bool {
+        T::string_moving(self)
     }
 }
 

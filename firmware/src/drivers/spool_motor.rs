@@ -154,6 +154,8 @@ pub struct SpoolMotor<B, E, I> {
     release_best_error: i32,
     release_stall: u16,
     over_ticks: u16,
+    last_spool: Option<i32>,
+    moving: bool,
     latched: bool,
     cooldown: u16,
     output: StageOutput,
@@ -175,6 +177,8 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             release_best_error: i32::MAX,
             release_stall: 0,
             over_ticks: 0,
+            last_spool: None,
+            moving: false,
             latched: false,
             cooldown: 0,
             output: StageOutput::Off,
@@ -288,6 +292,10 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
 }
 
 impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B, E, I> {
+    fn string_moving(&self) -> bool {
+        self.moving
+    }
+
     fn stop(&mut self) -> Result<(), ActuatorError> {
         self.stop_now();
         Ok(())
@@ -337,8 +345,12 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
             self.over_ticks = self.over_ticks.saturating_sub(1);
         }
         let Ok(spool) = self.encoder.spool_counts() else {
+            self.moving = false;
             return self.fail(ActuatorError::SpoolSensor);
         };
+        // Spool motion since the previous reading (at least one quadrature count).
+        self.moving = self.last_spool.is_some_and(|s| s != spool);
+        self.last_spool = Some(spool);
         match command {
             ActuatorCommand::Released => self.release(spool),
             ActuatorCommand::Position { ankle_angle_rad } => {
@@ -484,7 +496,11 @@ mod tests {
             }
         };
         assert_eq!(result, Err(ActuatorError::ReleaseStalled));
-        assert_eq!(ticks, cfg.release_stall_ticks + 1, "aborted at the stall time");
+        assert_eq!(
+            ticks,
+            cfg.release_stall_ticks + 1,
+            "aborted at the stall time"
+        );
         assert_eq!(m.output(), StageOutput::Off);
         assert_eq!(m.apply(ActuatorCommand::Released, None), Ok(()));
         assert_eq!(m.output(), StageOutput::Off);
@@ -524,7 +540,11 @@ mod tests {
         assert_eq!(Actuator::stop(&mut m), Ok(()));
         assert_eq!(m.output(), StageOutput::Off);
         m.apply(ActuatorCommand::Released, None).unwrap();
-        assert_eq!(m.output(), StageOutput::Off, "no pay-out resumed after a stop");
+        assert_eq!(
+            m.output(),
+            StageOutput::Off,
+            "no pay-out resumed after a stop"
+        );
     }
 
     #[test]
@@ -545,19 +565,35 @@ mod tests {
         assert_eq!(m.output(), StageOutput::Duty(-0.8), "inside the bound");
         spool.set(Some(1_000 - cfg.hold_payout_counts));
         m.apply(want_out, Some(0.0)).unwrap();
-        assert_eq!(m.output(), StageOutput::Duty(0.0), "bound reached: no more pay-out");
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.0),
+            "bound reached: no more pay-out"
+        );
         m.apply(HOLD, Some(0.0)).unwrap();
-        assert_eq!(m.output(), StageOutput::Duty(0.8), "winding in stays allowed");
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.8),
+            "winding in stays allowed"
+        );
         // Soft limits, absolute.
         spool.set(Some(cfg.spool_max_counts));
         m.apply(HOLD, Some(0.0)).unwrap();
-        assert_eq!(m.output(), StageOutput::Duty(0.0), "no wind-in past the upper limit");
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.0),
+            "no wind-in past the upper limit"
+        );
         let mut b2 = Bridge::default();
         let spool2 = Cell::new(Some(cfg.spool_min_counts));
         let mut m2 = SpoolMotor::new(&mut b2, Spool(&spool2), Amps(&amps), cfg);
         m2.apply(HOLD, Some(0.0)).unwrap();
         m2.apply(want_out, Some(0.0)).unwrap();
-        assert_eq!(m2.output(), StageOutput::Duty(0.0), "no pay-out past the lower limit");
+        assert_eq!(
+            m2.output(),
+            StageOutput::Duty(0.0),
+            "no pay-out past the lower limit"
+        );
     }
 
     #[test]
@@ -579,7 +615,10 @@ mod tests {
             }
         }
         let tripped_at = tripped_at.expect("the latch must trip on a stalled motor");
-        assert!(tripped_at < 2 * cfg.overcurrent_ticks as usize + 2, "{tripped_at}");
+        assert!(
+            tripped_at < 2 * cfg.overcurrent_ticks as usize + 2,
+            "{tripped_at}"
+        );
         assert!(m.overcurrent_latched());
         for _ in 0..100 {
             assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::OverCurrent));
