@@ -32,6 +32,9 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 pub const MAX_TX_PER_TICK: usize =
     1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
 
+// docs/firmware.md states the value: 33 with 10 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 33);
+
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

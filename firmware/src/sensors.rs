@@ -345,10 +345,16 @@ mod tests {
         }
         assert_eq!(seen, [true; 3]);
         assert!(longest < 20, "longest still run {longest}");
-        assert_eq!(
-            with_simulated_noise(0, 0),
-            16383.min(with_simulated_noise(0, 0))
-        );
+        // Wrapped into the encoder's range at both ends: below 0 to the top, above it to 0.
+        for n in 0..100u32 {
+            let low = with_simulated_noise(0, n);
+            let high = with_simulated_noise(16_383, n);
+            match simulated_noise_counts(n) {
+                -1 => assert_eq!((low, high), (16_383, 16_382)),
+                0 => assert_eq!((low, high), (0, 16_383)),
+                _ => assert_eq!((low, high), (1, 0)),
+            }
+        }
     }
 
     #[test]

@@ -9,8 +9,9 @@
 //!   the tick time after the tick), returns `WouldBlock` when there is none — the port keeps
 //!   the frame and offers it again at a later tick — and an error when the node is bus-off;
 //! * the orchestrator delivers the frames the bus delivered to this node
-//!   ([`CanLink::deliver`]) into a receive FIFO of the board's depth (16 frames by default,
-//!   `RxBuf<16>` in `firmware/board-g431`; a full FIFO loses the newest frame and counts it);
+//!   ([`CanLink::deliver`]) into a receive FIFO (`SilConfig::rx_queue_frames`, 16 frames by
+//!   default: a quarter of the board's `RxBuf<64>` in `firmware/board-g431`, so the
+//!   simulator is the more pessimistic; a full FIFO loses the newest frame and counts it);
 //!   `receive` yields them raw, so frames that are not protocol messages reach the firmware's
 //!   own `malformed` counter. A bus-off controller receives nothing and reports an error.
 //!
