@@ -181,8 +181,8 @@ pub struct AnkleNode {
     following: FollowingErrorMonitor,
     driven_setpoint: Option<f32>,
     peer_state: Option<(Instant, NodeState)>,
-    /// The peer's state when it dropped out of `Enabled` (to `Safe` or `EmergencyStop`) while
-    /// this node was enabled; cleared when this node leaves `Enabled` or the peer is enabled.
+    /// The peer's state when it changed into `Safe` or `EmergencyStop` while this node was
+    /// enabled; cleared when this node leaves `Enabled` or the peer is enabled.
     peer_dropped_out: Option<NodeState>,
     reporter: FaultReporter,
     history: heapless::Deque<HistoryRecord, FAULT_HISTORY_LEN>,
@@ -545,10 +545,13 @@ impl AnkleNode {
                     let before = self.peer_state.map(|(_, st)| st);
                     self.peer_state = Some((now, h.state));
                     // The edge, not the level: a peer still `Safe` from an earlier event
-                    // must not stop this node from being enabled first.
-                    let dropped = matches!(h.state, NodeState::Safe | NodeState::EmergencyStop);
-                    if before == Some(NodeState::Enabled)
-                        && dropped
+                    // must not stop this node from being enabled first. The edge is a change
+                    // into `Safe`/`EmergencyStop` from a state outside them (normally
+                    // `Enabled`; `Disabled` when its `Enabled` heartbeat was not seen).
+                    let is_down =
+                        |st: NodeState| matches!(st, NodeState::Safe | NodeState::EmergencyStop);
+                    if before.is_some_and(|b| !is_down(b))
+                        && is_down(h.state)
                         && self.state == NodeState::Enabled
                     {
                         self.peer_dropped_out = Some(h.state);

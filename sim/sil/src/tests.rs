@@ -661,3 +661,22 @@ fn no_heel_strike_is_announced_for_the_foot_down_at_power_up() {
     );
     assert!(r.host.per_class.get("Heartbeat").is_some_and(|n| *n > 0));
 }
+
+#[test]
+fn one_corrupted_frame_is_one_error_per_controller_and_no_safe_state() {
+    let config = SilConfig::default()
+        .with_fault_str("corrupt:count=1")
+        .unwrap();
+    let mut c = sil(config);
+    run(&mut c, 0.3, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        let n = r.node(side).unwrap();
+        // Each controller saw the error frame and its driver reported it once through the
+        // receive path; the port counted it; no fault.
+        assert_eq!(n.port_bus_errors, 1, "{side:?}");
+        assert_eq!(n.state, "Enabled", "{side:?}");
+    }
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    assert!(r.bus_off.is_empty());
+}
