@@ -32,8 +32,8 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 pub const MAX_TX_PER_TICK: usize =
     1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
 
-// docs/firmware.md states the value: 33 with 10 fault codes, 8 answers and 8 history records.
-const _: () = assert!(MAX_TX_PER_TICK == 33);
+// docs/firmware.md states the value: 34 with 11 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 34);
 
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
@@ -128,6 +128,8 @@ pub struct DriverHealth {
     /// The actuator moved the string in the last tick (`Actuator::string_moving`: the spool
     /// encoder turned); cross-checked against the ankle angle by the stuck check in hold.
     pub string_moving: bool,
+    /// Received frames the controller lost to a full receive buffer since the last tick.
+    pub rx_lost: u32,
 }
 
 /// Inputs of one tick.
@@ -184,6 +186,7 @@ pub struct AnkleNode {
     /// The peer's state when it changed into `Safe` or `EmergencyStop` while this node was
     /// enabled; cleared when this node leaves `Enabled` or the peer is enabled.
     peer_dropped_out: Option<NodeState>,
+    rx_lost_total: u32,
     reporter: FaultReporter,
     history: heapless::Deque<HistoryRecord, FAULT_HISTORY_LEN>,
     raised_this_tick: usize,
@@ -248,6 +251,7 @@ impl AnkleNode {
             driven_setpoint: None,
             peer_state: None,
             peer_dropped_out: None,
+            rx_lost_total: 0,
             reporter: FaultReporter::default(),
             history: heapless::Deque::new(),
             raised_this_tick: 0,
@@ -421,7 +425,7 @@ impl AnkleNode {
         self.reporter.suppressed()
     }
 
-    fn enter(&mut self, now: Instant, state: NodeState, contact_closed: bool) {
+    fn enter(&mut self, state: NodeState, contact_closed: bool) {
         if state == self.state {
             return;
         }
@@ -434,26 +438,20 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(
-        &mut self,
-        out: &mut Outbox,
-        now: Instant,
-        cmd: &Command,
-        inputs: &TickInputs,
-    ) {
+    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, inputs: &TickInputs) {
         let contact_closed = inputs.contact_closed;
         if !cmd.target.addresses(self.config.node) {
             return;
         }
         match cmd.kind {
-            CommandKind::EmergencyStop => self.enter(now, NodeState::EmergencyStop, contact_closed),
-            CommandKind::Disable => self.enter(now, NodeState::Disabled, contact_closed),
+            CommandKind::EmergencyStop => self.enter(NodeState::EmergencyStop, contact_closed),
+            CommandKind::Disable => self.enter(NodeState::Disabled, contact_closed),
             CommandKind::Enable => {
                 // From Disabled or Safe only, and only without a safety-relevant fault;
                 // emergency stop needs a Disable first.
                 let allowed = matches!(self.state, NodeState::Disabled | NodeState::Safe);
                 if allowed && !self.faults.any_safety_relevant() {
-                    self.enter(now, NodeState::Enabled, contact_closed);
+                    self.enter(NodeState::Enabled, contact_closed);
                 }
             }
             CommandKind::SetParam { param, value } => {
@@ -539,7 +537,7 @@ impl AnkleNode {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(&mut out, now, c, inputs),
+                Message::Command(c) => self.handle_command(&mut out, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
                     let before = self.peer_state.map(|(_, st)| st);
@@ -656,9 +654,20 @@ impl AnkleNode {
         let peer_detail = self.peer_dropped_out.map(|st| st.raw() as i16);
         self.set_fault(&mut out, now, FaultCode::PeerSafe, peer_detail);
 
+        // Receive overflow: every lost frame counted, reported as `CanRxOverflow` with the
+        // total (not safety-relevant).
+        self.rx_lost_total = self.rx_lost_total.wrapping_add(inputs.drivers.rx_lost);
+        let lost_detail = i16::try_from(self.rx_lost_total).unwrap_or(i16::MAX);
+        self.set_fault(
+            &mut out,
+            now,
+            FaultCode::CanRxOverflow,
+            (inputs.drivers.rx_lost > 0).then_some(lost_detail),
+        );
+
         // Safe state on any safety-relevant fault.
         if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
-            self.enter(now, NodeState::Safe, contact);
+            self.enter(NodeState::Safe, contact);
         }
 
         // 6. The reflex.

@@ -71,13 +71,16 @@ where
             .unwrap_or_else(|_| self.contact.closed());
         let mut received: Vec<_, MAX_RX_PER_TICK> = Vec::new();
         self.can.receive(&mut received);
+        let lost_before = self.can.stats().rx_lost;
         let bus = self.can.poll_status();
+        let rx_lost = self.can.stats().rx_lost.wrapping_sub(lost_before);
         let inputs = TickInputs {
             angle,
             contact_closed,
             received: &received,
             drivers: DriverHealth {
                 can_bus_off: bus == BusState::BusOff,
+                rx_lost,
                 ..self.health
             },
         };

@@ -877,3 +877,40 @@ fn encoder_zero_calibration_takes_the_current_reading() {
     let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
     assert_eq!(o.request, None, "no reading, no calibration");
 }
+
+#[test]
+fn every_lost_frame_is_counted_and_reported_without_a_safe_state() {
+    let mut b = Bench::enabled();
+    let mut msgs = Vec::new();
+    b.drivers.rx_lost = 3;
+    msgs.extend(b.tick().transmit);
+    b.drivers.rx_lost = 0;
+    msgs.extend(b.run(100));
+    b.drivers.rx_lost = 2;
+    msgs.extend(b.tick().transmit);
+    b.drivers.rx_lost = 0;
+    msgs.extend(b.run(100));
+    let raised: Vec<i16> = msgs
+        .iter()
+        .filter_map(|m| match m {
+            Message::Fault(f)
+                if f.code == FaultCode::CanRxOverflow
+                    && f.transition == FaultTransition::Raised =>
+            {
+                Some(f.detail)
+            }
+            _ => None,
+        })
+        .collect();
+    // Each event carries the total of frames lost since start-up: 3, then 3 + 2.
+    assert_eq!(raised, [3, 5]);
+    assert_eq!(
+        b.node.state(),
+        NodeState::Enabled,
+        "reported, not a safe state"
+    );
+    assert!(
+        !b.node.faults().contains(FaultCode::CanRxOverflow),
+        "cleared"
+    );
+}
