@@ -204,9 +204,11 @@ async fn main(_spawner: Spawner) {
     defmt::info!("current-sense offsets {} / {} counts", ou, ov);
 
     // Spool encoder: TIM4 in encoder mode on the Hall/encoder connector (PB6, PB7).
-    let mut qei_cfg = qei::Config::default();
-    qei_cfg.ch1_pull = Pull::Up;
-    qei_cfg.ch2_pull = Pull::Up;
+    let qei_cfg = qei::Config {
+        ch1_pull: Pull::Up,
+        ch2_pull: Pull::Up,
+        ..Default::default()
+    };
     let spool = SpoolQei::new(Qei::new(p.TIM4, p.PB6, p.PB7, qei_cfg));
     let actuator = SpoolMotor::new(bridges, spool, current, SpoolMotorConfig::default());
 
@@ -310,7 +312,7 @@ async fn main(_spawner: Spawner) {
         }
         worst = worst.max(cycles);
         n = n.wrapping_add(1);
-        if n % 1_000 == 0 {
+        if n.is_multiple_of(1_000) {
             let stats = drivers.can.stats();
             defmt::info!(
                 "state {} phase {} faults {:#06x}; worst tick {} cycles (budget {}, {} MHz); late ticks {}; CAN {} TEC {} REC {} lost {} errors {}",
