@@ -150,7 +150,12 @@ async fn main(_spawner: Spawner) {
     let boot_pin = boot_pin::ignore_boot0_pin();
     let cause = reset_cause::read_and_clear();
     let id = node_id();
-    defmt::info!("ankle node {} starting, reset cause {}, BOOT0 pin {}", id, cause, boot_pin);
+    defmt::info!(
+        "ankle node {} starting, reset cause {}, BOOT0 pin {}",
+        id,
+        cause,
+        boot_pin
+    );
 
     // Power stage: phases U and V as two half-bridges, W held low; off until driven.
     let pwm = ComplementaryPwm::new(
