@@ -13,9 +13,9 @@
 
 use embassy_stm32::pac;
 
-/// FLASH_KEYR unlock sequence (RM0440 §5.3.5).
+/// FLASH_KEYR unlock sequence (RM0440, flash key register).
 const FLASH_KEYS: [u32; 2] = [0x4567_0123, 0xCDEF_89AB];
-/// FLASH_OPTKEYR unlock sequence (RM0440 §5.4.2).
+/// FLASH_OPTKEYR unlock sequence (RM0440, flash option key register).
 const OPTION_KEYS: [u32; 2] = [0x0819_2A3B, 0x4C5D_6E7F];
 /// Polls of the busy flag before giving up (an option-byte write takes tens of ms at most).
 const BUSY_POLL_BUDGET: u32 = 20_000_000;
@@ -50,6 +50,8 @@ pub fn ignore_boot0_pin() -> BootPin {
     if !wait_not_busy() {
         return BootPin::ProgrammingFailed;
     }
+    // Error flags left from before (write 1 to clear) would block the option-byte start.
+    pac::FLASH.sr().write_value(pac::FLASH.sr().read());
     if pac::FLASH.cr().read().lock() {
         for k in FLASH_KEYS {
             pac::FLASH.keyr().write_value(k);
