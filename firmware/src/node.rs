@@ -32,6 +32,9 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 pub const MAX_TX_PER_TICK: usize =
     1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
 
+// docs/firmware.md states the value: 34 with 11 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 34);
+
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -122,6 +125,11 @@ pub struct DriverHealth {
     /// The CAN controller is bus-off (from its status register; error frames and
     /// error-passive are not faults).
     pub can_bus_off: bool,
+    /// The actuator moved the string in the last tick (`Actuator::string_moving`: the spool
+    /// encoder turned); cross-checked against the ankle angle by the stuck check in hold.
+    pub string_moving: bool,
+    /// Received frames the controller lost to a full receive buffer since the last tick.
+    pub rx_lost: u32,
 }
 
 /// Inputs of one tick.
@@ -174,8 +182,11 @@ pub struct AnkleNode {
     dropped_tx: u32,
     following: FollowingErrorMonitor,
     driven_setpoint: Option<f32>,
-    enabled_at: Option<Instant>,
     peer_state: Option<(Instant, NodeState)>,
+    /// The peer's state when it changed into `Safe` or `EmergencyStop` while this node was
+    /// enabled; cleared when this node leaves `Enabled` or the peer is enabled.
+    peer_dropped_out: Option<NodeState>,
+    rx_lost_total: u32,
     reporter: FaultReporter,
     history: heapless::Deque<HistoryRecord, FAULT_HISTORY_LEN>,
     raised_this_tick: usize,
@@ -238,8 +249,9 @@ impl AnkleNode {
             dropped_tx: 0,
             following: FollowingErrorMonitor::default(),
             driven_setpoint: None,
-            enabled_at: None,
             peer_state: None,
+            peer_dropped_out: None,
+            rx_lost_total: 0,
             reporter: FaultReporter::default(),
             history: heapless::Deque::new(),
             raised_this_tick: 0,
@@ -413,11 +425,10 @@ impl AnkleNode {
         self.reporter.suppressed()
     }
 
-    fn enter(&mut self, now: Instant, state: NodeState, contact_closed: bool) {
+    fn enter(&mut self, state: NodeState, contact_closed: bool) {
         if state == self.state {
             return;
         }
-        self.enabled_at = (state == NodeState::Enabled).then_some(now);
         log_info!("node state {} -> {}", self.state, state);
         self.state = state;
         if state == NodeState::Enabled {
@@ -427,26 +438,20 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(
-        &mut self,
-        out: &mut Outbox,
-        now: Instant,
-        cmd: &Command,
-        inputs: &TickInputs,
-    ) {
+    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, inputs: &TickInputs) {
         let contact_closed = inputs.contact_closed;
         if !cmd.target.addresses(self.config.node) {
             return;
         }
         match cmd.kind {
-            CommandKind::EmergencyStop => self.enter(now, NodeState::EmergencyStop, contact_closed),
-            CommandKind::Disable => self.enter(now, NodeState::Disabled, contact_closed),
+            CommandKind::EmergencyStop => self.enter(NodeState::EmergencyStop, contact_closed),
+            CommandKind::Disable => self.enter(NodeState::Disabled, contact_closed),
             CommandKind::Enable => {
                 // From Disabled or Safe only, and only without a safety-relevant fault;
                 // emergency stop needs a Disable first.
                 let allowed = matches!(self.state, NodeState::Disabled | NodeState::Safe);
                 if allowed && !self.faults.any_safety_relevant() {
-                    self.enter(now, NodeState::Enabled, contact_closed);
+                    self.enter(NodeState::Enabled, contact_closed);
                 }
             }
             CommandKind::SetParam { param, value } => {
@@ -532,20 +537,41 @@ impl AnkleNode {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(&mut out, now, c, inputs),
+                Message::Command(c) => self.handle_command(&mut out, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
+                    let before = self.peer_state.map(|(_, st)| st);
                     self.peer_state = Some((now, h.state));
+                    // The edge, not the level: a peer still `Safe` from an earlier event
+                    // must not stop this node from being enabled first. The edge is a change
+                    // into `Safe`/`EmergencyStop` from a state outside them (normally
+                    // `Enabled`; `Disabled` when its `Enabled` heartbeat was not seen).
+                    let is_down =
+                        |st: NodeState| matches!(st, NodeState::Safe | NodeState::EmergencyStop);
+                    if before.is_some_and(|b| !is_down(b))
+                        && is_down(h.state)
+                        && self.state == NodeState::Enabled
+                    {
+                        self.peer_dropped_out = Some(h.state);
+                    } else if h.state == NodeState::Enabled {
+                        self.peer_dropped_out = None;
+                    }
                 }
                 Message::HeelStrike(h) if h.node == self.peer => peer_heel_strike = true,
                 _ => {}
             }
         }
 
-        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check runs
-        // in every driven phase (push and hold): a working encoder's reading always moves by
-        // its noise, a frozen one does not.
-        let driving = matches!(self.reflex.phase(), ReflexPhase::Push | ReflexPhase::Hold);
+        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check counts
+        // ticks where the actuator moves the ankle: the whole push (the setpoint profile moves
+        // it), and hold ticks in which the spool turned (`DriverHealth::string_moving`). A
+        // still ankle with a still spool in hold is no fault: a healthy encoder may sit on one
+        // code then.
+        let driving = match self.reflex.phase() {
+            ReflexPhase::Push => true,
+            ReflexPhase::Hold => inputs.drivers.string_moving,
+            _ => false,
+        };
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
@@ -618,25 +644,30 @@ impl AnkleNode {
             }));
         }
 
-        // 5. The peer's own state, from heartbeats received since this node was enabled: a
-        // peer in its safe state or emergency stop cannot walk, so neither can this one.
-        let peer_safe = match (self.enabled_at, self.peer_state) {
-            (Some(since), Some((at, st))) if at > since => {
-                matches!(st, NodeState::Safe | NodeState::EmergencyStop)
-            }
-            _ => false,
-        };
-        let peer_detail = self.peer_state.map(|(_, st)| st.raw() as i16);
+        // 5. The peer's own state: a peer that dropped from `Enabled` to its safe state or
+        // emergency stop while this node walked cannot walk, so neither can this one. Only
+        // that transition counts (not the level), so after a safe event the ankles can be
+        // enabled one at a time.
+        if self.state != NodeState::Enabled {
+            self.peer_dropped_out = None;
+        }
+        let peer_detail = self.peer_dropped_out.map(|st| st.raw() as i16);
+        self.set_fault(&mut out, now, FaultCode::PeerSafe, peer_detail);
+
+        // Receive overflow: every lost frame counted, reported as `CanRxOverflow` with the
+        // total (not safety-relevant).
+        self.rx_lost_total = self.rx_lost_total.wrapping_add(inputs.drivers.rx_lost);
+        let lost_detail = i16::try_from(self.rx_lost_total).unwrap_or(i16::MAX);
         self.set_fault(
             &mut out,
             now,
-            FaultCode::PeerSafe,
-            if peer_safe { peer_detail } else { None },
+            FaultCode::CanRxOverflow,
+            (inputs.drivers.rx_lost > 0).then_some(lost_detail),
         );
 
         // Safe state on any safety-relevant fault.
         if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
-            self.enter(now, NodeState::Safe, contact);
+            self.enter(NodeState::Safe, contact);
         }
 
         // 6. The reflex.

@@ -12,6 +12,7 @@ use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
 use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
 use crate::time::Monotonic;
+use protocol::NodeState;
 
 /// Every driver of one ankle, and its node.
 pub struct AnkleDrivers<E, P, A, C, M> {
@@ -70,13 +71,16 @@ where
             .unwrap_or_else(|_| self.contact.closed());
         let mut received: Vec<_, MAX_RX_PER_TICK> = Vec::new();
         self.can.receive(&mut received);
+        let lost_before = self.can.stats().rx_lost;
         let bus = self.can.poll_status();
+        let rx_lost = self.can.stats().rx_lost.wrapping_sub(lost_before);
         let inputs = TickInputs {
             angle,
             contact_closed,
             received: &received,
             drivers: DriverHealth {
                 can_bus_off: bus == BusState::BusOff,
+                rx_lost,
                 ..self.health
             },
         };
@@ -87,7 +91,14 @@ where
             self.encoder.set_zero_counts(zero_counts);
         }
         let measured = self.node.estimate().map(|(a, _)| a);
-        self.health.actuator_error = self.actuator.apply(out.actuator, measured).is_err();
+        // Emergency stop: the actuator off at once (no pay-out sequence).
+        let result = if out.state == NodeState::EmergencyStop {
+            self.actuator.stop()
+        } else {
+            self.actuator.apply(out.actuator, measured)
+        };
+        self.health.actuator_error = result.is_err();
+        self.health.string_moving = self.actuator.string_moving();
         self.health.can_error = self.can.transmit(&out.transmit);
         out
     }

@@ -128,7 +128,10 @@ pub struct SensorFindings {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Plausibility {
     last_good: Option<(Instant, AngleSample)>,
-    last_change: Option<(Instant, u16)>,
+    /// The previous reading, its time and whether the actuator drove in that tick.
+    last_read: Option<(Instant, u16, bool)>,
+    /// Time [µs] the reading has stayed the same across consecutive driven ticks.
+    still_driven_us: u64,
     stuck_at: Option<u16>,
 }
 
@@ -138,8 +141,12 @@ fn saturate_i16(x: f32) -> i16 {
 }
 
 impl Plausibility {
-    /// Check one read. `driving` is true while the actuator is moving the ankle (push phase),
-    /// when a frozen reading means a stuck sensor.
+    /// Check one read. `driving` is true in a tick where the actuator is moving the ankle —
+    /// the push (the setpoint profile moves it), or a hold while the spool turns (the node
+    /// cross-checks the ankle angle against the spool's motion) — when a frozen reading means
+    /// a stuck sensor. The stuck time accumulates over intervals between two consecutive
+    /// driven ticks with the same reading; undriven ticks pause it (a still ankle with a
+    /// still spool is no evidence either way), a change of the reading resets it.
     pub fn check(
         &mut self,
         now: Instant,
@@ -167,17 +174,16 @@ impl Plausibility {
                 }
             }
         }
-        // The stuck timer runs only while driving, from the start of driving or the last
-        // change of the reading, whichever is later.
-        match self.last_change {
-            _ if !driving => self.last_change = None,
-            Some((_, c)) if c == s.counts => {}
-            _ => self.last_change = Some((now, s.counts)),
-        }
-        if let Some((since, c)) = self.last_change {
-            if driving && now.secs_since(since) >= params.stuck_timeout_s() {
-                self.stuck_at = Some(c);
+        match self.last_read {
+            Some((_, c, _)) if c != s.counts => self.still_driven_us = 0,
+            Some((t, _, was_driving)) if was_driving && driving => {
+                self.still_driven_us = self.still_driven_us.saturating_add(now.micros_since(t));
             }
+            _ => {}
+        }
+        self.last_read = Some((now, s.counts, driving));
+        if self.still_driven_us as f32 >= params.stuck_timeout_s() * 1.0e6 {
+            self.stuck_at = Some(s.counts);
         }
         // A stuck reading stays a fault, driving or not, until the reading changes.
         match self.stuck_at {
@@ -288,6 +294,41 @@ mod tests {
     }
 
     #[test]
+    fn undriven_ticks_pause_the_stuck_time_and_a_change_resets_it() {
+        let p = ReflexParams::default();
+        let t = |ms| Instant::from_millis(ms);
+        // A hold: the spool turns every other 10 ms, the reading never changes. Only the
+        // driven intervals count, so the timeout is reached after 50 ms of them.
+        let mut pl = Plausibility::default();
+        let mut stuck_at = None;
+        for ms in 0..400 {
+            let driving = (ms / 10) % 2 == 0;
+            if pl.check(t(ms), &sample(8000), driving, &p).stuck.is_some() {
+                stuck_at = Some(ms);
+                break;
+            }
+        }
+        // Blocks of 10 driven ticks give 9 ms each: 6 blocks (54 ms) in 0..110.
+        assert!(
+            stuck_at.is_some_and(|ms| (100..110).contains(&ms)),
+            "{stuck_at:?}"
+        );
+        // A still ankle with a still spool: no evidence, never stuck.
+        let mut pl = Plausibility::default();
+        for ms in 0..1000 {
+            assert_eq!(pl.check(t(ms), &sample(8000), false, &p).stuck, None);
+        }
+        // A change restarts the time.
+        let mut pl = Plausibility::default();
+        for ms in 0..45 {
+            assert_eq!(pl.check(t(ms), &sample(8000), true, &p).stuck, None);
+        }
+        for ms in 45..90 {
+            assert_eq!(pl.check(t(ms), &sample(8001), true, &p).stuck, None, "{ms}");
+        }
+    }
+
+    #[test]
     fn simulated_noise_moves_within_a_count_and_never_sits_still_long() {
         let mut run = 0;
         let mut longest = 0;
@@ -304,10 +345,16 @@ mod tests {
         }
         assert_eq!(seen, [true; 3]);
         assert!(longest < 20, "longest still run {longest}");
-        assert_eq!(
-            with_simulated_noise(0, 0),
-            16383.min(with_simulated_noise(0, 0))
-        );
+        // Wrapped into the encoder's range at both ends: below 0 to the top, above it to 0.
+        for n in 0..100u32 {
+            let low = with_simulated_noise(0, n);
+            let high = with_simulated_noise(16_383, n);
+            match simulated_noise_counts(n) {
+                -1 => assert_eq!((low, high), (16_383, 16_382)),
+                0 => assert_eq!((low, high), (0, 16_383)),
+                _ => assert_eq!((low, high), (1, 0)),
+            }
+        }
     }
 
     #[test]

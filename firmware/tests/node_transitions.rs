@@ -605,6 +605,8 @@ fn bench_in_hold() -> Bench {
 fn stuck_encoder_during_hold_releases_within_50_ms() {
     let mut b = bench_in_hold();
     b.frozen = Some(CALIBRATION.counts(b.angle));
+    // The spool keeps turning (the hold loop drives) while the reading stays frozen.
+    b.drivers.string_moving = true;
     let mut released_after = None;
     let mut msgs = Vec::new();
     // Tick k (from 0) runs k ms after the first frozen sample.
@@ -623,6 +625,26 @@ fn stuck_encoder_during_hold_releases_within_50_ms() {
         fault_events(&msgs, FaultCode::EncoderStuck),
         [FaultTransition::Raised]
     );
+}
+
+#[test]
+fn a_quiet_still_encoder_in_hold_with_a_still_spool_raises_nothing() {
+    // A healthy encoder that sits on one code (no noise at all) while the ankle is held and
+    // the spool does not turn: no evidence of a stuck sensor.
+    let mut b = bench_in_hold();
+    b.frozen = Some(CALIBRATION.counts(b.angle));
+    b.drivers.string_moving = false;
+    for _ in 0..1000 {
+        let o = b.tick();
+        assert_eq!(o.state, NodeState::Enabled);
+        assert_eq!(o.phase, ReflexPhase::Hold);
+    }
+    assert!(b.node.faults().is_empty(), "{:?}", b.node.faults());
+    // The same still reading while the spool turns for 50 ms is a stuck encoder.
+    b.drivers.string_moving = true;
+    let safe = (0..=60).find(|_| b.tick().state == NodeState::Safe);
+    assert!(safe.is_some_and(|k| k <= 51), "{safe:?}");
+    assert!(b.node.faults().contains(FaultCode::EncoderStuck));
 }
 
 #[test]
@@ -682,6 +704,35 @@ fn a_peer_in_its_safe_state_makes_this_node_safe_until_enabled_again() {
     b.peer_state = NodeState::Disabled;
     b.run(200);
     assert_eq!(b.node.state(), NodeState::Enabled);
+}
+
+#[test]
+fn after_a_safe_event_the_ankles_can_be_enabled_one_at_a_time() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    b.peer_state = NodeState::Safe;
+    b.run(150);
+    assert_eq!(b.node.state(), NodeState::Safe);
+    // Enable this (left) ankle first while the peer (right) still reports Safe: no fault.
+    assert_eq!(
+        b.tick_with(&[cmd(CommandKind::Enable)]).state,
+        NodeState::Enabled
+    );
+    let msgs = b.run(300);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+    assert!(fault_events(&msgs, FaultCode::PeerSafe).is_empty());
+    // Then the right one: its heartbeats say Enabled.
+    b.peer_state = NodeState::Enabled;
+    b.run(100);
+    assert_eq!(b.node.state(), NodeState::Enabled);
+    // A new drop of the peer from Enabled to EmergencyStop is an event again.
+    b.peer_state = NodeState::EmergencyStop;
+    let msgs = b.run(100);
+    assert_eq!(b.node.state(), NodeState::Safe);
+    assert_eq!(
+        fault_events(&msgs, FaultCode::PeerSafe).first(),
+        Some(&FaultTransition::Raised)
+    );
 }
 
 #[test]
@@ -825,4 +876,41 @@ fn encoder_zero_calibration_takes_the_current_reading() {
     b.encoder_error = Some(EncoderError::Parity { word: 1 });
     let o = b.tick_with(&[cmd(CommandKind::CalibrateEncoderZero)]);
     assert_eq!(o.request, None, "no reading, no calibration");
+}
+
+#[test]
+fn every_lost_frame_is_counted_and_reported_without_a_safe_state() {
+    let mut b = Bench::enabled();
+    let mut msgs = Vec::new();
+    b.drivers.rx_lost = 3;
+    msgs.extend(b.tick().transmit);
+    b.drivers.rx_lost = 0;
+    msgs.extend(b.run(100));
+    b.drivers.rx_lost = 2;
+    msgs.extend(b.tick().transmit);
+    b.drivers.rx_lost = 0;
+    msgs.extend(b.run(100));
+    let raised: Vec<i16> = msgs
+        .iter()
+        .filter_map(|m| match m {
+            Message::Fault(f)
+                if f.code == FaultCode::CanRxOverflow
+                    && f.transition == FaultTransition::Raised =>
+            {
+                Some(f.detail)
+            }
+            _ => None,
+        })
+        .collect();
+    // Each event carries the total of frames lost since start-up: 3, then 3 + 2.
+    assert_eq!(raised, [3, 5]);
+    assert_eq!(
+        b.node.state(),
+        NodeState::Enabled,
+        "reported, not a safe state"
+    );
+    assert!(
+        !b.node.faults().contains(FaultCode::CanRxOverflow),
+        "cleared"
+    );
 }

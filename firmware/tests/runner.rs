@@ -435,3 +435,58 @@ fn one_error_frame_is_no_safe_state_but_bus_off_is() {
     assert_eq!(o.actuator, firmware::ActuatorCommand::Released);
     assert!(d.node.faults().contains(FaultCode::CanBus));
 }
+
+/// Records how the runner drives its actuator.
+#[derive(Default)]
+struct Recording {
+    applied: Cell<u32>,
+    stopped: Cell<u32>,
+}
+struct RecordingActuator(Rc<Recording>);
+impl firmware::drivers::actuator::Actuator for RecordingActuator {
+    fn apply(
+        &mut self,
+        _: firmware::ActuatorCommand,
+        _: Option<f32>,
+    ) -> Result<(), firmware::drivers::actuator::ActuatorError> {
+        self.0.applied.set(self.0.applied.get() + 1);
+        Ok(())
+    }
+    fn stop(&mut self) -> Result<(), firmware::drivers::actuator::ActuatorError> {
+        self.0.stopped.set(self.0.stopped.get() + 1);
+        Ok(())
+    }
+}
+
+#[test]
+fn emergency_stop_switches_the_actuator_off_at_once_instead_of_releasing() {
+    let w = Rc::new(World::default());
+    w.angle_rad.set(0.1);
+    w.tx_room.set(1000);
+    let rec = Rc::new(Recording::default());
+    let mut d = AnkleDrivers::new(
+        AnkleNode::new(NodeConfig::nominal(NodeId::LeftAnkle)).unwrap(),
+        MagneticEncoder::new(Spi(w.clone(), 0), CALIBRATION),
+        ContactSwitch::new(Pin(w.clone()), ActiveLevel::Low, 3),
+        RecordingActuator(rec.clone()),
+        CanPort::new(Can(w.clone())),
+        Clock(w.clone()),
+    );
+    d.step();
+    assert_eq!((rec.applied.get(), rec.stopped.get()), (1, 0));
+    send(
+        &w,
+        Message::Command(Command {
+            target: Target::Broadcast,
+            kind: CommandKind::EmergencyStop,
+        }),
+    );
+    assert_eq!(d.step().state, NodeState::EmergencyStop);
+    assert_eq!(
+        (rec.applied.get(), rec.stopped.get()),
+        (1, 1),
+        "stopped in the tick the emergency stop was read, not applied"
+    );
+    d.step();
+    assert_eq!((rec.applied.get(), rec.stopped.get()), (1, 2));
+}

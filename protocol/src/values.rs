@@ -152,16 +152,25 @@ wire_enum!(
         /// where it is commanded — a reversed or failed motor, a broken string, a frozen
         /// encoder reading.
         FollowingError = 9,
-        /// The other ankle reported (in its heartbeat, after this node was enabled) that it is
-        /// in its safe state or emergency stop: one ankle cannot walk alone.
+        /// The other ankle reported (in its heartbeat, a change while this node was enabled)
+        /// that it went to its safe state or emergency stop: one ankle cannot walk alone.
         PeerSafe = 10,
+        /// Received frames were lost in this tick because a receive buffer was full (the
+        /// controller's FIFO 0: FDCAN_IR.RF0L on the board; the receive FIFO in the
+        /// simulator). `detail`: every frame lost since start-up as the controller reports
+        /// them, saturated at 32767. Reported, not safety-relevant (the loop that would let
+        /// the buffer fill is the watchdog's).
+        CanRxOverflow = 11,
     }
 );
 
 impl FaultCode {
     /// True when this fault puts the node in its safe state.
     pub const fn is_safety_relevant(self) -> bool {
-        !matches!(self, FaultCode::PeerHeelStrikeLate)
+        !matches!(
+            self,
+            FaultCode::PeerHeelStrikeLate | FaultCode::CanRxOverflow
+        )
     }
     /// The bit of this fault in [`FaultFlags`].
     pub const fn flag(self) -> u16 {

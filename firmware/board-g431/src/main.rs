@@ -15,6 +15,7 @@
 #![no_std]
 #![no_main]
 
+mod boot_pin;
 mod can_port;
 mod crash;
 mod current_sense;
@@ -84,7 +85,8 @@ const MAX_TICK_US: u64 = 200;
 const WATCHDOG_TIMEOUT_US: u32 = 50_000;
 
 /// Flash kept for parameters and calibration [offsets from the flash base]: the last four
-/// 2 KiB pages of the 128 KiB (the binary is held under 64 KiB by scripts/firmware-tier).
+/// 2 KiB pages of the 128 KiB. The linker script (memory.x) gives code only the first
+/// 120 KiB, so the binary can never overlap this range.
 const PARAM_FLASH: core::ops::Range<u32> = 0x1E000..0x20000;
 
 /// Encoder zero used until one is calibrated and stored (CalibrateEncoderZero, SaveParams).
@@ -143,9 +145,17 @@ async fn main(_spawner: Spawner) {
     // Before anything else: the power stage's pins are inputs at reset; TIM1 is configured
     // with its main output disabled below, before any other peripheral.
     let p = embassy_stm32::init(clocks());
+    // PB8 (contact switch) doubles as BOOT0: make the boot mode independent of it first
+    // (programs the option bytes and resets once on a board with factory option bytes).
+    let boot_pin = boot_pin::ignore_boot0_pin();
     let cause = reset_cause::read_and_clear();
     let id = node_id();
-    defmt::info!("ankle node {} starting, reset cause {}", id, cause);
+    defmt::info!(
+        "ankle node {} starting, reset cause {}, BOOT0 pin {}",
+        id,
+        cause,
+        boot_pin
+    );
 
     // Power stage: phases U and V as two half-bridges, W held low; off until driven.
     let pwm = ComplementaryPwm::new(
@@ -199,9 +209,11 @@ async fn main(_spawner: Spawner) {
     defmt::info!("current-sense offsets {} / {} counts", ou, ov);
 
     // Spool encoder: TIM4 in encoder mode on the Hall/encoder connector (PB6, PB7).
-    let mut qei_cfg = qei::Config::default();
-    qei_cfg.ch1_pull = Pull::Up;
-    qei_cfg.ch2_pull = Pull::Up;
+    let qei_cfg = qei::Config {
+        ch1_pull: Pull::Up,
+        ch2_pull: Pull::Up,
+        ..Default::default()
+    };
     let spool = SpoolQei::new(Qei::new(p.TIM4, p.PB6, p.PB7, qei_cfg));
     let actuator = SpoolMotor::new(bridges, spool, current, SpoolMotorConfig::default());
 
@@ -297,10 +309,15 @@ async fn main(_spawner: Spawner) {
             let ok = store.save(&params, cal).await.is_ok();
             defmt::info!("parameters saved: {}", ok);
             drivers.node.storage_done(ok);
+            // The stall made the ticker miss deadlines; without a reset it would fire them
+            // back to back, ticks microseconds apart, in which the ankle encoder's PWM
+            // capture sees no new period (NoSignal → a false EncoderComms fault). Restart
+            // the 1 kHz schedule from now instead.
+            ticker.reset();
         }
         worst = worst.max(cycles);
         n = n.wrapping_add(1);
-        if n % 1_000 == 0 {
+        if n.is_multiple_of(1_000) {
             let stats = drivers.can.stats();
             defmt::info!(
                 "state {} phase {} faults {:#06x}; worst tick {} cycles (budget {}, {} MHz); late ticks {}; CAN {} TEC {} REC {} lost {} errors {}",

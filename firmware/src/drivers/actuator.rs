@@ -26,6 +26,8 @@ pub enum ActuatorError {
     Bridge,
     /// Paying out the slack on release did not finish in time (jammed spool?).
     ReleaseTimeout,
+    /// The pay-out made no progress or moved the wrong way (jammed or reversed); stage off.
+    ReleaseStalled,
 }
 
 /// Anything that can hold the string at an ankle angle or release it.
@@ -40,11 +42,33 @@ pub trait Actuator {
         command: ActuatorCommand,
         measured_angle_rad: Option<f32>,
     ) -> Result<(), ActuatorError>;
+
+    /// True when the actuator moved the string in the last [`Actuator::apply`] (a spool
+    /// sensor saw it turn). The default, for actuators without such a sensor: false (the
+    /// node then has no evidence that a hold moves the ankle).
+    fn string_moving(&self) -> bool {
+        false
+    }
+
+    /// Emergency stop: the actuator off at once, without a release sequence. The default
+    /// applies `Released` (for actuators whose release is already immediate).
+    ///
+    /// # Errors
+    /// As [`Actuator::apply`].
+    fn stop(&mut self) -> Result<(), ActuatorError> {
+        self.apply(ActuatorCommand::Released, None)
+    }
 }
 
 impl<T: Actuator + ?Sized> Actuator for &mut T {
     fn apply(&mut self, c: ActuatorCommand, m: Option<f32>) -> Result<(), ActuatorError> {
         T::apply(self, c, m)
+    }
+    fn stop(&mut self) -> Result<(), ActuatorError> {
+        T::stop(self)
+    }
+    fn string_moving(&self) -> bool {
+        T::string_moving(self)
     }
 }
 

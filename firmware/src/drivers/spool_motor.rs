@@ -12,15 +12,26 @@
 //!
 //! What each command does:
 //! * `Position { ankle_angle_rad }` — proportional loop from the measured ankle angle to the
-//!   duty (the string is taut while held), duty clamped to `max_duty`. The spool position of
-//!   every such tick is remembered.
+//!   duty (the string is taut while held), duty clamped to `max_duty`. The string is unilateral (it can pull, not push), so the
+//!   duty toward release is bounded: the spool may pay out at most `hold_payout_counts`
+//!   below where this hold began; beyond that the loop may only wind in or stop. The spool
+//!   position of every such tick is remembered.
+//! * Soft limits: the spool never drives below `spool_min_counts` nor above
+//!   `spool_max_counts` (counts from the power-up position), in any command.
 //! * `Released` — a geared motor is not back-drivable: duty 0 would leave the string as it
 //!   was. So the spool pays out `slack_counts` from where it last held the string (a bounded
 //!   move at `release_max_duty`), then the power stage switches off. Without a previous hold
-//!   (power-up) there is nothing to pay out: off.
-//! * Over-current: above `current_limit_a` the bridge is off for that tick (chopping); for
-//!   `overcurrent_ticks` ticks in a row the actuator latches off and reports `OverCurrent`
-//!   until it has been commanded `Released` for `overcurrent_cooldown_ticks` ticks.
+//!   (power-up) there is nothing to pay out: off. The pay-out is supervised: if the pay-out
+//!   error grows by more than `release_tolerance_counts` beyond its best value so far (the
+//!   spool moves the wrong way) or does not improve for `release_stall_ticks` ticks (it does
+//!   not move), the stage goes off and `ReleaseStalled` is reported.
+//! * [`SpoolMotor::stop_now`] (emergency stop): the stage off at once, any pay-out abandoned.
+//! * Over-current: above `current_limit_a` the bridge is off for that tick (chopping). A leaky
+//!   count adds one per reading over the limit and takes one off per reading under it *taken
+//!   while the stage was driving*; readings with the stage off (the current decays at once)
+//!   leave it as it is, so a stalled motor that is chopped every other tick still latches.
+//!   At `overcurrent_ticks` the actuator latches off and reports `OverCurrent` until it has
+//!   been commanded `Released` for `overcurrent_cooldown_ticks` ticks.
 //! * A failed spool or current reading, a bridge error, or a pay-out that does not reach its
 //!   target in `release_timeout_ticks`: off and an error (the node raises `Actuator` and goes
 //!   `Safe`).
@@ -72,7 +83,8 @@ pub struct SpoolMotorConfig {
     pub max_duty: f32,
     /// Current limit [A].
     pub current_limit_a: f32,
-    /// Ticks in a row over the limit before the actuator latches off.
+    /// Level of the leaky over-current count (one up per reading over the limit, one down per
+    /// driven reading under it) at which the actuator latches off.
     pub overcurrent_ticks: u16,
     /// Ticks of `Released` that clear the over-current latch.
     pub overcurrent_cooldown_ticks: u16,
@@ -86,11 +98,20 @@ pub struct SpoolMotorConfig {
     pub release_tolerance_counts: i32,
     /// Pay-out must finish within this many ticks.
     pub release_timeout_ticks: u16,
+    /// Pay-out aborted when its error has not improved for this many ticks.
+    pub release_stall_ticks: u16,
+    /// Largest pay-out [counts] below the spool position where a hold began, while holding.
+    pub hold_payout_counts: i32,
+    /// Soft limit: no drive below this spool position [counts from power-up].
+    pub spool_min_counts: i32,
+    /// Soft limit: no drive above this spool position [counts from power-up].
+    pub spool_max_counts: i32,
 }
 
 impl Default for SpoolMotorConfig {
     /// 10 /rad up to 80 % duty; 4 A limit (5 ticks to latch, 0.5 s to clear at 1 kHz);
-    /// release pays out 2000 counts at up to 30 % duty within 0.3 s.
+    /// release pays out 2000 counts at up to 30 % duty within 0.3 s, aborted after 50 ms
+    /// without progress; a hold pays out at most 500 counts; soft limits ±60 000 counts.
     fn default() -> Self {
         SpoolMotorConfig {
             kp_per_rad: 10.0,
@@ -103,6 +124,10 @@ impl Default for SpoolMotorConfig {
             release_max_duty: 0.3,
             release_tolerance_counts: 50,
             release_timeout_ticks: 300,
+            release_stall_ticks: 50,
+            hold_payout_counts: 500,
+            spool_min_counts: -60_000,
+            spool_max_counts: 60_000,
         }
     }
 }
@@ -123,9 +148,14 @@ pub struct SpoolMotor<B, E, I> {
     current: I,
     config: SpoolMotorConfig,
     held_at: Option<i32>,
+    hold_anchor: Option<i32>,
     release_target: Option<i32>,
     release_ticks: u16,
+    release_best_error: i32,
+    release_stall: u16,
     over_ticks: u16,
+    last_spool: Option<i32>,
+    moving: bool,
     latched: bool,
     cooldown: u16,
     output: StageOutput,
@@ -141,9 +171,14 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             current,
             config,
             held_at: None,
+            hold_anchor: None,
             release_target: None,
             release_ticks: 0,
+            release_best_error: i32::MAX,
+            release_stall: 0,
             over_ticks: 0,
+            last_spool: None,
+            moving: false,
             latched: false,
             cooldown: 0,
             output: StageOutput::Off,
@@ -183,15 +218,41 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
         }
     }
 
+    /// The duty with the soft limits applied: no drive further past a limit.
+    fn soft_limited(&self, spool: i32, duty: f32) -> f32 {
+        if (duty < 0.0 && spool <= self.config.spool_min_counts)
+            || (duty > 0.0 && spool >= self.config.spool_max_counts)
+        {
+            0.0
+        } else {
+            duty
+        }
+    }
+
+    /// Emergency stop: every switch off at once (MOE cleared), the pay-out and the hold
+    /// forgotten (the string's state is not known after a stop).
+    pub fn stop_now(&mut self) {
+        self.off();
+        self.held_at = None;
+        self.hold_anchor = None;
+        self.release_target = None;
+    }
+
     fn fail(&mut self, e: ActuatorError) -> Result<(), ActuatorError> {
         self.off();
         Err(e)
     }
 
     fn release(&mut self, spool: i32) -> Result<(), ActuatorError> {
+        self.hold_anchor = None;
         if let Some(h) = self.held_at.take() {
-            self.release_target = Some(h.saturating_sub(self.config.slack_counts));
+            let target = h
+                .saturating_sub(self.config.slack_counts)
+                .max(self.config.spool_min_counts);
+            self.release_target = Some(target);
             self.release_ticks = 0;
+            self.release_best_error = i32::MAX;
+            self.release_stall = 0;
         }
         let Some(target) = self.release_target else {
             self.off();
@@ -208,19 +269,45 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             self.release_target = None;
             return self.fail(ActuatorError::ReleaseTimeout);
         }
+        let size = error.saturating_abs();
+        if size < self.release_best_error {
+            self.release_best_error = size;
+            self.release_stall = 0;
+        } else {
+            self.release_stall = self.release_stall.saturating_add(1);
+        }
+        let diverging = size
+            > self
+                .release_best_error
+                .saturating_add(self.config.release_tolerance_counts);
+        if diverging || self.release_stall >= self.config.release_stall_ticks {
+            self.release_target = None;
+            return self.fail(ActuatorError::ReleaseStalled);
+        }
         let m = self.config.release_max_duty;
         let d = (self.config.release_kp_per_count * error as f32).clamp(-m, m);
+        let d = self.soft_limited(spool, d);
         self.drive(d)
     }
 }
 
 impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B, E, I> {
+    fn string_moving(&self) -> bool {
+        self.moving
+    }
+
+    fn stop(&mut self) -> Result<(), ActuatorError> {
+        self.stop_now();
+        Ok(())
+    }
+
     fn apply(
         &mut self,
         command: ActuatorCommand,
         measured_angle_rad: Option<f32>,
     ) -> Result<(), ActuatorError> {
         let released = command == ActuatorCommand::Released;
+        let driven_before = matches!(self.output, StageOutput::Duty(d) if d != 0.0);
         if self.latched {
             self.off();
             self.cooldown = if released {
@@ -235,6 +322,7 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
             self.over_ticks = 0;
             // The string's state is unknown after the latch: nothing to pay out from.
             self.held_at = None;
+            self.hold_anchor = None;
             self.release_target = None;
         }
         let Ok(amps) = self.current.motor_current_a() else {
@@ -251,10 +339,18 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
             }
             return Ok(());
         }
-        self.over_ticks = 0;
+        if driven_before {
+            // Under the limit while driving: the count leaks. A reading with the stage off
+            // says nothing about the motor under drive and leaves the count as it is.
+            self.over_ticks = self.over_ticks.saturating_sub(1);
+        }
         let Ok(spool) = self.encoder.spool_counts() else {
+            self.moving = false;
             return self.fail(ActuatorError::SpoolSensor);
         };
+        // Spool motion since the previous reading (at least one quadrature count).
+        self.moving = self.last_spool.is_some_and(|s| s != spool);
+        self.last_spool = Some(spool);
         match command {
             ActuatorCommand::Released => self.release(spool),
             ActuatorCommand::Position { ankle_angle_rad } => {
@@ -267,6 +363,11 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
                 if d.is_nan() {
                     return self.fail(ActuatorError::NoFeedback);
                 }
+                let anchor = *self.hold_anchor.get_or_insert(spool);
+                // Unilateral string: pay out at most `hold_payout_counts` below the anchor.
+                let floor = anchor.saturating_sub(self.config.hold_payout_counts);
+                let d = if d < 0.0 && spool <= floor { 0.0 } else { d };
+                let d = self.soft_limited(spool, d);
                 self.held_at = Some(spool);
                 self.drive(d)
             }
@@ -379,21 +480,150 @@ mod tests {
     }
 
     #[test]
-    fn a_jammed_pay_out_times_out_off() {
+    fn a_jammed_pay_out_is_aborted_off_after_the_stall_time() {
         let mut b = Bridge::default();
         let spool = Cell::new(Some(0));
         let amps = Cell::new(Some(0.5));
         let cfg = SpoolMotorConfig::default();
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
         m.apply(HOLD, Some(0.2)).unwrap();
-        let mut result = Ok(());
-        for _ in 0..=cfg.release_timeout_ticks {
-            result = m.apply(ActuatorCommand::Released, None);
-        }
-        assert_eq!(result, Err(ActuatorError::ReleaseTimeout));
+        let mut ticks = 0;
+        let result = loop {
+            ticks += 1;
+            let r = m.apply(ActuatorCommand::Released, None);
+            if r.is_err() || ticks > cfg.release_timeout_ticks {
+                break r;
+            }
+        };
+        assert_eq!(result, Err(ActuatorError::ReleaseStalled));
+        assert_eq!(
+            ticks,
+            cfg.release_stall_ticks + 1,
+            "aborted at the stall time"
+        );
         assert_eq!(m.output(), StageOutput::Off);
         assert_eq!(m.apply(ActuatorCommand::Released, None), Ok(()));
         assert_eq!(m.output(), StageOutput::Off);
+    }
+
+    #[test]
+    fn a_pay_out_moving_the_wrong_way_is_aborted_off() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(10_000));
+        let amps = Cell::new(Some(0.5));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        m.apply(HOLD, Some(0.2)).unwrap();
+        // Reversed motor: the negative duty winds in; the error grows tick by tick.
+        let mut result = Ok(());
+        for k in 1..20 {
+            result = m.apply(ActuatorCommand::Released, None);
+            if result.is_err() {
+                break;
+            }
+            assert!(matches!(m.output(), StageOutput::Duty(d) if d < 0.0));
+            spool.set(Some(10_000 + 20 * k));
+        }
+        assert_eq!(result, Err(ActuatorError::ReleaseStalled));
+        assert_eq!(m.output(), StageOutput::Off);
+    }
+
+    #[test]
+    fn a_stop_switches_off_at_once_and_forgets_the_pay_out() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(10_000));
+        let amps = Cell::new(Some(0.5));
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
+        m.apply(HOLD, Some(0.0)).unwrap();
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(-0.3), "paying out");
+        assert_eq!(Actuator::stop(&mut m), Ok(()));
+        assert_eq!(m.output(), StageOutput::Off);
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(
+            m.output(),
+            StageOutput::Off,
+            "no pay-out resumed after a stop"
+        );
+    }
+
+    #[test]
+    fn hold_pays_out_at_most_the_bound_and_respects_the_soft_limits() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(1_000));
+        let amps = Cell::new(Some(0.5));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        // Setpoint below the measured angle: the loop wants to pay out.
+        let want_out = ActuatorCommand::Position {
+            ankle_angle_rad: -0.5,
+        };
+        m.apply(want_out, Some(0.0)).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(-0.8));
+        spool.set(Some(1_000 - cfg.hold_payout_counts + 1));
+        m.apply(want_out, Some(0.0)).unwrap();
+        assert_eq!(m.output(), StageOutput::Duty(-0.8), "inside the bound");
+        spool.set(Some(1_000 - cfg.hold_payout_counts));
+        m.apply(want_out, Some(0.0)).unwrap();
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.0),
+            "bound reached: no more pay-out"
+        );
+        m.apply(HOLD, Some(0.0)).unwrap();
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.8),
+            "winding in stays allowed"
+        );
+        // Soft limits, absolute.
+        spool.set(Some(cfg.spool_max_counts));
+        m.apply(HOLD, Some(0.0)).unwrap();
+        assert_eq!(
+            m.output(),
+            StageOutput::Duty(0.0),
+            "no wind-in past the upper limit"
+        );
+        let mut b2 = Bridge::default();
+        let spool2 = Cell::new(Some(cfg.spool_min_counts));
+        let mut m2 = SpoolMotor::new(&mut b2, Spool(&spool2), Amps(&amps), cfg);
+        m2.apply(HOLD, Some(0.0)).unwrap();
+        m2.apply(want_out, Some(0.0)).unwrap();
+        assert_eq!(
+            m2.output(),
+            StageOutput::Duty(0.0),
+            "no pay-out past the lower limit"
+        );
+    }
+
+    #[test]
+    fn a_stalled_motor_whose_current_collapses_while_off_still_latches() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(0));
+        let amps = Cell::new(Some(0.0));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        let mut tripped_at = None;
+        for tick in 0..100 {
+            // Stalled: over the limit whenever the stage drove in the last tick, near zero
+            // when it was off (the current decays within the tick).
+            let driven = matches!(m.output(), StageOutput::Duty(d) if d != 0.0);
+            amps.set(Some(if driven { 6.0 } else { 0.1 }));
+            if m.apply(HOLD, Some(0.0)) == Err(ActuatorError::OverCurrent) {
+                tripped_at = Some(tick);
+                break;
+            }
+        }
+        let tripped_at = tripped_at.expect("the latch must trip on a stalled motor");
+        assert!(
+            tripped_at < 2 * cfg.overcurrent_ticks as usize + 2,
+            "{tripped_at}"
+        );
+        assert!(m.overcurrent_latched());
+        for _ in 0..100 {
+            assert_eq!(m.apply(HOLD, Some(0.0)), Err(ActuatorError::OverCurrent));
+            assert_eq!(m.output(), StageOutput::Off, "stays tripped");
+        }
     }
 
     #[test]

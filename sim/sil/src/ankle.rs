@@ -146,6 +146,11 @@ impl Ankle {
         self.wiring.can.borrow_mut().deliver(frame);
     }
 
+    /// The bus carried an error frame; `as_receiver` when this node did not send the frame.
+    pub fn error_frame(&mut self, as_receiver: bool) {
+        self.wiring.can.borrow_mut().error_frame(as_receiver);
+    }
+
     /// One control tick, as on the board: set what the hardware sees (`scene`, the clock,
     /// the bus node's state, the actuator's tick interval), run one driver step, and see
     /// what the firmware read.

@@ -58,8 +58,9 @@ pub struct SilConfig {
     pub trailing_contact_s: f64,
     /// The string actuator.
     pub actuator: ActuatorParams,
-    /// Depth of each node's CAN receive FIFO [frames]. Default 16 (the board's `RxBuf<16>`);
-    /// a frame that finds it full is lost and counted (`NodeReport::rx_overflows`).
+    /// Depth of each node's CAN receive FIFO [frames]. Default 16: a quarter of the board's
+    /// software buffer (`RxBuf<64>` in `firmware/board-g431`), so the simulator is the more
+    /// pessimistic; a frame that finds it full is lost and counted (`NodeReport::rx_overflows`).
     pub rx_queue_frames: usize,
     /// Faults on the bus (`drop`, `delay`, `corrupt`, `babble`, `busoff`; nodes `host`,
     /// `left`, `right` or 1, 2, 3).

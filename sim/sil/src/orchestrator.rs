@@ -176,7 +176,16 @@ impl FirmwareInTheLoop {
                         *off |= a.handle() == node;
                     }
                 }
-                BusEvent::ErrorFrame { .. } => {}
+                // Every controller on the bus sees the error frame and reports it through its
+                // receive path (one error each), a receiver's REC counts it.
+                BusEvent::ErrorFrame { from, .. } => {
+                    for (a, off) in self.ankles.iter_mut().zip(off) {
+                        if !off {
+                            let as_receiver = a.handle() != from;
+                            a.error_frame(as_receiver);
+                        }
+                    }
+                }
             }
         }
         Ok(())

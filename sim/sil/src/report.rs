@@ -102,7 +102,8 @@ pub struct NodeReport {
     /// Frames the firmware's CAN port dropped (its own transmit queue of 32 full); each sets
     /// the node's `CanBus` fault.
     pub port_dropped: u64,
-    /// Controller errors the firmware's CAN port counted (bus-off).
+    /// Controller errors the firmware's CAN port counted (one per error frame seen, and the
+    /// refusals while bus-off).
     pub port_bus_errors: u64,
     /// Delivered frames lost because the node's receive FIFO was full.
     pub rx_overflows: u64,

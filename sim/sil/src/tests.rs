@@ -600,8 +600,14 @@ fn histories_are_bounded_and_count_what_they_leave_out() {
     );
 }
 
+/// The simulated servo tracks the setpoint, not the measured angle, so once it has settled in
+/// Hold its spool stands still: a reading frozen there equals the held angle and is no
+/// evidence of a failed sensor (a healthy encoder may sit on one code as well). The node
+/// raises nothing; the stuck check counts only ticks where the spool turns (the board's
+/// closed loop keeps driving against a frozen reading, host test
+/// `stuck_encoder_during_hold_releases_within_50_ms` in firmware/tests/node_transitions.rs).
 #[test]
-fn a_stuck_encoder_during_hold_releases_the_string_within_50_ms() {
+fn a_stuck_encoder_during_a_still_hold_raises_no_fault() {
     let config = SilConfig::default().with_sensor_fault(SensorFault::StuckInPhase {
         side: Side::Left,
         phase: crate::DrivenPhase::Hold,
@@ -620,16 +626,17 @@ fn a_stuck_encoder_during_hold_releases_the_string_within_50_ms() {
         frozen_at > hold && frozen_at <= hold + 0.001 + 1e-9,
         "{hold} {frozen_at}"
     );
-    let stuck = r.first_raise(Side::Left, "EncoderStuck").expect("caught");
-    let safe = r.first_state_at_or_after(Side::Left, "Safe", 0.0).unwrap();
+    // Held on: the run goes on past 4 × the stuck timeout with the string held.
     assert!(
-        safe - frozen_at <= 0.050 + 1e-9,
-        "frozen {frozen_at}, fault {stuck}, safe {safe}"
+        ticks.last().is_some_and(|t| t.t_s > frozen_at + 0.2),
+        "{frozen_at}"
     );
+    assert_eq!(r.first_raise(Side::Left, "EncoderStuck"), None);
+    assert_eq!(r.node(Side::Left).unwrap().state, "Enabled");
     assert!(ticks
         .iter()
-        .filter(|t| t.t_s >= safe)
-        .all(|t| t.seg.released));
+        .filter(|t| t.t_s > frozen_at && t.t_s < frozen_at + 0.2)
+        .all(|t| !t.seg.released));
 }
 
 #[test]
@@ -653,4 +660,23 @@ fn no_heel_strike_is_announced_for_the_foot_down_at_power_up() {
         r.host.per_class
     );
     assert!(r.host.per_class.get("Heartbeat").is_some_and(|n| *n > 0));
+}
+
+#[test]
+fn one_corrupted_frame_is_one_error_per_controller_and_no_safe_state() {
+    let config = SilConfig::default()
+        .with_fault_str("corrupt:count=1")
+        .unwrap();
+    let mut c = sil(config);
+    run(&mut c, 0.3, &[]);
+    let r = c.report();
+    for side in Side::BOTH {
+        let n = r.node(side).unwrap();
+        // Each controller saw the error frame and its driver reported it once through the
+        // receive path; the port counted it; no fault.
+        assert_eq!(n.port_bus_errors, 1, "{side:?}");
+        assert_eq!(n.state, "Enabled", "{side:?}");
+    }
+    assert!(r.faults.is_empty(), "{:?}", r.faults);
+    assert!(r.bus_off.is_empty());
 }

@@ -20,6 +20,11 @@ use firmware::ActuatorCommand;
 use crate::actuator::ActuatorModel;
 use sim::control::ActuatorSegment;
 
+/// Smallest motion of the servo's string limit in one tick that its spool sensor sees, as an
+/// ankle angle [rad]: a tenth of the ankle encoder's count (2π/16384 ≈ 0.38 mrad), since the
+/// spool's quadrature encoder sits before the gearbox and resolves far finer than the ankle.
+pub const SPOOL_RESOLUTION_RAD: f64 = 3.8e-5;
+
 /// State shared by a [`SimActuator`] and the orchestrator.
 #[derive(Clone, Debug)]
 pub struct ActuatorLink {
@@ -32,6 +37,7 @@ pub struct ActuatorLink {
     last_command: Option<ActuatorCommand>,
     last_measured_rad: Option<f32>,
     commands: u64,
+    moving: bool,
 }
 
 impl ActuatorLink {
@@ -47,6 +53,7 @@ impl ActuatorLink {
             last_command: None,
             last_measured_rad: None,
             commands: 0,
+            moving: false,
         }
     }
 
@@ -105,11 +112,16 @@ impl Actuator for SimActuator {
         };
         let (t0, t1, take_up, load) = (l.t0_s, l.t1_s, l.take_up_rad, l.load_n_m);
         let seg = l.model.tick(t0, t1, setpoint, take_up, load);
+        l.moving = !seg.released && (seg.p1_rad - seg.p0_rad).abs() >= SPOOL_RESOLUTION_RAD;
         l.segment = Some(seg);
         l.last_command = Some(command);
         l.last_measured_rad = measured_angle_rad;
         l.commands += 1;
         Ok(())
+    }
+
+    fn string_moving(&self) -> bool {
+        self.0.borrow().moving
     }
 }
 

@@ -9,8 +9,9 @@
 //!   the tick time after the tick), returns `WouldBlock` when there is none — the port keeps
 //!   the frame and offers it again at a later tick — and an error when the node is bus-off;
 //! * the orchestrator delivers the frames the bus delivered to this node
-//!   ([`CanLink::deliver`]) into a receive FIFO of the board's depth (16 frames by default,
-//!   `RxBuf<16>` in `firmware/board-g431`; a full FIFO loses the newest frame and counts it);
+//!   ([`CanLink::deliver`]) into a receive FIFO (`SilConfig::rx_queue_frames`, 16 frames by
+//!   default: a quarter of the board's `RxBuf<64>` in `firmware/board-g431`, so the
+//!   simulator is the more pessimistic; a full FIFO loses the newest frame and counts it);
 //!   `receive` yields them raw, so frames that are not protocol messages reach the firmware's
 //!   own `malformed` counter. A bus-off controller receives nothing and reports an error.
 //!
@@ -68,6 +69,10 @@ impl embedded_can::Frame for SimFrame {
 pub enum SimCanError {
     /// The node's transmit error counter passed 255: it takes no part in the bus.
     BusOff,
+    /// The controller saw an error frame (its protocol status' last error code), reported
+    /// through the receive path once per error frame, as embassy-stm32's buffered FDCAN
+    /// driver pushes it into its receive channel.
+    ErrorFrame,
 }
 
 impl embedded_can::Error for SimCanError {
@@ -90,7 +95,15 @@ pub struct CanLink {
     rx_overflows_reported: u64,
     refused_full: u64,
     refused_bus_off: u64,
+    error_frames_pending: u32,
+    error_frames_seen: u64,
+    rec: u16,
 }
+
+/// The receive error counter's ceiling as this model keeps it (ISO 11898-1 lets it grow past
+/// 127, error-passive, and stops counting relevance there; FDCAN_ECR.REC has 7 bits plus the
+/// RP flag).
+const REC_MAX: u16 = 128;
 
 impl CanLink {
     /// A link with a receive FIFO of `rx_capacity` frames (at least 1).
@@ -107,11 +120,37 @@ impl CanLink {
             rx_overflows_reported: 0,
             refused_full: 0,
             refused_bus_off: 0,
+            error_frames_pending: 0,
+            error_frames_seen: 0,
+            rec: 0,
         }
+    }
+
+    /// The bus carried an error frame. Every controller on the bus sees it and reports it
+    /// once through its receive path; a receiver's REC grows by 1 (ISO 11898-1 fault
+    /// confinement, the receiver's rule; the transmitter's TEC is the bus model's).
+    pub fn error_frame(&mut self, as_receiver: bool) {
+        self.error_frames_pending = self.error_frames_pending.saturating_add(1);
+        self.error_frames_seen += 1;
+        if as_receiver {
+            self.rec = (self.rec + 1).min(REC_MAX);
+        }
+    }
+
+    /// Error frames this controller saw.
+    pub fn error_frames_seen(&self) -> u64 {
+        self.error_frames_seen
+    }
+
+    /// The receive error counter.
+    pub fn rec(&self) -> u16 {
+        self.rec
     }
 
     /// A frame the bus delivered to this node; false (and counted) when the FIFO is full.
     pub fn deliver(&mut self, frame: canbus::Frame) -> bool {
+        // A successful reception takes one off the receive error counter.
+        self.rec = self.rec.saturating_sub(1);
         if self.rx.len() >= self.rx_capacity {
             self.rx_overflows += 1;
             return false;
@@ -180,8 +219,8 @@ impl SimCan {
 
 impl ControllerHealth for SimCan {
     /// As the board's driver reports it: the state from the status register, TEC saturated
-    /// to the register's 8 bits, REC 0 (the bus model keeps no receive counter), and the
-    /// frames lost to a full FIFO since the last call.
+    /// to the register's 8 bits, REC (one per error frame received, one off per frame
+    /// received), and the frames lost to a full FIFO since the last call.
     fn status(&mut self) -> ControllerStatus {
         let mut l = self.0.borrow_mut();
         let lost = l.rx_overflows - l.rx_overflows_reported;
@@ -194,7 +233,7 @@ impl ControllerHealth for SimCan {
                 canbus::ErrorState::BusOff => BusState::BusOff,
             },
             tx_errors: u8::try_from(tec).unwrap_or(u8::MAX),
-            rx_errors: 0,
+            rx_errors: u8::try_from(l.rec).unwrap_or(u8::MAX),
             rx_lost: u32::try_from(lost).unwrap_or(u32::MAX),
         }
     }
@@ -223,6 +262,10 @@ impl embedded_can::nb::Can for SimCan {
         let mut l = self.0.borrow_mut();
         if l.bus_off {
             return Err(nb::Error::Other(SimCanError::BusOff));
+        }
+        if l.error_frames_pending > 0 {
+            l.error_frames_pending -= 1;
+            return Err(nb::Error::Other(SimCanError::ErrorFrame));
         }
         match l.rx.pop_front() {
             Some(f) => {
@@ -307,6 +350,37 @@ mod tests {
         assert_eq!(port.poll_status(), BusState::BusOff);
         assert_eq!(port.stats().status.tx_errors, 255);
         assert_eq!(port.stats().bus_off_events, 1);
+    }
+
+    #[test]
+    fn each_error_frame_is_one_receive_error_and_counts_in_rec() {
+        let link = Rc::new(RefCell::new(CanLink::new(16)));
+        let mut port = CanPort::new(SimCan::new(Rc::clone(&link)));
+        link.borrow_mut().error_frame(true);
+        link.borrow_mut().error_frame(true);
+        link.borrow_mut()
+            .deliver(canbus::Frame::from(heartbeat(1).encode().unwrap()));
+        // Two error frames, then one good frame: REC 2 − 1.
+        assert_eq!(link.borrow().rec(), 1);
+        let mut rx = heapless::Vec::new();
+        port.receive(&mut rx);
+        assert_eq!(
+            port.stats().bus_errors,
+            1,
+            "one error per read, the port stops there"
+        );
+        port.receive(&mut rx);
+        assert_eq!(port.stats().bus_errors, 2);
+        port.receive(&mut rx);
+        assert_eq!(port.stats().bus_errors, 2, "no error frame left");
+        assert_eq!(rx.as_slice(), &[heartbeat(1)]);
+        assert_eq!(port.poll_status(), BusState::ErrorActive);
+        assert_eq!(port.stats().status.rx_errors, 1);
+        // The transmitter sees the error frame too, without a REC step.
+        let tx_link = Rc::new(RefCell::new(CanLink::new(16)));
+        tx_link.borrow_mut().error_frame(false);
+        assert_eq!(tx_link.borrow().rec(), 0);
+        assert_eq!(tx_link.borrow().error_frames_seen(), 1);
     }
 
     #[test]
