@@ -57,6 +57,12 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
+    if from == to {
+        return Err(InputError::Other(format!(
+            "--from and --to are equal ({from}): a sweep needs a range"
+        ))
+        .into());
+    }
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let max_period = limits::count("--max-period", max_period, 1, 64)?;
     let newton = common.newton();
