@@ -40,7 +40,10 @@ pub type SetupFor<'a> = dyn Fn(&Scene) -> Result<Setup, SceneError> + Sync + 'a;
 /// How a gait is followed from the defaults to the requested values ([`follow`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HomotopySettings {
-    /// The first step along the path, as a fraction of it (0 < · ≤ 1).
+    /// The first step along the path, as a fraction of it (0 < · ≤ 1). The default, 1, tries
+    /// the whole path at once and halves the step only when the corrector fails or jumps
+    /// (the guards below); every caller (`walker gait`, `gaits`, `sweep`, `orbit-diagram`,
+    /// `stability-map`) uses the default, so they all return the same gait.
     pub first_step: f64,
     /// Smallest step before the path is given up, as a fraction of it.
     pub min_step: f64,
@@ -72,7 +75,7 @@ impl HomotopySettings {
 impl Default for HomotopySettings {
     fn default() -> Self {
         Self {
-            first_step: 0.25,
+            first_step: 1.0,
             min_step: 1.0 / 256.0,
             max_correction: 0.1,
             max_period_change: 0.1,
@@ -309,23 +312,49 @@ pub fn census(
     })
 }
 
-/// The gait `walker gait` reports: at the scene's defaults, Newton from its guess (as ever);
-/// elsewhere the longer-period of Newton from the guess and the defaults' gait followed to
-/// the requested values ([`follow`]), so that the long-period gait is returned wherever the
-/// branch through the defaults reaches, not only near the guess. Two or three Newton searches
-/// in the usual case; the thorough search is [`census`].
+/// Where the gait [`nominal_gait`] returns comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GaitSource {
+    /// At the scene's defaults: Newton from the scene's guess.
+    Defaults,
+    /// Off the defaults: Newton from the scene's guess at the requested values (its period is
+    /// the longer, or the defaults' gait could not be followed).
+    Guess,
+    /// Off the defaults: the scene's gait at its defaults continued to the requested values
+    /// ([`follow`]).
+    ContinuedFromDefaults,
+}
+
+impl GaitSource {
+    /// In words, for text output.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Defaults => "the scene's gait at its defaults (Newton from its guess)",
+            Self::Guess => "Newton from the scene's guess at these values",
+            Self::ContinuedFromDefaults => "the scene's gait continued from its defaults",
+        }
+    }
+}
+
+/// The gait `walker gait` reports, the scene's **nominal** gait: at the scene's defaults,
+/// Newton from its guess (as ever); elsewhere the longer-period of Newton from the guess and
+/// the defaults' gait followed to the requested values ([`follow`]) — the branch of the
+/// scene's nominal gait, which for the simplest walker is Garcia's long-period gait, wherever
+/// that branch reaches, not only near the guess. Two or three Newton searches in the usual
+/// case; every period-1 gait is [`census`]'s job. With where it came from.
 ///
 /// # Errors
 /// The scene cannot be built at its values or at its defaults.
-pub fn long_period_gait(
+pub fn nominal_gait(
     scene: &Scene,
     setup_for: &SetupFor<'_>,
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
-) -> Result<Result<Gait, NewtonError>, SceneError> {
+) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
     let setup = setup_for(scene)?;
     if is_at_defaults(scene) {
-        return Ok(setup.find_gait(newton));
+        return Ok(setup.find_gait(newton).map(|g| (g, GaitSource::Defaults)));
     }
     let defaults = at_defaults(scene)?;
     let default_setup = setup_for(&defaults)?;
@@ -338,14 +367,28 @@ pub fn long_period_gait(
     );
     Ok(match (from_guess, followed) {
         (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
-            b
+            (b, GaitSource::ContinuedFromDefaults)
         } else {
-            a
+            (a, GaitSource::Guess)
         }),
-        (Ok(a), Err(_)) => Ok(a),
-        (Err(_), Ok(b)) => Ok(b),
+        (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
+        (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
         (Err(e), Err(_)) => Err(e),
     })
+}
+
+/// [`nominal_gait`] without its source: "the long-period gait" of `walker gait`, the sweep's
+/// first gait, the orbit diagram's seed and the stability map's seeds.
+///
+/// # Errors
+/// The scene cannot be built at its values or at its defaults.
+pub fn long_period_gait(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+) -> Result<Result<Gait, NewtonError>, SceneError> {
+    Ok(nominal_gait(scene, setup_for, newton, homotopy)?.map(|(g, _)| g))
 }
 
 /// The scene's guess as a stride-map vector of its setup.

@@ -156,6 +156,43 @@ fn a_coarse_sweep_stays_on_the_long_period_branch() {
     }
 }
 
+#[test]
+fn a_sweep_from_slope_0_015_starts_on_the_long_period_gait_as_walker_gait_does() {
+    // At 0.015 the scene's guess finds the unstable short-step gait; the sweep must start on
+    // the gait `walker gait` returns there (the long-period one) and follow it.
+    let scene = Scene::load("simplest").unwrap();
+    let c = run("simplest", "slope", (0.015, 0.017, 3), 1);
+    let main = &c.branches[0];
+    assert!(c.no_start.is_empty(), "{:?}", c.no_start);
+    let first = &main.grid[0];
+    assert_eq!(first.value, 0.015);
+    let mut at = scene.clone();
+    at.set("slope", 0.015).unwrap();
+    let setup_for = |s: &Scene| s.setup();
+    let gait = sim::census::long_period_gait(
+        &at,
+        &setup_for,
+        &NewtonSettings::default(),
+        &sim::census::HomotopySettings::default(),
+    )
+    .unwrap()
+    .unwrap();
+    assert!((&first.point.orbit[0] - &gait.fixed_point).amax() < 1e-8);
+    for gp in main.grid.iter().filter(|g| g.point.period_strides() == 1) {
+        let reference = garcia::continued(0.009, gp.value, GUESS_LONG, 100).unwrap();
+        let d = close(garcia_state(&gp.point.orbit[0]), reference.state);
+        assert!(
+            d < 1e-8,
+            "slope {}: off the long-period branch by {d}",
+            gp.value
+        );
+    }
+    // The short-step gait (Newton from the scene's guess there) is another one.
+    let setup = at.setup().unwrap();
+    let short = setup.find_gait(&NewtonSettings::default()).unwrap();
+    assert!(short.stride.duration_s < 0.9 * gait.stride.duration_s);
+}
+
 fn fold_test(p: &BranchPoint) -> f64 {
     sim::continuation::fold_test(&p.multipliers)
 }

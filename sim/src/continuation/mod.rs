@@ -28,8 +28,8 @@ pub use arclength::{
     BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
 };
 pub use bifurcation::{
-    complex_outside, fold_test, neimark_sacker_test, period_doubling_test, Bifurcation,
-    BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
+    complex_outside, fold_test, neimark_sacker_crossed, neimark_sacker_test, period_doubling_test,
+    Bifurcation, BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
 };
 pub use branch::{Branch, Grid, GridPoint};
 pub use branch_end::{BranchEnd, BranchEndKind};
@@ -37,8 +37,9 @@ pub use family::{EvalError, EventSignature, Family, Orbit};
 pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
 pub use period2::{flip_vector, SwitchError};
 
-use crate::limit_cycle::{GaitSearch, NewtonSettings};
-use crate::scene::Scene;
+use crate::census::{long_period_gait, HomotopySettings};
+use crate::limit_cycle::NewtonSettings;
+use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
 use std::collections::VecDeque;
 
@@ -62,7 +63,7 @@ pub struct ContinuationSettings {
     /// Stride settings for every parameter value instead of the scene's (`None`: the
     /// scene's own at each value).
     pub stride_settings: Option<crate::stride::StrideSettings>,
-    /// Grid values tried (from `from` on) for a first gait from the scene's guess.
+    /// Grid values tried (from `from` on) for a first gait ([`long_period_gait`]).
     pub start_attempts: usize,
 }
 
@@ -148,7 +149,8 @@ impl Continuation {
 }
 
 /// Pseudo-arclength continuation of `scene`'s gait in `param` from `from` to `to`: the gait
-/// at `from` (from the scene's guess; if none, the next grid value's), followed with the
+/// at `from` that `walker gait` returns there ([`long_period_gait`]: the branch of the scene's
+/// nominal gait; if none, the next grid value's), followed with the
 /// grid spacing `|to − from|/(points − 1)` as the largest step; its points at the grid values,
 /// bifurcations and end; then the period-doubled branches. `progress` is called with the
 /// fraction done.
@@ -193,9 +195,15 @@ pub fn continuation(
     // The first gait, at the first grid value that has one (of at most `start_attempts`).
     let mut start = None;
     for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
-        let setup = family.setup_at(g)?;
-        match GaitSearch::new(&setup.walker, &setup.settings, newton).find_from_guess(&setup.guess)
-        {
+        let setup_for = |s: &Scene| -> Result<Setup, SceneError> {
+            let mut setup = s.setup()?;
+            if let Some(st) = &family.stride_settings {
+                setup.settings = st.clone();
+            }
+            Ok(setup)
+        };
+        let homotopy = HomotopySettings::default();
+        match long_period_gait(&family.scene_at(g)?, &setup_for, newton, &homotopy)? {
             Ok(gait) => {
                 let n = gait.fixed_point.len();
                 let x = DVector::from_fn(n + 1, |i, _| if i < n { gait.fixed_point[i] } else { g });
