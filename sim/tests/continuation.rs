@@ -419,3 +419,39 @@ fn the_kneed_walkers_smallest_slope_is_a_fold_found_from_either_side() {
     assert!(solve(fold.value + 1e-5).is_ok());
     assert!(solve(fold.value - 1e-5).is_err());
 }
+
+#[test]
+fn a_step_refused_at_the_smallest_step_ends_the_branch_instead_of_being_taken() {
+    // Contrived: a tangent may turn by at most 1e-9° per step, so every step, down to the
+    // smallest, is refused; the branch must end at its start (`not_converged`, saying why)
+    // rather than take the step anyway.
+    let scene = Scene::load("simplest").unwrap();
+    let settings = ContinuationSettings {
+        max_period: 1,
+        max_turn_deg: 1e-9,
+        min_step_fraction: 0.1,
+        ..ContinuationSettings::default()
+    };
+    let c = continuation(
+        &scene,
+        "slope",
+        (0.009, 0.017, 3),
+        &NewtonSettings::default(),
+        &settings,
+        &|_| {},
+    )
+    .unwrap();
+    let main = &c.branches[0];
+    let end = main.end.as_ref().unwrap();
+    assert_eq!(end.kind, BranchEndKind::NotConverged, "{end:?}");
+    assert_eq!(end.value, 0.009);
+    assert!(
+        end.detail.contains("refused") && end.detail.contains("turned"),
+        "{}",
+        end.detail
+    );
+    assert_eq!(main.grid.len(), 1);
+    // With the default 60° the same sweep crosses the range.
+    let c = run("simplest", "slope", (0.009, 0.017, 3), 1);
+    assert!(c.branches[0].end.is_none(), "{:?}", c.branches[0].end);
+}

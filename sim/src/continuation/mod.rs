@@ -63,6 +63,9 @@ pub struct ContinuationSettings {
     /// Stride settings for every parameter value instead of the scene's (`None`: the
     /// scene's own at each value).
     pub stride_settings: Option<crate::stride::StrideSettings>,
+    /// Largest turn of the tangent in one accepted step [degrees]; a step that turns more is
+    /// halved, and at the smallest step the branch ends (`not_converged`) rather than jump.
+    pub max_turn_deg: f64,
     /// Grid values tried (from `from` on) for a first gait ([`long_period_gait`]).
     pub start_attempts: usize,
 }
@@ -77,6 +80,7 @@ impl Default for ContinuationSettings {
             min_step_fraction: 1e-4,
             corrector_iterations: 12,
             stride_settings: None,
+            max_turn_deg: 60.0,
             start_attempts: 32,
         }
     }
@@ -180,6 +184,7 @@ pub fn continuation(
         max_dp: spacing,
         min: spacing * settings.min_step_fraction,
         max_iterations: settings.corrector_iterations,
+        max_turn_deg: settings.max_turn_deg,
     };
     let mut out = Continuation {
         grid: grid.clone(),
