@@ -67,8 +67,11 @@ pub struct Bifurcation {
     pub stable_after: bool,
     /// The point itself (for branch switching).
     pub point: BranchPoint,
-    /// Width of the final parameter bracket.
+    /// Width of the final arclength bracket of the location (it bounds the parameter's).
     pub bracket: f64,
+    /// The location ran out of its trial budget ([`LOCATION_BUDGET`]) before the bracket
+    /// fell below [`LOCATION_TOLERANCE`].
+    pub budget_exhausted: bool,
 }
 
 fn product(m: &[Complex<f64>], f: impl Fn(Complex<f64>) -> Complex<f64>) -> f64 {
@@ -212,6 +215,7 @@ pub fn locate(
         stable_before: a.stable(),
         stable_after: b.stable(),
         bracket: (s_hi - s_lo).abs(),
+        budget_exhausted: (s_hi - s_lo).abs() >= LOCATION_TOLERANCE,
         point: best,
     })
 }

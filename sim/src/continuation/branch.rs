@@ -62,6 +62,18 @@ pub struct GridPoint {
     pub point: BranchPoint,
 }
 
+/// A bifurcation detected between two points of a branch (a test function changed sign) but
+/// not located, because a corrector failed during the location.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unlocated {
+    /// Its kind.
+    pub kind: BifurcationKind,
+    /// The parameter bracket it lies in: the two points' values, in arclength order.
+    pub bracket: (f64, f64),
+    /// Why it was not located.
+    pub reason: String,
+}
+
 /// One branch, followed.
 #[derive(Clone, Debug)]
 pub struct Branch {
@@ -77,7 +89,7 @@ pub struct Branch {
     /// Bifurcations, in arclength order.
     pub bifurcations: Vec<Bifurcation>,
     /// Bifurcations detected but not located (a corrector failed during location).
-    pub unlocated: Vec<(BifurcationKind, f64, String)>,
+    pub unlocated: Vec<Unlocated>,
     /// Grid values the branch crossed where the corrector at that value failed, with why.
     pub missed: Vec<(f64, String)>,
     /// Where and why it ends on the `from` side, when it started after `from` (no gait at the
@@ -220,6 +232,8 @@ pub fn follow(
                          branch is not taken"
                     ),
                     bracket: h,
+                    grazing: false,
+                    budget_exhausted: false,
                 });
                 break;
             }
@@ -228,7 +242,11 @@ pub fn follow(
                 for kind in bifurcation::crossings(&cur.0, &p) {
                     match bifurcation::locate(cont, kind, (&cur.0, &cur.1), &p) {
                         Ok(b) => branch.bifurcations.push(b),
-                        Err(e) => branch.unlocated.push((kind, p.value, e.to_string())),
+                        Err(e) => branch.unlocated.push(Unlocated {
+                            kind,
+                            bracket: (cur.0.value, p.value),
+                            reason: e.to_string(),
+                        }),
                     }
                 }
                 let mut crossed: Vec<f64> = grid
@@ -275,6 +293,8 @@ pub fn follow(
                             event: None,
                             detail,
                             bracket: 0.0,
+                            grazing: false,
+                            budget_exhausted: false,
                         });
                     }
                     break;
@@ -303,6 +323,8 @@ pub fn follow(
                             Ok(_) => "no point beyond".into(),
                         },
                         bracket: h,
+                        grazing: false,
+                        budget_exhausted: false,
                     }
                 });
                 break;
@@ -316,6 +338,8 @@ pub fn follow(
             event: None,
             detail: format!("the point budget of {budget} steps ran out"),
             bracket: 0.0,
+            grazing: false,
+            budget_exhausted: false,
         });
     }
     branch.steps = steps;

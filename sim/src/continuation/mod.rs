@@ -31,7 +31,7 @@ pub use bifurcation::{
     complex_outside, fold_test, neimark_sacker_crossed, neimark_sacker_test, period_doubling_test,
     Bifurcation, BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
 };
-pub use branch::{Branch, Grid, GridPoint};
+pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
 pub use family::{EvalError, EventSignature, Family, Orbit};
 pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
@@ -96,8 +96,22 @@ pub struct Continuation {
     /// The grid values where no gait was found to start from, with the reason, before the
     /// first start (`branches[0]` starts at the next value).
     pub no_start: Vec<(f64, String)>,
-    /// Period doublings whose doubled branch could not be started: value and why.
-    pub switch_failures: Vec<(f64, String)>,
+    /// Period doublings whose doubled branch could not be started.
+    pub switch_failures: Vec<SwitchFailure>,
+}
+
+/// A period doubling whose doubled branch was not followed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwitchFailure {
+    /// The branch the period doubling is on.
+    pub parent: usize,
+    /// Strides per cycle on that branch (the doubled branch would have twice as many).
+    pub period_strides: usize,
+    /// The parameter value of the period doubling.
+    pub value: f64,
+    /// Why: the switch failed, or the branch budget ([`ContinuationSettings::max_branches`])
+    /// was reached.
+    pub reason: String,
 }
 
 impl Continuation {
@@ -280,8 +294,15 @@ pub fn continuation(
     out.branches.push(main);
     while let Some((parent, pd, k)) = queue.pop_front() {
         if out.branches.len() >= settings.max_branches {
-            out.switch_failures
-                .push((pd.value, "branch budget reached".into()));
+            out.switch_failures.push(SwitchFailure {
+                parent,
+                period_strides: k,
+                value: pd.value,
+                reason: format!(
+                    "the branch budget of {} branches was reached",
+                    settings.max_branches
+                ),
+            });
             continue;
         }
         let doubled = Continuer {
@@ -305,7 +326,12 @@ pub fn continuation(
                 enqueue(&b, &mut queue);
                 out.branches.push(b);
             }
-            Err(e) => out.switch_failures.push((pd.value, e.to_string())),
+            Err(e) => out.switch_failures.push(SwitchFailure {
+                parent,
+                period_strides: k,
+                value: pd.value,
+                reason: format!("the period-{} branch could not be started: {e}", 2 * k),
+            }),
         }
     }
     progress(1.0);
