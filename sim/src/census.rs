@@ -9,10 +9,11 @@
 //! 1. **Newton from the guess** at the requested values.
 //! 2. **Homotopy from the defaults**: every gait found at the scene's default values (where
 //!    the guess is known to work) is followed to the requested values along the straight
-//!    path `p(s) = p_default + s (p_requested − p_default)`, `s` from 0 to 1, with a secant
-//!    predictor, a guard against jumping to another branch (a corrector step longer than
-//!    [`HomotopySettings::max_correction`] is refused) and step halving
-//!    ([`follow`]).
+//!    path `p(s) = p_default + s (p_requested − p_default)`, `s` from 0 to 1, by the guarded
+//!    secant step of [`crate::continuation::Secant`] (a corrector step longer than
+//!    [`HomotopySettings::max_correction`] or a period change beyond
+//!    [`HomotopySettings::max_period_change`] is refused as a jump to another branch) and
+//!    step halving ([`follow`]).
 //! 3. **Multi-start** from the guess scaled as a whole and with its rates scaled
 //!    ([`CensusSettings::scales`], [`CensusSettings::rate_scales`]), at the defaults (feeding
 //!    2) and at the requested values.
@@ -28,6 +29,7 @@
 //! search is bounded by [`NewtonSettings::max_iterations`] and each stride by the scene's
 //! [`crate::stride::StrideSettings`]. The independent searches run in parallel (rayon).
 
+use crate::continuation::Secant;
 use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
@@ -166,12 +168,10 @@ pub fn follow(
     newton: &NewtonSettings,
     settings: &HomotopySettings,
 ) -> (Result<Gait, NewtonError>, usize) {
-    let newton = &settings.corrector(newton);
-    let v0 = &start.fixed_point;
-    let mut period = start.stride.duration_s;
+    let mut path = Secant::default();
+    path.push(0.0, start);
     let mut s = 0.0;
     let mut step = settings.first_step.clamp(settings.min_step, 1.0);
-    let mut history: Vec<(f64, DVector<f64>)> = vec![(0.0, v0.clone())];
     let mut solves = 0;
     let mut last_error = NewtonError::NotConverged {
         iterations: 0,
@@ -179,42 +179,25 @@ pub fn follow(
     };
     while solves < settings.max_solves && step >= settings.min_step {
         let s_next = (s + step).min(1.0);
-        let predictor = match history.as_slice() {
-            [.., (s0, v0), (s1, v1)] => v1 + (v1 - v0) * ((s_next - s1) / (s1 - s0)),
-            [.., (_, v)] => v.clone(),
-            [] => v0.clone(),
-        };
         let Ok(setup) = between(from, to, s_next).and_then(|sc| setup_for(&sc)) else {
             step *= 0.5;
             continue;
         };
         solves += 1;
-        match GaitSearch::new(&setup.walker, &setup.settings, newton).find(&predictor) {
-            Ok(g)
-                if (&g.fixed_point - &predictor).amax()
-                    <= settings.max_correction * (1.0 + predictor.amax())
-                    && (g.stride.duration_s - period).abs()
-                        <= settings.max_period_change * period =>
-            {
+        match path.step(s_next, &setup, newton, settings) {
+            Some(Ok(g)) => {
                 if s_next >= 1.0 {
                     return (Ok(g), solves);
                 }
                 s = s_next;
-                period = g.stride.duration_s;
-                history.push((s, g.fixed_point));
+                path.push(s, &g);
                 step = (step * 2.0).min(1.0);
             }
-            Ok(g) => {
-                last_error = NewtonError::NotConverged {
-                    iterations: g.iterations,
-                    last_step: (&g.fixed_point - &predictor).amax(),
-                };
-                step *= 0.5;
-            }
-            Err(e) => {
+            Some(Err(e)) => {
                 last_error = e;
                 step *= 0.5;
             }
+            None => break,
         }
     }
     (Err(last_error), solves)

@@ -3,8 +3,10 @@
 //! (docs/bifurcations.md).
 //!
 //! By concept:
-//! - `natural`: the natural-parameter sweep [`sweep`] (one Newton solve per grid value, secant
-//!   predictor), kept for callers that fill grids row by row;
+//! - `natural`: natural-parameter continuation: [`Secant`] (secant predictor, Newton, guard
+//!   against jumping branches: the census's homotopy and the stability map's rows use it),
+//!   [`along`] (a gait along given values, seeded by the long-period gait; the stability map's
+//!   rows) and [`sweep`];
 //! - `family`: [`Family`], the stride maps `Sᵏ(v; p)` of a scene in one parameter: the walker
 //!   rebuilt at `p`, orbits, monodromy matrices, `∂Sᵏ/∂p`, event sequences;
 //! - `arclength`: pseudo-arclength predictor and corrector, [`BranchPoint`], [`StepControl`];
@@ -34,7 +36,7 @@ pub use bifurcation::{
 pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
 pub use family::{EvalError, EventSignature, Family, Orbit};
-pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
+pub use natural::{along, sweep, Secant, StabilityBoundary, SweepError, SweepPoint};
 pub use period2::{flip_vector, SwitchError};
 
 use crate::census::{long_period_gait, HomotopySettings};
