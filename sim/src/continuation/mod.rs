@@ -36,7 +36,7 @@ pub use bifurcation::{
 pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
 pub use family::{EvalError, EventSignature, Family, Orbit};
-pub use natural::{along, sweep, Secant, StabilityBoundary, SweepError, SweepPoint};
+pub use natural::{along, sweep, AlongPoint, Secant, StabilityBoundary, SweepError, SweepPoint};
 pub use period2::{flip_vector, SwitchError};
 
 use crate::census::{long_period_gait, HomotopySettings};

@@ -104,6 +104,9 @@ impl Secant {
     }
 }
 
+/// One value of [`along`]: the gait and whether it was seeded, or why there is none.
+pub type AlongPoint = Result<(Gait, bool), NewtonError>;
+
 /// Follows a gait along `values` of `param` (from `scene`): each value's gait is the guarded
 /// [`Secant::step`] from the last ones; the first value, a value after one without a gait,
 /// and a value where that step fails or jumps are **seeded** by [`long_period_gait`] (the
@@ -120,7 +123,7 @@ pub fn along(
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
     progress: &(dyn Fn() + Sync),
-) -> Result<Vec<Result<(Gait, bool), NewtonError>>, SceneError> {
+) -> Result<Vec<AlongPoint>, SceneError> {
     let mut scene = scene.clone();
     let mut path = Secant::default();
     let mut out = Vec::with_capacity(values.len());
