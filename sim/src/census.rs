@@ -9,10 +9,11 @@
 //! 1. **Newton from the guess** at the requested values.
 //! 2. **Homotopy from the defaults**: every gait found at the scene's default values (where
 //!    the guess is known to work) is followed to the requested values along the straight
-//!    path `p(s) = p_default + s (p_requested − p_default)`, `s` from 0 to 1, with a secant
-//!    predictor, a guard against jumping to another branch (a corrector step longer than
-//!    [`HomotopySettings::max_correction`] is refused) and step halving
-//!    ([`follow`]).
+//!    path `p(s) = p_default + s (p_requested − p_default)`, `s` from 0 to 1, by the guarded
+//!    secant step of [`crate::continuation::Secant`] (a corrector step longer than
+//!    [`HomotopySettings::max_correction`] or a period change beyond
+//!    [`HomotopySettings::max_period_change`] is refused as a jump to another branch) and
+//!    step halving ([`follow`]).
 //! 3. **Multi-start** from the guess scaled as a whole and with its rates scaled
 //!    ([`CensusSettings::scales`], [`CensusSettings::rate_scales`]), at the defaults (feeding
 //!    2) and at the requested values.
@@ -28,6 +29,7 @@
 //! search is bounded by [`NewtonSettings::max_iterations`] and each stride by the scene's
 //! [`crate::stride::StrideSettings`]. The independent searches run in parallel (rayon).
 
+use crate::continuation::Secant;
 use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
@@ -40,7 +42,10 @@ pub type SetupFor<'a> = dyn Fn(&Scene) -> Result<Setup, SceneError> + Sync + 'a;
 /// How a gait is followed from the defaults to the requested values ([`follow`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HomotopySettings {
-    /// The first step along the path, as a fraction of it (0 < · ≤ 1).
+    /// The first step along the path, as a fraction of it (0 < · ≤ 1). The default, 1, tries
+    /// the whole path at once and halves the step only when the corrector fails or jumps
+    /// (the guards below); every caller (`walker gait`, `gaits`, `sweep`, `orbit-diagram`,
+    /// `stability-map`) uses the default, so they all return the same gait.
     pub first_step: f64,
     /// Smallest step before the path is given up, as a fraction of it.
     pub min_step: f64,
@@ -72,7 +77,7 @@ impl HomotopySettings {
 impl Default for HomotopySettings {
     fn default() -> Self {
         Self {
-            first_step: 0.25,
+            first_step: 1.0,
             min_step: 1.0 / 256.0,
             max_correction: 0.1,
             max_period_change: 0.1,
@@ -163,12 +168,10 @@ pub fn follow(
     newton: &NewtonSettings,
     settings: &HomotopySettings,
 ) -> (Result<Gait, NewtonError>, usize) {
-    let newton = &settings.corrector(newton);
-    let v0 = &start.fixed_point;
-    let mut period = start.stride.duration_s;
+    let mut path = Secant::default();
+    path.push(0.0, start);
     let mut s = 0.0;
     let mut step = settings.first_step.clamp(settings.min_step, 1.0);
-    let mut history: Vec<(f64, DVector<f64>)> = vec![(0.0, v0.clone())];
     let mut solves = 0;
     let mut last_error = NewtonError::NotConverged {
         iterations: 0,
@@ -176,42 +179,25 @@ pub fn follow(
     };
     while solves < settings.max_solves && step >= settings.min_step {
         let s_next = (s + step).min(1.0);
-        let predictor = match history.as_slice() {
-            [.., (s0, v0), (s1, v1)] => v1 + (v1 - v0) * ((s_next - s1) / (s1 - s0)),
-            [.., (_, v)] => v.clone(),
-            [] => v0.clone(),
-        };
         let Ok(setup) = between(from, to, s_next).and_then(|sc| setup_for(&sc)) else {
             step *= 0.5;
             continue;
         };
         solves += 1;
-        match GaitSearch::new(&setup.walker, &setup.settings, newton).find(&predictor) {
-            Ok(g)
-                if (&g.fixed_point - &predictor).amax()
-                    <= settings.max_correction * (1.0 + predictor.amax())
-                    && (g.stride.duration_s - period).abs()
-                        <= settings.max_period_change * period =>
-            {
+        match path.step(s_next, &setup, newton, settings) {
+            Some(Ok(g)) => {
                 if s_next >= 1.0 {
                     return (Ok(g), solves);
                 }
                 s = s_next;
-                period = g.stride.duration_s;
-                history.push((s, g.fixed_point));
+                path.push(s, &g);
                 step = (step * 2.0).min(1.0);
             }
-            Ok(g) => {
-                last_error = NewtonError::NotConverged {
-                    iterations: g.iterations,
-                    last_step: (&g.fixed_point - &predictor).amax(),
-                };
-                step *= 0.5;
-            }
-            Err(e) => {
+            Some(Err(e)) => {
                 last_error = e;
                 step *= 0.5;
             }
+            None => break,
         }
     }
     (Err(last_error), solves)
@@ -309,23 +295,49 @@ pub fn census(
     })
 }
 
-/// The gait `walker gait` reports: at the scene's defaults, Newton from its guess (as ever);
-/// elsewhere the longer-period of Newton from the guess and the defaults' gait followed to
-/// the requested values ([`follow`]), so that the long-period gait is returned wherever the
-/// branch through the defaults reaches, not only near the guess. Two or three Newton searches
-/// in the usual case; the thorough search is [`census`].
+/// Where the gait [`nominal_gait`] returns comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GaitSource {
+    /// At the scene's defaults: Newton from the scene's guess.
+    Defaults,
+    /// Off the defaults: Newton from the scene's guess at the requested values (its period is
+    /// the longer, or the defaults' gait could not be followed).
+    Guess,
+    /// Off the defaults: the scene's gait at its defaults continued to the requested values
+    /// ([`follow`]).
+    ContinuedFromDefaults,
+}
+
+impl GaitSource {
+    /// In words, for text output.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Defaults => "the scene's gait at its defaults (Newton from its guess)",
+            Self::Guess => "Newton from the scene's guess at these values",
+            Self::ContinuedFromDefaults => "the scene's gait continued from its defaults",
+        }
+    }
+}
+
+/// The gait `walker gait` reports, the scene's **nominal** gait: at the scene's defaults,
+/// Newton from its guess (as ever); elsewhere the longer-period of Newton from the guess and
+/// the defaults' gait followed to the requested values ([`follow`]) — the branch of the
+/// scene's nominal gait, which for the simplest walker is Garcia's long-period gait, wherever
+/// that branch reaches, not only near the guess. Two or three Newton searches in the usual
+/// case; every period-1 gait is [`census`]'s job. With where it came from.
 ///
 /// # Errors
 /// The scene cannot be built at its values or at its defaults.
-pub fn long_period_gait(
+pub fn nominal_gait(
     scene: &Scene,
     setup_for: &SetupFor<'_>,
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
-) -> Result<Result<Gait, NewtonError>, SceneError> {
+) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
     let setup = setup_for(scene)?;
     if is_at_defaults(scene) {
-        return Ok(setup.find_gait(newton));
+        return Ok(setup.find_gait(newton).map(|g| (g, GaitSource::Defaults)));
     }
     let defaults = at_defaults(scene)?;
     let default_setup = setup_for(&defaults)?;
@@ -338,14 +350,28 @@ pub fn long_period_gait(
     );
     Ok(match (from_guess, followed) {
         (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
-            b
+            (b, GaitSource::ContinuedFromDefaults)
         } else {
-            a
+            (a, GaitSource::Guess)
         }),
-        (Ok(a), Err(_)) => Ok(a),
-        (Err(_), Ok(b)) => Ok(b),
+        (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
+        (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
         (Err(e), Err(_)) => Err(e),
     })
+}
+
+/// [`nominal_gait`] without its source: "the long-period gait" of `walker gait`, the sweep's
+/// first gait, the orbit diagram's seed and the stability map's seeds.
+///
+/// # Errors
+/// The scene cannot be built at its values or at its defaults.
+pub fn long_period_gait(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+) -> Result<Result<Gait, NewtonError>, SceneError> {
+    Ok(nominal_gait(scene, setup_for, newton, homotopy)?.map(|(g, _)| g))
 }
 
 /// The scene's guess as a stride-map vector of its setup.

@@ -1,14 +1,15 @@
 //! The stability map: the largest |eigenvalue| of the stride Jacobian of the long-period
 //! gait over a grid of two parameters — a designer's first picture of a walker.
 //!
-//! Each row (one value of the y parameter) is filled by continuation along x: a cell starts
-//! Newton from the secant predictor of the row's last two gaits (the last one alone after the
-//! first), and accepts the result unless its step period differs from the last gait's by more
-//! than [`HomotopySettings::max_period_change`] (a jump to another branch). The first cell of
-//! a row, a cell after one without a gait, and a cell whose continuation failed or jumped are
-//! **seeded** by [`long_period_gait`] (Newton from the scene's guess and the defaults' gait
-//! followed to the cell), so a row re-enters the long-period branch where it reappears. A
-//! cell has no gait when both fail.
+//! Each row (one value of the y parameter) is filled by natural-parameter continuation along x
+//! ([`crate::continuation::along`]): a cell starts Newton from the secant predictor of the
+//! row's last two gaits (the last one alone after the first), and accepts the result unless
+//! the corrector moved it by more than [`HomotopySettings::max_correction`] or its step period
+//! differs from the last gait's by more than [`HomotopySettings::max_period_change`] (a jump
+//! to another branch). The first cell of a row, a cell after one without a gait, and a cell
+//! whose continuation failed or jumped are **seeded** by [`crate::census::long_period_gait`]
+//! (Newton from the scene's guess and the defaults' gait followed to the cell), so a row
+//! re-enters the long-period branch where it reappears. A cell has no gait when both fail.
 //!
 //! Rows are independent and run in parallel (rayon); the results do not depend on the
 //! number of threads. Budget per cell: one continuation search of at most
@@ -16,8 +17,9 @@
 //! searches with the caller's Newton budget and at most [`HomotopySettings::max_solves`]
 //! corrector searches along the path from the defaults.
 
-use crate::census::{long_period_gait, HomotopySettings, SetupFor};
-use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
+use crate::census::{HomotopySettings, SetupFor};
+use crate::continuation::along;
+use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -65,56 +67,6 @@ impl MapCell {
     }
 }
 
-/// One row: the y parameter at `y`, continuation along `x`.
-fn row(
-    scene: &Scene,
-    setup_for: &SetupFor<'_>,
-    x: &Axis,
-    newton: &NewtonSettings,
-    homotopy: &HomotopySettings,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<Result<MapCell, NewtonError>>, SceneError> {
-    let corrector = &homotopy.corrector(newton);
-    let mut scene = scene.clone();
-    let mut out = Vec::with_capacity(x.values.len());
-    let mut history: Vec<(f64, DVector<f64>, f64)> = Vec::new();
-    for &xv in &x.values {
-        scene.set(&x.name, xv)?;
-        let continued = match history.as_slice() {
-            [] => None,
-            [.., (x0, v0, _), (x1, v1, t1)] => {
-                Some((v1 + (v1 - v0) * ((xv - x1) / (x1 - x0)), *t1))
-            }
-            [.., (_, v, t)] => Some((v.clone(), *t)),
-        }
-        .map(|(predictor, period)| -> Result<Option<Gait>, SceneError> {
-            let setup = setup_for(&scene)?;
-            let g = GaitSearch::new(&setup.walker, &setup.settings, corrector).find(&predictor);
-            Ok(g.ok().filter(|g| {
-                (g.stride.duration_s - period).abs() <= homotopy.max_period_change * period
-            }))
-        })
-        .transpose()?
-        .flatten();
-        let cell = match continued {
-            Some(g) => Ok((g, false)),
-            None => long_period_gait(&scene, setup_for, newton, homotopy)?.map(|g| (g, true)),
-        };
-        match &cell {
-            Ok((g, _)) => {
-                history.push((xv, g.fixed_point.clone(), g.stride.duration_s));
-                if history.len() > 2 {
-                    history.remove(0);
-                }
-            }
-            Err(_) => history.clear(),
-        }
-        out.push(cell.map(|(g, seeded)| MapCell::of(&g, seeded)));
-        progress();
-    }
-    Ok(out)
-}
-
 /// The stability map of `scene` over `x` × `y` (see the [module docs](self)); `progress` is
 /// called once per cell done.
 ///
@@ -144,7 +96,13 @@ pub fn stability_map(
         .map(|&yv| {
             let mut at = scene.clone();
             at.set(&y.name, yv)?;
-            row(&at, setup_for, x, newton, homotopy, progress)
+            let cells = along(
+                &at, &x.name, &x.values, setup_for, newton, homotopy, progress,
+            )?;
+            Ok(cells
+                .into_iter()
+                .map(|c| c.map(|(g, seeded)| MapCell::of(&g, seeded)))
+                .collect())
         })
         .collect();
     Ok(StabilityMap {

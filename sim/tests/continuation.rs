@@ -156,6 +156,43 @@ fn a_coarse_sweep_stays_on_the_long_period_branch() {
     }
 }
 
+#[test]
+fn a_sweep_from_slope_0_015_starts_on_the_long_period_gait_as_walker_gait_does() {
+    // At 0.015 the scene's guess finds the unstable short-step gait; the sweep must start on
+    // the gait `walker gait` returns there (the long-period one) and follow it.
+    let scene = Scene::load("simplest").unwrap();
+    let c = run("simplest", "slope", (0.015, 0.017, 3), 1);
+    let main = &c.branches[0];
+    assert!(c.no_start.is_empty(), "{:?}", c.no_start);
+    let first = &main.grid[0];
+    assert_eq!(first.value, 0.015);
+    let mut at = scene.clone();
+    at.set("slope", 0.015).unwrap();
+    let setup_for = |s: &Scene| s.setup();
+    let gait = sim::census::long_period_gait(
+        &at,
+        &setup_for,
+        &NewtonSettings::default(),
+        &sim::census::HomotopySettings::default(),
+    )
+    .unwrap()
+    .unwrap();
+    assert!((&first.point.orbit[0] - &gait.fixed_point).amax() < 1e-8);
+    for gp in main.grid.iter().filter(|g| g.point.period_strides() == 1) {
+        let reference = garcia::continued(0.009, gp.value, GUESS_LONG, 100).unwrap();
+        let d = close(garcia_state(&gp.point.orbit[0]), reference.state);
+        assert!(
+            d < 1e-8,
+            "slope {}: off the long-period branch by {d}",
+            gp.value
+        );
+    }
+    // The short-step gait (Newton from the scene's guess there) is another one.
+    let setup = at.setup().unwrap();
+    let short = setup.find_gait(&NewtonSettings::default()).unwrap();
+    assert!(short.stride.duration_s < 0.9 * gait.stride.duration_s);
+}
+
 fn fold_test(p: &BranchPoint) -> f64 {
     sim::continuation::fold_test(&p.multipliers)
 }
@@ -381,4 +418,128 @@ fn the_kneed_walkers_smallest_slope_is_a_fold_found_from_either_side() {
     };
     assert!(solve(fold.value + 1e-5).is_ok());
     assert!(solve(fold.value - 1e-5).is_err());
+}
+
+#[test]
+fn a_step_refused_at_the_smallest_step_ends_the_branch_instead_of_being_taken() {
+    // Contrived: a tangent may turn by at most 1e-9° per step, so every step, down to the
+    // smallest, is refused; the branch must end at its start (`not_converged`, saying why)
+    // rather than take the step anyway.
+    let scene = Scene::load("simplest").unwrap();
+    let settings = ContinuationSettings {
+        max_period: 1,
+        max_turn_deg: 1e-9,
+        min_step_fraction: 0.1,
+        ..ContinuationSettings::default()
+    };
+    let c = continuation(
+        &scene,
+        "slope",
+        (0.009, 0.017, 3),
+        &NewtonSettings::default(),
+        &settings,
+        &|_| {},
+    )
+    .unwrap();
+    let main = &c.branches[0];
+    let end = main.end.as_ref().unwrap();
+    assert_eq!(end.kind, BranchEndKind::NotConverged, "{end:?}");
+    assert_eq!(end.value, 0.009);
+    assert!(
+        end.detail.contains("refused") && end.detail.contains("turned"),
+        "{}",
+        end.detail
+    );
+    assert_eq!(main.grid.len(), 1);
+    // With the default 60° the same sweep crosses the range.
+    let c = run("simplest", "slope", (0.009, 0.017, 3), 1);
+    assert!(c.branches[0].end.is_none(), "{:?}", c.branches[0].end);
+}
+
+fn report(scene: &str, param: &str, c: &Continuation) -> serde_json::Value {
+    let family = sim::continuation::Family::new(
+        &Scene::load(scene).unwrap(),
+        param,
+        &NewtonSettings::default(),
+    )
+    .unwrap();
+    serde_json::to_value(sim::report::SweepReport::from_continuation(&family, c)).unwrap()
+}
+
+#[test]
+fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_reported() {
+    // A budget of one branch: the period doubling on branch 0 gets no period-2 branch, and
+    // the report says so with the reason.
+    let scene = Scene::load("simplest").unwrap();
+    let settings = ContinuationSettings {
+        max_period: 2,
+        max_branches: 1,
+        ..ContinuationSettings::default()
+    };
+    let mut c = continuation(
+        &scene,
+        "slope",
+        (0.009, 0.017, 5),
+        &NewtonSettings::default(),
+        &settings,
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(c.branches.len(), 1);
+    assert_eq!(c.switch_failures.len(), 1, "{:?}", c.switch_failures);
+    let pd = &c.branches[0].bifurcations[0];
+    assert_eq!(pd.kind, BifurcationKind::PeriodDoubling);
+    let v = report("simplest", "slope", &c);
+    let f = &v["switch_failures"][0];
+    assert_eq!(f["branch"], 0);
+    assert_eq!(f["period_strides"], 1);
+    assert_eq!(f["value"].as_f64().unwrap(), pd.value);
+    assert!(
+        f["reason"].as_str().unwrap().contains("branch budget of 1"),
+        "{f}"
+    );
+    assert_eq!(v["unlocated"].as_array().unwrap().len(), 0);
+    assert_eq!(v["param"], "slope");
+    assert_eq!(v["param_canonical"], "slope_rad");
+    // A bifurcation detected but not located reaches the report with its bracket and why.
+    c.branches[0].unlocated.push(sim::continuation::Unlocated {
+        kind: BifurcationKind::NeimarkSacker,
+        bracket: (0.011, 0.013),
+        reason: "the corrector failed".into(),
+    });
+    let v = report("simplest", "slope", &c);
+    let u = &v["unlocated"][0];
+    assert_eq!(u["kind"], "neimark_sacker");
+    assert_eq!(u["bracket"][0].as_f64(), Some(0.011));
+    assert_eq!(u["bracket"][1].as_f64(), Some(0.013));
+    assert_eq!(u["reason"], "the corrector failed");
+}
+
+#[test]
+fn a_grazing_end_does_not_claim_the_bisection_width_as_its_accuracy() {
+    // Uphill the wisse2d branch ends where a stride fails (the swing foot grazes the floor):
+    // the value depends on the stride grid beyond the 1e-9 bracket, so no accuracy is claimed.
+    let c = run("wisse2d", "slope_rad", (0.0, -0.02, 5), 1);
+    let end = c.branches[0].end.as_ref().unwrap();
+    assert_eq!(end.kind, BranchEndKind::EventChange, "{end:?}");
+    assert!(end.grazing, "{end:?}");
+    assert!(end.bracket < 1e-8 && !end.budget_exhausted, "{end:?}");
+    assert_eq!(end.accuracy(), None);
+    let v = report("wisse2d", "slope_rad", &c);
+    let e = &v["branch_ends"][0];
+    assert_eq!(e["grazing"], true);
+    assert!(e["accuracy"].is_null(), "{e}");
+    // Downhill it ends between two converged event sequences: the bracket bounds it.
+    let c = run("wisse2d", "slope_rad", (0.0, 0.05, 6), 1);
+    let end = c.branches[0].end.as_ref().unwrap();
+    assert!(!end.grazing, "{end:?}");
+    assert_eq!(end.accuracy(), Some(end.bracket));
+    let v = report("wisse2d", "slope_rad", &c);
+    assert_eq!(v["branch_ends"][0]["accuracy"].as_f64(), Some(end.bracket));
+    // Every located bifurcation carries its bracket.
+    let c = run("simplest", "slope", (0.009, 0.017, 5), 1);
+    let v = report("simplest", "slope", &c);
+    let b = &v["stability_boundaries"][0];
+    assert!(b["bracket"].as_f64().unwrap() < LOCATION_TOLERANCE, "{b}");
+    assert_eq!(b["budget_exhausted"], false);
 }

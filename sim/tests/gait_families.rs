@@ -180,3 +180,26 @@ fn census_at_the_defaults_starts_with_the_guess_gait_and_lists_each_gait_once() 
     assert!(!is_at_defaults(&moved));
     assert!(is_at_defaults(&at_defaults(&moved).unwrap()));
 }
+
+#[test]
+fn the_secant_step_refuses_a_jump_to_another_branch() {
+    // The one guarded secant step (census homotopy, stability-map rows): from the short-step
+    // gait of the simplest walker at slope 0.015 Newton converges back to it; recorded with a
+    // step period 25 % longer (as the long-period gait's), the same result is a jump.
+    let mut scene = Scene::load("simplest").unwrap();
+    scene.set("slope", 0.015).unwrap();
+    let setup = scene.setup().unwrap();
+    let newton = NewtonSettings::default();
+    let guard = sim::census::HomotopySettings::default();
+    let short = setup.find_gait(&newton).unwrap();
+    let mut path = sim::continuation::Secant::default();
+    assert!(path.step(0.015, &setup, &newton, &guard).is_none());
+    path.push(0.015, &short);
+    let again = path.step(0.015, &setup, &newton, &guard).unwrap().unwrap();
+    assert!((&again.fixed_point - &short.fixed_point).amax() < 1e-9);
+    let mut disguised = short.clone();
+    disguised.stride.duration_s *= 1.25;
+    let mut path = sim::continuation::Secant::default();
+    path.push(0.015, &disguised);
+    assert!(path.step(0.015, &setup, &newton, &guard).unwrap().is_err());
+}

@@ -98,9 +98,17 @@ fn gaits_lists_each_gait_exactly_as_walker_gait_reports_it() {
     let one = json(&["gait", "--scene", "compass", "--json"]);
     let all = json(&["gaits", "--scene", "compass", "--json"]);
     let first = &all["gaits"][0];
+    // The same object, but for `gait_source` (where `walker gait`'s one gait came from;
+    // `walker gaits` lists every gait found).
+    assert_eq!(one["gait_source"], "defaults");
+    assert!(first.get("gait_source").is_none());
     assert_eq!(
         first.as_object().unwrap().keys().collect::<Vec<_>>(),
-        one.as_object().unwrap().keys().collect::<Vec<_>>()
+        one.as_object()
+            .unwrap()
+            .keys()
+            .filter(|k| *k != "gait_source")
+            .collect::<Vec<_>>()
     );
     for key in ["scene", "parameters", "integrator", "converged"] {
         assert_eq!(first[key], one[key], "{key}");
@@ -129,7 +137,22 @@ fn gait_returns_the_long_period_gait_away_from_the_guess() {
             "--json",
         ]);
         assert_matches(&v, &r, &format!("walker gait, slope {gamma}"));
+        // It says where the gait comes from: the scene's gait continued from its defaults
+        // (Newton from the guess finds the short-step one).
+        assert_eq!(v["gait_source"], "continued_from_defaults", "slope {gamma}");
     }
+    let text = walker(&["gait", "--scene", "simplest", "--set", "slope=0.015"]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("the scene's gait continued from its defaults")
+            && text.contains("walker gaits"),
+        "{text}"
+    );
+    // At the defaults: Newton from the guess, said so in the JSON, nothing extra in the text.
+    let v = json(&["gait", "--scene", "simplest", "--json"]);
+    assert_eq!(v["gait_source"], "defaults");
+    let text = walker(&["gait", "--scene", "simplest"]);
+    assert!(!String::from_utf8_lossy(&text.stdout).contains("walker gaits"));
 }
 
 /// The attractor of the reference map, classified as the engine documents it.

@@ -55,6 +55,17 @@ fn bad_orbit_diagram_and_stability_map_options_are_named_and_exit_2() {
         ),
         (od(&["--from", "NaN"]), vec!["--from"]),
         (od(&["--to", "inf"]), vec!["--to"]),
+        (od(&["--to", "0.015"]), vec!["--from and --to are equal"]),
+        (
+            [
+                "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.015", "--to",
+                "0.015", "--points", "3",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            vec!["--from and --to are equal"],
+        ),
         (od(&["--to", "0.9"]), vec!["slope_rad", "0.9"]),
         (od(&["--chunk-points", "0"]), vec!["--chunk-points", "0"]),
         (

@@ -68,6 +68,25 @@ fn the_simplest_sweep_reports_branches_periods_orbits_and_the_period_doubling() 
             "a period-2 cycle has two distinct states: {orbit:?}"
         );
     }
+    // The parameter as given and its canonical name; nothing left unlocated or unswitched.
+    assert_eq!(v["param"], "slope");
+    assert_eq!(v["param_canonical"], "slope_rad");
+    assert_eq!(
+        v["unlocated"].as_array().unwrap().len(),
+        0,
+        "{}",
+        v["unlocated"]
+    );
+    assert_eq!(
+        v["switch_failures"].as_array().unwrap().len(),
+        0,
+        "{}",
+        v["switch_failures"]
+    );
+    for b in v["stability_boundaries"].as_array().unwrap() {
+        assert!(b["bracket"].as_f64().unwrap() < 1e-8, "{b}");
+        assert_eq!(b["budget_exhausted"], false);
+    }
     let branches = v["branches"].as_array().unwrap();
     assert_eq!(branches[1]["parent"], 0);
     assert_eq!(branches[1]["period_strides"], 2);

@@ -4,9 +4,11 @@
 //! - fold (a real multiplier through +1): `det(M − I) = Π(λᵢ − 1)`; a fold proper is where
 //!   the branch also turns (`dp/ds` changes sign); otherwise the crossing is a branch point;
 //! - period doubling (a real multiplier through −1): `det(M + I) = Π(λᵢ + 1)`;
-//! - Neimark–Sacker (a complex pair through the unit circle): the number of complex
-//!   multipliers outside the circle changes; located on `|λ_c| − 1` of the complex pair
-//!   nearest the circle.
+//! - Neimark–Sacker (a complex pair through the unit circle): a complex pair at both points
+//!   and `|λ_c| − 1` of the pair nearest the circle of opposite signs
+//!   ([`neimark_sacker_crossed`]; two real multipliers merging into a complex pair outside
+//!   the circle change the count of complex multipliers outside it, but are no
+//!   Neimark–Sacker bifurcation); located on `|λ_c| − 1`.
 //!
 //! Between two points whose test function has opposite signs the zero is located on the
 //! arclength by the Illinois variant of regula falsi, with the corrector at every trial,
@@ -65,8 +67,11 @@ pub struct Bifurcation {
     pub stable_after: bool,
     /// The point itself (for branch switching).
     pub point: BranchPoint,
-    /// Width of the final parameter bracket.
+    /// Width of the final arclength bracket of the location (it bounds the parameter's).
     pub bracket: f64,
+    /// The location ran out of its trial budget ([`LOCATION_BUDGET`]) before the bracket
+    /// fell below [`LOCATION_TOLERANCE`].
+    pub budget_exhausted: bool,
 }
 
 fn product(m: &[Complex<f64>], f: impl Fn(Complex<f64>) -> Complex<f64>) -> f64 {
@@ -102,6 +107,16 @@ pub fn neimark_sacker_test(m: &[Complex<f64>]) -> Option<f64> {
         .min_by(|a, b| a.abs().total_cmp(&b.abs()))
 }
 
+/// Whether a complex pair crossed the unit circle between multipliers `ma` and `mb`: both
+/// have a complex pair and [`neimark_sacker_test`] has opposite signs (not merely a change of
+/// [`complex_outside`], which also happens when two real multipliers merge into a pair).
+pub fn neimark_sacker_crossed(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> bool {
+    match (neimark_sacker_test(ma), neimark_sacker_test(mb)) {
+        (Some(a), Some(b)) => a.signum() != b.signum(),
+        _ => false,
+    }
+}
+
 /// The bifurcations between two successive points `a` (with its linearisation) and `b`:
 /// which test functions changed sign.
 pub fn crossings(a: &BranchPoint, b: &BranchPoint) -> Vec<BifurcationKind> {
@@ -118,7 +133,7 @@ pub fn crossings(a: &BranchPoint, b: &BranchPoint) -> Vec<BifurcationKind> {
     if period_doubling_test(ma).signum() != period_doubling_test(mb).signum() {
         kinds.push(BifurcationKind::PeriodDoubling);
     }
-    if complex_outside(ma) != complex_outside(mb) {
+    if neimark_sacker_crossed(ma, mb) {
         kinds.push(BifurcationKind::NeimarkSacker);
     }
     kinds
@@ -200,6 +215,7 @@ pub fn locate(
         stable_before: a.stable(),
         stable_after: b.stable(),
         bracket: (s_hi - s_lo).abs(),
+        budget_exhausted: (s_hi - s_lo).abs() >= LOCATION_TOLERANCE,
         point: best,
     })
 }
@@ -223,6 +239,7 @@ mod tests {
         assert_eq!(complex_outside(&outside), 2);
         let t = |m: &[Complex<f64>]| neimark_sacker_test(m).unwrap();
         assert!(t(&inside) < 0.0 && t(&outside) > 0.0);
+        assert!(neimark_sacker_crossed(&inside, &outside));
         // The fold and period-doubling functions keep their signs through it.
         assert_eq!(fold_test(&inside).signum(), fold_test(&outside).signum());
         assert_eq!(
@@ -242,5 +259,26 @@ mod tests {
         let before = [Complex::new(0.99, 0.0)];
         let after = [Complex::new(1.01, 0.0)];
         assert_ne!(fold_test(&before).signum(), fold_test(&after).signum());
+    }
+
+    #[test]
+    fn two_real_multipliers_merging_into_a_pair_outside_the_circle_are_no_neimark_sacker() {
+        // Two real multipliers > 1 merge and leave the real axis as a pair, still outside.
+        let real = [
+            Complex::new(1.3, 0.0),
+            Complex::new(1.5, 0.0),
+            Complex::new(0.2, 0.0),
+        ];
+        let pair = [polar(1.4, 0.1).as_slice(), &[Complex::new(0.2, 0.0)]].concat();
+        assert_ne!(complex_outside(&real), complex_outside(&pair));
+        assert!(!neimark_sacker_crossed(&real, &pair));
+        assert!(!neimark_sacker_crossed(&pair, &real));
+        // A pair that stays outside while moving is none either.
+        let further = [polar(1.6, 0.4).as_slice(), &[Complex::new(0.2, 0.0)]].concat();
+        assert!(!neimark_sacker_crossed(&pair, &further));
+        // A pair through the circle in either direction is one.
+        let inside = [polar(0.9, 0.4).as_slice(), &[Complex::new(0.2, 0.0)]].concat();
+        assert!(neimark_sacker_crossed(&pair, &inside));
+        assert!(neimark_sacker_crossed(&inside, &pair));
     }
 }

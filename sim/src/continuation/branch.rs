@@ -62,6 +62,18 @@ pub struct GridPoint {
     pub point: BranchPoint,
 }
 
+/// A bifurcation detected between two points of a branch (a test function changed sign) but
+/// not located, because a corrector failed during the location.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unlocated {
+    /// Its kind.
+    pub kind: BifurcationKind,
+    /// The parameter bracket it lies in: the two points' values, in arclength order.
+    pub bracket: (f64, f64),
+    /// Why it was not located.
+    pub reason: String,
+}
+
 /// One branch, followed.
 #[derive(Clone, Debug)]
 pub struct Branch {
@@ -77,7 +89,7 @@ pub struct Branch {
     /// Bifurcations, in arclength order.
     pub bifurcations: Vec<Bifurcation>,
     /// Bifurcations detected but not located (a corrector failed during location).
-    pub unlocated: Vec<(BifurcationKind, f64, String)>,
+    pub unlocated: Vec<Unlocated>,
     /// Grid values the branch crossed where the corrector at that value failed, with why.
     pub missed: Vec<(f64, String)>,
     /// Where and why it ends on the `from` side, when it started after `from` (no gait at the
@@ -125,17 +137,39 @@ pub fn prepend(forward: &mut Branch, back: Branch) {
     forward.end_before = back.end;
 }
 
-/// Whether the step `h` from `a` to `b` is taken: the corrector moved the point by at most
-/// `h` from the prediction and the tangent turned by less than 60° (more says the step
-/// skipped over structure, or jumped to another branch), and a period-`k` cycle (`k > 1`) has
-/// not collapsed onto the period-`k/2` one (its two halves at least 1e-7 apart).
-fn acceptable(a: &BranchPoint, b: &BranchPoint, h: f64) -> bool {
+/// Why the step `h` from `a` to `b` is refused (`None`: it is taken): the corrector must move
+/// the point by at most `h` from the prediction and the tangent turn by less than
+/// `max_turn_deg` (60° by default; more
+/// says the step skipped over structure, or jumped to another branch), and a period-`k` cycle
+/// (`k > 1`) must not have collapsed onto the period-`k/2` one (its two halves at least 1e-7
+/// apart).
+fn refused(a: &BranchPoint, b: &BranchPoint, h: f64, max_turn_deg: f64) -> Option<String> {
     let predicted = a.x() + &a.tangent * h;
-    if (b.x() - predicted).norm() > h || a.tangent.dot(&b.tangent) < 0.5 {
-        return false;
+    let moved = (b.x() - predicted).norm();
+    if moved > h {
+        return Some(format!(
+            "the corrector moved {moved:.3e} from the prediction, more than the step {h:.3e}"
+        ));
+    }
+    let deg = a
+        .tangent
+        .dot(&b.tangent)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    if deg > max_turn_deg {
+        return Some(format!(
+            "the tangent turned by {deg:.3}° (more than {max_turn_deg}°)"
+        ));
     }
     let k = b.period_strides();
-    k == 1 || (&b.orbit[k / 2] - &b.orbit[0]).amax() > 1e-7
+    if k > 1 && (&b.orbit[k / 2] - &b.orbit[0]).amax() <= 1e-7 {
+        return Some(format!(
+            "the period-{k} cycle collapsed onto the period-{} one",
+            k / 2
+        ));
+    }
+    None
 }
 
 /// Follows the branch from `start` across `grid` with at most `budget` steps, calling
@@ -180,15 +214,39 @@ pub fn follow(
         h = cont.steps.capped(h, &cur.0.tangent);
         let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
         match trial {
-            Ok((p, _)) if h > cont.steps.min && !acceptable(&cur.0, &p, h) => {
-                h = (h * 0.5).max(cont.steps.min);
+            Ok((p, _)) if refused(&cur.0, &p, h, cont.steps.max_turn_deg).is_some() => {
+                if h > cont.steps.min {
+                    h = (h * 0.5).max(cont.steps.min);
+                    continue;
+                }
+                // Even the smallest step fails the test: taking it could jump to another
+                // branch without a word, so the branch ends here.
+                steps += 1;
+                let why = refused(&cur.0, &p, h, cont.steps.max_turn_deg).unwrap_or_default();
+                branch.end = Some(BranchEnd {
+                    kind: BranchEndKind::NotConverged,
+                    value: cur.0.value,
+                    event: None,
+                    detail: format!(
+                        "the smallest step ({h:.3e}) is refused: {why}; a jump to another \
+                         branch is not taken"
+                    ),
+                    bracket: h,
+                    grazing: false,
+                    budget_exhausted: false,
+                });
+                break;
             }
             Ok((p, l)) if p.signature == cur.0.signature => {
                 steps += 1;
                 for kind in bifurcation::crossings(&cur.0, &p) {
                     match bifurcation::locate(cont, kind, (&cur.0, &cur.1), &p) {
                         Ok(b) => branch.bifurcations.push(b),
-                        Err(e) => branch.unlocated.push((kind, p.value, e.to_string())),
+                        Err(e) => branch.unlocated.push(Unlocated {
+                            kind,
+                            bracket: (cur.0.value, p.value),
+                            reason: e.to_string(),
+                        }),
                     }
                 }
                 let mut crossed: Vec<f64> = grid
@@ -235,6 +293,8 @@ pub fn follow(
                             event: None,
                             detail,
                             bracket: 0.0,
+                            grazing: false,
+                            budget_exhausted: false,
                         });
                     }
                     break;
@@ -263,6 +323,8 @@ pub fn follow(
                             Ok(_) => "no point beyond".into(),
                         },
                         bracket: h,
+                        grazing: false,
+                        budget_exhausted: false,
                     }
                 });
                 break;
@@ -276,6 +338,8 @@ pub fn follow(
             event: None,
             detail: format!("the point budget of {budget} steps ran out"),
             bracket: 0.0,
+            grazing: false,
+            budget_exhausted: false,
         });
     }
     branch.steps = steps;

@@ -53,9 +53,28 @@ pub struct BranchEnd {
     pub event: Option<String>,
     /// What happens there, in words.
     pub detail: String,
-    /// Width of the final arclength bracket, an upper bound on the parameter's (0 when not
-    /// located by bisection).
+    /// Width of the final arclength bracket of the bisection (0 when not located by
+    /// bisection; the step when the corrector gave up). It bounds the parameter's bracket,
+    /// but not the accuracy of a grazing end ([`Self::grazing`], [`Self::accuracy`]).
     pub bracket: f64,
+    /// The bad side of the final bracket is a stride that fails (a swing foot grazing the
+    /// floor, an event that is not found), not a converged point with another event
+    /// sequence: where the stride starts to fail depends on the integrator's step grid and
+    /// event detection (for wisse2d by ~2e-8 in the parameter while the bracket is 1e-9), so
+    /// the bisection width does not bound the location's error.
+    pub grazing: bool,
+    /// The location ran out of its trial budget ([`LOCATION_BUDGET`]) before the bracket
+    /// fell below [`LOCATION_TOLERANCE`].
+    pub budget_exhausted: bool,
+}
+
+impl BranchEnd {
+    /// An honest bound on the error of [`Self::value`] in the parameter: the bisection width
+    /// for an end between two converged event sequences, `None` (not known) for a grazing
+    /// end or an end not located by bisection.
+    pub fn accuracy(&self) -> Option<f64> {
+        (self.kind == BranchEndKind::EventChange && !self.grazing).then_some(self.bracket)
+    }
 }
 
 /// What a trial past the end gave: a stride failure or another event sequence.
@@ -104,8 +123,16 @@ pub fn locate(
     let (mut lo, mut hi) = (0.0, s_bad);
     let mut good = a.clone();
     let mut reason = describe(a, &bad);
+    // Whether the last trial that said why it is bad was a failing stride (rather than a
+    // point with another event sequence).
+    let stride_fails = |t: &Result<(BranchPoint, Linearisation), CorrectorError>| {
+        matches!(t, Err(CorrectorError::Eval(EvalError::Stride(_))))
+    };
+    let mut grazing = stride_fails(&bad);
+    let mut budget_exhausted = true;
     for _ in 0..LOCATION_BUDGET {
         if (hi - lo).abs() < LOCATION_TOLERANCE {
+            budget_exhausted = false;
             break;
         }
         let mid = 0.5 * (lo + hi);
@@ -122,6 +149,7 @@ pub fn locate(
             _ => {
                 if let Some(r) = describe(a, &trial) {
                     reason = Some(r);
+                    grazing = stride_fails(&trial);
                 }
                 hi = mid;
             }
@@ -137,5 +165,7 @@ pub fn locate(
         event,
         detail,
         bracket: (hi - lo).abs(),
+        grazing,
+        budget_exhausted: budget_exhausted && (hi - lo).abs() >= LOCATION_TOLERANCE,
     }
 }

@@ -3,8 +3,10 @@
 //! (docs/bifurcations.md).
 //!
 //! By concept:
-//! - `natural`: the natural-parameter sweep [`sweep`] (one Newton solve per grid value, secant
-//!   predictor), kept for callers that fill grids row by row;
+//! - `natural`: natural-parameter continuation: [`Secant`] (secant predictor, Newton, guard
+//!   against jumping branches: the census's homotopy and the stability map's rows use it),
+//!   [`along`] (a gait along given values, seeded by the long-period gait; the stability map's
+//!   rows) and [`sweep`];
 //! - `family`: [`Family`], the stride maps `Sᵏ(v; p)` of a scene in one parameter: the walker
 //!   rebuilt at `p`, orbits, monodromy matrices, `∂Sᵏ/∂p`, event sequences;
 //! - `arclength`: pseudo-arclength predictor and corrector, [`BranchPoint`], [`StepControl`];
@@ -28,17 +30,18 @@ pub use arclength::{
     BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
 };
 pub use bifurcation::{
-    complex_outside, fold_test, neimark_sacker_test, period_doubling_test, Bifurcation,
-    BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
+    complex_outside, fold_test, neimark_sacker_crossed, neimark_sacker_test, period_doubling_test,
+    Bifurcation, BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
 };
-pub use branch::{Branch, Grid, GridPoint};
+pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
 pub use family::{EvalError, EventSignature, Family, Orbit};
-pub use natural::{sweep, StabilityBoundary, SweepError, SweepPoint};
+pub use natural::{along, sweep, AlongPoint, Secant, StabilityBoundary, SweepError, SweepPoint};
 pub use period2::{flip_vector, SwitchError};
 
-use crate::limit_cycle::{GaitSearch, NewtonSettings};
-use crate::scene::Scene;
+use crate::census::{long_period_gait, HomotopySettings};
+use crate::limit_cycle::NewtonSettings;
+use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
 use std::collections::VecDeque;
 
@@ -62,7 +65,10 @@ pub struct ContinuationSettings {
     /// Stride settings for every parameter value instead of the scene's (`None`: the
     /// scene's own at each value).
     pub stride_settings: Option<crate::stride::StrideSettings>,
-    /// Grid values tried (from `from` on) for a first gait from the scene's guess.
+    /// Largest turn of the tangent in one accepted step [degrees]; a step that turns more is
+    /// halved, and at the smallest step the branch ends (`not_converged`) rather than jump.
+    pub max_turn_deg: f64,
+    /// Grid values tried (from `from` on) for a first gait ([`long_period_gait`]).
     pub start_attempts: usize,
 }
 
@@ -76,6 +82,7 @@ impl Default for ContinuationSettings {
             min_step_fraction: 1e-4,
             corrector_iterations: 12,
             stride_settings: None,
+            max_turn_deg: 60.0,
             start_attempts: 32,
         }
     }
@@ -91,8 +98,22 @@ pub struct Continuation {
     /// The grid values where no gait was found to start from, with the reason, before the
     /// first start (`branches[0]` starts at the next value).
     pub no_start: Vec<(f64, String)>,
-    /// Period doublings whose doubled branch could not be started: value and why.
-    pub switch_failures: Vec<(f64, String)>,
+    /// Period doublings whose doubled branch could not be started.
+    pub switch_failures: Vec<SwitchFailure>,
+}
+
+/// A period doubling whose doubled branch was not followed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwitchFailure {
+    /// The branch the period doubling is on.
+    pub parent: usize,
+    /// Strides per cycle on that branch (the doubled branch would have twice as many).
+    pub period_strides: usize,
+    /// The parameter value of the period doubling.
+    pub value: f64,
+    /// Why: the switch failed, or the branch budget ([`ContinuationSettings::max_branches`])
+    /// was reached.
+    pub reason: String,
 }
 
 impl Continuation {
@@ -148,7 +169,8 @@ impl Continuation {
 }
 
 /// Pseudo-arclength continuation of `scene`'s gait in `param` from `from` to `to`: the gait
-/// at `from` (from the scene's guess; if none, the next grid value's), followed with the
+/// at `from` that `walker gait` returns there ([`long_period_gait`]: the branch of the scene's
+/// nominal gait; if none, the next grid value's), followed with the
 /// grid spacing `|to − from|/(points − 1)` as the largest step; its points at the grid values,
 /// bifurcations and end; then the period-doubled branches. `progress` is called with the
 /// fraction done.
@@ -178,6 +200,7 @@ pub fn continuation(
         max_dp: spacing,
         min: spacing * settings.min_step_fraction,
         max_iterations: settings.corrector_iterations,
+        max_turn_deg: settings.max_turn_deg,
     };
     let mut out = Continuation {
         grid: grid.clone(),
@@ -193,9 +216,15 @@ pub fn continuation(
     // The first gait, at the first grid value that has one (of at most `start_attempts`).
     let mut start = None;
     for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
-        let setup = family.setup_at(g)?;
-        match GaitSearch::new(&setup.walker, &setup.settings, newton).find_from_guess(&setup.guess)
-        {
+        let setup_for = |s: &Scene| -> Result<Setup, SceneError> {
+            let mut setup = s.setup()?;
+            if let Some(st) = &family.stride_settings {
+                setup.settings = st.clone();
+            }
+            Ok(setup)
+        };
+        let homotopy = HomotopySettings::default();
+        match long_period_gait(&family.scene_at(g)?, &setup_for, newton, &homotopy)? {
             Ok(gait) => {
                 let n = gait.fixed_point.len();
                 let x = DVector::from_fn(n + 1, |i, _| if i < n { gait.fixed_point[i] } else { g });
@@ -267,8 +296,15 @@ pub fn continuation(
     out.branches.push(main);
     while let Some((parent, pd, k)) = queue.pop_front() {
         if out.branches.len() >= settings.max_branches {
-            out.switch_failures
-                .push((pd.value, "branch budget reached".into()));
+            out.switch_failures.push(SwitchFailure {
+                parent,
+                period_strides: k,
+                value: pd.value,
+                reason: format!(
+                    "the branch budget of {} branches was reached",
+                    settings.max_branches
+                ),
+            });
             continue;
         }
         let doubled = Continuer {
@@ -292,7 +328,12 @@ pub fn continuation(
                 enqueue(&b, &mut queue);
                 out.branches.push(b);
             }
-            Err(e) => out.switch_failures.push((pd.value, e.to_string())),
+            Err(e) => out.switch_failures.push(SwitchFailure {
+                parent,
+                period_strides: k,
+                value: pd.value,
+                reason: format!("the period-{} branch could not be started: {e}", 2 * k),
+            }),
         }
     }
     progress(1.0);

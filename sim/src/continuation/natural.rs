@@ -1,8 +1,13 @@
-//! Natural-parameter continuation: follow a gait while one scene parameter changes, and report
-//! where the largest |eigenvalue| crosses 1.
+//! Natural-parameter continuation: a gait followed over given values of one parameter (or a
+//! path fraction), one Newton solve per value from a secant predictor, with a guard against
+//! jumping to another branch — the one implementation of that step ([`Secant`]) used by the
+//! census's homotopy ([`crate::census::follow`]), the stability map's rows ([`along`]) and
+//! the natural-parameter [`sweep`] (kept for tests and callers that want the gait at given
+//! values without the pseudo-arclength machinery of [`super::continuation`]).
 
+use crate::census::{long_period_gait, HomotopySettings, SetupFor};
 use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
-use crate::scene::{Scene, SceneError};
+use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
 
 /// One point of a sweep.
@@ -35,8 +40,116 @@ pub enum SweepError {
     TooFewPoints(usize),
 }
 
-/// Sweeps `param` over `points` values from `from` to `to`, continuing each gait from the
-/// previous ones (secant predictor).
+/// The last (at most two) gaits of a path, at path coordinates `s`: a secant predictor, and
+/// one guarded Newton step from it.
+#[derive(Clone, Debug, Default)]
+pub struct Secant {
+    /// `(s, fixed point, step period [s])`, oldest first.
+    history: Vec<(f64, DVector<f64>, f64)>,
+}
+
+impl Secant {
+    /// Appends the gait `g` at `s` (keeps the last two).
+    pub fn push(&mut self, s: f64, g: &Gait) {
+        self.history
+            .push((s, g.fixed_point.clone(), g.stride.duration_s));
+        if self.history.len() > 2 {
+            self.history.remove(0);
+        }
+    }
+
+    /// Forgets the path (the next step has no predictor).
+    pub fn clear(&mut self) {
+        self.history.clear();
+    }
+
+    /// The predictor at `s` (linear through the last two gaits, the last one alone after
+    /// the first) and the last gait's step period; `None` before the first gait.
+    pub fn predict(&self, s: f64) -> Option<(DVector<f64>, f64)> {
+        match self.history.as_slice() {
+            [.., (s0, v0, _), (s1, v1, t1)] => Some((v1 + (v1 - v0) * ((s - s1) / (s1 - s0)), *t1)),
+            [.., (_, v, t)] => Some((v.clone(), *t)),
+            [] => None,
+        }
+    }
+
+    /// Newton (budget cut to [`HomotopySettings::max_corrector_iterations`]) at `setup` from
+    /// the predictor at `s`; the gait is refused as a jump to another branch when the
+    /// corrector moved it by more than [`HomotopySettings::max_correction`] (relative) or its
+    /// step period changed by more than [`HomotopySettings::max_period_change`]. `None`
+    /// before the first gait.
+    pub fn step(
+        &self,
+        s: f64,
+        setup: &Setup,
+        newton: &NewtonSettings,
+        guard: &HomotopySettings,
+    ) -> Option<Result<Gait, NewtonError>> {
+        let (predictor, period) = self.predict(s)?;
+        let corrector = guard.corrector(newton);
+        let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).find(&predictor);
+        Some(g.and_then(|g| {
+            let moved = (&g.fixed_point - &predictor).amax();
+            let jumped = moved > guard.max_correction * (1.0 + predictor.amax())
+                || (g.stride.duration_s - period).abs() > guard.max_period_change * period;
+            if jumped {
+                Err(NewtonError::NotConverged {
+                    iterations: g.iterations,
+                    last_step: moved,
+                })
+            } else {
+                Ok(g)
+            }
+        }))
+    }
+}
+
+/// One value of [`along`]: the gait and whether it was seeded, or why there is none.
+pub type AlongPoint = Result<(Gait, bool), NewtonError>;
+
+/// Follows a gait along `values` of `param` (from `scene`): each value's gait is the guarded
+/// [`Secant::step`] from the last ones; the first value, a value after one without a gait,
+/// and a value where that step fails or jumps are **seeded** by [`long_period_gait`] (the
+/// gait `walker gait` returns there). Each result says whether it was seeded. `progress` is
+/// called once per value.
+///
+/// # Errors
+/// An unknown parameter, a value out of its range, a scene that cannot be built.
+pub fn along(
+    scene: &Scene,
+    param: &str,
+    values: &[f64],
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<AlongPoint>, SceneError> {
+    let mut scene = scene.clone();
+    let mut path = Secant::default();
+    let mut out = Vec::with_capacity(values.len());
+    for &value in values {
+        scene.set(param, value)?;
+        let setup = setup_for(&scene)?;
+        let cell = match path.step(value, &setup, newton, homotopy) {
+            Some(Ok(g)) => Ok((g, false)),
+            _ => long_period_gait(&scene, setup_for, newton, homotopy)?.map(|g| (g, true)),
+        };
+        match &cell {
+            Ok((g, _)) => path.push(value, g),
+            Err(_) => path.clear(),
+        }
+        out.push(cell);
+        progress();
+    }
+    Ok(out)
+}
+
+/// Sweeps `param` over `points` values from `from` to `to` ([`along`], with the scene's own
+/// stride settings and [`HomotopySettings::default`]), and the changes of stability between
+/// successive converged points.
+///
+/// # Errors
+/// A bad parameter name or value, fewer than two points.
 pub fn sweep(
     scene: &Scene,
     param: &str,
@@ -48,35 +161,31 @@ pub fn sweep(
     if points < 2 {
         return Err(SweepError::TooFewPoints(points));
     }
-    let mut scene = scene.clone();
     // Validate the name and both ends before any work.
-    scene.set(param, from)?;
-    scene.set(param, to)?;
-    let mut out: Vec<SweepPoint> = Vec::with_capacity(points);
-    let mut history: Vec<(f64, DVector<f64>)> = Vec::new();
-    for i in 0..points {
-        let value = from + (to - from) * i as f64 / (points - 1) as f64;
-        scene.set(param, value)?;
-        let setup = scene.setup()?;
-        let search = GaitSearch::new(&setup.walker, &setup.settings, settings);
-        let from_guess = || setup.walker.pack(&setup.guess.q, &setup.guess.qd);
-        let guess = match history.as_slice() {
-            [] => from_guess(),
-            [.., (_, v)] if history.len() == 1 => v.clone(),
-            [.., (p0, v0), (p1, v1)] => v1 + (v1 - v0) * ((value - p1) / (p1 - p0)),
-            _ => from_guess(),
-        };
-        let mut gait = search.find(&guess);
-        if gait.is_err() && !history.is_empty() {
-            if let Some((_, last)) = history.last() {
-                gait = search.find(last);
-            }
-        }
-        if let Ok(g) = &gait {
-            history.push((value, g.fixed_point.clone()));
-        }
-        out.push(SweepPoint { value, gait });
-    }
+    let mut check = scene.clone();
+    check.set(param, from)?;
+    check.set(param, to)?;
+    let values: Vec<f64> = (0..points)
+        .map(|i| from + (to - from) * i as f64 / (points - 1) as f64)
+        .collect();
+    let setup_for = |s: &Scene| s.setup();
+    let gaits = along(
+        scene,
+        param,
+        &values,
+        &setup_for,
+        settings,
+        &HomotopySettings::default(),
+        &|| {},
+    )?;
+    let out: Vec<SweepPoint> = values
+        .iter()
+        .zip(gaits)
+        .map(|(&value, g)| SweepPoint {
+            value,
+            gait: g.map(|(g, _)| g),
+        })
+        .collect();
     let mut boundaries = Vec::new();
     let converged: Vec<(f64, f64)> = out
         .iter()

@@ -21,6 +21,12 @@ pub struct GaitReport {
     pub parameters: BTreeMap<String, f64>,
     /// The integrator the search ran with.
     pub integrator: IntegratorChoice,
+    /// Where `walker gait`'s gait comes from: `defaults` (Newton from the scene's guess at its
+    /// defaults), `guess` (Newton from the guess off the defaults) or
+    /// `continued_from_defaults` (the scene's gait continued from its defaults); absent in
+    /// `walker gaits`, which lists every gait found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gait_source: Option<crate::census::GaitSource>,
     /// The gait, or why none was found.
     #[serde(flatten)]
     pub outcome: GaitOutcome,
@@ -172,6 +178,7 @@ impl GaitReport {
             scene: scene.name().to_string(),
             parameters: scene.values.clone(),
             integrator: integrator.clone(),
+            gait_source: None,
             outcome,
         }
     }

@@ -40,7 +40,7 @@ pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
 pub use stability_map::{AxisRecord, StabilityMapReport};
 pub use sweep::{
     BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, SweepPointRecord,
-    SweepReport,
+    SweepReport, SwitchFailureRecord, UnlocatedRecord,
 };
 pub use walk::WalkReport;
 pub use walk_gait::WalkGaitRecord;

@@ -1,13 +1,10 @@
-//! The `walker sweep` report: the gait at each parameter value and where stability changes;
-//! from a pseudo-arclength continuation ([`SweepReport::from_continuation`]) also each point's
-//! branch and period, the bifurcations by kind, and where and why branches end.
+//! The `walker sweep` report of a pseudo-arclength continuation
+//! ([`SweepReport::from_continuation`]): the gait at each parameter value with its branch and
+//! period, the bifurcations by kind, where and why branches end, the bifurcations not
+//! located and the period doublings with no doubled branch.
 
 use super::{eigenvalue_pairs, FixedPoint};
-use crate::continuation::{
-    Bifurcation, BranchPoint, Continuation, Family, StabilityBoundary, SweepPoint,
-};
-use crate::scene::Scene;
-use crate::walker::Walker;
+use crate::continuation::{Bifurcation, BranchPoint, Continuation, Family};
 use serde::Serialize;
 
 /// The `walker sweep --json` object.
@@ -15,17 +12,53 @@ use serde::Serialize;
 pub struct SweepReport {
     /// Scene name.
     pub scene: String,
-    /// The parameter varied.
+    /// The parameter varied, as given on the command line (an alias such as `slope` stays).
     pub param: String,
+    /// Its canonical name (e.g. `slope_rad`).
+    pub param_canonical: String,
     /// One record per parameter value, in sweep order.
     pub points: Vec<SweepPointRecord>,
-    /// Changes of stability between successive converged points; from a continuation, every
-    /// located bifurcation (with its `kind`).
+    /// Every located bifurcation (with its `kind`).
     pub stability_boundaries: Vec<BoundaryRecord>,
-    /// Where and why branches end (empty for the natural-parameter sweep).
+    /// Where and why branches end.
     pub branch_ends: Vec<BranchEndRecord>,
-    /// The branches followed (empty for the natural-parameter sweep).
+    /// The branches followed.
     pub branches: Vec<BranchRecord>,
+    /// Bifurcations detected (a test function changed sign between two points) but not
+    /// located, with their bracket and why.
+    pub unlocated: Vec<UnlocatedRecord>,
+    /// Period doublings with no doubled branch, with why (a failed switch, the branch
+    /// budget).
+    pub switch_failures: Vec<SwitchFailureRecord>,
+}
+
+/// A bifurcation detected but not located.
+#[derive(Clone, Debug, Serialize)]
+pub struct UnlocatedRecord {
+    /// The branch.
+    pub branch: usize,
+    /// Strides per cycle on it.
+    pub period_strides: usize,
+    /// `fold`, `branch_point`, `period_doubling`, `neimark_sacker`.
+    pub kind: &'static str,
+    /// The parameter values of the two branch points between which its test function
+    /// changed sign, in arclength order.
+    pub bracket: [f64; 2],
+    /// Why it was not located.
+    pub reason: String,
+}
+
+/// A period doubling whose doubled branch was not followed.
+#[derive(Clone, Debug, Serialize)]
+pub struct SwitchFailureRecord {
+    /// The branch the period doubling is on.
+    pub branch: usize,
+    /// Strides per cycle on it.
+    pub period_strides: usize,
+    /// The parameter value of the period doubling.
+    pub value: f64,
+    /// Why there is no doubled branch.
+    pub reason: String,
 }
 
 /// Where a branch ends.
@@ -43,8 +76,18 @@ pub struct BranchEndRecord {
     pub event: Option<String>,
     /// What happens there, in words.
     pub detail: String,
-    /// Width of the arclength bracket of its location (an upper bound on the parameter's).
+    /// Width of the arclength bracket of the bisection that located it (it bounds the
+    /// parameter's bracket; 0 when not located by bisection). Not the accuracy of a grazing
+    /// end: see `accuracy`.
     pub bracket: f64,
+    /// The bad side is a failing stride (a grazing swing foot, an event not found): the
+    /// location depends on the integrator's step grid and event detection, beyond `bracket`.
+    pub grazing: bool,
+    /// A bound on the error of `value`: `bracket` for an end between two converged event
+    /// sequences; `null` when not known (a grazing end, an end not located by bisection).
+    pub accuracy: Option<f64>,
+    /// The location ran out of its trial budget before reaching its tolerance.
+    pub budget_exhausted: bool,
 }
 
 /// A branch of the continuation.
@@ -137,82 +180,43 @@ pub struct FailedPoint {
 pub struct BoundaryRecord {
     /// Estimated parameter value where `max |λ| = 1`.
     pub value: f64,
-    /// `lost` or `gained` (with increasing point index; from a continuation, along the
-    /// branch), `none` when the crossing keeps the point unstable.
+    /// `lost` or `gained` (along the branch), `none` when the crossing keeps the point
+    /// unstable.
     pub change: &'static str,
-    /// `fold`, `branch_point`, `period_doubling`, `neimark_sacker`; `stability_change` for the
-    /// natural-parameter sweep (interpolated, not located).
+    /// `fold`, `branch_point`, `period_doubling`, `neimark_sacker`.
     pub kind: &'static str,
-    /// The branch (0 for the natural-parameter sweep).
+    /// The branch.
     pub branch: usize,
     /// Strides per cycle on the branch.
     pub period_strides: usize,
-    /// The multipliers at the located point, `[re, im]` (empty for the natural sweep).
+    /// The multipliers at the located point, `[re, im]`.
     pub multipliers: Vec<[f64; 2]>,
+    /// Width of the final arclength bracket of the location (it bounds the parameter's).
+    pub bracket: f64,
+    /// The location ran out of its trial budget before reaching its tolerance.
+    pub budget_exhausted: bool,
+}
+
+impl FailedPoint {
+    /// The record of grid value `value` of `param` that branch 0 (period 1) did not reach,
+    /// and why.
+    pub fn new(param: &str, value: f64, reason: String) -> Self {
+        Self {
+            parameter: param.to_string(),
+            value,
+            converged: false,
+            max_abs_eigenvalue: None,
+            stable: false,
+            fixed_point: None,
+            error: reason.clone(),
+            reason,
+            branch: 0,
+            period_strides: 1,
+        }
+    }
 }
 
 impl SweepReport {
-    /// The report of a sweep of `param` over `scene`. `walker_for(value)` gives the scene and
-    /// walker at a parameter value, to name the fixed point's entries (`None`: unnamed, `null`).
-    pub fn new(
-        scene: &Scene,
-        walker_for: &dyn Fn(f64) -> Option<(Scene, Walker)>,
-        param: &str,
-        points: &[SweepPoint],
-        boundaries: &[StabilityBoundary],
-    ) -> Self {
-        let points = points
-            .iter()
-            .map(|p| match &p.gait {
-                Ok(g) => SweepPointRecord::Converged(Box::new(ConvergedPoint {
-                    parameter: param.to_string(),
-                    value: p.value,
-                    converged: true,
-                    max_abs_eigenvalue: g.max_abs_eigenvalue(),
-                    stable: g.stable(),
-                    eigenvalues: eigenvalue_pairs(&g.eigenvalues),
-                    fixed_point: walker_for(p.value).map(|(s, w)| FixedPoint::of(&s, &w, g)),
-                    step_period_s: g.stride.duration_s,
-                    step_length_m: g.stride.step_m.norm(),
-                    period_strides: 1,
-                    branch: 0,
-                    orbit: None,
-                    jacobian_method: g.jacobian_method,
-                })),
-                Err(e) => SweepPointRecord::Failed(FailedPoint {
-                    parameter: param.to_string(),
-                    value: p.value,
-                    converged: false,
-                    max_abs_eigenvalue: None,
-                    stable: false,
-                    fixed_point: None,
-                    error: e.to_string(),
-                    reason: e.to_string(),
-                    branch: 0,
-                    period_strides: 1,
-                }),
-            })
-            .collect();
-        Self {
-            scene: scene.name().to_string(),
-            param: param.to_string(),
-            points,
-            stability_boundaries: boundaries
-                .iter()
-                .map(|b| BoundaryRecord {
-                    value: b.value,
-                    change: b.change,
-                    kind: "stability_change",
-                    branch: 0,
-                    period_strides: 1,
-                    multipliers: Vec::new(),
-                })
-                .collect(),
-            branch_ends: Vec::new(),
-            branches: Vec::new(),
-        }
-    }
-
     /// The report of a pseudo-arclength continuation of `family`'s parameter: each branch's
     /// points at the grid values in arclength order (branch 0 first, then the grid values it
     /// did not reach, with the reason; then the period-doubled branches), every located
@@ -228,35 +232,17 @@ impl SweepReport {
             }
             if b.id == 0 {
                 for (value, reason) in c.unreached(&param) {
-                    points.push(SweepPointRecord::Failed(FailedPoint {
-                        parameter: param.clone(),
-                        value,
-                        converged: false,
-                        max_abs_eigenvalue: None,
-                        stable: false,
-                        fixed_point: None,
-                        error: reason.clone(),
-                        reason,
-                        branch: 0,
-                        period_strides: 1,
-                    }));
+                    points.push(SweepPointRecord::Failed(FailedPoint::new(
+                        &param, value, reason,
+                    )));
                 }
             }
         }
         if c.branches.is_empty() {
             for (value, reason) in c.unreached(&param) {
-                points.push(SweepPointRecord::Failed(FailedPoint {
-                    parameter: param.clone(),
-                    value,
-                    converged: false,
-                    max_abs_eigenvalue: None,
-                    stable: false,
-                    fixed_point: None,
-                    error: reason.clone(),
-                    reason,
-                    branch: 0,
-                    period_strides: 1,
-                }));
+                points.push(SweepPointRecord::Failed(FailedPoint::new(
+                    &param, value, reason,
+                )));
             }
         }
         let boundary = |id: usize, k: usize, b: &Bifurcation| BoundaryRecord {
@@ -270,9 +256,15 @@ impl SweepReport {
             branch: id,
             period_strides: k,
             multipliers: eigenvalue_pairs(&b.multipliers),
+            bracket: b.bracket,
+            budget_exhausted: b.budget_exhausted,
         };
         Self {
             scene: family.scene.name().to_string(),
+            param_canonical: family
+                .scene
+                .parameter_name(&param)
+                .unwrap_or_else(|_| param.clone()),
             param: param.clone(),
             points,
             stability_boundaries: c
@@ -299,6 +291,9 @@ impl SweepReport {
                             event: e.event.clone(),
                             detail: e.detail.clone(),
                             bracket: e.bracket,
+                            grazing: e.grazing,
+                            accuracy: e.accuracy(),
+                            budget_exhausted: e.budget_exhausted,
                         })
                 })
                 .collect(),
@@ -316,6 +311,29 @@ impl SweepReport {
                         .first()
                         .map(|g| g.point.signature.0.clone())
                         .unwrap_or_default(),
+                })
+                .collect(),
+            unlocated: c
+                .branches
+                .iter()
+                .flat_map(|br| {
+                    br.unlocated.iter().map(move |u| UnlocatedRecord {
+                        branch: br.id,
+                        period_strides: br.period_strides,
+                        kind: u.kind.name(),
+                        bracket: [u.bracket.0, u.bracket.1],
+                        reason: u.reason.clone(),
+                    })
+                })
+                .collect(),
+            switch_failures: c
+                .switch_failures
+                .iter()
+                .map(|f| SwitchFailureRecord {
+                    branch: f.parent,
+                    period_strides: f.period_strides,
+                    value: f.value,
+                    reason: f.reason.clone(),
                 })
                 .collect(),
         }

@@ -135,9 +135,6 @@ pub fn stride(gamma: f64, s: State) -> Option<(State, f64)> {
         // is ahead, so track the sign with the foot-ahead rule.
         y = next;
         t += H;
-        if collision(&y) >= 0.0 && !foot_ahead(&y) {
-            // Mid-swing scuff region (ignored): keep going.
-        }
     }
     None
 }

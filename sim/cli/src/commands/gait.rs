@@ -1,7 +1,7 @@
 //! `walker gait`: find the periodic gait of a scene and its stability.
 //!
 //! At the scene's default values, Newton from its guess; elsewhere the longer-period of that
-//! and the defaults' gait followed to the requested values ([`long_period_gait`]), so the
+//! and the defaults' gait followed to the requested values ([`nominal_gait`]), so the
 //! long-period gait comes back wherever its branch reaches (`walker gaits` lists them all).
 
 use super::{print_json, shown};
@@ -10,7 +10,7 @@ use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use clap::Args;
-use sim::census::{long_period_gait, HomotopySettings};
+use sim::census::{nominal_gait, GaitSource, HomotopySettings};
 use sim::limit_cycle::{Gait, NewtonError};
 use sim::report::{GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
@@ -38,12 +38,16 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
         output::create_dir("--plot", dir)?;
     }
     let walker = &setup.walker;
-    let homotopy = HomotopySettings {
-        first_step: 1.0,
-        ..HomotopySettings::default()
-    };
-    let result = long_period_gait(&scene, &common.setup_for(), &common.newton(), &homotopy)?;
-    let (report, figures_stride) = report(&scene, &setup, &result, plot.is_some());
+    let sourced = nominal_gait(
+        &scene,
+        &common.setup_for(),
+        &common.newton(),
+        &HomotopySettings::default(),
+    )?;
+    let source = sourced.as_ref().ok().map(|(_, s)| *s);
+    let result = sourced.map(|(g, _)| g);
+    let (mut report, figures_stride) = report(&scene, &setup, &result, plot.is_some());
+    report.gait_source = source;
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let name = scene.name();
         let eig = figures::eigenvalues(
@@ -147,5 +151,13 @@ fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
         shown(g.step_length_m),
         shown(g.speed_m_s),
         g.newton_iterations,
-    )
+    )?;
+    match r.gait_source {
+        Some(s @ (GaitSource::Guess | GaitSource::ContinuedFromDefaults)) => writeln!(
+            out,
+            "gait: {} (the scene's nominal branch); `walker gaits` lists every period-1 gait",
+            s.describe()
+        ),
+        _ => Ok(()),
+    }
 }

@@ -63,6 +63,12 @@ pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
+    if from == to {
+        return Err(InputError::Other(format!(
+            "--from and --to are equal ({from}): an orbit diagram needs a range"
+        ))
+        .into());
+    }
     let points = limits::count("--points", points, 2, limits::MAX_ORBIT_POINTS)?;
     let chunk_points =
         limits::count("--chunk-points", chunk_points, 1, limits::MAX_ORBIT_POINTS)?.min(points);

@@ -86,10 +86,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
         output::create_dir("--plot", dir)?;
     }
     let progress = Progress::new(cells, "stability map", !common.json);
-    let homotopy = HomotopySettings {
-        first_step: 1.0,
-        ..HomotopySettings::default()
-    };
+    let homotopy = HomotopySettings::default();
     let map = stability_map(
         &scene,
         &common.setup_for(),

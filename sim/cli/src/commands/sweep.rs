@@ -57,6 +57,12 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     if !(from.is_finite() && to.is_finite()) {
         return Err(InputError::Other("--from and --to must be finite".into()).into());
     }
+    if from == to {
+        return Err(InputError::Other(format!(
+            "--from and --to are equal ({from}): a sweep needs a range"
+        ))
+        .into());
+    }
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let max_period = limits::count("--max-period", max_period, 1, 64)?;
     let newton = common.newton();
@@ -129,26 +135,71 @@ fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
             .collect();
         writeln!(
             out,
-            "{} on branch {} (period {}) at {} = {:.10} (stability {}); multipliers {}",
+            "{} on branch {} (period {}) at {} = {:.10} (stability {}); multipliers {}{}",
             b.kind.replace('_', " "),
             b.branch,
             b.period_strides,
             param,
             b.value,
             b.change,
-            m.join(", ")
+            m.join(", "),
+            if b.budget_exhausted {
+                " (the location ran out of its trial budget)"
+            } else {
+                ""
+            }
         )?;
     }
     for e in &r.branch_ends {
+        let accuracy = match e.accuracy {
+            Some(a) if e.kind == "event_change" => format!(" (to {a:.1e})"),
+            _ if e.grazing => {
+                " (grazing: the location depends on the integrator's event detection, \
+                 beyond its bracket)"
+                    .to_string()
+            }
+            _ => String::new(),
+        };
         writeln!(
             out,
-            "branch {} (period {}) ends at {} = {:.10}: {} — {}",
+            "branch {} (period {}) ends at {} = {:.10}{}: {} — {}{}",
             e.branch,
             e.period_strides,
             param,
             e.value,
+            accuracy,
             e.kind.replace('_', " "),
-            e.detail
+            e.detail,
+            if e.budget_exhausted {
+                " (the location ran out of its trial budget)"
+            } else {
+                ""
+            }
+        )?;
+    }
+    for u in &r.unlocated {
+        writeln!(
+            out,
+            "{} on branch {} (period {}) between {} = {:.10} and {:.10}, not located: {}",
+            u.kind.replace('_', " "),
+            u.branch,
+            u.period_strides,
+            param,
+            u.bracket[0],
+            u.bracket[1],
+            u.reason
+        )?;
+    }
+    for f in &r.switch_failures {
+        writeln!(
+            out,
+            "period doubling on branch {} (period {}) at {} = {:.10}: no period-{} branch — {}",
+            f.branch,
+            f.period_strides,
+            param,
+            f.value,
+            2 * f.period_strides,
+            f.reason
         )?;
     }
     Ok(())
