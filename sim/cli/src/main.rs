@@ -13,6 +13,7 @@ mod input_error;
 mod limits;
 mod options;
 mod output;
+mod param_range;
 mod plot;
 mod progress;
 

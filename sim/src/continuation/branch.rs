@@ -214,7 +214,13 @@ pub fn follow(
         h = cont.steps.capped(h, &cur.0.tangent);
         let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
         match trial {
-            Ok((p, _)) if refused(&cur.0, &p, h, cont.steps.max_turn_deg).is_some() => {
+            // A refused trial is retried with a shorter step; at the smallest step it ends the
+            // branch only when its event sequence is the branch's own (a trial with another
+            // sequence is never taken as a step: the arm for it locates the event change).
+            Ok((p, _))
+                if refused(&cur.0, &p, h, cont.steps.max_turn_deg).is_some()
+                    && (h > cont.steps.min || p.signature == cur.0.signature) =>
+            {
                 if h > cont.steps.min {
                     h = (h * 0.5).max(cont.steps.min);
                     continue;

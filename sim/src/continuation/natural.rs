@@ -17,6 +17,9 @@ pub struct SweepPoint {
     pub value: f64,
     /// The gait, or why none was found.
     pub gait: Result<Gait, NewtonError>,
+    /// The gait was seeded ([`long_period_gait`]) rather than followed from the previous
+    /// points: it may lie on another branch, so no stability change is interpolated across it.
+    pub seeded: bool,
 }
 
 /// A change of stability between two successive converged points, located by linear
@@ -146,7 +149,8 @@ pub fn along(
 
 /// Sweeps `param` over `points` values from `from` to `to` ([`along`], with the scene's own
 /// stride settings and [`HomotopySettings::default`]), and the changes of stability between
-/// successive converged points.
+/// successive converged points of one followed path (never across a seeded point, which may
+/// lie on another branch; each point says whether it was seeded).
 ///
 /// # Errors
 /// A bad parameter name or value, fewer than two points.
@@ -183,22 +187,24 @@ pub fn sweep(
         .zip(gaits)
         .map(|(&value, g)| SweepPoint {
             value,
+            seeded: g.as_ref().is_ok_and(|(_, seeded)| *seeded),
             gait: g.map(|(g, _)| g),
         })
         .collect();
     let mut boundaries = Vec::new();
-    let converged: Vec<(f64, f64)> = out
+    // Successive points of one followed path only: a seeded point starts a new one.
+    let converged: Vec<(f64, f64, bool)> = out
         .iter()
         .filter_map(|p| {
             p.gait
                 .as_ref()
                 .ok()
-                .map(|g| (p.value, g.max_abs_eigenvalue()))
+                .map(|g| (p.value, g.max_abs_eigenvalue(), p.seeded))
         })
         .collect();
     for w in converged.windows(2) {
-        let ((p0, m0), (p1, m1)) = (w[0], w[1]);
-        if (m0 < 1.0) != (m1 < 1.0) {
+        let ((p0, m0, _), (p1, m1, seeded)) = (w[0], w[1]);
+        if !seeded && (m0 < 1.0) != (m1 < 1.0) {
             let value = p0 + (1.0 - m0) * (p1 - p0) / (m1 - m0);
             boundaries.push(StabilityBoundary {
                 value,

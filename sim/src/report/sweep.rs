@@ -77,7 +77,8 @@ pub struct BranchEndRecord {
     /// What happens there, in words.
     pub detail: String,
     /// Width of the arclength bracket of the bisection that located it (it bounds the
-    /// parameter's bracket; 0 when not located by bisection). Not the accuracy of a grazing
+    /// parameter's bracket; for a `not_converged` end, the last step tried; 0 for a fold). Not
+    /// the accuracy of a grazing
     /// end: see `accuracy`.
     pub bracket: f64,
     /// The bad side is a failing stride (a grazing swing foot, an event not found): the

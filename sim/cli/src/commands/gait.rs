@@ -153,9 +153,15 @@ fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
         g.newton_iterations,
     )?;
     match r.gait_source {
-        Some(s @ (GaitSource::Guess | GaitSource::ContinuedFromDefaults)) => writeln!(
+        Some(s @ GaitSource::ContinuedFromDefaults) => writeln!(
             out,
             "gait: {} (the scene's nominal branch); `walker gaits` lists every period-1 gait",
+            s.describe()
+        ),
+        Some(s @ GaitSource::Guess) => writeln!(
+            out,
+            "gait: {} (the defaults' gait was not followed this far, or its period is \
+             shorter); `walker gaits` lists every period-1 gait",
             s.describe()
         ),
         _ => Ok(()),

@@ -7,6 +7,7 @@ use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
+use crate::param_range::ParamRange;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
@@ -20,15 +21,8 @@ use std::process::ExitCode;
 pub struct OrbitDiagramArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Parameter to vary.
-    #[arg(long)]
-    pub param: String,
-    /// First value.
-    #[arg(long, allow_negative_numbers = true)]
-    pub from: f64,
-    /// Last value.
-    #[arg(long, allow_negative_numbers = true)]
-    pub to: f64,
+    #[command(flatten)]
+    pub range: ParamRange,
     /// Number of values (2 to 5,000).
     #[arg(long)]
     pub points: usize,
@@ -49,26 +43,16 @@ pub struct OrbitDiagramArgs {
 pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
     let OrbitDiagramArgs {
         common,
-        param,
-        from,
-        to,
+        range,
         points,
         chunk_points,
         coordinate,
         plot,
     } = args;
+    let (param, from, to) = range.checked("an orbit diagram")?;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
     let param = scene.parameter_name(&param).map_err(InputError::Scene)?;
-    if !(from.is_finite() && to.is_finite()) {
-        return Err(InputError::Other("--from and --to must be finite".into()).into());
-    }
-    if from == to {
-        return Err(InputError::Other(format!(
-            "--from and --to are equal ({from}): an orbit diagram needs a range"
-        ))
-        .into());
-    }
     let points = limits::count("--points", points, 2, limits::MAX_ORBIT_POINTS)?;
     let chunk_points =
         limits::count("--chunk-points", chunk_points, 1, limits::MAX_ORBIT_POINTS)?.min(points);

@@ -7,6 +7,7 @@ use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
+use crate::param_range::ParamRange;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
@@ -23,15 +24,8 @@ const PROGRESS_STEPS: usize = 1000;
 pub struct SweepArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Parameter to vary.
-    #[arg(long)]
-    pub param: String,
-    /// First value.
-    #[arg(long, allow_negative_numbers = true)]
-    pub from: f64,
-    /// Last value.
-    #[arg(long, allow_negative_numbers = true)]
-    pub to: f64,
+    #[command(flatten)]
+    pub range: ParamRange,
     /// Number of grid values reported (2 to 10,000); their spacing is the largest
     /// continuation step.
     #[arg(long)]
@@ -46,23 +40,13 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> Result<ExitCode> {
     let SweepArgs {
         common,
-        param,
-        from,
-        to,
+        range,
         points,
         max_period,
     } = args;
+    let (param, from, to) = range.checked("a sweep")?;
     let scene = common.scene()?;
     let base = common.setup(&scene)?;
-    if !(from.is_finite() && to.is_finite()) {
-        return Err(InputError::Other("--from and --to must be finite".into()).into());
-    }
-    if from == to {
-        return Err(InputError::Other(format!(
-            "--from and --to are equal ({from}): a sweep needs a range"
-        ))
-        .into());
-    }
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let max_period = limits::count("--max-period", max_period, 1, 64)?;
     let newton = common.newton();
