@@ -456,14 +456,8 @@ fn a_step_refused_at_the_smallest_step_ends_the_branch_instead_of_being_taken() 
     assert!(c.branches[0].end.is_none(), "{:?}", c.branches[0].end);
 }
 
-fn report(scene: &str, param: &str, c: &Continuation) -> serde_json::Value {
-    let family = sim::continuation::Family::new(
-        &Scene::load(scene).unwrap(),
-        param,
-        &NewtonSettings::default(),
-    )
-    .unwrap();
-    serde_json::to_value(sim::report::SweepReport::from_continuation(&family, c)).unwrap()
+fn report(c: &Continuation) -> serde_json::Value {
+    serde_json::to_value(sim::report::SweepReport::from_continuation(c)).unwrap()
 }
 
 #[test]
@@ -489,7 +483,7 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
     assert_eq!(c.switch_failures.len(), 1, "{:?}", c.switch_failures);
     let pd = &c.branches[0].bifurcations[0];
     assert_eq!(pd.kind, BifurcationKind::PeriodDoubling);
-    let v = report("simplest", "slope", &c);
+    let v = report(&c);
     let f = &v["switch_failures"][0];
     assert_eq!(f["branch"], 0);
     assert_eq!(f["period_strides"], 1);
@@ -507,7 +501,7 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
         bracket: (0.011, 0.013),
         reason: "the corrector failed".into(),
     });
-    let v = report("simplest", "slope", &c);
+    let v = report(&c);
     let u = &v["unlocated"][0];
     assert_eq!(u["kind"], "neimark_sacker");
     assert_eq!(u["bracket"][0].as_f64(), Some(0.011));
@@ -525,7 +519,7 @@ fn a_grazing_end_does_not_claim_the_bisection_width_as_its_accuracy() {
     assert!(end.grazing, "{end:?}");
     assert!(end.bracket < 1e-8 && !end.budget_exhausted, "{end:?}");
     assert_eq!(end.accuracy(), None);
-    let v = report("wisse2d", "slope_rad", &c);
+    let v = report(&c);
     let e = &v["branch_ends"][0];
     assert_eq!(e["grazing"], true);
     assert!(e["accuracy"].is_null(), "{e}");
@@ -534,11 +528,11 @@ fn a_grazing_end_does_not_claim_the_bisection_width_as_its_accuracy() {
     let end = c.branches[0].end.as_ref().unwrap();
     assert!(!end.grazing, "{end:?}");
     assert_eq!(end.accuracy(), Some(end.bracket));
-    let v = report("wisse2d", "slope_rad", &c);
+    let v = report(&c);
     assert_eq!(v["branch_ends"][0]["accuracy"].as_f64(), Some(end.bracket));
     // Every located bifurcation carries its bracket.
     let c = run("simplest", "slope", (0.009, 0.017, 5), 1);
-    let v = report("simplest", "slope", &c);
+    let v = report(&c);
     let b = &v["stability_boundaries"][0];
     assert!(b["bracket"].as_f64().unwrap() < LOCATION_TOLERANCE, "{b}");
     assert_eq!(b["budget_exhausted"], false);

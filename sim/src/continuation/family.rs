@@ -117,9 +117,15 @@ impl Family {
     /// # Errors
     /// A value the scene rejects.
     pub fn setup_at(&self, p: f64) -> Result<Setup, SceneError> {
-        let mut s = self.scene.clone();
-        s.set(&self.param, p)?;
-        let mut setup = s.setup()?;
+        self.setup_of(&self.scene_at(p)?)
+    }
+
+    /// `scene`'s setup with this family's stride settings (when it has its own).
+    ///
+    /// # Errors
+    /// A scene that cannot be built.
+    pub fn setup_of(&self, scene: &Scene) -> Result<Setup, SceneError> {
+        let mut setup = scene.setup()?;
         if let Some(settings) = &self.stride_settings {
             setup.settings = settings.clone();
         }

@@ -41,7 +41,7 @@ pub use period2::{flip_vector, SwitchError};
 
 use crate::census::{long_period_gait, HomotopySettings};
 use crate::limit_cycle::NewtonSettings;
-use crate::scene::{Scene, SceneError, Setup};
+use crate::scene::Scene;
 use nalgebra::DVector;
 use std::collections::VecDeque;
 
@@ -91,6 +91,8 @@ impl Default for ContinuationSettings {
 /// The branches of a continuation over a grid.
 #[derive(Clone, Debug)]
 pub struct Continuation {
+    /// The family followed (scene, parameter, settings), which names the points in reports.
+    pub family: Family,
     /// The grid.
     pub grid: Grid,
     /// The branches: `[0]` through the first gait found, then the period-doubled ones.
@@ -203,6 +205,7 @@ pub fn continuation(
         max_turn_deg: settings.max_turn_deg,
     };
     let mut out = Continuation {
+        family: family.clone(),
         grid: grid.clone(),
         branches: Vec::new(),
         no_start: Vec::new(),
@@ -216,13 +219,7 @@ pub fn continuation(
     // The first gait, at the first grid value that has one (of at most `start_attempts`).
     let mut start = None;
     for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
-        let setup_for = |s: &Scene| -> Result<Setup, SceneError> {
-            let mut setup = s.setup()?;
-            if let Some(st) = &family.stride_settings {
-                setup.settings = st.clone();
-            }
-            Ok(setup)
-        };
+        let setup_for = |s: &Scene| family.setup_of(s);
         let homotopy = HomotopySettings::default();
         match long_period_gait(&family.scene_at(g)?, &setup_for, newton, &homotopy)? {
             Ok(gait) => {

@@ -218,11 +218,12 @@ impl FailedPoint {
 }
 
 impl SweepReport {
-    /// The report of a pseudo-arclength continuation of `family`'s parameter: each branch's
+    /// The report of a pseudo-arclength continuation (of its family's parameter): each branch's
     /// points at the grid values in arclength order (branch 0 first, then the grid values it
     /// did not reach, with the reason; then the period-doubled branches), every located
     /// bifurcation, and the branches' ends.
-    pub fn from_continuation(family: &Family, c: &Continuation) -> Self {
+    pub fn from_continuation(c: &Continuation) -> Self {
+        let family = &c.family;
         let param = family.param.clone();
         let mut points = Vec::new();
         for b in &c.branches {

@@ -11,7 +11,7 @@ use crate::param_range::ParamRange;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::continuation::{continuation, ContinuationSettings, Family, SweepError};
+use sim::continuation::{continuation, ContinuationSettings, SweepError};
 use sim::report::{SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;
@@ -62,8 +62,6 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         SweepError::Scene(s) => InputError::Scene(s),
         other => InputError::Other(other.to_string()),
     };
-    let mut family = Family::new(&scene, &param, &newton).map_err(InputError::Scene)?;
-    family.stride_settings = settings.stride_settings.clone();
     let progress = Progress::new(PROGRESS_STEPS, "sweep", !common.json);
     let result = continuation(
         &scene,
@@ -75,7 +73,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     )
     .map_err(scene_error)?;
     progress.finish();
-    let report = SweepReport::from_continuation(&family, &result);
+    let report = SweepReport::from_continuation(&result);
     if common.json {
         print_json(&report)?;
     } else {
