@@ -6,6 +6,7 @@ use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
 use super::bifurcation::{self, Bifurcation, BifurcationKind};
 use super::branch_end::{self, BranchEnd, BranchEndKind};
 use super::family::EvalError;
+use nalgebra::DVector;
 
 /// The parameter range of a sweep and its grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -206,6 +207,7 @@ pub fn follow(
             point: start.0.clone(),
         });
     }
+    let origin = Origin::of(&start.0);
     let mut cur = start;
     let mut h = cont.steps.initial;
     let mut furthest = grid.fraction(cur.0.value);
@@ -305,6 +307,10 @@ pub fn follow(
                     }
                     break;
                 }
+                if let Some(end) = origin.closed_by(&cur.0, &p, &branch.bifurcations) {
+                    branch.end = Some(end);
+                    break;
+                }
                 h = cont.steps.adapt(h, p.iterations);
                 cur = (p, l);
             }
@@ -351,4 +357,125 @@ pub fn follow(
     branch.steps = steps;
     progress(1.0);
     branch
+}
+
+/// Where a branch started: to recognise a closed branch (an isola) coming back to it.
+struct Origin {
+    /// `(v₀, p)` at the start.
+    x: DVector<f64>,
+    /// The start's tangent.
+    tangent: DVector<f64>,
+}
+
+impl Origin {
+    fn of(p: &BranchPoint) -> Self {
+        Origin {
+            x: p.x(),
+            tangent: p.tangent.clone(),
+        }
+    }
+
+    /// The branch's end when the step from `prev` to `next` closed the branch.
+    fn closed_by(
+        &self,
+        prev: &BranchPoint,
+        next: &BranchPoint,
+        bifurcations: &[Bifurcation],
+    ) -> Option<BranchEnd> {
+        let folds: Vec<f64> = bifurcations
+            .iter()
+            .filter(|b| b.kind == BifurcationKind::Fold)
+            .map(|b| b.value)
+            .collect();
+        if !self.passed(&prev.x(), &next.x(), &next.tangent, folds.len()) {
+            return None;
+        }
+        let lo = folds.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = folds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        Some(BranchEnd {
+            kind: BranchEndKind::ClosedLoop,
+            value: next.value,
+            event: None,
+            detail: format!(
+                "the branch is a closed loop: it came back to where it was started, between \
+                 folds at {lo} and {hi}; no gait of it lies outside that interval"
+            ),
+            bracket: 0.0,
+            grazing: false,
+            budget_exhausted: false,
+        })
+    }
+
+    /// Whether the step from `a` to `b` (tangent `tb` at `b`) passed through the start again,
+    /// heading the same way, after at least two folds (a closed curve in `(v, p)` turns at two
+    /// folds at least): the segment comes within a tenth of its own length of the start.
+    fn passed(&self, a: &DVector<f64>, b: &DVector<f64>, tb: &DVector<f64>, folds: usize) -> bool {
+        if folds < 2
+            || a.len() != self.x.len()
+            || b.len() != self.x.len()
+            || tb.len() != self.tangent.len()
+        {
+            return false;
+        }
+        let seg = b - a;
+        let len2 = seg.norm_squared();
+        if len2 == 0.0 || !len2.is_finite() {
+            return false;
+        }
+        let t = ((&self.x - a).dot(&seg) / len2).clamp(0.0, 1.0);
+        let gap = (a + &seg * t - &self.x).norm();
+        gap <= 0.1 * len2.sqrt() && tb.dot(&self.tangent) > 0.0
+    }
+}
+
+#[cfg(test)]
+mod closed_loop_tests {
+    use super::*;
+
+    /// The unit circle in `(v, p)`, started at angle 0 heading counter-clockwise.
+    fn origin() -> Origin {
+        Origin {
+            x: DVector::from_vec(vec![1.0, 0.0]),
+            tangent: DVector::from_vec(vec![0.0, 1.0]),
+        }
+    }
+
+    fn at(angle: f64) -> DVector<f64> {
+        DVector::from_vec(vec![angle.cos(), angle.sin()])
+    }
+
+    fn tangent(angle: f64) -> DVector<f64> {
+        DVector::from_vec(vec![-angle.sin(), angle.cos()])
+    }
+
+    #[test]
+    fn a_step_over_the_start_after_two_folds_closes_the_branch() {
+        let o = origin();
+        let (a, b) = (at(-0.1), at(0.1));
+        assert!(o.passed(&a, &b, &tangent(0.1), 2));
+        // Not before the branch has turned at two folds (the first step leaves the start).
+        assert!(!o.passed(&a, &b, &tangent(0.1), 1));
+        // Passing the start the other way (tangent reversed) is not a return.
+        assert!(!o.passed(&b, &a, &tangent(-0.1).scale(-1.0), 2));
+        // A step elsewhere on the curve does not close it.
+        assert!(!o.passed(&at(2.0), &at(2.2), &tangent(2.2), 2));
+        // Nor a step that passes the start at a distance (another sheet).
+        let off = DVector::from_vec(vec![0.0, 0.5]);
+        assert!(!o.passed(
+            &(at(-0.1) * 1.5 + &off),
+            &(at(0.1) * 1.5 + &off),
+            &tangent(0.1),
+            2
+        ));
+    }
+
+    #[test]
+    fn non_finite_or_mismatched_points_never_close() {
+        let o = origin();
+        let nan = DVector::from_vec(vec![f64::NAN, 0.0]);
+        assert!(!o.passed(&nan, &at(0.1), &tangent(0.1), 2));
+        let short = DVector::from_vec(vec![1.0]);
+        assert!(!o.passed(&short, &at(0.1), &tangent(0.1), 2));
+        assert!(!o.passed(&at(0.1), &at(0.1), &tangent(0.1), 2));
+    }
 }

@@ -28,6 +28,9 @@ pub enum BranchEndKind {
     NotConverged,
     /// The point budget ran out.
     Budget,
+    /// The branch is a closed curve (an isola): it came back to the point it started from,
+    /// heading the same way, so following it further would only repeat it.
+    ClosedLoop,
 }
 
 impl BranchEndKind {
@@ -38,6 +41,7 @@ impl BranchEndKind {
             Self::Fold => "fold",
             Self::NotConverged => "not_converged",
             Self::Budget => "budget",
+            Self::ClosedLoop => "closed_loop",
         }
     }
 }
