@@ -36,6 +36,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../scenes/wisse3d-tuned.toml"),
     ),
     (
+        "wisse3d-locked-compensator",
+        include_str!("../../scenes/wisse3d-locked-compensator.toml"),
+    ),
+    (
         "wisse2d-tuned",
         include_str!("../../scenes/wisse2d-tuned.toml"),
     ),
