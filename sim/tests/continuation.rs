@@ -198,8 +198,8 @@ fn fold_test(p: &BranchPoint) -> f64 {
 }
 
 #[test]
-fn the_wisse2d_branch_turns_at_a_fold_and_the_gait_does_not_exist_beyond_it() {
-    let c = run("wisse2d", "ankle_engage_rad", (-0.055, -0.06, 3), 1);
+fn the_tuned_wisse2d_branch_turns_at_a_fold_and_the_gait_does_not_exist_beyond_it() {
+    let c = run("wisse2d-tuned", "ankle_engage_rad", (-0.055, -0.06, 3), 1);
     let main = &c.branches[0];
     let folds: Vec<_> = main
         .bifurcations
@@ -221,7 +221,7 @@ fn the_wisse2d_branch_turns_at_a_fold_and_the_gait_does_not_exist_beyond_it() {
     assert!(at_start[0].point.stable() && !at_start[1].point.stable());
     // Independently, Newton at single values: just before the fold it converges from the
     // fold's state; just beyond it, it does not.
-    let scene = Scene::load("wisse2d").unwrap();
+    let scene = Scene::load("wisse2d-tuned").unwrap();
     let newton = NewtonSettings::default();
     let solve = |p: f64| {
         let mut s = scene.clone();
@@ -257,8 +257,8 @@ fn the_parallel_stride_jacobian_is_bit_identical_to_the_sequential_columns() {
 }
 
 #[test]
-fn the_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
-    let c = run("wisse2d", "slope_rad", (0.0, 0.05, 6), 1);
+fn the_tuned_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
+    let c = run("wisse2d-tuned", "slope_rad", (0.0, 0.05, 6), 1);
     let main = &c.branches[0];
     let end = main.end.as_ref().expect("the branch ends");
     assert_eq!(end.kind, BranchEndKind::EventChange, "{end:?}");
@@ -273,7 +273,7 @@ fn the_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
     // the end the gait keeps the old order (string, then knee); 1e-7 beyond it there is no
     // gait with that order.
     let last = &main.grid.last().unwrap().point;
-    let scene = Scene::load("wisse2d").unwrap();
+    let scene = Scene::load("wisse2d-tuned").unwrap();
     let newton = NewtonSettings::default();
     let events_at = |p: f64| {
         let mut s = scene.clone();
@@ -300,7 +300,7 @@ fn the_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages() {
 
 /// The stride Jacobian's error at located points (docs/bifurcations.md, "The stride map and its
 /// Jacobian"): the simplest walker's has no variational Jacobian (infinitesimal feet) and is
-/// compared with central differences on frozen step sizes; the wisse2d one with the
+/// compared with central differences on frozen step sizes; the tuned wisse2d one with the
 /// variational Jacobian. The located values must not move by more than 1e-9 between methods.
 #[test]
 fn the_stride_jacobian_error_at_the_located_points_is_small() {
@@ -314,7 +314,7 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
             true,
         ),
         (
-            "wisse2d",
+            "wisse2d-tuned",
             "ankle_engage_rad",
             (-0.055, -0.06, 3),
             BifurcationKind::Fold,
@@ -511,9 +511,9 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
 
 #[test]
 fn a_grazing_end_does_not_claim_the_bisection_width_as_its_accuracy() {
-    // Uphill the wisse2d branch ends where a stride fails (the swing foot grazes the floor):
+    // Uphill the tuned wisse2d branch ends where a stride fails (the swing foot grazes the floor):
     // the value depends on the stride grid beyond the 1e-9 bracket, so no accuracy is claimed.
-    let c = run("wisse2d", "slope_rad", (0.0, -0.02, 5), 1);
+    let c = run("wisse2d-tuned", "slope_rad", (0.0, -0.02, 5), 1);
     let end = c.branches[0].end.as_ref().unwrap();
     assert_eq!(end.kind, BranchEndKind::EventChange, "{end:?}");
     assert!(end.grazing, "{end:?}");
@@ -524,7 +524,7 @@ fn a_grazing_end_does_not_claim_the_bisection_width_as_its_accuracy() {
     assert_eq!(e["grazing"], true);
     assert!(e["accuracy"].is_null(), "{e}");
     // Downhill it ends between two converged event sequences: the bracket bounds it.
-    let c = run("wisse2d", "slope_rad", (0.0, 0.05, 6), 1);
+    let c = run("wisse2d-tuned", "slope_rad", (0.0, 0.05, 6), 1);
     let end = c.branches[0].end.as_ref().unwrap();
     assert!(!end.grazing, "{end:?}");
     assert_eq!(end.accuracy(), Some(end.bracket));

@@ -131,11 +131,11 @@ fn the_simplest_sweep_says_so_in_text() {
 }
 
 #[test]
-fn the_issue_wisse2d_sweep_names_the_fold_where_its_branch_ends() {
+fn the_tuned_wisse2d_sweep_names_the_fold_where_its_branch_ends() {
     let v = json(&walker(&[
         "sweep",
         "--scene",
-        "wisse2d",
+        "wisse2d-tuned",
         "--param",
         "ankle_engage_rad",
         "--from",

@@ -32,8 +32,16 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../scenes/wisse3d-uncompensated.toml"),
     ),
     (
-        "wisse3d-table1",
-        include_str!("../../scenes/wisse3d-table1.toml"),
+        "wisse3d-tuned",
+        include_str!("../../scenes/wisse3d-tuned.toml"),
+    ),
+    (
+        "wisse3d-locked-compensator",
+        include_str!("../../scenes/wisse3d-locked-compensator.toml"),
+    ),
+    (
+        "wisse2d-tuned",
+        include_str!("../../scenes/wisse2d-tuned.toml"),
     ),
     (
         "wisse2d-uncompensated",
@@ -380,6 +388,28 @@ impl Scene {
         }
     }
 
+    /// A link's principal moments about its c.m., each checked to be non-negative: a scene
+    /// that computes them from other parameters (e.g. a moment about a joint less m d²) can
+    /// make one negative, and the error then names the expression and the value.
+    fn inertia_diag(&self, l: &file::LinkDef) -> Result<Vector3<f64>, SceneError> {
+        let what = format!("link `{}`.inertia_diag_kg_m2", l.name);
+        let d = self.vec3(&l.inertia_diag_kg_m2, &what)?;
+        let texts = l.inertia_diag_kg_m2.as_ref();
+        for (k, &v) in d.iter().enumerate() {
+            if v < 0.0 {
+                let text = texts.map_or_else(String::new, |t| match &t[k] {
+                    Num::Value(x) => format!("{x}"),
+                    Num::Expr(e) => format!("`{e}`"),
+                });
+                return Err(SceneError::Invalid(format!(
+                    "{what}[{k}] = {text} is {v} kg·m² with these parameter values: a moment \
+                     of inertia about the centre of mass cannot be negative"
+                )));
+            }
+        }
+        Ok(d)
+    }
+
     fn opt(&self, n: &Option<Num>, what: &str) -> Result<f64, SceneError> {
         n.as_ref().map_or(Ok(0.0), |n| self.num(n, what))
     }
@@ -410,7 +440,7 @@ impl Scene {
                     )))
                 }
             };
-            let d = self.vec3(&l.inertia_diag_kg_m2, &what("inertia_diag_kg_m2"))?;
+            let d = self.inertia_diag(l)?;
             let body = BodyInertia {
                 mass_kg: self.opt(&l.mass_kg, &what("mass_kg"))?,
                 p_link_com_m: self.vec3(&l.com_m, &what("com_m"))?,
