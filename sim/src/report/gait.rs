@@ -1,7 +1,7 @@
 //! The `walker gait` report: the gait found (or why none was), its stability and figures.
 
-use super::CostOfTransport;
 use super::{eigenvalue_pairs, gait_numbers, FixedPoint};
+use super::{AnkleExtension, CostOfTransport};
 use crate::integrators::IntegratorChoice;
 use crate::limit_cycle::{Gait, JacobianMethod, NewtonError};
 use crate::scene::Scene;
@@ -86,6 +86,12 @@ pub struct FoundGait {
     /// Actuator figures (walkers with actuated ankles only).
     #[serde(flatten)]
     pub actuator: Option<ActuatorFigures>,
+    /// The stance ankle's extension as it happens in the periodic stride: engagement, release,
+    /// the angle reached and how much of the profile ran (walkers with an ankle reflex only;
+    /// absent otherwise). A found gait's stride always ends in a heel strike, so the record is
+    /// always readable for them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ankle_extension: Option<AnkleExtension>,
     /// Contact figures of the stride from the fixed point (when the caller could compute them).
     #[serde(flatten)]
     pub contact: Option<ContactFigures>,
@@ -227,6 +233,10 @@ impl FoundGait {
                 &walker.three_d_freedoms,
             ),
             actuator,
+            ankle_extension: walker
+                .ankle
+                .as_ref()
+                .and_then(|r| AnkleExtension::of(r, s).ok()),
             contact: contact.map(ContactFigures::from),
         }
     }

@@ -18,6 +18,7 @@
 //! `cost_of_transport_J_per_kg_m`, has an upper-case `J`; it is kept for compatibility, with
 //! its lower-case twin `cost_of_transport_j_per_kg_m` (the same number) beside it.
 
+mod ankle_extension;
 mod cost_of_transport;
 mod fixed_point;
 mod gait;
@@ -30,6 +31,7 @@ mod sweep;
 mod walk;
 mod walk_gait;
 
+pub use ankle_extension::{AnkleExtension, AnkleExtensionError};
 pub use cost_of_transport::CostOfTransport;
 pub use fixed_point::FixedPoint;
 pub use gait::{ActuatorFigures, ContactFigures, FoundGait, GaitNotFound, GaitOutcome, GaitReport};

@@ -12,7 +12,7 @@ use anyhow::Result;
 use clap::Args;
 use sim::census::{nominal_gait, GaitSource, HomotopySettings};
 use sim::limit_cycle::{Gait, NewtonError};
-use sim::report::{GaitOutcome, GaitReport};
+use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
 use sim::stride::{StrideOptions, StrideRequest, StrideResult};
 use std::io::Write;
@@ -152,6 +152,9 @@ fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
         shown(g.speed_m_s),
         g.newton_iterations,
     )?;
+    if let Some(x) = &g.ankle_extension {
+        print_ankle_extension(out, x)?;
+    }
     match r.gait_source {
         Some(s @ GaitSource::ContinuedFromDefaults) => writeln!(
             out,
@@ -165,5 +168,30 @@ fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
             s.describe()
         ),
         _ => Ok(()),
+    }
+}
+
+/// The `ankle extension:` line of the text output.
+fn print_ankle_extension(out: &mut dyn Write, x: &AnkleExtension) -> std::io::Result<()> {
+    match x.engaged_at_s {
+        Some(t0) => writeln!(
+            out,
+            "ankle extension: string engaged at {:.6} s, released at {:.6} s: {:.6} s of the \
+             {:.6} s profile ({:.1} %); ankle at release {:.6} rad of {:.6} rad ({:.1} % of \
+             the extension)",
+            shown(t0),
+            shown(x.released_at_s),
+            shown(x.released_at_s - t0),
+            shown(x.profile_duration_s),
+            100.0 * shown(x.profile_fraction_completed),
+            shown(x.angle_at_release_rad),
+            shown(x.final_angle_rad),
+            100.0 * shown(x.angle_fraction_completed),
+        ),
+        None => writeln!(
+            out,
+            "ankle extension: the string did not engage; ankle at heel strike {:.6} rad",
+            shown(x.angle_at_release_rad),
+        ),
     }
 }
