@@ -145,13 +145,19 @@ impl<T: Scalar> Extension<T> {
 
 /// The duration [s] an extension over `span` [rad] needs so that its peak rate
 /// (`PEAK_SLOPE · span / duration`) stays within `max_rate` [rad/s]: `duration` itself when
-/// that is long enough, else the stretched one. `f32`, for the firmware's rate bound.
-pub fn duration_within_rate(span_rad: f32, duration_s: f32, max_rate_rad_per_s: f32) -> f32 {
-    let by_rate = PEAK_SLOPE as f32 * span_rad / max_rate_rad_per_s;
-    if by_rate > duration_s {
+/// that is long enough, else the stretched one (the firmware's rate bound; the host's report
+/// of it).
+pub fn duration_within_rate<T: Scalar>(
+    span: T,
+    duration: T,
+    max_rate: T,
+    lift: impl Fn(f32) -> T,
+) -> T {
+    let by_rate = lift(PEAK_SLOPE as f32) * span / max_rate;
+    if by_rate > duration {
         by_rate
     } else {
-        duration_s
+        duration
     }
 }
 
@@ -225,7 +231,8 @@ mod tests {
     #[test]
     fn the_rate_bound_stretches_only_a_too_fast_extension() {
         // 1.875 · 0.28 / 4 = 0.13125 s < 0.27 s: not stretched.
-        assert_eq!(duration_within_rate(0.28, 0.27, 4.0), 0.27);
-        assert!((duration_within_rate(0.28, 0.27, 1.0) - 0.525).abs() < 1e-6);
+        assert_eq!(duration_within_rate(0.28_f32, 0.27, 4.0, id), 0.27);
+        assert!((duration_within_rate(0.28_f32, 0.27, 1.0, id) - 0.525).abs() < 1e-6);
+        assert_eq!(duration_within_rate(0.28_f64, 0.27, 4.0, f64_of), 0.27);
     }
 }

@@ -120,6 +120,7 @@ impl ReflexParams {
             self.extended_angle_rad - self.taut_angle_rad,
             self.push_duration_s,
             self.max_push_rate_rad_per_s,
+            |c| c,
         )
     }
 }
