@@ -68,7 +68,8 @@ mod tests {
             ("ankle_final_rad", reflex.final_rad, ParamId::ExtendedAngle),
             ("ankle_extension_duration_s", reflex.duration_s, ParamId::PushDuration),
         ] {
-            let firmware = f64::from(id.default_si());
+            let firmware =
+                crate::host::param_si(protocol::ParamValue::saturating_from_si(id.default_si()));
             assert!(
                 (scene_value - firmware).abs() <= PROFILE_TOLERANCE,
                 "wisse3d's {scene_name} = {scene_value}, the firmware's {id:?} default = {firmware}"
