@@ -36,12 +36,7 @@ pub trait Scalar:
 }
 
 impl<T> Scalar for T where
-    T: Copy
-        + PartialOrd
-        + Add<Output = T>
-        + Sub<Output = T>
-        + Mul<Output = T>
-        + Div<Output = T>
+    T: Copy + PartialOrd + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Div<Output = T>
 {
 }
 
@@ -195,7 +190,10 @@ mod tests {
             let s = blend(k as f32 / 1000.0, id).s;
             assert!((0.0..=1.0).contains(&s));
             assert!(s >= last - 1e-6, "monotone up to rounding");
-            assert!((s - last) * 1000.0 <= PEAK_SLOPE as f32 + 1e-3, "peak slope");
+            assert!(
+                (s - last) * 1000.0 <= PEAK_SLOPE as f32 + 1e-3,
+                "peak slope"
+            );
             last = s;
         }
         // Peak slope at the middle, and the middle is half-way.
@@ -216,7 +214,10 @@ mod tests {
         for t in [0.02, 0.1, 0.135, 0.2, 0.26] {
             let s = e.sample(t, f64_of);
             let (p, m) = (e.sample(t + h, f64_of), e.sample(t - h, f64_of));
-            assert!(((p.angle - m.angle) / (2.0 * h) - s.rate).abs() < 1e-6, "{t}");
+            assert!(
+                ((p.angle - m.angle) / (2.0 * h) - s.rate).abs() < 1e-6,
+                "{t}"
+            );
             assert!(((p.rate - m.rate) / (2.0 * h) - s.acceleration).abs() < 1e-4);
             assert_eq!(s.angle, e.angle(t, f64_of));
         }

@@ -19,10 +19,6 @@ fn stats(r: &SilReport, side: Side) -> ActuatorStats {
     r.node(side).unwrap().actuator
 }
 
-fn mean_period_s(w: &Walk) -> f64 {
-    w.steps.iter().map(|s| s.duration_s).sum::<f64>() / w.steps.len() as f64
-}
-
 fn with_limit(max_torque_n_m: f64) -> sil::SilConfig {
     let mut c = matched();
     c.actuator.max_torque_n_m = max_torque_n_m;

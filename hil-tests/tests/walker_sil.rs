@@ -9,7 +9,7 @@
 mod common;
 
 use common::{matched, setup, walk, walk_with, TICK_S};
-use sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport};
+use sil::{FirmwareInTheLoop, SensorFault, Side, SilReport};
 
 /// Time of the stride `k`'s start on the nominal gait, plus `frac` of a stride [s].
 fn in_stride(k: usize, frac: f64) -> f64 {
@@ -32,7 +32,10 @@ fn nominal_200_steps_with_the_firmware_in_the_loop() {
     let ideal = setup().period_s;
     // The mean period is the ideal one within 0.5 ms (measured +0.30 ms).
     let mean = walk.steps.iter().map(|s| s.duration_s).sum::<f64>() / 200.0;
-    assert!((mean - ideal).abs() < 5e-4, "mean period {mean}, ideal {ideal}");
+    assert!(
+        (mean - ideal).abs() < 5e-4,
+        "mean period {mean}, ideal {ideal}"
+    );
     for s in &walk.steps {
         // Engagement is detected by the firmware (quantised encoder, estimator, 1 kHz): with
         // the lightly damped pelvic roll of the Table I gait (|λ| 0.988) the period moves

@@ -39,9 +39,17 @@ fn without_a_write_the_nodes_report_the_firmware_defaults() {
     for side in ["Left", "Right"] {
         let p = &v["nodes"][side]["parameters"];
         for name in ["taut_angle_rad", "extended_angle_rad", "push_duration_s"] {
-            assert_eq!(p[name].as_f64(), Some(default_of(name)), "{side} {name}: {p}");
+            assert_eq!(
+                p[name].as_f64(),
+                Some(default_of(name)),
+                "{side} {name}: {p}"
+            );
         }
-        assert_eq!(p["push_duration_s"].as_f64(), Some(0.27), "the chosen reading");
+        assert_eq!(
+            p["push_duration_s"].as_f64(),
+            Some(0.27),
+            "the chosen reading"
+        );
         assert_eq!(p["effective_push_duration_s"], p["push_duration_s"]);
     }
     assert!(v["warnings"].is_array());
@@ -68,11 +76,11 @@ fn a_written_parameter_is_the_one_the_nodes_report_and_the_difference_is_warned(
             Some(default_of("extended_angle_rad"))
         );
         // The scene's ideal drive engages elsewhere: said, per node.
-        let warned = v["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|w| w.as_str().unwrap().starts_with(&format!("{side} node's taut_angle_rad -0.07")));
+        let warned = v["warnings"].as_array().unwrap().iter().any(|w| {
+            w.as_str()
+                .unwrap()
+                .starts_with(&format!("{side} node's taut_angle_rad -0.07"))
+        });
         assert!(warned, "{}", v["warnings"]);
     }
 }

@@ -20,8 +20,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("wisse3d_5_steps", |b| {
         b.iter(|| {
-            let mut ctl =
-                FirmwareInTheLoop::new(SilConfig::default()).unwrap();
+            let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
             let request = WalkRequest::new(&settings, 5).controlled(&mut ctl);
             let walk = sim::walk::walk(walker, &q, &qd, request);
             assert!(walk.failure.is_none());

@@ -147,13 +147,13 @@ impl FromStr for FirmwareParam {
             .find(|(_, n)| *n == name)
             .copied()
             .ok_or_else(|| FirmwareParamError::UnknownName(name.to_owned()))?;
-        let value: f32 =
-            text.trim()
-                .parse()
-                .map_err(|_| FirmwareParamError::NotANumber {
-                    name,
-                    text: text.to_owned(),
-                })?;
+        let value: f32 = text
+            .trim()
+            .parse()
+            .map_err(|_| FirmwareParamError::NotANumber {
+                name,
+                text: text.to_owned(),
+            })?;
         FirmwareParam::new(id, value)
     }
 }
@@ -175,13 +175,15 @@ pub fn check_writes(writes: &[FirmwareParam]) -> Result<(), FirmwareParamError> 
         FirmwareParam::new(w.id, w.value_si)?;
         let wire = protocol::ParamValue::saturating_from_si(w.value_si);
         let before = params;
-        params.set(w.id, wire).map_err(|_| FirmwareParamError::Inconsistent {
-            name,
-            value: w.value_si,
-            taut: before.taut_angle_rad(),
-            extended: before.extended_angle_rad(),
-            min_extension: firmware::params::MIN_EXTENSION_RAD,
-        })?;
+        params
+            .set(w.id, wire)
+            .map_err(|_| FirmwareParamError::Inconsistent {
+                name,
+                value: w.value_si,
+                taut: before.taut_angle_rad(),
+                extended: before.extended_angle_rad(),
+                min_extension: firmware::params::MIN_EXTENSION_RAD,
+            })?;
     }
     Ok(())
 }
@@ -203,14 +205,23 @@ mod tests {
         assert_eq!(PARAM_NAMES.len(), ParamId::ALL.len());
         let e = "taut_angle=-0.07".parse::<FirmwareParam>().unwrap_err();
         assert!(matches!(e, FirmwareParamError::UnknownName(_)), "{e}");
-        assert!(e.to_string().contains("push_duration_s [s]: 0.02 to 0.5, default 0.27"));
+        assert!(e
+            .to_string()
+            .contains("push_duration_s [s]: 0.02 to 0.5, default 0.27"));
         let e = "taut_angle_rad".parse::<FirmwareParam>().unwrap_err();
         assert!(matches!(e, FirmwareParamError::Form(_)), "{e}");
         let e = "push_duration_s=fast".parse::<FirmwareParam>().unwrap_err();
         assert!(e.to_string().contains("`fast` is not a number"), "{e}");
-        for bad in ["push_duration_s=0.6", "push_duration_s=NaN", "taut_angle_rad=inf"] {
+        for bad in [
+            "push_duration_s=0.6",
+            "push_duration_s=NaN",
+            "taut_angle_rad=inf",
+        ] {
             let e = bad.parse::<FirmwareParam>().unwrap_err();
-            assert!(matches!(e, FirmwareParamError::OutOfRange { .. }), "{bad}: {e}");
+            assert!(
+                matches!(e, FirmwareParamError::OutOfRange { .. }),
+                "{bad}: {e}"
+            );
             assert!(e.to_string().contains("outside its range"), "{e}");
         }
     }
@@ -218,12 +229,25 @@ mod tests {
     #[test]
     fn writes_are_checked_in_order_as_the_node_would_take_them() {
         let w = |s: &str| s.parse::<FirmwareParam>().unwrap();
-        assert_eq!(check_writes(&[w("taut_angle_rad=-0.07"), w("push_duration_s=0.2")]), Ok(()));
+        assert_eq!(
+            check_writes(&[w("taut_angle_rad=-0.07"), w("push_duration_s=0.2")]),
+            Ok(())
+        );
         let e = check_writes(&[w("taut_angle_rad=-0.07"), w("taut_angle_rad=-0.06")]);
         assert_eq!(e, Err(FirmwareParamError::Repeated("taut_angle_rad")));
         // 0.02 above the default taut angle −0.08: less than the 0.05 minimum.
-        let e = check_writes(&[w("extended_angle_rad=0.0"), w("taut_angle_rad=-0.03")]).unwrap_err();
-        assert!(matches!(e, FirmwareParamError::Inconsistent { name: "taut_angle_rad", .. }), "{e}");
+        let e =
+            check_writes(&[w("extended_angle_rad=0.0"), w("taut_angle_rad=-0.03")]).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FirmwareParamError::Inconsistent {
+                    name: "taut_angle_rad",
+                    ..
+                }
+            ),
+            "{e}"
+        );
         assert!(e.to_string().contains("at least 0.05 rad"), "{e}");
     }
 }

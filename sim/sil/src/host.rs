@@ -160,11 +160,7 @@ impl Host {
 
     /// The extension profile's parameters `side` last reported.
     pub fn parameters(&self, side: Side) -> NodeParameters {
-        let reported = |id: ParamId| {
-            self.in_force[side.index()]
-                .get(&id)
-                .map(|v| param_si(*v))
-        };
+        let reported = |id: ParamId| self.in_force[side.index()].get(&id).map(|v| param_si(*v));
         NodeParameters::from_reported(
             reported(ParamId::TautAngle),
             reported(ParamId::ExtendedAngle),

@@ -51,14 +51,14 @@ mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
 pub use config::{HostCommand, SilConfig, READ_BACK_PARAMS};
-pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use error::SilError;
+pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;
 pub use report::{
-    FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport, PhaseChange, SilReport,
-    SocketcandReport, StateChange,
+    FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport, PhaseChange,
+    SilReport, SocketcandReport, StateChange,
 };
 pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,

@@ -19,8 +19,18 @@ pub fn profile_mismatches(reflex: &AnkleReflex, nodes: &BTreeMap<Side, NodeRepor
     for (side, node) in nodes {
         let p = &node.parameters;
         let pairs = [
-            ("taut_angle_rad", p.taut_angle_rad, "ankle_engage_rad", reflex.engage_rad),
-            ("extended_angle_rad", p.extended_angle_rad, "ankle_final_rad", reflex.final_rad),
+            (
+                "taut_angle_rad",
+                p.taut_angle_rad,
+                "ankle_engage_rad",
+                reflex.engage_rad,
+            ),
+            (
+                "extended_angle_rad",
+                p.extended_angle_rad,
+                "ankle_final_rad",
+                reflex.final_rad,
+            ),
             (
                 "effective_push_duration_s",
                 p.effective_push_duration_s,
@@ -66,7 +76,11 @@ mod tests {
         for (scene_name, scene_value, id) in [
             ("ankle_engage_rad", reflex.engage_rad, ParamId::TautAngle),
             ("ankle_final_rad", reflex.final_rad, ParamId::ExtendedAngle),
-            ("ankle_extension_duration_s", reflex.duration_s, ParamId::PushDuration),
+            (
+                "ankle_extension_duration_s",
+                reflex.duration_s,
+                ParamId::PushDuration,
+            ),
         ] {
             let firmware =
                 crate::host::param_si(protocol::ParamValue::saturating_from_si(id.default_si()));
@@ -85,7 +99,12 @@ mod tests {
 
     fn node(taut: f64, extended: f64, duration: f64) -> NodeReport {
         NodeReport {
-            parameters: NodeParameters::from_reported(Some(taut), Some(extended), Some(duration), Some(4.0)),
+            parameters: NodeParameters::from_reported(
+                Some(taut),
+                Some(extended),
+                Some(duration),
+                Some(4.0),
+            ),
             ..NodeReport::default()
         }
     }
@@ -95,16 +114,33 @@ mod tests {
         let walker = sim::scene::Scene::load("wisse3d").unwrap().build().unwrap();
         let mut reflex = walker.ankle.clone().unwrap();
         (reflex.engage_rad, reflex.final_rad, reflex.duration_s) = (-0.08, 0.2, 0.27);
-        let same = BTreeMap::from([(Side::Left, node(-0.08, 0.2, 0.27)), (Side::Right, node(-0.08, 0.2, 0.27))]);
+        let same = BTreeMap::from([
+            (Side::Left, node(-0.08, 0.2, 0.27)),
+            (Side::Right, node(-0.08, 0.2, 0.27)),
+        ]);
         assert!(profile_mismatches(&reflex, &same).is_empty());
-        let differ = BTreeMap::from([(Side::Left, node(-0.07, 0.2, 0.27)), (Side::Right, NodeReport::default())]);
+        let differ = BTreeMap::from([
+            (Side::Left, node(-0.07, 0.2, 0.27)),
+            (Side::Right, NodeReport::default()),
+        ]);
         let w = profile_mismatches(&reflex, &differ);
         assert_eq!(w.len(), 4, "{w:?}");
-        assert!(w[0].contains("taut_angle_rad -0.07") && w[0].contains("ankle_engage_rad -0.08"), "{w:?}");
-        assert!(w[1].starts_with("Right node did not report its taut_angle_rad"), "{w:?}");
+        assert!(
+            w[0].contains("taut_angle_rad -0.07") && w[0].contains("ankle_engage_rad -0.08"),
+            "{w:?}"
+        );
+        assert!(
+            w[1].starts_with("Right node did not report its taut_angle_rad"),
+            "{w:?}"
+        );
         // A rate bound that stretches the push is a difference of duration.
         let slow = NodeReport {
-            parameters: NodeParameters::from_reported(Some(-0.08), Some(0.2), Some(0.27), Some(1.0)),
+            parameters: NodeParameters::from_reported(
+                Some(-0.08),
+                Some(0.2),
+                Some(0.27),
+                Some(1.0),
+            ),
             ..NodeReport::default()
         };
         let w = profile_mismatches(&reflex, &BTreeMap::from([(Side::Left, slow)]));

@@ -186,7 +186,10 @@ fn written_parameters_are_in_force_and_reported_as_the_nodes_read_them_back() {
     }
     // Each SetParam the host sent is followed by a GetParam of it.
     let sent = &r.host.commands_sent;
-    let gets = sent.iter().filter(|(_, c)| c.contains("GetParam { param: ExtendedAngle }")).count();
+    let gets = sent
+        .iter()
+        .filter(|(_, c)| c.contains("GetParam { param: ExtendedAngle }"))
+        .count();
     assert_eq!(gets, 3, "{sent:?}");
 }
 

@@ -55,7 +55,11 @@ pub struct SilArgs {
     /// `peer_heartbeat_timeout_s`, `max_angular_rate_rad_per_s`, `stuck_timeout_s`; e.g.
     /// `--firmware-param taut_angle_rad=-0.07`. Checked against each parameter's range and
     /// the writes before it.
-    #[arg(long = "firmware-param", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    #[arg(
+        long = "firmware-param",
+        value_name = "NAME=VALUE",
+        allow_hyphen_values = true
+    )]
     pub firmware_params: Vec<String>,
     /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
     /// figures use the last 10 and `steps_completed` counts every step. For long runs:
@@ -324,7 +328,8 @@ fn print_text<Bus: Serialize>(
     }
     for (side, n) in r.nodes {
         let p = &n.parameters;
-        let shown_opt = |v: Option<f64>| v.map_or_else(|| "not reported".to_owned(), |v| v.to_string());
+        let shown_opt =
+            |v: Option<f64>| v.map_or_else(|| "not reported".to_owned(), |v| v.to_string());
         writeln!(
             out,
             "{side:?} node reports: taut {} rad, extended {} rad, push {} s (effective {} s)",
