@@ -114,15 +114,14 @@ impl ReflexParams {
 
     /// Duration of the extension profile actually used [s]: the nominal duration, stretched
     /// so that the minimum-jerk profile's peak rate (1.875 × extension / duration) stays
-    /// within [`Self::max_push_rate_rad_per_s`].
+    /// within [`Self::max_push_rate_rad_per_s`] ([`ankle_profile::duration_within_rate`]).
     pub fn effective_push_duration_s(&self) -> f32 {
-        let extension = self.extended_angle_rad - self.taut_angle_rad;
-        let by_rate = 1.875 * extension / self.max_push_rate_rad_per_s;
-        if by_rate > self.push_duration_s {
-            by_rate
-        } else {
-            self.push_duration_s
-        }
+        ankle_profile::duration_within_rate(
+            self.extended_angle_rad - self.taut_angle_rad,
+            self.push_duration_s,
+            self.max_push_rate_rad_per_s,
+            |c| c,
+        )
     }
 }
 
@@ -172,8 +171,10 @@ mod tests {
     #[test]
     fn profile_duration_respects_rate_bound() {
         let mut p = ReflexParams::default();
-        // 1.875 * 0.28 / 4.0 = 0.13125 < 0.15: nominal duration.
-        assert_eq!(p.effective_push_duration_s(), 0.15);
+        // 1.875 * 0.28 / 4.0 = 0.13125 < 0.27: the default rate bound does not stretch the
+        // default duration.
+        assert_eq!(p.effective_push_duration_s(), 0.27);
+        assert_eq!(p.effective_push_duration_s(), p.push_duration_s());
         p.set(ParamId::MaxPushRate, wire(ParamId::MaxPushRate, 1.0))
             .unwrap();
         assert!((p.effective_push_duration_s() - 0.525).abs() < 1e-6);

@@ -82,12 +82,11 @@ pub struct ReflexInputs {
     pub peer_heel_strike: bool,
 }
 
-/// Minimum-jerk blend `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` for τ clamped to [0, 1]; peak slope 1.875.
+/// Minimum-jerk blend `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` for τ clamped to [0, 1]; peak slope
+/// [`ankle_profile::PEAK_SLOPE`] (1.875). The one profile of the `ankle-profile` crate, which
+/// the simulator's ideal ankle drive follows too.
 pub fn min_jerk(tau: f32) -> f32 {
-    let t = tau.clamp(0.0, 1.0);
-    let t3 = t * t * t;
-    // Clamped again: f32 rounding near τ = 1 may overshoot 1 by an ulp.
-    (t3 * (10.0 + t * (-15.0 + 6.0 * t))).clamp(0.0, 1.0)
+    ankle_profile::blend(tau, |c| c).s
 }
 
 /// The reflex state.
@@ -139,9 +138,12 @@ impl Reflex {
     }
 
     fn setpoint(&mut self, now: Instant, p: &ReflexParams) -> f32 {
-        let tau = now.secs_since(self.push_start) / p.effective_push_duration_s();
-        let extension = p.extended_angle_rad() - p.taut_angle_rad();
-        p.taut_angle_rad() + extension * min_jerk(tau)
+        ankle_profile::Extension {
+            from: p.taut_angle_rad(),
+            to: p.extended_angle_rad(),
+            duration: p.effective_push_duration_s(),
+        }
+        .angle(now.secs_since(self.push_start), |c| c)
     }
 
     /// One control step: at most one phase change, constant work.
@@ -268,7 +270,7 @@ mod tests {
                 extended_at = Some(ms);
             }
         }
-        assert_eq!(extended_at, Some(160), "150 ms profile");
+        assert_eq!(extended_at, Some(280), "270 ms profile");
         assert_eq!(r.phase(), ReflexPhase::Hold);
         assert_eq!(last, 0.2);
         let mut i = inputs(401, 0.2);

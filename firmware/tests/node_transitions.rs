@@ -224,7 +224,8 @@ fn full_reflex_cycle_through_the_node() {
     assert_eq!(o.actuator, ActuatorCommand::Released);
     b.drive_to_push();
     let mut last = -1.0;
-    for _ in 0..200 {
+    // The default profile lasts 0.27 s: 300 ticks of 1 ms reach Hold.
+    for _ in 0..300 {
         let o = b.tick();
         if let ActuatorCommand::Position { ankle_angle_rad } = o.actuator {
             assert!(ankle_angle_rad >= last - 1e-6);

@@ -1,6 +1,7 @@
 //! The string servo's torque limit (`ActuatorParams::max_torque_n_m`) with the `wisse3d`
 //! walker and both ankle nodes' firmware in the loop: the nominal walk stays within the
-//! default limit; a servo too weak for the push stalls in it and the gait changes; one too
+//! default limit; a servo too weak for the push stalls in it, its catch-up trips the encoder's
+//! rate check and the robot falls (Table I gait); one too
 //! weak to hold the robot at engagement never pushes (the firmware's stuck-encoder check
 //! catches the motionless push) and the robot falls.
 //!
@@ -16,10 +17,6 @@ use sim::walk::Walk;
 
 fn stats(r: &SilReport, side: Side) -> ActuatorStats {
     r.node(side).unwrap().actuator
-}
-
-fn mean_period_s(w: &Walk) -> f64 {
-    w.steps.iter().map(|s| s.duration_s).sum::<f64>() / w.steps.len() as f64
 }
 
 fn with_limit(max_torque_n_m: f64) -> sil::SilConfig {
@@ -39,9 +36,10 @@ fn the_nominal_200_steps_stay_within_the_default_torque_limit() {
     assert!(w.failure.is_none(), "{:?}", w.failure);
     for side in Side::BOTH {
         let a = stats(&r, side);
-        // Measured: 1.664 N·m on both sides (docs/sil.md); the default leaves 50 % margin.
+        // Measured: 1.226 N·m on both sides with the 0.27 s push (docs/sil.md); the default
+        // leaves 100 % margin.
         assert!(
-            a.peak_torque_n_m > 1.5 && a.peak_torque_n_m < limit / 1.4,
+            a.peak_torque_n_m > 1.1 && a.peak_torque_n_m < limit / 1.8,
             "{side:?}: {a:?}"
         );
         assert_eq!(a.over_torque_ticks, 0, "{side:?}: {a:?}");
@@ -54,12 +52,11 @@ fn the_nominal_200_steps_stay_within_the_default_torque_limit() {
     debug_assertions,
     ignore = "minutes unoptimised: cargo test --release -p hil-tests"
 )]
-fn a_servo_weaker_than_the_push_stalls_and_the_gait_changes() {
+fn a_servo_weaker_than_the_push_stalls_and_the_walk_ends_safe() {
     let (nominal, rn) = walk(matched(), 20);
-    // 1 N·m: 60 % of the nominal push's peak, above the torque that holds the robot when the
-    // string engages (0.66 N·m).
-    let (weak, rw) = walk(with_limit(1.0), 20);
-    assert!(nominal.failure.is_none() && weak.failure.is_none());
+    // 1.1 N·m: 90 % of the nominal push's peak (1.226 N·m with the 0.27 s push).
+    let (weak, rw) = walk(with_limit(1.1), 20);
+    assert!(nominal.failure.is_none(), "{:?}", nominal.failure);
     let engaged = |w: &Walk, k: usize| {
         let s = &w.steps[k];
         s.start_t_walk_s
@@ -72,14 +69,14 @@ fn a_servo_weaker_than_the_push_stalls_and_the_gait_changes() {
     for side in Side::BOTH {
         let (a, n) = (stats(&rw, side), stats(&rn, side));
         assert_eq!(n.over_torque_ticks, 0);
-        // Stalled in every push (10 per side), many ticks each.
-        assert!(a.over_torque_ticks > 10 * 20, "{side:?}: {a:?}");
+        // Stalled, many ticks (measured 313 / 263 before the walk ends).
+        assert!(a.over_torque_ticks > 100, "{side:?}: {a:?}");
         // The first stall comes in this side's first push (left: stride 0, right: stride 1),
-        // within its 0.2 s.
+        // within its 0.27 s.
         let k = side.index();
         let first = a.first_over_torque_s.unwrap();
         let e = engaged(&weak, k);
-        assert!(first > e && first < e + 0.2, "{side:?}: {first} vs {e}");
+        assert!(first > e && first < e + 0.27, "{side:?}: {first} vs {e}");
         // The servo falls behind its setpoint: the tracking error doubles.
         assert!(
             a.max_tracking_error_rad > 2.0 * n.max_tracking_error_rad,
@@ -88,12 +85,18 @@ fn a_servo_weaker_than_the_push_stalls_and_the_gait_changes() {
             n.max_tracking_error_rad
         );
     }
-    // The gait changes: the mean step period by −0.09 ms (measured), the impact loss by
-    // −0.3 %.
-    let dp = mean_period_s(&weak) - mean_period_s(&nominal);
-    assert!(dp < -3e-5, "{dp}");
-    let loss = |w: &Walk| w.steps.iter().map(|s| s.impact_energy_loss_j).sum::<f64>();
-    assert!(loss(&weak) < 0.999 * loss(&nominal));
+    // With the Table I gait the stall-and-catch-up does not settle (it did with the former
+    // −0.055 rad, 0.2 s reading): a catch-up finally moves the ankle faster than the
+    // plausibility limit, a node raises `EncoderRate` and goes `Safe`, the other follows
+    // (`PeerSafe`), and without pushes the robot falls (measured: right `Safe` at 10.194 s,
+    // `FellBackward` in step 14).
+    let rate = Side::BOTH
+        .iter()
+        .filter_map(|s| rw.first_raise(*s, "EncoderRate"))
+        .fold(f64::INFINITY, f64::min);
+    assert!(rate.is_finite(), "no EncoderRate: {:?}", rw.faults);
+    let f = weak.failure.as_ref().expect("the walk ends");
+    assert!(f.t_walk_s > rate, "{f:?} before {rate}");
 }
 
 #[test]

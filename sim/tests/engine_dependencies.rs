@@ -2,9 +2,11 @@
 //! the engine, never the other way round; docs/engine.md).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-/// Every dependency the engine may have: the numerics, serialisation, errors, and rayon for
-/// parallel stride evaluations (independent Jacobian columns, parameter sides).
-const ALLOWED: [&str; 7] = [
+/// Every dependency the engine may have: the numerics, serialisation, errors, rayon for
+/// parallel stride evaluations (independent Jacobian columns, parameter sides), and the
+/// dependency-free extension profile it shares with the firmware.
+const ALLOWED: [&str; 8] = [
+    "ankle-profile",
     "nalgebra",
     "num-dual",
     "serde",

@@ -48,13 +48,26 @@ pub fn setup() -> &'static Setup {
     })
 }
 
-/// The firmware's reflex parameters set to the scene's ideal reflex (taut −0.055 rad, extended
-/// 0.2 rad, 0.2 s), as the host would before enabling.
+/// The firmware with its own parameters, nothing written (as `walker sil --scene wisse3d`):
+/// the scene's extension profile is the firmware's default one (taut −0.08 rad, extended
+/// 0.2 rad, 0.27 s; checked here, and by the `sil` crate's `scene_profile` test).
 pub fn matched() -> SilConfig {
-    let w = &setup().walker;
+    let reflex = setup()
+        .walker
+        .ankle
+        .clone()
+        .expect("wisse3d has actuated ankles");
+    for (scene, id) in [
+        (reflex.engage_rad, protocol::ParamId::TautAngle),
+        (reflex.final_rad, protocol::ParamId::ExtendedAngle),
+        (reflex.duration_s, protocol::ParamId::PushDuration),
+    ] {
+        assert!(
+            (scene - f64::from(id.default_si())).abs() < 2e-6,
+            "{SCENE}'s reflex {scene} differs from the firmware's {id:?} default"
+        );
+    }
     SilConfig::default()
-        .with_reflex(w.ankle.as_ref().expect("wisse3d has actuated ankles"))
-        .expect("scene's reflex within the firmware's parameter ranges")
 }
 
 /// Walk `steps` strides from the limit cycle with the firmware in the loop.

@@ -1,5 +1,9 @@
 //! `walker sil --sensor-fault stuck:side=left,state=hold --json`: the fault applied is listed
 //! as `sensor_faults_applied: [{side, kind, t_s}]`, and its outcome is the firmware's.
+//!
+//! With the Table I gait the firmware's default 0.27 s push never reaches `Hold`: the string
+//! engages about 0.19 s before the other foot's heel strike releases it. The test writes a
+//! 0.15 s push (`--firmware-param`), which ends in `Hold` before the release.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use serde_json::Value;
@@ -17,6 +21,8 @@ fn sil_stuck_in_hold_lists_the_fault_applied() {
         "3",
         "--sensor-fault",
         "stuck:side=left,state=hold",
+        "--firmware-param",
+        "push_duration_s=0.15",
         "--json",
     ]);
     assert_eq!(

@@ -16,13 +16,11 @@ fn bench(c: &mut Criterion) {
     let walker = &setup.walker;
     let (q, qd) = walker.unpack(&gait.fixed_point);
     let settings = setup.settings.with_integrator(sil::SIL_INTEGRATOR);
-    let reflex = walker.ankle.clone().unwrap();
     let mut group = c.benchmark_group("sil");
     group.sample_size(10);
     group.bench_function("wisse3d_5_steps", |b| {
         b.iter(|| {
-            let mut ctl =
-                FirmwareInTheLoop::new(SilConfig::default().with_reflex(&reflex).unwrap()).unwrap();
+            let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
             let request = WalkRequest::new(&settings, 5).controlled(&mut ctl);
             let walk = sim::walk::walk(walker, &q, &qd, request);
             assert!(walk.failure.is_none());

@@ -31,9 +31,7 @@ fn main() {
         _ => sil::SIL_INTEGRATOR,
     };
     let settings = setup.settings.with_integrator(integrator);
-    let reflex = w.ankle.clone().unwrap();
-    let mut ctl =
-        FirmwareInTheLoop::new(SilConfig::default().with_reflex(&reflex).unwrap()).unwrap();
+    let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
     let mut evals = 0usize;
     let start = std::time::Instant::now();
     let mut count = |s: &sim::walk::StepSummary| evals += s.evaluations;

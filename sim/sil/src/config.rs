@@ -7,10 +7,21 @@ use canbus::{BusConfig, FaultSpec};
 use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 
 use crate::actuator::ActuatorParams;
+use crate::firmware_param::{check_writes, FirmwareParam, FirmwareParamError};
 use crate::sensors::{SensorFault, SensorFaultParseError};
 
 pub use crate::side::Side;
 pub use crate::swing::SwingAnkleModel;
+
+/// The parameters the host reads back from each node (`GetParam`) after its `Enable` and
+/// after each `SetParam` it sends (the report's `nodes.<side>.parameters`): those of the
+/// extension profile.
+pub const READ_BACK_PARAMS: [protocol::ParamId; 4] = [
+    protocol::ParamId::TautAngle,
+    protocol::ParamId::ExtendedAngle,
+    protocol::ParamId::PushDuration,
+    protocol::ParamId::MaxPushRate,
+];
 
 /// A host command to put on the bus at a given time.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,7 +79,10 @@ pub struct SilConfig {
     /// Encoder faults.
     pub sensor_faults: Vec<SensorFault>,
     /// Commands the host sends to the still disabled ankles at the first tick, before its
-    /// `Enable` to every ankle (parameters: see [`SilConfig::with_reflex`]).
+    /// `Enable` to every ankle. Empty by default: the nodes run with the firmware's own
+    /// parameters unless some are written ([`SilConfig::with_firmware_param`]). After the
+    /// `Enable` the host reads the parameters in force back (`GetParam`,
+    /// [`READ_BACK_PARAMS`]), as after any `SetParam` it sends later.
     pub setup_commands: Vec<protocol::Command>,
     /// Host commands besides the setup and the `Enable`.
     pub host_commands: Vec<HostCommand>,
@@ -129,7 +143,9 @@ impl SilConfig {
     }
 
     /// Set a reflex parameter of both ankles at start-up (a broadcast `SetParam` before the
-    /// `Enable`).
+    /// `Enable`), unchecked against the parameters written before (the node's answer, in
+    /// `host.param_acks`, says whether it took it; [`SilConfig::with_firmware_param`]
+    /// checks first).
     ///
     /// # Errors
     /// The value is outside the parameter's range ([`protocol::ParamId::range_si`]).
@@ -146,9 +162,58 @@ impl SilConfig {
         Ok(self)
     }
 
-    /// Set both ankles' taut angle, extended angle and push duration to a scene's ideal
-    /// reflex (the firmware's defaults are Table I's −0.08 rad, 0.2 rad and 0.15 s; the
-    /// `wisse3d` scene engages at −0.055 rad and extends over 0.2 s).
+    /// Write one firmware parameter to both ankles at start-up (`walker sil
+    /// --firmware-param`), checked as the nodes would take it after the writes before it.
+    ///
+    /// # Errors
+    /// [`FirmwareParamError`]: out of range, given twice, or inconsistent (the extended angle
+    /// not above the taut angle by the firmware's minimum).
+    pub fn with_firmware_param(self, param: FirmwareParam) -> Result<Self, FirmwareParamError> {
+        let mut writes = self.firmware_param_writes();
+        writes.push(param);
+        check_writes(&writes)?;
+        // In range (checked above): the encoding cannot fail; its error as the range's.
+        self.with_param(param.id, f64::from(param.value_si))
+            .map_err(|_| {
+                let (min, max) = param.id.range_si();
+                FirmwareParamError::OutOfRange {
+                    name: crate::firmware_param::param_name(param.id),
+                    value: param.value_si,
+                    min,
+                    max,
+                    unit: param.id.unit(),
+                }
+            })
+    }
+
+    /// [`SilConfig::with_firmware_param`] from its text form, `taut_angle_rad=-0.07` (names:
+    /// [`crate::firmware_param::PARAM_NAMES`]).
+    ///
+    /// # Errors
+    /// As [`FirmwareParam`]'s `FromStr` and [`SilConfig::with_firmware_param`].
+    pub fn with_firmware_param_str(self, spec: &str) -> Result<Self, FirmwareParamError> {
+        self.with_firmware_param(spec.parse()?)
+    }
+
+    /// The broadcast parameter writes among the setup commands, in order.
+    pub fn firmware_param_writes(&self) -> Vec<FirmwareParam> {
+        self.setup_commands
+            .iter()
+            .filter(|c| c.target == protocol::Target::Broadcast)
+            .filter_map(|c| match c.kind {
+                protocol::CommandKind::SetParam { param, value } => Some(FirmwareParam {
+                    id: param,
+                    // The f32 nearest the wire's decimal (−0.07, not −0.0700000003).
+                    value_si: crate::host::param_si(value) as f32,
+                }),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Write the scene's ideal reflex over the firmware's own parameters: taut angle,
+    /// extended angle and push duration (an explicit choice: by default the firmware runs
+    /// with its own defaults, which the `wisse3d` scene shares).
     ///
     /// # Errors
     /// A value outside the firmware's parameter range.

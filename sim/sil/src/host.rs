@@ -2,14 +2,17 @@
 //! schedule, then whatever socketcand clients send) and what it sees on the bus.
 
 use canbus::Frame;
-use protocol::{Command, CommandKind, DecodeError, Message, Target};
+use std::collections::BTreeMap;
+
+use protocol::{Command, CommandKind, DecodeError, Message, ParamId, ParamValue, Target};
 use sim::control::ControlError;
 
 use crate::bus_side::BusSide;
-use crate::config::{HostCommand, SilConfig};
+use crate::config::{HostCommand, SilConfig, READ_BACK_PARAMS};
 use crate::error::control_error;
 use crate::history::BoundedLog;
-use crate::report::{fault_names, HostReport};
+use crate::report::{fault_names, HostReport, NodeParameters};
+use crate::side::Side;
 use crate::tick::TickTime;
 
 /// The host node's commands and observations.
@@ -25,6 +28,9 @@ pub(crate) struct Host {
     commands_sent: BoundedLog<(f64, String)>,
     /// Parameter acknowledgements seen.
     param_acks: BoundedLog<String>,
+    /// The value in force of each parameter per node (left, right), from its last
+    /// `ParamAck`.
+    in_force: [BTreeMap<ParamId, ParamValue>; 2],
 }
 
 impl Host {
@@ -40,6 +46,7 @@ impl Host {
             report: HostReport::default(),
             commands_sent: BoundedLog::new(config.history_capacity),
             param_acks: BoundedLog::new(config.history_capacity),
+            in_force: [BTreeMap::new(), BTreeMap::new()],
         }
     }
 
@@ -56,8 +63,10 @@ impl Host {
         self.schedule.insert(at, HostCommand { at_s: t_s, command });
     }
 
-    /// Send the commands due at `t`: at the first tick the setup and `Enable` to every
-    /// ankle; the scheduled ones due; the frames socketcand clients sent.
+    /// Send the commands due at `t`: at the first tick the setup, `Enable` to every ankle and
+    /// a `GetParam` of each of [`READ_BACK_PARAMS`]; the scheduled ones due (each `SetParam`
+    /// followed by a `GetParam` of that parameter to the same target); the frames socketcand
+    /// clients sent.
     ///
     /// # Errors
     /// A command that does not encode, a frame the bus refuses.
@@ -72,6 +81,10 @@ impl Host {
                 kind: CommandKind::Enable,
             });
             self.send(t, bus, &enable)?;
+            // After the Enable, so that it is read at the next tick as ever.
+            for param in READ_BACK_PARAMS {
+                self.send(t, bus, &get_param(Target::Broadcast, param))?;
+            }
         }
         while let Some(c) = self.schedule.get(self.next).copied() {
             if c.at_s > t.t_s {
@@ -79,6 +92,9 @@ impl Host {
             }
             self.next += 1;
             self.send(t, bus, &Message::Command(c.command))?;
+            if let CommandKind::SetParam { param, .. } = c.command.kind {
+                self.send(t, bus, &get_param(c.command.target, param))?;
+            }
         }
         for f in bus.take_client_frames() {
             self.report.frames_from_clients += 1;
@@ -115,14 +131,20 @@ impl Host {
                 );
             }
             Message::Fault(_) => h.fault_events_seen += 1,
-            Message::ParamAck(a) => self.param_acks.push(format!(
-                "{:.3} s {:?} {:?} {:?} {}",
-                t_ns as f64 * 1e-9,
-                a.node,
-                a.param,
-                a.status,
-                a.value.to_si()
-            )),
+            Message::ParamAck(a) => {
+                // Every answer carries the value in force, whatever its status.
+                if let Some(side) = Side::BOTH.iter().find(|s| s.node() == a.node) {
+                    self.in_force[side.index()].insert(a.param, a.value);
+                }
+                self.param_acks.push(format!(
+                    "{:.3} s {:?} {:?} {:?} {}",
+                    t_ns as f64 * 1e-9,
+                    a.node,
+                    a.param,
+                    a.status,
+                    a.value.to_si()
+                ))
+            }
             _ => {}
         }
     }
@@ -136,8 +158,33 @@ impl Host {
         }
     }
 
+    /// The extension profile's parameters `side` last reported.
+    pub fn parameters(&self, side: Side) -> NodeParameters {
+        let reported = |id: ParamId| self.in_force[side.index()].get(&id).map(|v| param_si(*v));
+        NodeParameters::from_reported(
+            reported(ParamId::TautAngle),
+            reported(ParamId::ExtendedAngle),
+            reported(ParamId::PushDuration),
+            reported(ParamId::MaxPushRate),
+        )
+    }
+
     /// Entries left out of the commands sent and of the parameter acknowledgements.
     pub fn elided(&self) -> (u64, u64) {
         (self.commands_sent.elided(), self.param_acks.elided())
     }
+}
+
+/// A `GetParam` of `param` to `target`.
+fn get_param(target: Target, param: ParamId) -> Message {
+    Message::Command(Command {
+        target,
+        kind: CommandKind::GetParam { param },
+    })
+}
+
+/// A parameter's wire value in its SI unit, as the nearest `f64` to the decimal the wire
+/// holds (`-80000` counts of 1e-6 is −0.08, not `f32`'s −0.07999999821).
+pub(crate) fn param_si(v: ParamValue) -> f64 {
+    f64::from(v.0) / (1.0 / ParamValue::SCALE)
 }

@@ -31,6 +31,7 @@ mod ankle;
 mod bus_side;
 pub mod config;
 mod error;
+pub mod firmware_param;
 mod gait;
 pub mod hal;
 pub mod history;
@@ -39,6 +40,7 @@ mod integrator;
 mod orchestrator;
 mod records;
 pub mod report;
+pub mod scene_profile;
 pub mod sensors;
 pub mod side;
 pub mod swing;
@@ -48,14 +50,15 @@ mod tick;
 mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
-pub use config::{HostCommand, SilConfig};
+pub use config::{HostCommand, SilConfig, READ_BACK_PARAMS};
 pub use error::SilError;
+pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;
 pub use report::{
-    FaultRecord, HistoryElided, HostReport, Landing, NodeReport, PhaseChange, SilReport,
-    SocketcandReport, StateChange,
+    FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport, PhaseChange,
+    SilReport, SocketcandReport, StateChange,
 };
 pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,

@@ -104,6 +104,7 @@ impl FirmwareInTheLoop {
             .map(|&side| {
                 let mut r = self.records.node_report(side);
                 self.ankles[side.index()].fill_report(&mut r);
+                r.parameters = self.host.parameters(side);
                 (side, r)
             })
             .collect();

@@ -61,6 +61,56 @@ pub struct Landing {
     pub angle_rad: f64,
 }
 
+/// The extension profile's parameters in force on a node, as the node reported them over the
+/// bus (its last `ParamAck` for each: the answers to the host's `GetParam` after start-up and
+/// after each write). `null` for one the node never reported (a dropped frame, say).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct NodeParameters {
+    /// Ankle angle at which the string becomes taut [rad] (`TautAngle`).
+    pub taut_angle_rad: Option<f64>,
+    /// Ankle angle the actuator extends to [rad] (`ExtendedAngle`).
+    pub extended_angle_rad: Option<f64>,
+    /// Nominal duration of the extension [s] (`PushDuration`).
+    pub push_duration_s: Option<f64>,
+    /// Bound on the profile's rate [rad/s] (`MaxPushRate`).
+    pub max_push_rate_rad_per_s: Option<f64>,
+    /// The duration the node's profile takes with these values [s]: the nominal one,
+    /// stretched by the rate bound when needed (`ankle_profile::duration_within_rate`, the
+    /// firmware's own rule).
+    pub effective_push_duration_s: Option<f64>,
+}
+
+impl NodeParameters {
+    /// From the values reported [SI units], computing the effective duration.
+    pub fn from_reported(
+        taut_angle_rad: Option<f64>,
+        extended_angle_rad: Option<f64>,
+        push_duration_s: Option<f64>,
+        max_push_rate_rad_per_s: Option<f64>,
+    ) -> Self {
+        let effective_push_duration_s = match (
+            taut_angle_rad,
+            extended_angle_rad,
+            push_duration_s,
+            max_push_rate_rad_per_s,
+        ) {
+            (Some(taut), Some(extended), Some(duration), Some(rate)) => Some(
+                ankle_profile::duration_within_rate(extended - taut, duration, rate, |c| {
+                    f64::from(c)
+                }),
+            ),
+            _ => None,
+        };
+        NodeParameters {
+            taut_angle_rad,
+            extended_angle_rad,
+            push_duration_s,
+            max_push_rate_rad_per_s,
+            effective_push_duration_s,
+        }
+    }
+}
+
 /// One ankle node over the run.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct NodeReport {
@@ -114,6 +164,8 @@ pub struct NodeReport {
     pub firmware_dropped_tx: u32,
     /// The string actuator of this ankle.
     pub actuator: ActuatorStats,
+    /// The extension profile's parameters in force, as the node reported them.
+    pub parameters: NodeParameters,
 }
 
 /// What the host saw on the bus.

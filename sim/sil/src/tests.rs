@@ -73,7 +73,7 @@ fn sil(config: SilConfig) -> FirmwareInTheLoop {
 #[test]
 fn host_enables_both_nodes_and_the_stance_node_engages_and_extends() {
     let mut c = sil(SilConfig::default());
-    let ticks = run(&mut c, 0.65, &[]);
+    let ticks = run(&mut c, 0.75, &[]);
     let r = c.report();
     for side in Side::BOTH {
         assert_eq!(
@@ -92,8 +92,8 @@ fn host_enables_both_nodes_and_the_stance_node_engages_and_extends() {
     );
     let hold = first_phase(&r, Side::Left, "Hold", 0.0).unwrap();
     assert!(
-        (hold - push - 0.15).abs() <= 0.0015,
-        "150 ms profile: {hold}"
+        (hold - push - 0.27).abs() <= 0.0015,
+        "270 ms profile (the firmware's default): {hold}"
     );
     // Segments: released before the push, then C¹ and within the rate limit, reaching 0.2.
     let max_rate = ActuatorParams::default().max_rate_rad_per_s;
@@ -122,13 +122,75 @@ fn host_enables_both_nodes_and_the_stance_node_engages_and_extends() {
     // the firmware's debouncer starting open.
     assert_eq!(st.heel_strikes_sent, 0);
     assert_eq!(r.node(Side::Right).unwrap().heel_strikes_sent, 0);
-    // The firmware's profile peaks at 1.875 × 0.28 / 0.15 = 3.5 rad/s: no saturation, a lag
-    // of about τ × 3.5 rad/s = 17.5 mrad.
+    // The firmware's profile peaks at 1.875 × 0.28 / 0.27 = 1.94 rad/s: no saturation, a lag
+    // of about τ × 1.94 rad/s = 10 mrad.
     assert_eq!(st.actuator.saturated_ticks, 0);
-    assert!(st.actuator.max_tracking_error_rad < 0.02);
-    assert!(st.actuator.max_rate_rad_per_s < 3.6);
+    assert!(st.actuator.max_tracking_error_rad < 0.012);
+    assert!(st.actuator.max_rate_rad_per_s < 2.0);
+    // The parameters in force, as both nodes reported them over the bus: the defaults.
+    for side in Side::BOTH {
+        let p = r.node(side).unwrap().parameters;
+        assert_eq!(p.taut_angle_rad, Some(-0.08));
+        assert_eq!(p.extended_angle_rad, Some(0.2));
+        assert_eq!(p.push_duration_s, Some(0.27));
+        assert_eq!(p.max_push_rate_rad_per_s, Some(4.0));
+        assert_eq!(p.effective_push_duration_s, Some(0.27));
+    }
     assert!(r.faults.is_empty(), "{:?}", r.faults);
     assert_eq!(r.nodes[&Side::Right].engagements, 0);
+}
+
+#[test]
+fn written_parameters_are_in_force_and_reported_as_the_nodes_read_them_back() {
+    let config = SilConfig::default()
+        .with_firmware_param_str("taut_angle_rad=-0.07")
+        .and_then(|c| c.with_firmware_param_str("push_duration_s=0.2"))
+        .unwrap();
+    let mut c = sil(config);
+    // Later: a write while enabled is refused (the value stays), one after a Disable taken;
+    // the host reads each back.
+    let set = |v: f32| {
+        protocol::Command::set_param(
+            protocol::Target::Broadcast,
+            protocol::ParamId::ExtendedAngle,
+            v,
+        )
+        .unwrap()
+    };
+    c.host_command_at(0.4, set(0.25));
+    c.host_command_at(
+        0.45,
+        protocol::Command {
+            target: protocol::Target::Broadcast,
+            kind: protocol::CommandKind::Disable,
+        },
+    );
+    c.host_command_at(0.45, set(0.3));
+    run(&mut c, 0.5, &[]);
+    let r = c.report();
+    // The free ramp reaches −0.07 rad 20 ms before −0.08: the written taut angle is in force.
+    let push = first_phase(&r, Side::Left, "Push", 0.0).unwrap();
+    let at = TAUT_AFTER_S - 0.02;
+    assert!((at..=at + 0.005).contains(&push), "{push}");
+    assert!(r
+        .host
+        .param_acks
+        .iter()
+        .any(|a| a.contains("ExtendedAngle NotWhileEnabled 0.2")));
+    for side in Side::BOTH {
+        let p = r.node(side).unwrap().parameters;
+        assert_eq!(p.taut_angle_rad, Some(-0.07), "{side:?}");
+        assert_eq!(p.push_duration_s, Some(0.2));
+        assert_eq!(p.effective_push_duration_s, Some(0.2));
+        assert_eq!(p.extended_angle_rad, Some(0.3), "taken while disabled");
+    }
+    // Each SetParam the host sent is followed by a GetParam of it.
+    let sent = &r.host.commands_sent;
+    let gets = sent
+        .iter()
+        .filter(|(_, c)| c.contains("GetParam { param: ExtendedAngle }"))
+        .count();
+    assert_eq!(gets, 3, "{sent:?}");
 }
 
 #[test]
@@ -232,7 +294,11 @@ fn emergency_stop_releases_both_strings_within_two_ticks() {
     assert!(ticks
         .iter()
         .any(|t| t.t_s > 0.36 && t.t_s < 0.45 && !t.seg.released));
-    assert_eq!(r.host.commands_sent.len(), 2, "Enable and the stop");
+    assert_eq!(
+        r.host.commands_sent.len(),
+        6,
+        "Enable, four GetParam and the stop"
+    );
 }
 
 /// The left node must reach `Safe` with `PeerHeartbeatLost` no later than 0.3 s + one tick
@@ -403,9 +469,10 @@ fn candump_log_and_socketcand_server_see_the_traffic() {
     assert_eq!(records.len() as u64, r.frames_delivered);
     assert!(r.socketcand.is_some());
     std::fs::remove_dir_all(&dir).unwrap();
-    // 200 Hz AnkleState ×2, 20 Hz heartbeats ×2, the Enable and two versions in 0.2 s.
+    // 200 Hz AnkleState ×2, 20 Hz heartbeats ×2, the Enable, four GetParam and their eight
+    // answers, and two versions in 0.2 s.
     assert!(
-        r.frames_delivered > 80 && r.frames_delivered < 100,
+        r.frames_delivered > 92 && r.frames_delivered < 112,
         "{}",
         r.frames_delivered
     );

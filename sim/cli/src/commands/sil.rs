@@ -49,6 +49,18 @@ pub struct SilArgs {
     /// 1000); by default it runs as fast as it can.
     #[arg(long, value_name = "FACTOR", allow_negative_numbers = true)]
     pub realtime: Option<f64>,
+    /// Write a firmware parameter to both ankles over the bus before enabling them
+    /// (repeatable; by default the nodes run with the firmware's own parameters):
+    /// `taut_angle_rad`, `extended_angle_rad`, `push_duration_s`, `max_push_rate_rad_per_s`,
+    /// `peer_heartbeat_timeout_s`, `max_angular_rate_rad_per_s`, `stuck_timeout_s`; e.g.
+    /// `--firmware-param taut_angle_rad=-0.07`. Checked against each parameter's range and
+    /// the writes before it.
+    #[arg(
+        long = "firmware-param",
+        value_name = "NAME=VALUE",
+        allow_hyphen_values = true
+    )]
+    pub firmware_params: Vec<String>,
     /// Keep only the last N step summaries in the JSON's `steps` (default: all); the gait
     /// figures use the last 10 and `steps_completed` counts every step. For long runs:
     /// memory and output stay bounded.
@@ -74,8 +86,14 @@ struct SilWalkReport<'a, Bus: Serialize> {
     ideal_gait: IdealGaitRecord,
     /// Faults the nodes raised or cleared.
     node_faults: &'a [sil::FaultRecord],
-    /// The left and the right node.
+    /// The left and the right node; `nodes.<side>.parameters`: the extension profile's
+    /// parameters in force as the node reported them over the bus.
     nodes: &'a BTreeMap<sil::Side, sil::NodeReport>,
+    /// Firmware parameters written at start-up (`--firmware-param`), by name [SI units].
+    firmware_params_written: BTreeMap<&'static str, f64>,
+    /// Differences between the scene's extension profile (the plant's string geometry and
+    /// the ideal gait) and the one the nodes report; empty when they agree.
+    warnings: &'a [String],
     /// Bus load [-].
     bus_load: f64,
     /// Bus statistics.
@@ -101,6 +119,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         socketcand,
         realtime,
         keep_steps,
+        firmware_params,
     } = args;
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     if let Some(t) = estop_at {
@@ -127,9 +146,18 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         ))
         .into());
     };
-    let mut config = sil::config::SilConfig::default()
-        .with_reflex(&reflex)
-        .map_err(|e| InputError::Other(format!("reflex parameters: {e}")))?;
+    // The firmware's own parameters unless some are written.
+    let mut config = sil::config::SilConfig::default();
+    for p in &firmware_params {
+        config = config
+            .with_firmware_param_str(p)
+            .map_err(|e| InputError::Other(format!("--firmware-param `{p}`: {e}")))?;
+    }
+    let firmware_params_written = config
+        .firmware_param_writes()
+        .iter()
+        .map(|w| (sil::firmware_param::param_name(w.id), w.wire_value_f64()))
+        .collect();
     for f in &faults {
         config = config
             .with_fault_str(f)
@@ -217,6 +245,10 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         InputError::Other(m) => anyhow::anyhow!(m),
         other => anyhow::Error::from(other),
     })?;
+    let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
+    for w in &warnings {
+        output::note(format_args!("warning: {w}"));
+    }
     let report = SilWalkReport {
         scene: scene.name(),
         integrator: &stride_settings.integrator,
@@ -226,6 +258,8 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         ideal_gait: IdealGaitRecord::of(ideal_walker, &ideal),
         node_faults: &firmware.faults,
         nodes: &firmware.nodes,
+        firmware_params_written,
+        warnings: &warnings,
         bus_load: firmware.bus.load,
         bus: &firmware.bus,
         frames: firmware.frames_delivered,
@@ -290,6 +324,19 @@ fn print_text<Bus: Serialize>(
         writeln!(
             out,
             "{label:>9}: period {period:.5} s, step {length:.5} m, speed {speed:.5} m/s, cost of transport {cost:.5} J/(kg m)"
+        )?;
+    }
+    for (side, n) in r.nodes {
+        let p = &n.parameters;
+        let shown_opt =
+            |v: Option<f64>| v.map_or_else(|| "not reported".to_owned(), |v| v.to_string());
+        writeln!(
+            out,
+            "{side:?} node reports: taut {} rad, extended {} rad, push {} s (effective {} s)",
+            shown_opt(p.taut_angle_rad),
+            shown_opt(p.extended_angle_rad),
+            shown_opt(p.push_duration_s),
+            shown_opt(p.effective_push_duration_s)
         )?;
     }
     writeln!(
