@@ -1,4 +1,4 @@
-//! The ankle stretch reflex with an ideal actuator (paper Fig. 8, `MODEL.md`).
+//! The ankle stretch reflex with an ideal actuator (paper Fig. 8, `docs/model.md`).
 //!
 //! While the string is slack the ankle is free and the foot flat. When the ankle angle falls to
 //! the engagement angle the string is taut: an inelastic impact stops the ankle, the foot starts

@@ -1,6 +1,6 @@
 //! The stance contact's load from the total momentum balance: the ground reaction force and
 //! moment that the whole walker's motion requires, and the lateral centre of pressure under
-//! the stance foot that carries the roll moment (`MODEL.md`: roll is judged this way, since the
+//! the stance foot that carries the roll moment (`docs/model.md`: roll is judged this way, since the
 //! foot has no roll freedom).
 
 use crate::kinematics::Kinematics;

@@ -2,7 +2,7 @@
 //!
 //! A model is a kinematic tree rooted at the ground (the stance contact). Each link owns at
 //! most one coordinate (its joint's), so each joint owns its slice of `q` and `q̇`. Positions are
-//! in metres, angles in radians, masses in kilograms, in the floor frame of `MODEL.md`: x forward
+//! in metres, angles in radians, masses in kilograms, in the floor frame of `docs/model.md`: x forward
 //! (down the slope), y normal to the floor (up), z = x × y.
 
 use nalgebra::{Matrix3, Vector3};
