@@ -239,7 +239,20 @@ impl Dynamics {
             return Ok(qdd);
         }
         self.assemble(model, q, qd, None);
-        let n = q.len();
+        self.solve_assembled_limit(active, qdd_prescribed)
+    }
+
+    /// The vanishing-mass limit of `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` on the matrices already
+    /// assembled here (finite and infinitesimal parts; see [`Dynamics::accelerations`]).
+    ///
+    /// # Errors
+    /// [`DynamicsError`]: no limit exists, or a non-finite result.
+    pub fn solve_assembled_limit(
+        &self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        let n = active.len();
         let mut qdd = match qdd_prescribed {
             Some(p) => p.clone(),
             None => DVector::zeros(n),
@@ -311,7 +324,7 @@ impl Dynamics {
 /// Solves `A x = b` for the leading `k × k` block of a symmetric positive definite `A` stored
 /// row-major with row stride `stride`, overwriting `A` with its Cholesky factor and `b` with
 /// `x`. Returns false if `A` is not positive definite.
-fn cholesky_solve_in_place<T: RealField + Copy>(
+pub(crate) fn cholesky_solve_in_place<T: RealField + Copy>(
     a: &mut [T],
     stride: usize,
     k: usize,

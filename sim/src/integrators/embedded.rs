@@ -3,6 +3,7 @@
 //! shared step controller ([`adaptive_step`]); a pair ([`EmbeddedPair`]) gives only its
 //! coefficients, its controller constants and its error estimate.
 
+use super::dense::{DenseCoefficients, DenseOutput};
 use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
 use nalgebra::DVector;
 use std::fmt::Debug;
@@ -10,6 +11,18 @@ use std::marker::PhantomData;
 
 /// A kept derivative: time [s], positions, velocities, accelerations.
 type Kept = (f64, DVector<f64>, DVector<f64>, DVector<f64>);
+
+/// One trial step's start, size, stages and end, from which its dense output is built.
+#[derive(Clone, Debug)]
+struct LastStep {
+    t0_s: f64,
+    h_s: f64,
+    q0: DVector<f64>,
+    kq: Vec<DVector<f64>>,
+    kv: Vec<DVector<f64>>,
+    q1: DVector<f64>,
+    v1: DVector<f64>,
+}
 
 /// Local-error tolerances of an embedded pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +53,8 @@ pub trait EmbeddedPair: Clone + Debug {
     /// First same as last: the last stage is the derivative at the step's end (kept from an
     /// accepted step for the next one). Otherwise the first stage is kept once evaluated.
     const FSAL: bool;
+    /// The pair's continuous extension, if it has one.
+    const DENSE: Option<DenseCoefficients> = None;
 
     /// The scaled error norm of a step of size `h` [s] from `s` to `(q_new, v_new)` with
     /// stage derivatives `kq` (of the positions) and `kv` (of the velocities).
@@ -70,6 +85,8 @@ pub struct EmbeddedRk<P: EmbeddedPair> {
     kept: Option<Kept>,
     /// The last trial step's final stage (FSAL pairs).
     last_stage: Option<DVector<f64>>,
+    /// The last trial step, kept for its dense output (pairs with a continuous extension).
+    last_step: Option<LastStep>,
     pair: PhantomData<P>,
 }
 
@@ -84,6 +101,7 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             h_min_s: 1e-14,
             kept: None,
             last_stage: None,
+            last_step: None,
             pair: PhantomData,
         }
     }
@@ -105,6 +123,69 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             self.kept = Some((s.t_s, s.q.clone(), s.qd.clone(), a.clone()));
         }
         Ok(a)
+    }
+
+    /// The dense output of the kept last step: the derivative at its end (kept for a next
+    /// step from there), the extra stages, and Hairer's coefficients
+    /// `F0 = Δy, F1 = h f0 − Δy, F2 = 2Δy − h (f0 + f1), F3… = h D K`.
+    fn build_dense(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        last: &LastStep,
+        coefficients: &DenseCoefficients,
+    ) -> Result<DenseOutput, IntegrationError> {
+        let (t0, h) = (last.t0_s, last.h_s);
+        let t1 = t0 + h;
+        let end = Sample {
+            t_s: t1,
+            q: last.q1.clone(),
+            qd: last.v1.clone(),
+        };
+        self.evaluations += 1;
+        let a_end = sys.accelerations(end.t_s, &end.q, &end.qd)?;
+        let (mut kq, mut kv) = (last.kq.clone(), last.kv.clone());
+        kq.truncate(P::C.len());
+        kv.truncate(P::C.len());
+        kq.push(end.qd.clone());
+        kv.push(a_end);
+        for (c, row) in coefficients.extra_c.iter().zip(coefficients.extra_a) {
+            let mut q = last.q0.clone();
+            let mut v = last.kq[0].clone();
+            for &(j, a) in row.iter() {
+                q.axpy(h * a, &kq[j], 1.0);
+                v.axpy(h * a, &kv[j], 1.0);
+            }
+            self.evaluations += 1;
+            let acc = sys.accelerations(t0 + c * h, &q, &v)?;
+            kq.push(v);
+            kv.push(acc);
+        }
+        let s = P::C.len();
+        let dq = &last.q1 - &last.q0;
+        let dv = &last.v1 - &last.kq[0];
+        let mut f = Vec::with_capacity(3 + coefficients.d.len());
+        f.push((dq.clone(), dv.clone()));
+        f.push((&kq[0] * h - &dq, &kv[0] * h - &dv));
+        f.push((
+            &dq * 2.0 - (&kq[0] + &kq[s]) * h,
+            &dv * 2.0 - (&kv[0] + &kv[s]) * h,
+        ));
+        for row in coefficients.d {
+            let mut fq = DVector::zeros(dq.len());
+            let mut fv = DVector::zeros(dq.len());
+            for &(j, d) in row.iter() {
+                fq.axpy(h * d, &kq[j], 1.0);
+                fv.axpy(h * d, &kv[j], 1.0);
+            }
+            f.push((fq, fv));
+        }
+        Ok(DenseOutput::new(
+            t0,
+            h,
+            last.q0.clone(),
+            last.kq[0].clone(),
+            f,
+        ))
     }
 
     /// Keeps an accepted step's end derivative for the next step (FSAL pairs).
@@ -153,14 +234,23 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             // next step if this one is accepted.
             self.last_stage = kv.pop();
         }
-        Ok((
-            Sample {
-                t_s: s.t_s + h,
-                q: q_new,
-                qd: v_new,
-            },
-            err,
-        ))
+        let next = Sample {
+            t_s: s.t_s + h,
+            q: q_new,
+            qd: v_new,
+        };
+        if P::DENSE.is_some() {
+            self.last_step = Some(LastStep {
+                t0_s: s.t_s,
+                h_s: h,
+                q0: s.q.clone(),
+                kq,
+                kv,
+                q1: next.q.clone(),
+                v1: next.qd.clone(),
+            });
+        }
+        Ok((next, err))
     }
 }
 
@@ -172,9 +262,27 @@ impl<P: EmbeddedPair> Integrator for EmbeddedRk<P> {
         self.evaluations = 0;
         self.h_next_s = 0.0;
         self.kept = None;
+        self.last_step = None;
     }
     fn system_changed(&mut self) {
         self.kept = None;
+        self.last_step = None;
+    }
+    fn dense_output(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        from: &Sample,
+        to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        let coefficients = P::DENSE?;
+        let last = self.last_step.take()?;
+        let same = last.t0_s == from.t_s
+            && last.t0_s + last.h_s == to.t_s
+            && last.q0 == from.q
+            && last.kq[0] == from.qd;
+        let dense = same.then(|| self.build_dense(sys, &last, &coefficients));
+        self.last_step = Some(last);
+        dense
     }
     fn proposed_step_s(&self) -> f64 {
         if self.h_next_s > 0.0 {

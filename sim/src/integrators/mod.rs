@@ -3,12 +3,14 @@
 //! Every integrator advances a [`SecondOrderSystem`] by one accepted step and can take an
 //! exact step of any smaller size, which the event locator uses to refine event times.
 
+mod dense;
 mod dop853;
 mod dopri5;
 mod embedded;
 mod meijaard;
 mod rk4;
 
+pub use dense::{DenseCoefficients, DenseOutput};
 pub use dop853::{Dop853, Dop853Pair};
 pub use dopri5::{Dopri5, Dopri5Pair};
 pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
@@ -388,4 +390,15 @@ pub trait Integrator {
     /// The equations changed without the state changing (e.g. a control tick moved an
     /// actuator): forget any derivative kept from the last step.
     fn system_changed(&mut self) {}
+    /// The dense output of the last step taken (by `advance` or `step_exact`) when it went
+    /// from `from` to `to` and the integrator has a continuous extension; `None` otherwise
+    /// (then events are refined with exact steps). Its extra stages count as evaluations.
+    fn dense_output(
+        &mut self,
+        _sys: &mut dyn SecondOrderSystem,
+        _from: &Sample,
+        _to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        None
+    }
 }
