@@ -324,7 +324,7 @@ impl Dynamics {
 /// Solves `A x = b` for the leading `k × k` block of a symmetric positive definite `A` stored
 /// row-major with row stride `stride`, overwriting `A` with its Cholesky factor and `b` with
 /// `x`. Returns false if `A` is not positive definite.
-pub(crate) fn cholesky_solve_in_place<T: RealField + Copy>(
+fn cholesky_solve_in_place<T: RealField + Copy>(
     a: &mut [T],
     stride: usize,
     k: usize,

@@ -13,7 +13,7 @@
 //! point `p` fixed in a link is the link origin's minus `ω² (p − o)`; the gyroscopic torque
 //! `ω × I ω` has no z component, so only each body's `I_zz` enters.
 
-use crate::dynamics::{cholesky_solve_in_place, Dynamics, DynamicsError};
+use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::model::{JointKind, Model};
 use crate::singular_limit::LimitSolveError;
@@ -22,7 +22,7 @@ use nalgebra::{DVector, SMatrix, SVector};
 /// Most coordinates a tree may have to take the fast path.
 pub const MAX_COORDINATES: usize = 6;
 /// Most links (welds included) a tree may have to take the fast path.
-pub const MAX_LINKS: usize = 16;
+pub const MAX_LINKS: usize = 12;
 
 /// Which evaluation of the equations of motion a phase uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -172,13 +172,31 @@ impl PlanarTree {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
+        let mut out = DVector::zeros(q.len());
+        self.accelerations_into(limit, active, drive, q, qd, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::accelerations`] written into `out` (no allocation for finite bodies).
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`]; also a state or `out` whose length is not the model's.
+    pub fn accelerations_into(
+        &self,
+        limit: &mut Dynamics,
+        active: &[bool],
+        drive: Option<&DriveValues<f64>>,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
         match self.dof {
-            1 => self.accelerations_n::<1>(limit, active, drive, q, qd),
-            2 => self.accelerations_n::<2>(limit, active, drive, q, qd),
-            3 => self.accelerations_n::<3>(limit, active, drive, q, qd),
-            4 => self.accelerations_n::<4>(limit, active, drive, q, qd),
-            5 => self.accelerations_n::<5>(limit, active, drive, q, qd),
-            _ => self.accelerations_n::<6>(limit, active, drive, q, qd),
+            1 => self.accelerations_n::<1>(limit, active, drive, q, qd, out),
+            2 => self.accelerations_n::<2>(limit, active, drive, q, qd, out),
+            3 => self.accelerations_n::<3>(limit, active, drive, q, qd, out),
+            4 => self.accelerations_n::<4>(limit, active, drive, q, qd, out),
+            5 => self.accelerations_n::<5>(limit, active, drive, q, qd, out),
+            _ => self.accelerations_n::<6>(limit, active, drive, q, qd, out),
         }
     }
 
@@ -189,8 +207,9 @@ impl PlanarTree {
         drive: Option<&DriveValues<f64>>,
         q: &DVector<f64>,
         qd: &DVector<f64>,
-    ) -> Result<DVector<f64>, DynamicsError> {
-        if q.len() != N || qd.len() != N || active.len() != N {
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        if q.len() != N || qd.len() != N || active.len() != N || out.len() != N {
             return Err(DynamicsError::NonFinite);
         }
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
@@ -205,27 +224,28 @@ impl PlanarTree {
             qdd[d.coordinate] = d.acceleration_rad_s2;
         }
         let a = self.assemble::<N>(&qs, &qds);
-        let out = if self.has_infinitesimal {
+        if self.has_infinitesimal {
             limit.mass_matrix.copy_from(&a.m);
             limit.mass_matrix_infinitesimal.copy_from(&a.m_eps);
             limit.force.copy_from(&a.f);
             limit.force_infinitesimal.copy_from(&a.f_eps);
             let prescribed = drive.map(|_| DVector::from_iterator(N, qdd.iter().copied()));
-            limit.solve_assembled_limit(active, prescribed.as_ref())?
+            *out = limit.solve_assembled_limit(active, prescribed.as_ref())?;
         } else {
-            solve_active(&a.m, &a.f, active, drive.is_some(), &mut qdd)?;
-            DVector::from_iterator(N, qdd.iter().copied())
-        };
+            solve_active(&a.m, &a.f, active, &mut qdd)?;
+            out.copy_from_slice(qdd.as_slice());
+        }
         if out.iter().any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
-        Ok(out)
+        Ok(())
     }
 
     /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and
     /// dampers, body by body, over the planar kinematics.
     fn assemble<const N: usize>(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Assembled<N> {
         let mut st = [LinkState::default(); MAX_LINKS];
+        let st = &mut st[..self.links.len()];
         let mut out = Assembled {
             m: SMatrix::zeros(),
             m_eps: SMatrix::zeros(),
@@ -301,37 +321,75 @@ impl PlanarTree {
     }
 }
 
-/// Solves `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` for the active coordinates by Cholesky on fixed-size
-/// scratch, writing them into `qdd` (which holds the prescribed accelerations, zero when
-/// locked).
+/// Solves `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` for the active coordinates, writing them into `qdd`
+/// (which holds the prescribed accelerations, zero when locked): a fixed-size Cholesky
+/// factorisation of `M̄` with the rows and columns of the coordinates that are not free
+/// replaced by the identity's, whose solution there is `q̈_p` itself.
 fn solve_active<const N: usize>(
     m: &SMatrix<f64, N, N>,
     f: &SVector<f64, N>,
     active: &[bool],
-    prescribed: bool,
     qdd: &mut SVector<f64, N>,
 ) -> Result<(), DynamicsError> {
-    let mut work_m = SMatrix::<f64, N, N>::zeros();
-    let mut work_b = SVector::<f64, N>::zeros();
-    let mut k = 0;
-    for i in (0..N).filter(|&i| active[i]) {
-        let mut b = f[i];
-        if prescribed {
-            for j in (0..N).filter(|&j| !active[j]) {
-                b -= m[(i, j)] * qdd[j];
+    let mut reduced = *m;
+    let mut b = *f;
+    for j in (0..N).filter(|&j| !active[j]) {
+        if qdd[j] != 0.0 {
+            for i in 0..N {
+                b[i] -= m[(i, j)] * qdd[j];
             }
         }
-        work_b[k] = b;
-        for (l, j) in (0..N).filter(|&j| active[j]).enumerate() {
-            work_m.as_mut_slice()[k * N + l] = m[(i, j)];
-        }
-        k += 1;
     }
-    if !cholesky_solve_in_place(work_m.as_mut_slice(), N, k, work_b.as_mut_slice()) {
-        return Err(LimitSolveError::Degenerate { nullity: 1 }.into());
+    for j in (0..N).filter(|&j| !active[j]) {
+        reduced.fill_row(j, 0.0);
+        reduced.fill_column(j, 0.0);
+        reduced[(j, j)] = 1.0;
+        b[j] = qdd[j];
     }
-    for (r, i) in (0..N).filter(|&i| active[i]).enumerate() {
-        qdd[i] = work_b[r];
+    if !cholesky_solve(&mut reduced, &mut b) {
+        return Err(DynamicsError::Singular(LimitSolveError::Degenerate {
+            nullity: 1,
+        }));
     }
+    *qdd = b;
     Ok(())
+}
+
+/// Solves `A x = b` in place for a symmetric positive definite `A` (its lower triangle
+/// overwritten with the Cholesky factor, `b` with `x`); false if `A` is not positive definite.
+fn cholesky_solve<const N: usize>(a: &mut SMatrix<f64, N, N>, b: &mut SVector<f64, N>) -> bool {
+    for j in 0..N {
+        let mut d = a[(j, j)];
+        for p in 0..j {
+            d -= a[(j, p)] * a[(j, p)];
+        }
+        // Also rejects NaN.
+        if !(d > 0.0) {
+            return false;
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..N {
+            let mut v = a[(i, j)];
+            for p in 0..j {
+                v -= a[(i, p)] * a[(j, p)];
+            }
+            a[(i, j)] = v / d;
+        }
+    }
+    for i in 0..N {
+        let mut v = b[i];
+        for p in 0..i {
+            v -= a[(i, p)] * b[p];
+        }
+        b[i] = v / a[(i, i)];
+    }
+    for i in (0..N).rev() {
+        let mut v = b[i];
+        for p in i + 1..N {
+            v -= a[(p, i)] * b[p];
+        }
+        b[i] = v / a[(i, i)];
+    }
+    true
 }

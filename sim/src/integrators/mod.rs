@@ -31,6 +31,24 @@ pub trait SecondOrderSystem {
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError>;
 
+    /// Accelerations at `t`, `q`, `q̇` written into `out` (of the state's length): the
+    /// integrators' entry point, which a system can implement without allocating.
+    fn accelerations_into(
+        &mut self,
+        t_s: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        let a = self.accelerations(t_s, q, qd)?;
+        if out.len() == a.len() {
+            out.copy_from(&a);
+        } else {
+            *out = a;
+        }
+        Ok(())
+    }
+
     /// Largest undamped eigenfrequency `λ_max` [rad/s] and its relative damping `β` of the
     /// linearised system at `q`, `q̇` (for eq. 12). `None` if the system cannot tell.
     fn stability_limit(

@@ -136,6 +136,25 @@ impl SecondOrderSystem for Phase<'_> {
         }
     }
 
+    fn accelerations_into(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        match &self.planar {
+            Some(p) if out.len() == q.len() => {
+                let drive = self.drive_at(t);
+                p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
+            }
+            _ => {
+                *out = self.accelerations(t, q, qd)?;
+                Ok(())
+            }
+        }
+    }
+
     fn stability_limit(
         &mut self,
         _t: f64,
