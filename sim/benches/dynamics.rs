@@ -1,7 +1,8 @@
 //! Criterion benchmarks of one evaluation of the equations of motion per scene, at the scene's
 //! gait guess (just after heel strike), in the phase the stride starts in: the kinematics
 //! alone, the assembly of `M̄` and `f̄`, and the accelerations (assembly and the active-set
-//! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions).
+//! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions), and
+//! for the planar scenes the same accelerations on the planar fast path (`sim::planar`).
 //! Results and the machine: docs/performance.md.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -10,6 +11,7 @@ use nalgebra::{DVector, SVector};
 use num_dual::{Derivative, DualSVec64};
 use sim::dynamics::{Dynamics, DynamicsOf};
 use sim::kinematics::Kinematics;
+use sim::planar::PlanarTree;
 use sim::scene::Scene;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
@@ -39,6 +41,22 @@ fn benches(c: &mut Criterion) {
                     .unwrap()
             })
         });
+        if let Some(tree) = PlanarTree::of(model) {
+            let mut out = DVector::zeros(model.dof());
+            group.bench_function("accelerations_planar_fast_path", |b| {
+                b.iter(|| {
+                    tree.accelerations_into(
+                        &mut dynamics,
+                        &active,
+                        None,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut out,
+                    )
+                    .unwrap()
+                })
+            });
+        }
         if !model.has_infinitesimal_bodies() {
             // Each coordinate carries a unit direction (mod 6), as the variational equations
             // seed them.

@@ -79,11 +79,18 @@ impl Stages {
 
     /// Stage state `q = q0 + h Σ a_j kq_j`, `v = v0 + h Σ a_j kv_j`.
     fn combine(&mut self, q0: &DVector<f64>, v0: &DVector<f64>, h: f64, row: &[(usize, f64)]) {
-        self.q.copy_from(q0);
-        self.v.copy_from(v0);
+        let (q, v) = (self.q.as_mut_slice(), self.v.as_mut_slice());
+        q.copy_from_slice(q0.as_slice());
+        v.copy_from_slice(v0.as_slice());
         for &(j, a) in row {
-            self.q.axpy(h * a, &self.kq[j], 1.0);
-            self.v.axpy(h * a, &self.kv[j], 1.0);
+            let ha = h * a;
+            let (kq, kv) = (self.kq[j].as_slice(), self.kv[j].as_slice());
+            for (x, k) in q.iter_mut().zip(kq) {
+                *x += ha * k;
+            }
+            for (x, k) in v.iter_mut().zip(kv) {
+                *x += ha * k;
+            }
         }
     }
 
