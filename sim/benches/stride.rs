@@ -6,6 +6,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::planar::EvaluationPath;
 use sim::scene::Scene;
 use sim::stride::StrideRequest;
 
@@ -67,6 +68,19 @@ fn benches(c: &mut Criterion) {
             ),
         ] {
             let settings = setup.settings.with_integrator(integrator);
+            if label == "default" {
+                // The same stride on the general engine with events estimated on the Hermite
+                // interpolant (the path before the planar fast path and dense output).
+                let mut general = settings.clone();
+                general.evaluation = EvaluationPath::General;
+                general.event_tolerance.dense_output = false;
+                group.bench_function("default_general_hermite", |b| {
+                    b.iter(|| {
+                        let request = StrideRequest::new(&general);
+                        walker.stride(black_box(&q), black_box(&qd), request)
+                    })
+                });
+            }
             group.bench_function(label, |b| {
                 b.iter(|| {
                     let request = StrideRequest::new(&settings);
