@@ -109,6 +109,15 @@ fn benches(c: &mut Criterion) {
                     h_max_s: period / 10.0,
                 },
             ),
+            (
+                // Eigenvalues to about 5e-7 on the 3D walker (docs/accuracy.md).
+                "dop853_1e-8",
+                IntegratorChoice::Dop853 {
+                    rtol: 1e-8,
+                    atol: 1e-8,
+                    h_max_s: period / 10.0,
+                },
+            ),
         ] {
             let settings = setup.settings.with_integrator(integrator);
             let search = GaitSearch::new(walker, &settings, &newton);
