@@ -26,7 +26,7 @@ struct Coordinates {
 }
 
 impl Coordinates {
-    fn to_drake(&self, q: &DVector<f64>, qd: &DVector<f64>) -> [f64; 4] {
+    fn drake_of_ours(&self, q: &DVector<f64>, qd: &DVector<f64>) -> [f64; 4] {
         let (st, sw) = (q[self.stance], q[self.swing]);
         let (vst, vsw) = (qd[self.stance], qd[self.swing]);
         [
@@ -37,7 +37,7 @@ impl Coordinates {
         ]
     }
 
-    fn from_drake(&self, x: [f64; 4], n: usize) -> (DVector<f64>, DVector<f64>) {
+    fn ours_of_drake(&self, x: [f64; 4], n: usize) -> (DVector<f64>, DVector<f64>) {
         let mut q = DVector::zeros(n);
         let mut qd = DVector::zeros(n);
         q[self.stance] = self.slope_rad - x[0];
@@ -89,7 +89,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     };
     let gait = setup.find_gait(&Default::default())?;
     let (q_fp, qd_fp) = walker.unpack(&gait.fixed_point);
-    let fixed = coords.to_drake(&q_fp, &qd_fp);
+    let fixed = coords.drake_of_ours(&q_fp, &qd_fp);
     let start: [f64; 4] = std::array::from_fn(|i| fixed[i] + perturb[i]);
     for rtol in rtols {
         let settings = setup.settings.with_integrator(IntegratorChoice::Dop853 {
@@ -102,7 +102,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let mut walk_times = Vec::new();
         let mut evaluations = 0;
         for rep in 0..repeats {
-            let (mut q, mut qd) = coords.from_drake(start, model.dof());
+            let (mut q, mut qd) = coords.ours_of_drake(start, model.dof());
             let mut t_walk = 0.0;
             let clock = Instant::now();
             for _ in 0..strides {
@@ -113,7 +113,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     t_walk += r.duration_s;
                     evaluations += r.evaluations;
                     let (before, _) = r.event_states.last().ok_or("no heel strike")?;
-                    states.push(coords.to_drake(&before.q, &before.qd));
+                    states.push(coords.drake_of_ours(&before.q, &before.qd));
                     walk_times.push(t_walk);
                 }
                 q = r.q_next;

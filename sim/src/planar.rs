@@ -363,8 +363,8 @@ fn cholesky_solve<const N: usize>(a: &mut SMatrix<f64, N, N>, b: &mut SVector<f6
         for p in 0..j {
             d -= a[(j, p)] * a[(j, p)];
         }
-        // Also rejects NaN.
-        if !(d > 0.0) {
+        // Also rejects NaN (which is not greater than zero).
+        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
         let d = d.sqrt();
