@@ -13,6 +13,7 @@ use sim::dynamics::{Dynamics, DynamicsOf};
 use sim::kinematics::Kinematics;
 use sim::planar::PlanarTree;
 use sim::scene::Scene;
+use std::time::Duration;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
 
@@ -26,6 +27,9 @@ fn benches(c: &mut Criterion) {
             active[c.0] = false;
         }
         let mut group = c.benchmark_group(format!("dynamics/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         let mut kin = Kinematics::new(model);
         group.bench_function("kinematics", |b| {
             b.iter(|| kin.update(model, black_box(&q), black_box(&qd)))

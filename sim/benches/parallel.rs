@@ -29,6 +29,7 @@ fn benches(c: &mut Criterion) {
     let search = GaitSearch::new(&wisse3d.walker, &wisse3d.settings, &newton);
     let mut group = c.benchmark_group("parallel");
     group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(4));
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()

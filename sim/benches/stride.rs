@@ -9,6 +9,7 @@ use sim::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::planar::EvaluationPath;
 use sim::scene::Scene;
 use sim::stride::StrideRequest;
+use std::time::Duration;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
 
@@ -27,6 +28,9 @@ fn benches(c: &mut Criterion) {
         let (q, qd) = walker.unpack(&gait.fixed_point);
         let period = gait.stride.duration_s;
         let mut group = c.benchmark_group(format!("stride/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         for (label, integrator) in [
             ("default", setup.settings.integrator.clone()),
             (
@@ -90,6 +94,9 @@ fn benches(c: &mut Criterion) {
         }
         group.finish();
         let mut group = c.benchmark_group(format!("gait/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         group.sample_size(10);
         group.bench_function("default", |b| b.iter(|| search.find(black_box(&v0))));
         for (label, integrator) in [
