@@ -1,7 +1,8 @@
 //! Criterion benchmarks of one evaluation of the equations of motion per scene, at the scene's
 //! gait guess (just after heel strike), in the phase the stride starts in: the kinematics
 //! alone, the assembly of `M̄` and `f̄`, and the accelerations (assembly and the active-set
-//! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions).
+//! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions), and
+//! for the planar scenes the same accelerations on the planar fast path (`sim::planar`).
 //! Results and the machine: docs/performance.md.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -10,7 +11,9 @@ use nalgebra::{DVector, SVector};
 use num_dual::{Derivative, DualSVec64};
 use sim::dynamics::{Dynamics, DynamicsOf};
 use sim::kinematics::Kinematics;
+use sim::planar::PlanarTree;
 use sim::scene::Scene;
+use std::time::Duration;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
 
@@ -24,6 +27,9 @@ fn benches(c: &mut Criterion) {
             active[c.0] = false;
         }
         let mut group = c.benchmark_group(format!("dynamics/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         let mut kin = Kinematics::new(model);
         group.bench_function("kinematics", |b| {
             b.iter(|| kin.update(model, black_box(&q), black_box(&qd)))
@@ -39,6 +45,22 @@ fn benches(c: &mut Criterion) {
                     .unwrap()
             })
         });
+        if let Some(tree) = PlanarTree::of(model) {
+            let mut out = DVector::zeros(model.dof());
+            group.bench_function("accelerations_planar_fast_path", |b| {
+                b.iter(|| {
+                    tree.accelerations_into(
+                        &mut dynamics,
+                        &active,
+                        None,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut out,
+                    )
+                    .unwrap()
+                })
+            });
+        }
         if !model.has_infinitesimal_bodies() {
             // Each coordinate carries a unit direction (mod 6), as the variational equations
             // seed them.

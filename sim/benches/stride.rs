@@ -1,13 +1,15 @@
 //! Criterion benchmarks: one stride per scene and integrator, and a whole gait computation
-//! (fixed point and eigenvalues) per scene with its default integrator. Results and the machine
-//! are in docs/performance.md.
+//! (fixed point and eigenvalues) per scene and adaptive integrator (the fixed-step ones do not
+//! reach Newton's tolerance). Results and the machine are in docs/performance.md.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use sim::integrators::IntegratorChoice;
 use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::planar::EvaluationPath;
 use sim::scene::Scene;
 use sim::stride::StrideRequest;
+use std::time::Duration;
 
 const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d"];
 
@@ -26,6 +28,9 @@ fn benches(c: &mut Criterion) {
         let (q, qd) = walker.unpack(&gait.fixed_point);
         let period = gait.stride.duration_s;
         let mut group = c.benchmark_group(format!("stride/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         for (label, integrator) in [
             ("default", setup.settings.integrator.clone()),
             (
@@ -50,6 +55,14 @@ fn benches(c: &mut Criterion) {
                 },
             ),
             (
+                "dop853_1e-10",
+                IntegratorChoice::Dop853 {
+                    rtol: 1e-10,
+                    atol: 1e-10,
+                    h_max_s: period / 10.0,
+                },
+            ),
+            (
                 "dop853_1e-8",
                 IntegratorChoice::Dop853 {
                     rtol: 1e-8,
@@ -59,6 +72,19 @@ fn benches(c: &mut Criterion) {
             ),
         ] {
             let settings = setup.settings.with_integrator(integrator);
+            if label == "default" {
+                // The same stride on the general engine with events estimated on the Hermite
+                // interpolant (the path before the planar fast path and dense output).
+                let mut general = settings.clone();
+                general.evaluation = EvaluationPath::General;
+                general.event_tolerance.dense_output = false;
+                group.bench_function("default_general_hermite", |b| {
+                    b.iter(|| {
+                        let request = StrideRequest::new(&general);
+                        walker.stride(black_box(&q), black_box(&qd), request)
+                    })
+                });
+            }
             group.bench_function(label, |b| {
                 b.iter(|| {
                     let request = StrideRequest::new(&settings);
@@ -67,9 +93,46 @@ fn benches(c: &mut Criterion) {
             });
         }
         group.finish();
-        let mut group = c.benchmark_group("gait");
+        let mut group = c.benchmark_group(format!("gait/{name}"));
+        // Short times keep the whole `cargo bench` moderate on the shared 2-core machine.
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(2));
         group.sample_size(10);
-        group.bench_function(name, |b| b.iter(|| search.find(black_box(&v0))));
+        group.bench_function("default", |b| b.iter(|| search.find(black_box(&v0))));
+        for (label, integrator) in [
+            (
+                "dopri5_1e-10",
+                IntegratorChoice::Dopri5 {
+                    rtol: 1e-10,
+                    atol: 1e-10,
+                    h_max_s: period / 10.0,
+                },
+            ),
+            (
+                "dop853_1e-10",
+                IntegratorChoice::Dop853 {
+                    rtol: 1e-10,
+                    atol: 1e-10,
+                    h_max_s: period / 10.0,
+                },
+            ),
+            (
+                // Eigenvalues to about 5e-7 on the 3D walker (docs/accuracy.md).
+                "dop853_1e-8",
+                IntegratorChoice::Dop853 {
+                    rtol: 1e-8,
+                    atol: 1e-8,
+                    h_max_s: period / 10.0,
+                },
+            ),
+        ] {
+            let settings = setup.settings.with_integrator(integrator);
+            let search = GaitSearch::new(walker, &settings, &newton);
+            if search.find(&v0).is_err() {
+                continue;
+            }
+            group.bench_function(label, |b| b.iter(|| search.find(black_box(&v0))));
+        }
         group.finish();
     }
 }

@@ -239,7 +239,20 @@ impl Dynamics {
             return Ok(qdd);
         }
         self.assemble(model, q, qd, None);
-        let n = q.len();
+        self.solve_assembled_limit(active, qdd_prescribed)
+    }
+
+    /// The vanishing-mass limit of `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` on the matrices already
+    /// assembled here (finite and infinitesimal parts; see [`Dynamics::accelerations`]).
+    ///
+    /// # Errors
+    /// [`DynamicsError`]: no limit exists, or a non-finite result.
+    pub fn solve_assembled_limit(
+        &self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        let n = active.len();
         let mut qdd = match qdd_prescribed {
             Some(p) => p.clone(),
             None => DVector::zeros(n),

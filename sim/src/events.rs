@@ -1,7 +1,8 @@
-//! Events as witness functions with a direction rule, located by cubic Hermite interpolation
-//! (eq. 14) and refined by exact integrator steps.
+//! Events as witness functions with a direction rule, estimated on the integrator's dense output
+//! where it has one (DOP853), otherwise by cubic Hermite interpolation (eq. 14), and refined by
+//! exact integrator steps.
 
-use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem};
+use crate::integrators::{DenseOutput, IntegrationError, Integrator, Sample, SecondOrderSystem};
 use nalgebra::DVector;
 use serde::Serialize;
 
@@ -38,6 +39,11 @@ pub struct EventTolerance {
     /// Hermite interpolant, so that a foot that dips below the floor and comes back up within
     /// one step (a grazing contact) is not missed (0: endpoints only).
     pub grazing_samples: usize,
+    /// Estimate the crossing on the integrator's dense output when it has one (DOP853's
+    /// seventh-order continuous extension: four more evaluations per located step), so that
+    /// the refinement on exact steps starts next to the root and takes one Newton step; false:
+    /// estimate on the cubic Hermite interpolant (eq. 14), several exact steps to refine.
+    pub dense_output: bool,
 }
 
 impl Default for EventTolerance {
@@ -47,6 +53,7 @@ impl Default for EventTolerance {
             witness: 1e-14,
             max_iterations: 60,
             grazing_samples: 4,
+            dense_output: true,
         }
     }
 }
@@ -75,8 +82,10 @@ pub enum EventError {
 }
 
 /// Finds the crossing of `g` between samples `a` and `b` (with `g(a)`, `g(b)` of opposite
-/// sign): a first estimate on the Hermite interpolant, then the Illinois method on exact
-/// integrator steps from `a`. Returns the sample at the event.
+/// sign) on the integrator's own solution: a first estimate — on the dense output of the step
+/// when the integrator has one and `tol.dense_output` asks for it (its root, and the witness's
+/// slope there for one Newton correction), else on the cubic Hermite interpolant — then the
+/// Illinois method on exact integrator steps from `a`. Returns the sample at the event.
 pub fn locate(
     integrator: &mut dyn Integrator,
     sys: &mut dyn SecondOrderSystem,
@@ -86,24 +95,17 @@ pub fn locate(
     tol: &EventTolerance,
 ) -> Result<Sample, EventError> {
     let (ga, gb) = (g(a), g(b));
-    // Estimate on the interpolant (eq. 14): bisection, cheap since no dynamics is evaluated.
-    let (mut lo, mut hi) = (a.t_s, b.t_s);
-    let (mut glo, _ghi) = (ga, gb);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        let (q, qd) = hermite(a, b, mid);
-        let gm = g(&Sample { t_s: mid, q, qd });
-        if (gm <= 0.0) == (glo <= 0.0) {
-            lo = mid;
-            glo = gm;
-        } else {
-            hi = mid;
+    let dense = match tol.dense_output {
+        true => integrator.dense_output(sys, a, b).transpose()?,
+        false => None,
+    };
+    let (guess, slope) = match dense {
+        Some(d) => {
+            let (t, slope) = root_on_dense(&d, (a.t_s, ga), (b.t_s, gb), g, tol);
+            (t, Some(slope))
         }
-        if hi - lo < tol.time_s {
-            break;
-        }
-    }
-    let guess = 0.5 * (lo + hi);
+        None => (root_on_hermite(a, b, ga, g, tol), None),
+    };
     // Refinement: Illinois regula falsi on the exact flow, bracketed by [a, b].
     let (mut t0, mut g0) = (a.t_s, ga);
     let (mut t1, mut g1) = (b.t_s, gb);
@@ -121,6 +123,7 @@ pub fn locate(
         if gt.abs() <= tol.witness || (t1 - t0).abs() <= tol.time_s {
             return Ok(best);
         }
+        let t_prev = t;
         if (gt <= 0.0) == (g0 <= 0.0) {
             t0 = t;
             g0 = gt;
@@ -141,6 +144,12 @@ pub fn locate(
         } else {
             0.5 * (t0 + t1)
         };
+        // After the dense estimate: one Newton correction with the dense output's slope.
+        if let (0, Some(d)) = (it, slope) {
+            if d != 0.0 && d.is_finite() {
+                t = t_prev - gt / d;
+            }
+        }
         if !(t > t0.min(t1) && t < t0.max(t1)) {
             t = 0.5 * (t0 + t1);
         }
@@ -155,6 +164,81 @@ pub fn locate(
         iterations: tol.max_iterations,
         bracket_s: (t1 - t0).abs(),
     })
+}
+
+/// The crossing's estimate on the cubic Hermite interpolant of the step (eq. 14): bisection,
+/// cheap since no dynamics is evaluated.
+fn root_on_hermite(
+    a: &Sample,
+    b: &Sample,
+    ga: f64,
+    g: &mut dyn FnMut(&Sample) -> f64,
+    tol: &EventTolerance,
+) -> f64 {
+    let (mut lo, mut hi) = (a.t_s, b.t_s);
+    let mut glo = ga;
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        let (q, qd) = hermite(a, b, mid);
+        let gm = g(&Sample { t_s: mid, q, qd });
+        if (gm <= 0.0) == (glo <= 0.0) {
+            lo = mid;
+            glo = gm;
+        } else {
+            hi = mid;
+        }
+        if hi - lo < tol.time_s {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The crossing's estimate on the dense output of the step: the Illinois method (no
+/// evaluation of the equations of motion per iteration, at most 60), until the witness is
+/// within its tolerance or the bracket narrower than the time tolerance; and the witness's
+/// slope there along the dense output (central difference).
+fn root_on_dense(
+    dense: &DenseOutput,
+    (mut t0, mut g0): (f64, f64),
+    (mut t1, mut g1): (f64, f64),
+    g: &mut dyn FnMut(&Sample) -> f64,
+    tol: &EventTolerance,
+) -> (f64, f64) {
+    let mut side = 0i8;
+    let mut t = 0.5 * (t0 + t1);
+    for _ in 0..60 {
+        t = if g1 != g0 {
+            t0 - g0 * (t1 - t0) / (g1 - g0)
+        } else {
+            0.5 * (t0 + t1)
+        };
+        if !(t > t0.min(t1) && t < t0.max(t1)) {
+            t = 0.5 * (t0 + t1);
+        }
+        let gt = g(&dense.eval(t));
+        if gt.abs() <= tol.witness || (t1 - t0).abs() <= tol.time_s {
+            break;
+        }
+        if (gt <= 0.0) == (g0 <= 0.0) {
+            t0 = t;
+            g0 = gt;
+            if side == -1 {
+                g1 *= 0.5;
+            }
+            side = -1;
+        } else {
+            t1 = t;
+            g1 = gt;
+            if side == 1 {
+                g0 *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    let e = 1e-6 * dense.h_s;
+    let slope = (g(&dense.eval(t + e)) - g(&dense.eval(t - e))) / (2.0 * e);
+    (t, slope)
 }
 
 #[cfg(test)]

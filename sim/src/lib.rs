@@ -19,6 +19,7 @@ pub mod limit_cycle;
 pub mod math;
 pub mod model;
 pub mod orbit_diagram;
+pub mod planar;
 pub mod relabel;
 pub mod report;
 pub mod scene;

@@ -3,13 +3,109 @@
 //! shared step controller ([`adaptive_step`]); a pair ([`EmbeddedPair`]) gives only its
 //! coefficients, its controller constants and its error estimate.
 
+use super::dense::{DenseCoefficients, DenseOutput};
 use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
 use nalgebra::DVector;
 use std::fmt::Debug;
 use std::marker::PhantomData;
 
-/// A kept derivative: time [s], positions, velocities, accelerations.
-type Kept = (f64, DVector<f64>, DVector<f64>, DVector<f64>);
+/// A kept derivative: at time `t_s` [s] and state `q`, `v`, the accelerations `a` (buffers
+/// reused from step to step; `valid` says whether they hold one).
+#[derive(Clone, Debug, Default)]
+struct Kept {
+    valid: bool,
+    t_s: f64,
+    q: DVector<f64>,
+    v: DVector<f64>,
+    a: DVector<f64>,
+}
+
+impl Kept {
+    fn matches(&self, s: &Sample) -> bool {
+        self.valid && self.t_s == s.t_s && self.q == s.q && self.v == s.qd
+    }
+
+    fn set(&mut self, t_s: f64, q: &DVector<f64>, v: &DVector<f64>, a: &DVector<f64>) {
+        self.valid = true;
+        self.t_s = t_s;
+        copy_into(&mut self.q, q);
+        copy_into(&mut self.v, v);
+        copy_into(&mut self.a, a);
+    }
+}
+
+/// `dst = src`, reusing `dst`'s storage when the lengths agree.
+fn copy_into(dst: &mut DVector<f64>, src: &DVector<f64>) {
+    if dst.len() == src.len() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
+    }
+}
+
+/// The last trial step's start and size, its start and end states (buffers), for its dense
+/// output: its stages are still in the integrator's stage buffers.
+#[derive(Clone, Debug, Default)]
+struct LastStep {
+    valid: bool,
+    t0_s: f64,
+    h_s: f64,
+    q0: DVector<f64>,
+    v0: DVector<f64>,
+    q1: DVector<f64>,
+    v1: DVector<f64>,
+}
+
+/// The stage buffers of one step, allocated once per state size: `kq[i]`, `kv[i]` the
+/// derivatives of positions and velocities at stage `i` (the step's stages, then the end
+/// derivative and the extra stages of the continuous extension), and the stage state.
+#[derive(Clone, Debug, Default)]
+struct Stages {
+    kq: Vec<DVector<f64>>,
+    kv: Vec<DVector<f64>>,
+    q: DVector<f64>,
+    v: DVector<f64>,
+}
+
+impl Stages {
+    fn fit(&mut self, count: usize, n: usize) {
+        if self.kq.len() != count || self.q.len() != n {
+            self.kq = vec![DVector::zeros(n); count];
+            self.kv = vec![DVector::zeros(n); count];
+            self.q = DVector::zeros(n);
+            self.v = DVector::zeros(n);
+        }
+    }
+
+    /// Stage state `q = q0 + h Σ a_j kq_j`, `v = v0 + h Σ a_j kv_j`.
+    fn combine(&mut self, q0: &DVector<f64>, v0: &DVector<f64>, h: f64, row: &[(usize, f64)]) {
+        let (q, v) = (self.q.as_mut_slice(), self.v.as_mut_slice());
+        q.copy_from_slice(q0.as_slice());
+        v.copy_from_slice(v0.as_slice());
+        for &(j, a) in row {
+            let ha = h * a;
+            let (kq, kv) = (self.kq[j].as_slice(), self.kv[j].as_slice());
+            for (x, k) in q.iter_mut().zip(kq) {
+                *x += ha * k;
+            }
+            for (x, k) in v.iter_mut().zip(kv) {
+                *x += ha * k;
+            }
+        }
+    }
+
+    /// Evaluates stage `i` at time `t_s` from the stage state.
+    fn evaluate(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        i: usize,
+        t_s: f64,
+    ) -> Result<(), IntegrationError> {
+        sys.accelerations_into(t_s, &self.q, &self.v, &mut self.kv[i])?;
+        self.kq[i].copy_from(&self.v);
+        Ok(())
+    }
+}
 
 /// Local-error tolerances of an embedded pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +136,8 @@ pub trait EmbeddedPair: Clone + Debug {
     /// First same as last: the last stage is the derivative at the step's end (kept from an
     /// accepted step for the next one). Otherwise the first stage is kept once evaluated.
     const FSAL: bool;
+    /// The pair's continuous extension, if it has one.
+    const DENSE: Option<DenseCoefficients> = None;
 
     /// The scaled error norm of a step of size `h` [s] from `s` to `(q_new, v_new)` with
     /// stage derivatives `kq` (of the positions) and `kv` (of the velocities).
@@ -67,9 +165,13 @@ pub struct EmbeddedRk<P: EmbeddedPair> {
     /// A kept derivative reused as the first stage of a step from exactly that sample (same
     /// time, same state): the end of the last accepted step (FSAL pairs) or the last evaluated
     /// first stage (so a retried step after a rejection does not evaluate it again).
-    kept: Option<Kept>,
-    /// The last trial step's final stage (FSAL pairs).
-    last_stage: Option<DVector<f64>>,
+    kept: Kept,
+    /// The last trial step's final stage is valid for `kept` (FSAL pairs).
+    last_stage: bool,
+    /// The last trial step, kept for its dense output (pairs with a continuous extension).
+    last_step: LastStep,
+    /// Stage buffers, reused from step to step.
+    stages: Stages,
     pair: PhantomData<P>,
 }
 
@@ -82,38 +184,99 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             h_next_s: 0.0,
             evaluations: 0,
             h_min_s: 1e-14,
-            kept: None,
-            last_stage: None,
+            kept: Kept::default(),
+            last_stage: false,
+            last_step: LastStep::default(),
+            stages: Stages::default(),
             pair: PhantomData,
         }
     }
 
-    /// The derivative at the step's start, from the kept one when it is at `s`.
+    /// Number of stage buffers: the step's stages, and with a continuous extension the end
+    /// derivative and its extra stages.
+    fn stage_count() -> usize {
+        P::C.len() + P::DENSE.map_or(0, |d| 1 + d.extra_c.len())
+    }
+
+    /// The derivative at the step's start into stage 0, from the kept one when it is at `s`.
     fn first_stage(
         &mut self,
         sys: &mut dyn SecondOrderSystem,
         s: &Sample,
-    ) -> Result<DVector<f64>, IntegrationError> {
-        if let Some((t, q, v, a)) = &self.kept {
-            if *t == s.t_s && *q == s.q && *v == s.qd {
-                return Ok(a.clone());
-            }
+    ) -> Result<(), IntegrationError> {
+        self.stages.kq[0].copy_from(&s.qd);
+        if self.kept.matches(s) {
+            self.stages.kv[0].copy_from(&self.kept.a);
+            return Ok(());
         }
         self.evaluations += 1;
-        let a = sys.accelerations(s.t_s, &s.q, &s.qd)?;
+        sys.accelerations_into(s.t_s, &s.q, &s.qd, &mut self.stages.kv[0])?;
         if !P::FSAL {
-            self.kept = Some((s.t_s, s.q.clone(), s.qd.clone(), a.clone()));
+            self.kept.set(s.t_s, &s.q, &s.qd, &self.stages.kv[0]);
         }
-        Ok(a)
+        Ok(())
+    }
+
+    /// The dense output of the last step (its stages still in the buffers): the derivative at
+    /// its end, the extra stages, and Hairer's coefficients
+    /// `F0 = Δy, F1 = h f0 − Δy, F2 = 2Δy − h (f0 + f1), F3… = h D K`.
+    fn build_dense(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        coefficients: &DenseCoefficients,
+    ) -> Result<DenseOutput, IntegrationError> {
+        let last = &self.last_step;
+        let (t0, h) = (last.t0_s, last.h_s);
+        let s = P::C.len();
+        let st = &mut self.stages;
+        st.q.copy_from(&last.q1);
+        st.v.copy_from(&last.v1);
+        self.evaluations += 1;
+        st.evaluate(sys, s, t0 + h)?;
+        for (k, (c, row)) in coefficients
+            .extra_c
+            .iter()
+            .zip(coefficients.extra_a)
+            .enumerate()
+        {
+            st.combine(&last.q0, &last.v0, h, row);
+            self.evaluations += 1;
+            st.evaluate(sys, s + 1 + k, t0 + c * h)?;
+        }
+        let (kq, kv) = (&st.kq, &st.kv);
+        let dq = &last.q1 - &last.q0;
+        let dv = &last.v1 - &last.v0;
+        let mut f = Vec::with_capacity(3 + coefficients.d.len());
+        f.push((&kq[0] * h - &dq, &kv[0] * h - &dv));
+        f.push((
+            &dq * 2.0 - (&kq[0] + &kq[s]) * h,
+            &dv * 2.0 - (&kv[0] + &kv[s]) * h,
+        ));
+        f.insert(0, (dq, dv));
+        for row in coefficients.d {
+            let n = last.q0.len();
+            let mut fq = DVector::zeros(n);
+            let mut fv = DVector::zeros(n);
+            for &(j, d) in row.iter() {
+                fq.axpy(h * d, &kq[j], 1.0);
+                fv.axpy(h * d, &kv[j], 1.0);
+            }
+            f.push((fq, fv));
+        }
+        Ok(DenseOutput::new(t0, h, last.q0.clone(), last.v0.clone(), f))
     }
 
     /// Keeps an accepted step's end derivative for the next step (FSAL pairs).
     fn accept(&mut self, next: &Sample) {
         if P::FSAL {
-            self.kept = self
-                .last_stage
-                .take()
-                .map(|k| (next.t_s, next.q.clone(), next.qd.clone(), k));
+            if self.last_stage {
+                let last = P::C.len() - 1;
+                self.kept
+                    .set(next.t_s, &next.q, &next.qd, &self.stages.kv[last]);
+            } else {
+                self.kept.valid = false;
+            }
+            self.last_stage = false;
         }
     }
 
@@ -125,33 +288,35 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
         h: f64,
     ) -> Result<(Sample, f64), IntegrationError> {
         let stages = P::C.len();
-        let mut kq: Vec<DVector<f64>> = Vec::with_capacity(stages);
-        let mut kv: Vec<DVector<f64>> = Vec::with_capacity(stages);
-        kq.push(s.qd.clone());
-        kv.push(self.first_stage(sys, s)?);
+        self.stages.fit(Self::stage_count(), s.q.len());
+        self.last_step.valid = false;
+        self.last_stage = false;
+        self.first_stage(sys, s)?;
         for (i, row) in P::A.iter().enumerate().skip(1) {
-            let mut q = s.q.clone();
-            let mut v = s.qd.clone();
-            for &(j, a) in row.iter() {
-                q.axpy(h * a, &kq[j], 1.0);
-                v.axpy(h * a, &kv[j], 1.0);
-            }
+            self.stages.combine(&s.q, &s.qd, h, row);
             self.evaluations += 1;
-            let acc = sys.accelerations(s.t_s + P::C[i] * h, &q, &v)?;
-            kq.push(v);
-            kv.push(acc);
+            self.stages.evaluate(sys, i, s.t_s + P::C[i] * h)?;
         }
         let mut q_new = s.q.clone();
         let mut v_new = s.qd.clone();
+        let (kq, kv) = (&self.stages.kq, &self.stages.kv);
         for &(j, b) in P::B {
             q_new.axpy(h * b, &kq[j], 1.0);
             v_new.axpy(h * b, &kv[j], 1.0);
         }
-        let err = P::error_norm(self.tol, h, s, &q_new, &v_new, &kq, &kv);
-        if P::FSAL {
-            // The last stage was evaluated at the propagated solution at t + h: kept for the
-            // next step if this one is accepted.
-            self.last_stage = kv.pop();
+        let err = P::error_norm(self.tol, h, s, &q_new, &v_new, &kq[..stages], &kv[..stages]);
+        // FSAL: the last stage was evaluated at the propagated solution at t + h, kept for
+        // the next step if this one is accepted.
+        self.last_stage = P::FSAL;
+        if P::DENSE.is_some() {
+            let l = &mut self.last_step;
+            l.valid = true;
+            l.t0_s = s.t_s;
+            l.h_s = h;
+            copy_into(&mut l.q0, &s.q);
+            copy_into(&mut l.v0, &s.qd);
+            copy_into(&mut l.q1, &q_new);
+            copy_into(&mut l.v1, &v_new);
         }
         Ok((
             Sample {
@@ -171,10 +336,27 @@ impl<P: EmbeddedPair> Integrator for EmbeddedRk<P> {
     fn reset(&mut self) {
         self.evaluations = 0;
         self.h_next_s = 0.0;
-        self.kept = None;
+        self.kept.valid = false;
+        self.last_step.valid = false;
     }
     fn system_changed(&mut self) {
-        self.kept = None;
+        self.kept.valid = false;
+        self.last_step.valid = false;
+    }
+    fn dense_output(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        from: &Sample,
+        to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        let coefficients = P::DENSE?;
+        let last = &self.last_step;
+        let same = last.valid
+            && last.t0_s == from.t_s
+            && last.t0_s + last.h_s == to.t_s
+            && last.q0 == from.q
+            && last.v0 == from.qd;
+        same.then(|| self.build_dense(sys, &coefficients))
     }
     fn proposed_step_s(&self) -> f64 {
         if self.h_next_s > 0.0 {

@@ -3,12 +3,14 @@
 //! Every integrator advances a [`SecondOrderSystem`] by one accepted step and can take an
 //! exact step of any smaller size, which the event locator uses to refine event times.
 
+mod dense;
 mod dop853;
 mod dopri5;
 mod embedded;
 mod meijaard;
 mod rk4;
 
+pub use dense::{DenseCoefficients, DenseOutput};
 pub use dop853::{Dop853, Dop853Pair};
 pub use dopri5::{Dopri5, Dopri5Pair};
 pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
@@ -28,6 +30,24 @@ pub trait SecondOrderSystem {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError>;
+
+    /// Accelerations at `t`, `q`, `q̇` written into `out` (of the state's length): the
+    /// integrators' entry point, which a system can implement without allocating.
+    fn accelerations_into(
+        &mut self,
+        t_s: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        let a = self.accelerations(t_s, q, qd)?;
+        if out.len() == a.len() {
+            out.copy_from(&a);
+        } else {
+            *out = a;
+        }
+        Ok(())
+    }
 
     /// Largest undamped eigenfrequency `λ_max` [rad/s] and its relative damping `β` of the
     /// linearised system at `q`, `q̇` (for eq. 12). `None` if the system cannot tell.
@@ -388,4 +408,15 @@ pub trait Integrator {
     /// The equations changed without the state changing (e.g. a control tick moved an
     /// actuator): forget any derivative kept from the last step.
     fn system_changed(&mut self) {}
+    /// The dense output of the last step taken (by `advance` or `step_exact`) when it went
+    /// from `from` to `to` and the integrator has a continuous extension; `None` otherwise
+    /// (then events are refined with exact steps). Its extra stages count as evaluations.
+    fn dense_output(
+        &mut self,
+        _sys: &mut dyn SecondOrderSystem,
+        _from: &Sample,
+        _to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        None
+    }
 }

@@ -7,6 +7,7 @@ use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::integrators::{Sample, SecondOrderSystem, StabilityLimit};
 use crate::model::{CoordIndex, Model};
+use crate::planar::{EvaluationPath, PlanarTree};
 use nalgebra::{DMatrix, DVector};
 
 /// How a driven coordinate moves (times are from the start of the stride).
@@ -32,6 +33,8 @@ impl Drive {
 pub struct Phase<'a> {
     model: &'a Model,
     dynamics: Dynamics,
+    /// The planar fast path, when the model qualifies and the settings allow it.
+    planar: Option<PlanarTree>,
     /// Which coordinates are free to move.
     pub active: Vec<bool>,
     /// A coordinate driven along a profile (not free, not locked).
@@ -39,11 +42,20 @@ pub struct Phase<'a> {
 }
 
 impl<'a> Phase<'a> {
-    /// All coordinates active.
+    /// All coordinates active; the planar fast path when the model qualifies.
     pub fn new(model: &'a Model) -> Self {
+        Self::with_path(model, EvaluationPath::Auto)
+    }
+
+    /// All coordinates active, evaluated along `path`.
+    pub fn with_path(model: &'a Model, path: EvaluationPath) -> Self {
         Self {
             model,
             dynamics: Dynamics::new(model),
+            planar: match path {
+                EvaluationPath::Auto => PlanarTree::of(model),
+                EvaluationPath::General => None,
+            },
             active: vec![true; model.dof()],
             prescribed: None,
         }
@@ -64,10 +76,47 @@ impl<'a> Phase<'a> {
         let Some((c, _)) = self.prescribed else {
             return Ok((0.0, 0.0));
         };
-        let qdd = self.accelerations(s.t_s, &s.q, &s.qd)?;
+        // The general path: its workspace keeps the assembled M̄ and f̄ read below.
+        let qdd = self.general_accelerations(s.t_s, &s.q, &s.qd)?;
         let m = &self.dynamics.mass_matrix;
         let tau = (m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0];
         Ok((tau, s.qd[c.0]))
+    }
+
+    /// Whether this phase evaluates along the planar fast path.
+    pub fn is_planar_fast_path(&self) -> bool {
+        self.planar.is_some()
+    }
+
+    /// The drive's prescribed motion at `t` [s], if a coordinate is driven.
+    fn drive_at(&self, t: f64) -> Option<DriveValues<f64>> {
+        self.prescribed.map(|(c, p)| {
+            let (angle_rad, rate_rad_s, acceleration_rad_s2) = p.eval(t);
+            DriveValues {
+                coordinate: c.0,
+                angle_rad,
+                rate_rad_s,
+                acceleration_rad_s2,
+            }
+        })
+    }
+
+    /// `q̈` by the general engine, whatever the path.
+    fn general_accelerations(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        let drive = self.drive_at(t);
+        crate::hybrid::phase::accelerations(
+            self.model,
+            &mut self.dynamics,
+            &self.active,
+            drive.as_ref(),
+            q,
+            qd,
+        )
     }
 }
 
@@ -78,23 +127,32 @@ impl SecondOrderSystem for Phase<'_> {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
-        let drive = self.prescribed.map(|(c, p)| {
-            let (angle_rad, rate_rad_s, acceleration_rad_s2) = p.eval(t);
-            DriveValues {
-                coordinate: c.0,
-                angle_rad,
-                rate_rad_s,
-                acceleration_rad_s2,
+        match &self.planar {
+            Some(p) => {
+                let drive = self.drive_at(t);
+                p.accelerations(&mut self.dynamics, &self.active, drive.as_ref(), q, qd)
             }
-        });
-        crate::hybrid::phase::accelerations(
-            self.model,
-            &mut self.dynamics,
-            &self.active,
-            drive.as_ref(),
-            q,
-            qd,
-        )
+            None => self.general_accelerations(t, q, qd),
+        }
+    }
+
+    fn accelerations_into(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        match &self.planar {
+            Some(p) if out.len() == q.len() => {
+                let drive = self.drive_at(t);
+                p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
+            }
+            _ => {
+                *out = self.accelerations(t, q, qd)?;
+                Ok(())
+            }
+        }
     }
 
     fn stability_limit(

@@ -123,7 +123,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     ) -> Result<Self, StrideFailure> {
         let mut integrator = settings.integrator.build();
         integrator.reset();
-        let mut phase = Phase::new(&walker.model);
+        let mut phase = Phase::with_path(&walker.model, settings.evaluation);
         for c in &walker.initially_locked {
             phase.active[c.0] = false;
         }

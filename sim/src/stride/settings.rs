@@ -4,6 +4,7 @@
 
 use crate::events::EventTolerance;
 use crate::integrators::{IntegratorChoice, IntegratorError};
+use crate::planar::EvaluationPath;
 use serde::Serialize;
 
 /// Solver settings of a stride (after rapier's `IntegrationParameters`: each field with its unit
@@ -27,6 +28,10 @@ pub struct StrideSettings {
     /// event location, grazing checks) without ending fails with
     /// `evaluation_budget_exceeded`. Default: [`Self::DEFAULT_MAX_EVALUATIONS`].
     pub max_evaluations: usize,
+    /// Which evaluation of the equations of motion the smooth phases use. Default:
+    /// [`EvaluationPath::Auto`] (the planar fast path when the walker qualifies); `General`
+    /// forces the general engine, the reference.
+    pub evaluation: EvaluationPath,
 }
 
 impl Default for StrideSettings {
@@ -41,6 +46,7 @@ impl Default for StrideSettings {
             max_stride_time_s: 10.0,
             max_steps: Self::DEFAULT_MAX_STEPS,
             max_evaluations: Self::DEFAULT_MAX_EVALUATIONS,
+            evaluation: EvaluationPath::Auto,
         }
     }
 }

@@ -1,0 +1,395 @@
+//! The planar fast path: the equations of motion `M̄ q̈ = f̄` of a small planar tree — every
+//! joint a revolute about the floor's z axis or a weld, gravity in the x-y plane — with
+//! fixed-size matrices (`nalgebra::SMatrix`, the number of coordinates a const generic), one
+//! `sin_cos` per joint instead of 3 × 3 rotations, and no allocation but the returned `q̈`.
+//!
+//! The general engine ([`crate::dynamics`]) stays the reference: a phase selects this path
+//! automatically when its model qualifies ([`PlanarTree::of`]), and `sim/tests/fast_path.rs`
+//! checks both against each other on the equations of motion and on whole gaits.
+//!
+//! Planar kinematics: a link's angle is its parent's plus `±q` (the sign of its axis along z),
+//! its origin its parent's plus the joint offset turned by the parent's angle. With every
+//! angular velocity along z the angular bias acceleration is zero and the bias acceleration of a
+//! point `p` fixed in a link is the link origin's minus `ω² (p − o)`; the gyroscopic torque
+//! `ω × I ω` has no z component, so only each body's `I_zz` enters.
+
+use crate::dynamics::{Dynamics, DynamicsError};
+use crate::hybrid::phase::DriveValues;
+use crate::model::{JointKind, Model};
+use crate::singular_limit::LimitSolveError;
+use nalgebra::{DVector, SMatrix, SVector};
+
+/// Most coordinates a tree may have to take the fast path.
+pub const MAX_COORDINATES: usize = 6;
+/// Most links (welds included) a tree may have to take the fast path.
+pub const MAX_LINKS: usize = 12;
+
+/// Which evaluation of the equations of motion a phase uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EvaluationPath {
+    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the general one.
+    #[default]
+    Auto,
+    /// Always the general 3D engine (the reference the fast path is tested against).
+    General,
+}
+
+/// One link of a planar tree, with what the evaluation needs of it.
+#[derive(Clone, Debug)]
+struct PlanarLink {
+    /// Parent link (`None`: the ground).
+    parent: Option<usize>,
+    /// Joint origin in the parent frame, x and y [m].
+    joint_xy_m: [f64; 2],
+    /// The coordinate this joint owns and the sign of its axis along z (`None`: a weld).
+    coordinate: Option<(usize, f64)>,
+    /// Mass [kg] (of the `ε` part for an infinitesimal body).
+    mass_kg: f64,
+    /// Centre of mass in the link frame, x and y [m].
+    com_xy_m: [f64; 2],
+    /// Inertia about the centre of mass along z [kg·m²].
+    izz_kg_m2: f64,
+    /// The body is infinitesimal (its terms go to the `ε` part).
+    infinitesimal: bool,
+    /// The body carries neither mass nor inertia (skipped, as the general engine does).
+    empty: bool,
+}
+
+/// Per-link state of one evaluation: angle's cos and sin, angular rate, origin and its bias
+/// acceleration (floor x-y).
+#[derive(Clone, Copy, Debug, Default)]
+struct LinkState {
+    cos: f64,
+    sin: f64,
+    omega_rad_s: f64,
+    origin_m: [f64; 2],
+    a_bias_m_s2: [f64; 2],
+}
+
+/// A small planar tree, ready for fast evaluations: built once from a [`Model`] that qualifies.
+#[derive(Clone, Debug)]
+pub struct PlanarTree {
+    links: Vec<PlanarLink>,
+    /// For each link, `(coordinate, owning link, axis sign)` along its ancestry.
+    chains: Vec<Vec<(usize, usize, f64)>>,
+    /// Joint spring and damper per coordinate: stiffness, rest position, damping.
+    springs: Vec<(f64, f64, f64)>,
+    gravity_m_s2: [f64; 2],
+    dof: usize,
+    has_infinitesimal: bool,
+}
+
+/// `M̄` and `f̄` of one evaluation, finite and infinitesimal parts.
+struct Assembled<const N: usize> {
+    m: SMatrix<f64, N, N>,
+    m_eps: SMatrix<f64, N, N>,
+    f: SVector<f64, N>,
+    f_eps: SVector<f64, N>,
+}
+
+impl PlanarTree {
+    /// The planar tree of `model`, or `None` when it does not qualify: more than
+    /// [`MAX_COORDINATES`] coordinates or [`MAX_LINKS`] links, a prismatic joint, a revolute
+    /// axis not along the floor's z axis, or gravity out of the x-y plane.
+    pub fn of(model: &Model) -> Option<Self> {
+        let dof = model.dof();
+        if dof == 0 || dof > MAX_COORDINATES || model.links.len() > MAX_LINKS {
+            return None;
+        }
+        if model.gravity_floor_m_s2.z != 0.0 {
+            return None;
+        }
+        let mut links = Vec::with_capacity(model.links.len());
+        let mut springs = vec![(0.0, 0.0, 0.0); dof];
+        for link in &model.links {
+            let coordinate = match (&link.joint, link.coordinate) {
+                (JointKind::Weld, _) => None,
+                (JointKind::Revolute { axis_parent }, Some(c)) => {
+                    if axis_parent.x != 0.0 || axis_parent.y != 0.0 || axis_parent.z.abs() != 1.0 {
+                        return None;
+                    }
+                    Some((c.0, axis_parent.z))
+                }
+                _ => return None,
+            };
+            if let Some(c) = link.coordinate {
+                let jf = &link.joint_force;
+                springs[c.0] = (jf.stiffness, jf.rest_position, jf.damping);
+            }
+            let b = &link.body;
+            let rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
+            links.push(PlanarLink {
+                parent: link.parent.map(|p| p.0),
+                joint_xy_m: [link.p_parent_joint_m.x, link.p_parent_joint_m.y],
+                coordinate,
+                mass_kg: b.mass_kg,
+                com_xy_m: [b.p_link_com_m.x, b.p_link_com_m.y],
+                izz_kg_m2: b.inertia_com_kg_m2[(2, 2)],
+                infinitesimal: b.infinitesimal,
+                empty: b.mass_kg == 0.0 && !rot,
+            });
+        }
+        let chains = (0..links.len())
+            .map(|i| {
+                let mut chain = Vec::new();
+                let mut cur = Some(i);
+                while let Some(l) = cur {
+                    if let Some((c, sign)) = links[l].coordinate {
+                        chain.push((c, l, sign));
+                    }
+                    cur = links[l].parent;
+                }
+                chain
+            })
+            .collect();
+        Some(Self {
+            links,
+            chains,
+            springs,
+            gravity_m_s2: [model.gravity_floor_m_s2.x, model.gravity_floor_m_s2.y],
+            dof,
+            has_infinitesimal: model.has_infinitesimal_bodies(),
+        })
+    }
+
+    /// Number of coordinates.
+    pub fn dof(&self) -> usize {
+        self.dof
+    }
+
+    /// `q̈` at `q`, `q̇` exactly as [`crate::hybrid::phase::accelerations`] defines it (free,
+    /// locked and driven coordinates). Models with infinitesimal bodies assemble here and solve
+    /// their vanishing-mass limit in `limit` (the general workspace, its matrices overwritten).
+    ///
+    /// # Errors
+    /// [`DynamicsError`]: a non-finite state or result, a singular reduced mass matrix.
+    pub fn accelerations(
+        &self,
+        limit: &mut Dynamics,
+        active: &[bool],
+        drive: Option<&DriveValues<f64>>,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+    ) -> Result<DVector<f64>, DynamicsError> {
+        let mut out = DVector::zeros(q.len());
+        self.accelerations_into(limit, active, drive, q, qd, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::accelerations`] written into `out` (no allocation for finite bodies).
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`]; also a state or `out` whose length is not the model's.
+    pub fn accelerations_into(
+        &self,
+        limit: &mut Dynamics,
+        active: &[bool],
+        drive: Option<&DriveValues<f64>>,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        match self.dof {
+            1 => self.accelerations_n::<1>(limit, active, drive, q, qd, out),
+            2 => self.accelerations_n::<2>(limit, active, drive, q, qd, out),
+            3 => self.accelerations_n::<3>(limit, active, drive, q, qd, out),
+            4 => self.accelerations_n::<4>(limit, active, drive, q, qd, out),
+            5 => self.accelerations_n::<5>(limit, active, drive, q, qd, out),
+            _ => self.accelerations_n::<6>(limit, active, drive, q, qd, out),
+        }
+    }
+
+    fn accelerations_n<const N: usize>(
+        &self,
+        limit: &mut Dynamics,
+        active: &[bool],
+        drive: Option<&DriveValues<f64>>,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        if q.len() != N || qd.len() != N || active.len() != N || out.len() != N {
+            return Err(DynamicsError::NonFinite);
+        }
+        if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        let mut qs = SVector::<f64, N>::from_iterator(q.iter().copied());
+        let mut qds = SVector::<f64, N>::from_iterator(qd.iter().copied());
+        let mut qdd = SVector::<f64, N>::zeros();
+        if let Some(d) = drive {
+            qs[d.coordinate] = d.angle_rad;
+            qds[d.coordinate] = d.rate_rad_s;
+            qdd[d.coordinate] = d.acceleration_rad_s2;
+        }
+        let a = self.assemble::<N>(&qs, &qds);
+        if self.has_infinitesimal {
+            limit.mass_matrix.copy_from(&a.m);
+            limit.mass_matrix_infinitesimal.copy_from(&a.m_eps);
+            limit.force.copy_from(&a.f);
+            limit.force_infinitesimal.copy_from(&a.f_eps);
+            let prescribed = drive.map(|_| DVector::from_iterator(N, qdd.iter().copied()));
+            *out = limit.solve_assembled_limit(active, prescribed.as_ref())?;
+        } else {
+            solve_active(&a.m, &a.f, active, &mut qdd)?;
+            out.copy_from_slice(qdd.as_slice());
+        }
+        if out.iter().any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        Ok(())
+    }
+
+    /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and
+    /// dampers, body by body, over the planar kinematics.
+    fn assemble<const N: usize>(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Assembled<N> {
+        let mut st = [LinkState::default(); MAX_LINKS];
+        let st = &mut st[..self.links.len()];
+        let mut out = Assembled {
+            m: SMatrix::zeros(),
+            m_eps: SMatrix::zeros(),
+            f: SVector::zeros(),
+            f_eps: SVector::zeros(),
+        };
+        let [gx, gy] = self.gravity_m_s2;
+        for (i, link) in self.links.iter().enumerate() {
+            let parent = match link.parent {
+                Some(p) => st[p],
+                None => LinkState {
+                    cos: 1.0,
+                    ..LinkState::default()
+                },
+            };
+            let [jx, jy] = link.joint_xy_m;
+            let (dx, dy) = (
+                parent.cos * jx - parent.sin * jy,
+                parent.sin * jx + parent.cos * jy,
+            );
+            let w2 = parent.omega_rad_s * parent.omega_rad_s;
+            let mut s = LinkState {
+                origin_m: [parent.origin_m[0] + dx, parent.origin_m[1] + dy],
+                a_bias_m_s2: [
+                    parent.a_bias_m_s2[0] - w2 * dx,
+                    parent.a_bias_m_s2[1] - w2 * dy,
+                ],
+                ..parent
+            };
+            if let Some((c, sign)) = link.coordinate {
+                let (sin_q, cos_q) = (sign * q[c]).sin_cos();
+                s.cos = parent.cos * cos_q - parent.sin * sin_q;
+                s.sin = parent.sin * cos_q + parent.cos * sin_q;
+                s.omega_rad_s = parent.omega_rad_s + sign * qd[c];
+            }
+            st[i] = s;
+            if link.empty {
+                continue;
+            }
+            let [cx, cy] = link.com_xy_m;
+            let (rx, ry) = (s.cos * cx - s.sin * cy, s.sin * cx + s.cos * cy);
+            let (px, py) = (s.origin_m[0] + rx, s.origin_m[1] + ry);
+            let w2 = s.omega_rad_s * s.omega_rad_s;
+            let (ax, ay) = (s.a_bias_m_s2[0] - w2 * rx, s.a_bias_m_s2[1] - w2 * ry);
+            let (m, izz) = (link.mass_kg, link.izz_kg_m2);
+            let (fx, fy) = (m * (gx - ax), m * (gy - ay));
+            let (mm, ff) = if link.infinitesimal {
+                (&mut out.m_eps, &mut out.f_eps)
+            } else {
+                (&mut out.m, &mut out.f)
+            };
+            let chain = &self.chains[i];
+            for (x, &(ci, li, si)) in chain.iter().enumerate() {
+                let o = st[li].origin_m;
+                // Jv = sign · z × (p − o), Jw = sign.
+                let (vix, viy) = (-si * (py - o[1]), si * (px - o[0]));
+                ff[ci] += vix * fx + viy * fy;
+                for &(cj, lj, sj) in &chain[..=x] {
+                    let o = st[lj].origin_m;
+                    let (vjx, vjy) = (-sj * (py - o[1]), sj * (px - o[0]));
+                    let v = m * (vix * vjx + viy * vjy) + izz * si * sj;
+                    mm[(ci, cj)] += v;
+                    if ci != cj {
+                        mm[(cj, ci)] += v;
+                    }
+                }
+            }
+        }
+        for (c, &(k, rest, d)) in self.springs.iter().enumerate() {
+            out.f[c] -= (q[c] - rest) * k + qd[c] * d;
+        }
+        out
+    }
+}
+
+/// Solves `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` for the active coordinates, writing them into `qdd`
+/// (which holds the prescribed accelerations, zero when locked): a fixed-size Cholesky
+/// factorisation of `M̄` with the rows and columns of the coordinates that are not free
+/// replaced by the identity's, whose solution there is `q̈_p` itself.
+fn solve_active<const N: usize>(
+    m: &SMatrix<f64, N, N>,
+    f: &SVector<f64, N>,
+    active: &[bool],
+    qdd: &mut SVector<f64, N>,
+) -> Result<(), DynamicsError> {
+    let mut reduced = *m;
+    let mut b = *f;
+    for j in (0..N).filter(|&j| !active[j]) {
+        if qdd[j] != 0.0 {
+            for i in 0..N {
+                b[i] -= m[(i, j)] * qdd[j];
+            }
+        }
+    }
+    for j in (0..N).filter(|&j| !active[j]) {
+        reduced.fill_row(j, 0.0);
+        reduced.fill_column(j, 0.0);
+        reduced[(j, j)] = 1.0;
+        b[j] = qdd[j];
+    }
+    if !cholesky_solve(&mut reduced, &mut b) {
+        return Err(DynamicsError::Singular(LimitSolveError::Degenerate {
+            nullity: 1,
+        }));
+    }
+    *qdd = b;
+    Ok(())
+}
+
+/// Solves `A x = b` in place for a symmetric positive definite `A` (its lower triangle
+/// overwritten with the Cholesky factor, `b` with `x`); false if `A` is not positive definite.
+fn cholesky_solve<const N: usize>(a: &mut SMatrix<f64, N, N>, b: &mut SVector<f64, N>) -> bool {
+    for j in 0..N {
+        let mut d = a[(j, j)];
+        for p in 0..j {
+            d -= a[(j, p)] * a[(j, p)];
+        }
+        // Also rejects NaN (which is not greater than zero).
+        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..N {
+            let mut v = a[(i, j)];
+            for p in 0..j {
+                v -= a[(i, p)] * a[(j, p)];
+            }
+            a[(i, j)] = v / d;
+        }
+    }
+    for i in 0..N {
+        let mut v = b[i];
+        for p in 0..i {
+            v -= a[(i, p)] * b[p];
+        }
+        b[i] = v / a[(i, i)];
+    }
+    for i in (0..N).rev() {
+        let mut v = b[i];
+        for p in i + 1..N {
+            v -= a[(p, i)] * b[p];
+        }
+        b[i] = v / a[(i, i)];
+    }
+    true
+}
