@@ -99,22 +99,62 @@ pub fn complex_outside(m: &[Complex<f64>]) -> usize {
     m.iter().filter(|z| is_complex(z) && z.norm() > 1.0).count()
 }
 
-/// `|λ| − 1` of the complex multiplier nearest the unit circle (`None` without one).
-pub fn neimark_sacker_test(m: &[Complex<f64>]) -> Option<f64> {
-    m.iter()
-        .filter(|z| is_complex(z))
-        .map(|z| z.norm() - 1.0)
-        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+/// Multipliers outside the unit circle, real or complex.
+fn outside(m: &[Complex<f64>]) -> usize {
+    m.iter().filter(|z| z.norm() > 1.0).count()
 }
 
-/// Whether a complex pair crossed the unit circle between multipliers `ma` and `mb`: both
-/// have a complex pair and [`neimark_sacker_test`] has opposite signs (not merely a change of
-/// [`complex_outside`], which also happens when two real multipliers merge into a pair).
-pub fn neimark_sacker_crossed(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> bool {
-    match (neimark_sacker_test(ma), neimark_sacker_test(mb)) {
-        (Some(a), Some(b)) => a.signum() != b.signum(),
-        _ => false,
+/// Complex pairs (each counted once, by its member with a positive imaginary part).
+fn pairs(m: &[Complex<f64>]) -> impl Iterator<Item = &Complex<f64>> {
+    m.iter().filter(|z| is_complex(z) && z.im > 0.0)
+}
+
+/// `∏ (|λ| − 1)` over the complex pairs (`None` without one): it changes sign when one pair
+/// crosses the unit circle, whichever pair is nearest the circle. (The modulus of the pair
+/// *nearest* the circle, used before, changed sign without any crossing when one pair inside
+/// and another outside swapped their distances to it.)
+pub fn neimark_sacker_test(m: &[Complex<f64>]) -> Option<f64> {
+    let mut any = false;
+    let product = pairs(m).fold(1.0, |acc, z| {
+        any = true;
+        acc * (z.norm() - 1.0)
+    });
+    any.then_some(product)
+}
+
+/// How many complex pairs crossed the unit circle between multipliers `ma` and `mb`: each
+/// pair of `ma` is matched to the nearest pair of `mb` (a short continuation step moves a
+/// multiplier little) and counted when `|λ| − 1` changed sign. Where pairs formed or split
+/// in between (their numbers differ), a change of the count of all multipliers outside the
+/// circle by an even number, while no real multiplier passed ±1 (the fold and
+/// period-doubling functions keep their signs), counts as one crossing: two real
+/// multipliers merging into a pair outside leave that count unchanged and are none.
+pub fn neimark_sacker_crossings(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> usize {
+    let (pa, pb): (Vec<_>, Vec<_>) = (pairs(ma).collect(), pairs(mb).collect());
+    if pa.len() == pb.len() {
+        return pa
+            .iter()
+            .filter(|za| {
+                let nearest = pb
+                    .iter()
+                    .min_by(|x, y| (**x - **za).norm().total_cmp(&(**y - **za).norm()));
+                nearest.is_some_and(|zb| (za.norm() > 1.0) != (zb.norm() > 1.0))
+            })
+            .count();
     }
+    let all = outside(mb) as i64 - outside(ma) as i64;
+    usize::from(
+        all != 0
+            && all % 2 == 0
+            && fold_test(ma).signum() == fold_test(mb).signum()
+            && period_doubling_test(ma).signum() == period_doubling_test(mb).signum(),
+    )
+}
+
+/// Whether a complex pair crossed the unit circle between multipliers `ma` and `mb`
+/// ([`neimark_sacker_crossings`] at least one).
+pub fn neimark_sacker_crossed(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> bool {
+    neimark_sacker_crossings(ma, mb) > 0
 }
 
 /// The bifurcations between two successive points `a` (with its linearisation) and `b`:
@@ -280,5 +320,36 @@ mod tests {
         let inside = [polar(0.9, 0.4).as_slice(), &[Complex::new(0.2, 0.0)]].concat();
         assert!(neimark_sacker_crossed(&pair, &inside));
         assert!(neimark_sacker_crossed(&inside, &pair));
+    }
+
+    #[test]
+    fn two_pairs_trading_places_near_the_circle_are_no_crossing() {
+        // The roll pair stays outside (1.003 → 1.002) while another pair approaches the circle
+        // from inside (0.990 → 0.999): the pair nearest the circle changes, no pair crosses.
+        // (The modulus of the nearest pair, the test before, changed sign here.)
+        let a = [polar(1.003, 2.0).as_slice(), polar(0.990, 0.5).as_slice()].concat();
+        let b = [polar(1.002, 2.0).as_slice(), polar(0.999, 0.5).as_slice()].concat();
+        assert!(!neimark_sacker_crossed(&a, &b));
+        assert!(!neimark_sacker_crossed(&b, &a));
+        // Then the first pair goes inside: that is a crossing.
+        let c = [polar(0.998, 2.0).as_slice(), polar(0.999, 0.5).as_slice()].concat();
+        assert!(neimark_sacker_crossed(&b, &c));
+        // And a pair crossing while a real pair outside merges into a pair: still a crossing.
+        let d = [
+            polar(1.01, 2.0).as_slice(),
+            &[Complex::new(1.2, 0.0), Complex::new(1.3, 0.0)],
+        ]
+        .concat();
+        let e = [polar(0.99, 2.0).as_slice(), polar(1.25, 0.05).as_slice()].concat();
+        assert!(neimark_sacker_crossed(&d, &e));
+        // Two pairs crossing in opposite directions in one step: two crossings, though the
+        // product of the pairs' `|λ| − 1` keeps its sign (the branch halves such a step).
+        let f = [polar(1.01, 2.0).as_slice(), polar(0.99, 0.5).as_slice()].concat();
+        let g = [polar(0.99, 2.0).as_slice(), polar(1.01, 0.5).as_slice()].concat();
+        assert_eq!(neimark_sacker_crossings(&f, &g), 2);
+        assert_eq!(
+            neimark_sacker_test(&f).map(f64::signum),
+            neimark_sacker_test(&g).map(f64::signum)
+        );
     }
 }

@@ -245,6 +245,20 @@ pub fn follow(
                 });
                 break;
             }
+            // Two complex pairs through the unit circle in one step cannot be located one by
+            // one (their test function may keep its sign): the step is halved until they
+            // come one per step, or the smallest step takes them together.
+            Ok((p, _))
+                if h > cont.steps.min
+                    && p.signature == cur.0.signature
+                    && bifurcation::neimark_sacker_crossings(
+                        &cur.0.multipliers,
+                        &p.multipliers,
+                    ) > 1 =>
+            {
+                h = (h * 0.5).max(cont.steps.min);
+                continue;
+            }
             Ok((p, l)) if p.signature == cur.0.signature => {
                 steps += 1;
                 for kind in bifurcation::crossings(&cur.0, &p) {

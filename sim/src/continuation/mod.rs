@@ -30,8 +30,9 @@ pub use arclength::{
     BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
 };
 pub use bifurcation::{
-    complex_outside, fold_test, neimark_sacker_crossed, neimark_sacker_test, period_doubling_test,
-    Bifurcation, BifurcationKind, LOCATION_BUDGET, LOCATION_TOLERANCE,
+    complex_outside, fold_test, neimark_sacker_crossed, neimark_sacker_crossings,
+    neimark_sacker_test, period_doubling_test, Bifurcation, BifurcationKind, LOCATION_BUDGET,
+    LOCATION_TOLERANCE,
 };
 pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
