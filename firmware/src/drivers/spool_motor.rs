@@ -33,10 +33,12 @@
 //!   push began, whether the push was cut short or reached its hold (a fixed pay-out from the
 //!   last hold would leave the string too long after a short push and too short after a full
 //!   one). A bounded move at `release_max_duty`, then the power stage switches off. Without a
-//!   previous drive (power-up) there is nothing to pay out: off. The pay-out is supervised: if the pay-out
-//!   error grows by more than `release_tolerance_counts` beyond its best value so far (the
-//!   spool moves the wrong way) or does not improve for `release_stall_ticks` ticks (it does
-//!   not move), the stage goes off and `ReleaseStalled` is reported.
+//!   previous drive (power-up) there is nothing to pay out: off. A PD move (error and
+//!   spool rate) at up to `release_max_duty`, done when the spool is at the target and at
+//!   rest — then the stage switches off (switched off while still turning, the motor would
+//!   coast far past it). Supervised: if the pay-out error does not improve for
+//!   `release_stall_ticks` ticks (jammed, or a reversed motor winding in), the stage goes
+//!   off and `ReleaseStalled` is reported.
 //! * [`SpoolMotor::stop_now`] (emergency stop): the stage off at once, any pay-out abandoned.
 //! * Over-current: above `current_limit_a` the bridge is off for that tick (chopping). A leaky
 //!   count adds one per reading over the limit and takes one off per reading under it *taken
@@ -114,6 +116,8 @@ pub struct SpoolMotorConfig {
     pub slack_counts: i32,
     /// Duty per count of pay-out error.
     pub release_kp_per_count: f32,
+    /// Duty per count-per-tick of spool rate while paying out (braking ahead of the target).
+    pub release_kd_per_count_per_tick: f32,
     /// Largest duty while paying out (0..1].
     pub release_max_duty: f32,
     /// Pay-out done within this many counts.
@@ -131,15 +135,15 @@ pub struct SpoolMotorConfig {
 }
 
 impl Default for SpoolMotorConfig {
-    /// PD 20 /rad and 0.5 s/rad up to 80 % duty at 1 kHz; 16 297 counts per ankle radian (the
+    /// PD 40 /rad and 0.5 s/rad up to 80 % duty at 1 kHz; 16 297 counts per ankle radian (the
     /// assumed build: 1024 counts per motor turn, gear 25:1, lever arm 20 mm, spool radius
     /// 5 mm, docs/firmware.md); 4 A limit (5 ticks to latch, 0.5 s to clear); release
-    /// re-spools to 326 counts (0.02 rad) below the push's start at up to 30 % duty within
-    /// 0.3 s, aborted after 50 ms without progress; a hold pays out at most 2000 counts
+    /// re-spools to 49 counts (3 mrad) below the push's start at up to 30 % duty within
+    /// 0.3 s (done within 16 counts, at rest), aborted after 50 ms without progress; a hold pays out at most 2000 counts
     /// (0.12 rad); soft limits ±60 000 counts (±3.7 rad of ankle).
     fn default() -> Self {
         SpoolMotorConfig {
-            kp_per_rad: 20.0,
+            kp_per_rad: 40.0,
             kd_s_per_rad: 0.5,
             tick_s: 0.001,
             counts_per_ankle_rad: 16_297.0,
@@ -147,10 +151,11 @@ impl Default for SpoolMotorConfig {
             current_limit_a: 4.0,
             overcurrent_ticks: 5,
             overcurrent_cooldown_ticks: 500,
-            slack_counts: 326,
-            release_kp_per_count: 0.001,
+            slack_counts: 49,
+            release_kp_per_count: 0.003,
+            release_kd_per_count_per_tick: 0.02,
             release_max_duty: 0.3,
-            release_tolerance_counts: 50,
+            release_tolerance_counts: 16,
             release_timeout_ticks: 300,
             release_stall_ticks: 50,
             hold_payout_counts: 2000,
@@ -185,6 +190,8 @@ pub struct SpoolMotor<B, E, I> {
     release_target: Option<i32>,
     release_ticks: u16,
     release_best_error: i32,
+    /// Spool position at the previous pay-out tick.
+    release_last: Option<i32>,
     release_stall: u16,
     over_ticks: u16,
     last_spool: Option<i32>,
@@ -210,6 +217,7 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             release_target: None,
             release_ticks: 0,
             release_best_error: i32::MAX,
+            release_last: None,
             release_stall: 0,
             over_ticks: 0,
             last_spool: None,
@@ -300,6 +308,7 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             self.release_target = Some(target);
             self.release_ticks = 0;
             self.release_best_error = i32::MAX;
+            self.release_last = None;
             self.release_stall = 0;
         }
         let Some(target) = self.release_target else {
@@ -307,7 +316,11 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
             return Ok(());
         };
         let error = target.saturating_sub(spool);
-        if error.abs() <= self.config.release_tolerance_counts {
+        // Spool rate [counts per tick]; a pay-out is done at the target *and* at rest (a
+        // motor switched off while still turning would coast far past it).
+        let rate = self.release_last.map_or(0, |p| spool.saturating_sub(p));
+        self.release_last = Some(spool);
+        if error.abs() <= self.config.release_tolerance_counts && rate.abs() <= 1 {
             self.release_target = None;
             self.off();
             return Ok(());
@@ -324,16 +337,17 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
         } else {
             self.release_stall = self.release_stall.saturating_add(1);
         }
-        let diverging = size
-            > self
-                .release_best_error
-                .saturating_add(self.config.release_tolerance_counts);
-        if diverging || self.release_stall >= self.config.release_stall_ticks {
+        // No progress for the stall time: jammed, or a reversed motor winding in (the error
+        // never shrinks). A motor still coasting on from the drive, or braking after an
+        // overshoot, makes progress again within it.
+        if self.release_stall >= self.config.release_stall_ticks {
             self.release_target = None;
             return self.fail(ActuatorError::ReleaseStalled);
         }
         let m = self.config.release_max_duty;
-        let d = (self.config.release_kp_per_count * error as f32).clamp(-m, m);
+        let d = (self.config.release_kp_per_count * error as f32
+            - self.config.release_kd_per_count_per_tick * rate as f32)
+            .clamp(-m, m);
         let d = self.soft_limited(spool, d);
         self.drive(d)
     }
@@ -531,18 +545,17 @@ mod tests {
         // hold), less the 326-count slack: 9674; at most 30 %.
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert_eq!(m.output(), StageOutput::Duty(-0.3));
+        // Past the target and still turning fast: the rate term brakes (clamped).
         spool.set(Some(9_600));
         m.apply(ActuatorCommand::Released, None).unwrap();
-        let StageOutput::Duty(d) = m.output() else {
-            panic!("still paying out")
-        };
-        assert!(
-            (d - 0.074).abs() < 1e-6,
-            "overshoot corrected proportionally: {d}"
-        );
+        assert_eq!(m.output(), StageOutput::Duty(0.3), "braking");
+        // Within the tolerance but still moving: not done.
         spool.set(Some(9_700));
         m.apply(ActuatorCommand::Released, None).unwrap();
-        assert_eq!(m.output(), StageOutput::Off, "within tolerance: off");
+        assert!(matches!(m.output(), StageOutput::Duty(_)), "at the target, moving");
+        // At rest within the tolerance: off.
+        m.apply(ActuatorCommand::Released, None).unwrap();
+        assert_eq!(m.output(), StageOutput::Off, "within tolerance, at rest: off");
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert_eq!(m.output(), StageOutput::Off, "stays off");
     }
@@ -604,9 +617,12 @@ mod tests {
         let cfg = SpoolMotorConfig::default();
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
         m.apply(HOLD, Some(0.2)).unwrap();
-        // Reversed motor: the negative duty winds in; the error grows tick by tick.
+        // Reversed motor: the negative duty winds in; the error grows tick by tick and never
+        // shrinks: aborted at the stall time.
         let mut result = Ok(());
-        for k in 1..20 {
+        let mut ticks = 0;
+        for k in 1..200 {
+            ticks = k;
             result = m.apply(ActuatorCommand::Released, None);
             if result.is_err() {
                 break;
@@ -615,7 +631,26 @@ mod tests {
             spool.set(Some(10_000 + 20 * k));
         }
         assert_eq!(result, Err(ActuatorError::ReleaseStalled));
+        assert_eq!(ticks, i32::from(cfg.release_stall_ticks) + 1);
         assert_eq!(m.output(), StageOutput::Off);
+    }
+
+    #[test]
+    fn a_motor_coasting_on_from_the_push_is_not_a_wrong_way_pay_out() {
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(10_000));
+        let amps = Cell::new(Some(0.5));
+        let cfg = SpoolMotorConfig::default();
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        m.apply(HOLD, Some(0.2)).unwrap();
+        // The motor winds on for a few ticks after the release (decelerating), then pays out.
+        for (k, s) in [10_030, 10_050, 10_060, 10_062, 10_050, 10_000, 9_900]
+            .into_iter()
+            .enumerate()
+        {
+            assert_eq!(m.apply(ActuatorCommand::Released, None), Ok(()), "tick {k}");
+            spool.set(Some(s));
+        }
     }
 
     #[test]

@@ -43,6 +43,7 @@ pub mod report;
 pub mod scene_profile;
 pub mod sensors;
 pub mod side;
+pub mod spool_plant;
 pub mod swing;
 mod tick;
 
@@ -50,7 +51,7 @@ mod tick;
 mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
-pub use config::{HostCommand, SilConfig, READ_BACK_PARAMS};
+pub use config::{ActuatorChoice, HostCommand, SupplyDropInHold, SilConfig, READ_BACK_PARAMS};
 pub use error::SilError;
 pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use history::BoundedLog;
@@ -64,4 +65,5 @@ pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,
 };
 pub use side::Side;
+pub use spool_plant::{SpoolPlant, SpoolPlantParams, SpoolPlantStats};
 pub use swing::{SwingAnkle, SwingAnkleModel};
