@@ -277,6 +277,16 @@ impl Ankle {
             .ok_or_else(|| control_error("the firmware applied no actuator command"))
     }
 
+    /// What the power stage did in the last tick (motor plant only).
+    pub fn stage_output(&self) -> Option<firmware::drivers::spool_motor::StageOutput> {
+        self.wiring.plant.as_ref().map(|p| p.borrow().stage())
+    }
+
+    /// The spool encoder's count (motor plant only).
+    pub fn spool_counts(&self) -> Option<i32> {
+        self.wiring.plant.as_ref().map(|p| p.borrow().spool_counts())
+    }
+
     /// The injected encoder faults that took effect at this ankle.
     pub fn sensor_faults_applied(&self) -> &[crate::sensors::AppliedSensorFault] {
         self.drivers.encoder.device().encoder().applied()

@@ -66,4 +66,6 @@ pub use sensors::{
 };
 pub use side::Side;
 pub use spool_plant::{SpoolPlant, SpoolPlantParams, SpoolPlantStats};
+/// What the firmware's spool-motor driver set the power stage to.
+pub use firmware::drivers::spool_motor::StageOutput;
 pub use swing::{SwingAnkle, SwingAnkleModel};
