@@ -97,7 +97,9 @@ fn with_the_motor_a_still_hold_leaves_a_frozen_reading_right_and_raises_nothing(
     // reading frozen there it keeps the duty it had, the load stays as it was, the gearbox's
     // friction holds: the ankle stays within one count of the frozen reading, the reading is
     // *right*, and no check can tell it from a healthy encoder sitting on one code.
-    let config = motor_config().with_firmware_param_str("push_duration_s=0.15").unwrap();
+    let config = motor_config()
+        .with_firmware_param_str("push_duration_s=0.15")
+        .unwrap();
     let (_walk, r, seen) = walk_recorded(config, 2);
     let frozen_at = r.sensor_faults_applied[0].t_s;
     let during: Vec<&Seen> = seen
@@ -110,7 +112,10 @@ fn with_the_motor_a_still_hold_leaves_a_frozen_reading_right_and_raises_nothing(
         .iter()
         .map(|s| (s.ankle_rad - first).abs())
         .fold(0.0, f64::max);
-    assert!(drift < COUNT_RAD, "the ankle moved {drift} rad under the frozen reading");
+    assert!(
+        drift < COUNT_RAD,
+        "the ankle moved {drift} rad under the frozen reading"
+    );
     let spool_ticks = during
         .windows(2)
         .filter(|w| w[0].left_spool != w[1].left_spool)
@@ -125,8 +130,8 @@ fn with_the_motor_a_still_hold_leaves_a_frozen_reading_right_and_raises_nothing(
     debug_assertions,
     ignore = "minutes unoptimised: cargo test --release -p hil-tests"
 )]
-fn with_the_motor_a_load_change_under_a_frozen_reading_is_caught_and_the_stage_stops_within_50_ms(
-) {
+fn with_the_motor_a_load_change_under_a_frozen_reading_is_caught_and_the_stage_stops_within_50_ms()
+{
     // The same frozen reading, and at the same tick the stage's supply drops from 12 V to
     // 6 V (a load change: the same duty now gives half the torque). The walker's load
     // back-drives the spool and the ankle sinks, while the frozen reading says it has not
@@ -165,13 +170,19 @@ fn with_the_motor_a_load_change_under_a_frozen_reading_is_caught_and_the_stage_s
         .map(|w| w[1].t_s)
         .collect();
     assert!(still.is_empty(), "the spool stood still at {still:?}");
-    assert!(turning >= 50, "{turning} ticks with the spool turning before the fault");
+    assert!(
+        turning >= 50,
+        "{turning} ticks with the spool turning before the fault"
+    );
     assert!(
         stuck > frozen_at && stuck <= frozen_at + 0.055 + 1e-9,
         "frozen at {frozen_at}, raised at {stuck}"
     );
     eprintln!("frozen {frozen_at:.3} s, EncoderStuck {stuck:.3} s, {turning} ticks turning");
-    assert_eq!(r.first_state_at_or_after(Side::Left, "Safe", 0.0), Some(stuck));
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", 0.0),
+        Some(stuck)
+    );
     // The true ankle moved away from the frozen reading by more than a count before that.
     let first = seen.iter().find(|s| s.t_s >= frozen_at).unwrap().ankle_rad;
     let moved = seen

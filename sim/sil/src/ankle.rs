@@ -18,20 +18,20 @@ use sim::control::{ActuatorSegment, ControlError};
 
 use crate::actuator::ActuatorModel;
 use crate::bus_side::BusSide;
+use crate::config::ActuatorChoice;
 use crate::config::SilConfig;
 use crate::error::{control_error, SilError};
 use crate::gait::AnkleScene;
-use crate::config::ActuatorChoice;
 use crate::hal::{
     ActuatorLink, AnkleActuator, CanLink, PlantLink, Shaft, SimActuator, SimBridges, SimCan,
     SimClock, SimContactPin, SimCurrentSense, SimSpi, SimSpoolEncoder,
 };
-use crate::spool_plant::{PlantTick, SpoolPlant};
-use firmware::drivers::spool_motor::SpoolMotor;
 use crate::report::NodeReport;
 use crate::sensors::SimEncoder;
 use crate::side::Side;
+use crate::spool_plant::{PlantTick, SpoolPlant};
 use crate::tick::TickTime;
+use firmware::drivers::spool_motor::SpoolMotor;
 
 /// The board's drivers over the simulator's hardware.
 type SimDrivers =
@@ -118,9 +118,9 @@ impl Ankle {
                 config.actuator,
             )))),
             plant: match config.actuator_choice {
-                ActuatorChoice::SpoolMotor => Some(Rc::new(RefCell::new(SpoolPlant::new(
-                    config.spool_plant,
-                )))),
+                ActuatorChoice::SpoolMotor => {
+                    Some(Rc::new(RefCell::new(SpoolPlant::new(config.spool_plant))))
+                }
                 ActuatorChoice::Servo => None,
             },
             supply_drop_v: config
@@ -284,7 +284,10 @@ impl Ankle {
 
     /// The spool encoder's count (motor plant only).
     pub fn spool_counts(&self) -> Option<i32> {
-        self.wiring.plant.as_ref().map(|p| p.borrow().spool_counts())
+        self.wiring
+            .plant
+            .as_ref()
+            .map(|p| p.borrow().spool_counts())
     }
 
     /// The injected encoder faults that took effect at this ankle.

@@ -7,10 +7,10 @@ use canbus::{BusConfig, FaultSpec};
 use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 
 use crate::actuator::ActuatorParams;
-use crate::spool_plant::SpoolPlantParams;
-use firmware::drivers::spool_motor::SpoolMotorConfig;
 use crate::firmware_param::{check_writes, FirmwareParam, FirmwareParamError};
 use crate::sensors::{SensorFault, SensorFaultParseError};
+use crate::spool_plant::SpoolPlantParams;
+use firmware::drivers::spool_motor::SpoolMotorConfig;
 
 pub use crate::side::Side;
 pub use crate::swing::SwingAnkleModel;

@@ -51,8 +51,10 @@ mod tick;
 mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
-pub use config::{ActuatorChoice, HostCommand, SupplyDropInHold, SilConfig, READ_BACK_PARAMS};
+pub use config::{ActuatorChoice, HostCommand, SilConfig, SupplyDropInHold, READ_BACK_PARAMS};
 pub use error::SilError;
+/// What the firmware's spool-motor driver set the power stage to.
+pub use firmware::drivers::spool_motor::StageOutput;
 pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
@@ -66,6 +68,4 @@ pub use sensors::{
 };
 pub use side::Side;
 pub use spool_plant::{SpoolPlant, SpoolPlantParams, SpoolPlantStats};
-/// What the firmware's spool-motor driver set the power stage to.
-pub use firmware::drivers::spool_motor::StageOutput;
 pub use swing::{SwingAnkle, SwingAnkleModel};

@@ -304,11 +304,7 @@ impl SpoolPlant {
         let (drive, damping, duty) = match self.stage {
             StageOutput::Duty(d) => {
                 let d = f64::from(d).clamp(-1.0, 1.0);
-                (
-                    k * supply_v * d / r,
-                    p.viscous_n_m_s + k * k / r,
-                    Some(d),
-                )
+                (k * supply_v * d / r, p.viscous_n_m_s + k * k / r, Some(d))
             }
             StageOutput::Off => (0.0, p.viscous_n_m_s, None),
         };
@@ -344,10 +340,52 @@ impl SpoolPlant {
     }
 }
 
+/// The motion `J·ω̇ = a − β·ω` from `(θ0, ω0)`: exponential towards `a/β` (β > 0), uniformly
+/// accelerated when β = 0.
+#[derive(Clone, Copy, Debug)]
+struct Motion {
+    theta0: f64,
+    omega0: f64,
+    a: f64,
+    beta: f64,
+    j: f64,
+}
+
+impl Motion {
+    /// ω at `s` after the start.
+    fn omega(&self, s: f64) -> f64 {
+        if self.beta > 0.0 {
+            let w_inf = self.a / self.beta;
+            w_inf + (self.omega0 - w_inf) * (-s * self.beta / self.j).exp()
+        } else {
+            self.omega0 + self.a / self.j * s
+        }
+    }
+
+    /// θ at `s` after the start.
+    fn theta(&self, s: f64) -> f64 {
+        if self.beta > 0.0 {
+            let w_inf = self.a / self.beta;
+            let tc = self.j / self.beta;
+            self.theta0 + w_inf * s + (self.omega0 - w_inf) * tc * (1.0 - (-s / tc).exp())
+        } else {
+            self.theta0 + self.omega0 * s + 0.5 * self.a / self.j * s * s
+        }
+    }
+}
+
 /// `J·ω̇ = a − β·ω − τ_c·sgn ω` over `h` from `(θ0, ω0)`, exactly for a constant sign of ω;
 /// a motion that would reverse against friction stops where ω reaches 0, and a motor at rest
 /// stays there while `|a| ≤ τ_c` (static friction).
-fn integrate(theta0: f64, omega0: f64, a: f64, beta: f64, tau_c: f64, j: f64, h: f64) -> (f64, f64) {
+fn integrate(
+    theta0: f64,
+    omega0: f64,
+    a: f64,
+    beta: f64,
+    tau_c: f64,
+    j: f64,
+    h: f64,
+) -> (f64, f64) {
     if h <= 0.0 || j <= 0.0 {
         return (theta0, omega0);
     }
@@ -358,40 +396,28 @@ fn integrate(theta0: f64, omega0: f64, a: f64, beta: f64, tau_c: f64, j: f64, h:
     } else {
         return (theta0, 0.0);
     };
-    let a = a - sign * tau_c;
-    // ω(t) = ω∞ + (ω0 − ω∞)·e^{−t/T}, T = J/β (β > 0); linear when β = 0.
-    let (omega_at, theta_at): (Box<dyn Fn(f64) -> f64>, Box<dyn Fn(f64) -> f64>) = if beta > 0.0
-    {
-        let w_inf = a / beta;
-        let tc = j / beta;
-        (
-            Box::new(move |s: f64| w_inf + (omega0 - w_inf) * (-s / tc).exp()),
-            Box::new(move |s: f64| {
-                theta0 + w_inf * s + (omega0 - w_inf) * tc * (1.0 - (-s / tc).exp())
-            }),
-        )
-    } else {
-        let acc = a / j;
-        (
-            Box::new(move |s: f64| omega0 + acc * s),
-            Box::new(move |s: f64| theta0 + omega0 * s + 0.5 * acc * s * s),
-        )
+    let m = Motion {
+        theta0,
+        omega0,
+        a: a - sign * tau_c,
+        beta: beta.max(0.0),
+        j,
     };
-    let w1 = omega_at(h);
+    let w1 = m.omega(h);
     if w1 * sign >= 0.0 {
-        return (theta_at(h), w1);
+        return (m.theta(h), w1);
     }
-    // Reverses within the tick: stops at ω = 0 (bisection on the monotone ω(t)).
+    // Reverses within the tick: stops at ω = 0 (bisection on the monotone ω(t), 60 halvings).
     let (mut lo, mut hi) = (0.0, h);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if omega_at(mid) * sign > 0.0 {
+        if m.omega(mid) * sign > 0.0 {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    (theta_at(hi), 0.0)
+    (m.theta(hi), 0.0)
 }
 
 #[cfg(test)]
@@ -431,7 +457,11 @@ mod tests {
         // Steady state: k·i = b·ω + τ_c, i = (V − kω)/R.
         let beta = p.viscous_n_m_s + k_t * k_t / p.resistance_ohm;
         let w = (k_t * p.supply_v / p.resistance_ohm - p.coulomb_n_m) / beta;
-        assert!((m.motor_rad_s - w).abs() < 1e-6 * w, "{} {w}", m.motor_rad_s);
+        assert!(
+            (m.motor_rad_s - w).abs() < 1e-6 * w,
+            "{} {w}",
+            m.motor_rad_s
+        );
         assert!(m.current_a > 0.0 && m.current_a < 0.2, "{}", m.current_a);
         // The energy balance of one tick at steady speed: V·i = R·i² + (b·ω + τ_c)·ω.
         let i = m.current_a;
@@ -446,13 +476,23 @@ mod tests {
         let mut m = SpoolPlant::new(p);
         // A load the stage cannot beat at 10 % duty: no motion, current V·d/R.
         m.set_stage(StageOutput::Duty(0.1));
-        let stall_ankle = p.torque_constant_n_m_per_a * p.supply_v * 0.1 / p.resistance_ohm
+        let stall_ankle = p.torque_constant_n_m_per_a * p.supply_v * 0.1
+            / p.resistance_ohm
             / p.ankle_per_motor_rad();
-        m.set_tick(tick(0.0, -0.1, true, stall_ankle + p.coulomb_n_m / 0.01 * 0.5));
+        m.set_tick(tick(
+            0.0,
+            -0.1,
+            true,
+            stall_ankle + p.coulomb_n_m / 0.01 * 0.5,
+        ));
         let s = m.finish_tick();
         assert_eq!((s.p0_rad, s.p1_rad, s.v1_rad_s), (-0.1, -0.1, 0.0));
         let stall_a = p.supply_v * 0.1 / p.resistance_ohm;
-        assert!((m.current_reading_a() - stall_a).abs() <= 0.0147, "{}", m.current_a);
+        assert!(
+            (m.current_reading_a() - stall_a).abs() <= 0.0147,
+            "{}",
+            m.current_a
+        );
         // Stage off, a load under the friction: stays.
         m.set_stage(StageOutput::Off);
         m.set_tick(tick(1e-3, -0.1, true, 0.5 * p.coulomb_n_m / 0.01));
