@@ -462,7 +462,12 @@ mod tests {
             "{} {w}",
             m.motor_rad_s
         );
-        assert!(m.current_a > 0.0 && m.current_a < 0.2, "{}", m.current_a);
+        let i_expected = (p.viscous_n_m_s * w + p.coulomb_n_m) / k_t;
+        assert!(
+            (m.current_a - i_expected).abs() < 1e-6,
+            "{} {i_expected}",
+            m.current_a
+        );
         // The energy balance of one tick at steady speed: V·i = R·i² + (b·ω + τ_c)·ω.
         let i = m.current_a;
         let lhs = p.supply_v * i;
@@ -486,7 +491,8 @@ mod tests {
             stall_ankle + p.coulomb_n_m / 0.01 * 0.5,
         ));
         let s = m.finish_tick();
-        assert_eq!((s.p0_rad, s.p1_rad, s.v1_rad_s), (-0.1, -0.1, 0.0));
+        let l0 = p.initial_limit_rad;
+        assert_eq!((s.p0_rad, s.p1_rad, s.v1_rad_s), (l0, l0, 0.0));
         let stall_a = p.supply_v * 0.1 / p.resistance_ohm;
         assert!(
             (m.current_reading_a() - stall_a).abs() <= 0.0147,
@@ -497,12 +503,12 @@ mod tests {
         m.set_stage(StageOutput::Off);
         m.set_tick(tick(1e-3, -0.1, true, 0.5 * p.coulomb_n_m / 0.01));
         let s = m.finish_tick();
-        assert_eq!((s.p1_rad, s.v1_rad_s), (-0.1, 0.0));
+        assert_eq!((s.p1_rad, s.v1_rad_s), (l0, 0.0));
         assert_eq!(m.current_reading_a(), 0.0);
         // Over it: the load back-drives the gearbox, the string pays out.
         m.set_tick(tick(2e-3, -0.1, true, 1.0));
         let s = m.finish_tick();
-        assert!(s.p1_rad < -0.1 && s.v1_rad_s < 0.0, "{s:?}");
+        assert!(s.p1_rad < l0 && s.v1_rad_s < 0.0, "{s:?}");
     }
 
     #[test]
