@@ -20,6 +20,7 @@ mod can_port;
 mod crash;
 mod current_sense;
 mod encoders;
+mod overcurrent_break;
 mod power_stage;
 mod reset_cause;
 
@@ -207,6 +208,14 @@ async fn main(_spawner: Spawner) {
     );
     let (ou, ov) = current.offsets();
     defmt::info!("current-sense offsets {} / {} counts", ou, ov);
+    // Hardware over-current backstop: COMP1/COMP2 on the shunt inputs (PA1, PA7, analogue
+    // since the op-amps took them) against DAC3, into TIM1's break input. The stage is off.
+    overcurrent_break::arm();
+    defmt::info!(
+        "over-current break armed: {} A, DAC3 code {}",
+        overcurrent_break::BREAK_CURRENT_A,
+        overcurrent_break::BREAK_CODE
+    );
 
     // Spool encoder: TIM4 in encoder mode on the Hall/encoder connector (PB6, PB7).
     let qei_cfg = qei::Config {

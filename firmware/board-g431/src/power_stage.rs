@@ -7,6 +7,10 @@
 //! The stage is off from construction until the first `drive`, and [`power_stage_off`]
 //! clears MOE from any context (panic and HardFault handlers included) without needing the
 //! driver object.
+//!
+//! The over-current comparators ([`crate::overcurrent_break`]) clear MOE in hardware; `drive`
+//! sees the break flag, keeps the stage off and reports a [`HardwareError`] (the node raises
+//! `Actuator` and goes `Safe`); `off` clears the flag, so the next `drive` may switch on again.
 
 use embassy_stm32::peripherals::TIM1;
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwm;
@@ -55,6 +59,12 @@ impl HalfBridges for Tim1Bridges<'_> {
         if signed_duty.is_nan() {
             return Err(HardwareError);
         }
+        if crate::overcurrent_break::tripped() {
+            // The hardware has already cleared MOE: stay off, report it.
+            power_stage_off();
+            self.enabled = false;
+            return Err(HardwareError);
+        }
         let max = self.pwm.get_max_duty();
         // Float-to-int `as` saturates; min() keeps set_duty's assertion unreachable.
         let duty = ((signed_duty.abs().min(1.0) * max as f32) as u32).min(max);
@@ -74,6 +84,7 @@ impl HalfBridges for Tim1Bridges<'_> {
 
     fn off(&mut self) {
         power_stage_off();
+        crate::overcurrent_break::clear();
         self.enabled = false;
         self.pwm.set_duty(Channel::Ch1, 0);
         self.pwm.set_duty(Channel::Ch2, 0);

@@ -18,20 +18,24 @@ use sim::control::{ActuatorSegment, ControlError};
 
 use crate::actuator::ActuatorModel;
 use crate::bus_side::BusSide;
+use crate::config::ActuatorChoice;
 use crate::config::SilConfig;
 use crate::error::{control_error, SilError};
 use crate::gait::AnkleScene;
 use crate::hal::{
-    ActuatorLink, CanLink, Shaft, SimActuator, SimCan, SimClock, SimContactPin, SimSpi,
+    ActuatorLink, AnkleActuator, CanLink, PlantLink, Shaft, SimActuator, SimBridges, SimCan,
+    SimClock, SimContactPin, SimCurrentSense, SimSpi, SimSpoolEncoder,
 };
 use crate::report::NodeReport;
 use crate::sensors::SimEncoder;
 use crate::side::Side;
+use crate::spool_plant::{PlantTick, SpoolPlant};
 use crate::tick::TickTime;
+use firmware::drivers::spool_motor::SpoolMotor;
 
 /// The board's drivers over the simulator's hardware.
 type SimDrivers =
-    AnkleDrivers<MagneticEncoder<SimSpi>, SimContactPin, SimActuator, SimCan, SimClock>;
+    AnkleDrivers<MagneticEncoder<SimSpi>, SimContactPin, AnkleActuator, SimCan, SimClock>;
 
 /// The orchestrator's ends of one ankle's hardware (shared with the drivers' ends).
 struct Wiring {
@@ -40,6 +44,10 @@ struct Wiring {
     clock: SimClock,
     can: Rc<RefCell<CanLink>>,
     actuator: Rc<RefCell<ActuatorLink>>,
+    /// The motor plant, with [`ActuatorChoice::SpoolMotor`].
+    plant: Option<PlantLink>,
+    /// A supply drop still to apply at the first tick in `Hold` [V].
+    supply_drop_v: Option<f64>,
 }
 
 /// What the ankle's bus node allows at a tick.
@@ -109,6 +117,26 @@ impl Ankle {
             actuator: Rc::new(RefCell::new(ActuatorLink::new(ActuatorModel::new(
                 config.actuator,
             )))),
+            plant: match config.actuator_choice {
+                ActuatorChoice::SpoolMotor => {
+                    Some(Rc::new(RefCell::new(SpoolPlant::new(config.spool_plant))))
+                }
+                ActuatorChoice::Servo => None,
+            },
+            supply_drop_v: config
+                .supply_drops
+                .iter()
+                .find(|d| d.side == side)
+                .map(|d| d.supply_v),
+        };
+        let actuator = match &wiring.plant {
+            Some(plant) => AnkleActuator::SpoolMotor(Box::new(SpoolMotor::new(
+                SimBridges(Rc::clone(plant)),
+                SimSpoolEncoder(Rc::clone(plant)),
+                SimCurrentSense(Rc::clone(plant)),
+                config.spool_motor,
+            ))),
+            None => AnkleActuator::Servo(SimActuator::new(Rc::clone(&wiring.actuator))),
         };
         let spi = SimSpi::new(SimEncoder::new(calibration, faults), wiring.shaft.clone());
         let drivers = AnkleDrivers::new(
@@ -119,7 +147,7 @@ impl Ankle {
                 ActiveLevel::Low,
                 config.debounce_samples,
             ),
-            SimActuator::new(Rc::clone(&wiring.actuator)),
+            actuator,
             CanPort::new(SimCan::new(Rc::clone(&wiring.can))),
             wiring.clock.clone(),
         );
@@ -166,10 +194,31 @@ impl Ankle {
             can.set_bus_off(access.bus_off);
             can.set_error_state(access.error_state.0, access.error_state.1);
         }
-        // The string's torque acts on the stance ankle's servo only.
-        w.actuator
-            .borrow_mut()
-            .set_tick(t.t_s, t.t_end_s, scene.angle_rad, scene.string_load_n_m);
+        let in_hold = self.drivers.node.phase() == protocol::ReflexPhase::Hold;
+        let w = &mut self.wiring;
+        if let (Some(plant), true) = (&w.plant, in_hold) {
+            if let Some(v) = w.supply_drop_v.take() {
+                plant.borrow_mut().drop_supply(v);
+            }
+        }
+        let w = &self.wiring;
+        // The string's torque acts on the stance ankle's actuator only.
+        match &w.plant {
+            Some(plant) => plant.borrow_mut().set_tick(PlantTick {
+                t0_s: t.t_s,
+                t1_s: t.t_end_s,
+                stance: scene.stance,
+                ankle_rad: scene.angle_rad,
+                engaged: scene.string_engaged,
+                load_n_m: scene.string_load_n_m,
+            }),
+            None => w.actuator.borrow_mut().set_tick(
+                t.t_s,
+                t.t_end_s,
+                scene.angle_rad,
+                scene.string_load_n_m,
+            ),
+        }
         // The firmware, as on the board.
         let outputs = self.drivers.step();
         let peer = self.side.other().node();
@@ -217,11 +266,28 @@ impl Ankle {
     /// # Errors
     /// When the firmware applied no actuator command.
     pub fn take_segment(&mut self) -> Result<ActuatorSegment, ControlError> {
+        if let Some(plant) = &self.wiring.plant {
+            // The duty the firmware set in this step, integrated over the tick.
+            return Ok(plant.borrow_mut().finish_tick());
+        }
         self.wiring
             .actuator
             .borrow_mut()
             .take_segment()
             .ok_or_else(|| control_error("the firmware applied no actuator command"))
+    }
+
+    /// What the power stage did in the last tick (motor plant only).
+    pub fn stage_output(&self) -> Option<firmware::drivers::spool_motor::StageOutput> {
+        self.wiring.plant.as_ref().map(|p| p.borrow().stage())
+    }
+
+    /// The spool encoder's count (motor plant only).
+    pub fn spool_counts(&self) -> Option<i32> {
+        self.wiring
+            .plant
+            .as_ref()
+            .map(|p| p.borrow().spool_counts())
     }
 
     /// The injected encoder faults that took effect at this ankle.
@@ -246,5 +312,6 @@ impl Ankle {
         r.frames_refused_bus_off = link.refused_bus_off();
         r.rx_overflows = link.rx_overflows();
         r.actuator = *self.wiring.actuator.borrow().model().stats();
+        r.spool_plant = self.wiring.plant.as_ref().map(|p| *p.borrow().stats());
     }
 }

@@ -9,6 +9,8 @@ use firmware::sensors::{AngleCalibration, SIMULATED_CALIBRATION};
 use crate::actuator::ActuatorParams;
 use crate::firmware_param::{check_writes, FirmwareParam, FirmwareParamError};
 use crate::sensors::{SensorFault, SensorFaultParseError};
+use crate::spool_plant::SpoolPlantParams;
+use firmware::drivers::spool_motor::SpoolMotorConfig;
 
 pub use crate::side::Side;
 pub use crate::swing::SwingAnkleModel;
@@ -43,6 +45,49 @@ pub enum BusFaultError {
     UnknownId(#[from] UnknownFaultId),
 }
 
+/// Which actuator each simulated ankle has.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum ActuatorChoice {
+    /// The board's: the firmware's own `SpoolMotor` driver (PD loop on the measured angle,
+    /// spool encoder, current limit, re-spool on release) over a DC gear motor, spool and
+    /// string model ([`crate::spool_plant::SpoolPlant`]). Not the default: the nominal
+    /// `wisse3d` walk falls after 45 steps with it (docs/sil.md).
+    SpoolMotor,
+    /// A position servo that follows the setpoint ([`crate::ActuatorModel`]): the default.
+    #[default]
+    Servo,
+}
+
+impl ActuatorChoice {
+    /// The name `walker sil --actuator` takes (`motor`, `servo`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            ActuatorChoice::SpoolMotor => "motor",
+            ActuatorChoice::Servo => "servo",
+        }
+    }
+
+    /// From [`Self::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "motor" => Some(ActuatorChoice::SpoolMotor),
+            "servo" => Some(ActuatorChoice::Servo),
+            _ => None,
+        }
+    }
+}
+
+/// A drop of one ankle's power-stage supply (with [`ActuatorChoice::SpoolMotor`]): from the
+/// first tick that ankle's node is in `Hold`, the supply is `supply_v`. A load change during
+/// a hold: the motor's torque at the same duty falls, the load back-drives the spool.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SupplyDropInHold {
+    /// Which ankle.
+    pub side: Side,
+    /// The supply after the drop [V].
+    pub supply_v: f64,
+}
+
 /// Everything a [`crate::FirmwareInTheLoop`] run needs.
 #[derive(Clone, Debug)]
 pub struct SilConfig {
@@ -67,8 +112,18 @@ pub struct SilConfig {
     /// the other foot's heel strike and beats its message by one tick: the firmware then
     /// releases every stride by its fallback and raises `PeerHeelStrikeLate`.
     pub trailing_contact_s: f64,
-    /// The string actuator.
+    /// Which actuator the ankles have. Default [`ActuatorChoice::Servo`].
+    pub actuator_choice: ActuatorChoice,
+    /// The servo model's parameters (with [`ActuatorChoice::Servo`]).
     pub actuator: ActuatorParams,
+    /// The motor, gearbox, spool and string (with [`ActuatorChoice::SpoolMotor`]).
+    pub spool_plant: SpoolPlantParams,
+    /// Supply drops during a hold (with [`ActuatorChoice::SpoolMotor`]).
+    pub supply_drops: Vec<SupplyDropInHold>,
+    /// The firmware's spool-motor driver's configuration (with
+    /// [`ActuatorChoice::SpoolMotor`]); default the board's, whose `counts_per_ankle_rad`
+    /// matches [`SpoolPlantParams::default`].
+    pub spool_motor: SpoolMotorConfig,
     /// Depth of each node's CAN receive FIFO [frames]. Default 16: a quarter of the board's
     /// software buffer (`RxBuf<64>` in `firmware/board-g431`), so the simulator is the more
     /// pessimistic; a frame that finds it full is lost and counted (`NodeReport::rx_overflows`).
@@ -107,7 +162,11 @@ impl Default for SilConfig {
             swing_ankle: SwingAnkleModel::default(),
             debounce_samples: 3,
             trailing_contact_s: 0.010,
+            actuator_choice: ActuatorChoice::default(),
             actuator: ActuatorParams::default(),
+            spool_plant: SpoolPlantParams::default(),
+            spool_motor: SpoolMotorConfig::default(),
+            supply_drops: Vec::new(),
             rx_queue_frames: 16,
             bus_faults: Vec::new(),
             sensor_faults: Vec::new(),

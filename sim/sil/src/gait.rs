@@ -23,8 +23,10 @@ pub(crate) struct AnkleScene {
     pub angle_rad: f64,
     /// The foot's contact switch is closed (the foot is on the floor).
     pub contact_closed: bool,
-    /// The string's torque on the ankle's servo [N·m] (0 for the massless swing foot).
+    /// The string's torque on the ankle's actuator [N·m] (0 for the massless swing foot).
     pub string_load_n_m: f64,
+    /// The walker holds the ankle on the string's limit (never for the swing foot).
+    pub string_engaged: bool,
 }
 
 /// Which foot is the stance foot, when the last heel strike was, and where each foot landed.
@@ -88,6 +90,7 @@ impl Gait {
                 angle_rad: sensing.stance_ankle_rad,
                 contact_closed: sensing.stance_foot_on_floor,
                 string_load_n_m: sensing.string_torque_n_m,
+                string_engaged: sensing.string_engaged,
             };
         }
         let landing = self.landing_rad[side.index()]
@@ -106,6 +109,7 @@ impl Gait {
             contact_closed: sensing.swing_foot_on_floor || trailing,
             // The swing foot is massless: its string carries nothing.
             string_load_n_m: 0.0,
+            string_engaged: false,
         }
     }
 

@@ -16,17 +16,17 @@
 //!   the node is bus-off); `receive` yields the raw frames the bus delivered to this node
 //!   (the firmware decodes them and counts malformed ones itself);
 //! * [`SimClock`] — `firmware::time::Monotonic`, the tick time;
+//! * [`SimBridges`], [`SimSpoolEncoder`], [`SimCurrentSense`] — the board's power stage,
+//!   spool encoder and current sense over [`crate::spool_plant::SpoolPlant`] (a DC gear motor,
+//!   spool and string), for the firmware's own `SpoolMotor` driver
+//!   ([`crate::config::ActuatorChoice::SpoolMotor`]);
 //! * [`SimActuator`] — `firmware::drivers::actuator::Actuator` over the simulator's
-//!   [`crate::ActuatorModel`].
+//!   [`crate::ActuatorModel`], a position servo (rate limit and first-order lag) that follows
+//!   the setpoint and leaves the string slack when released: the default
+//!   ([`crate::config::ActuatorChoice::Servo`]). It follows the setpoint, not the measured
+//!   angle, so a frozen reading changes nothing it does.
 //!
-//! The actuator is where the simulator departs from the board: the board's `PwmDirActuator`
-//! is a proportional loop over PWM duty and a direction pin driving a DC motor; the
-//! simulator replaces it by a position servo (rate limit and first-order lag) that leaves the
-//! string slack when released. A DC motor at zero duty would not release the string in the
-//! model (it has no back-drive model), while the firmware's reflex relies on the string going
-//! slack at release; so [`SimActuator`] takes the firmware's command (a position setpoint or
-//! release) and the measured angle it is given, as any `Actuator` does, and moves the string's
-//! limit through the servo model.
+//! [`AnkleActuator`] is either, behind the firmware's `Actuator` trait.
 //!
 //! Every piece shares its state with the orchestrator ([`crate::FirmwareInTheLoop`]) through
 //! `Rc<Cell<..>>` / `Rc<RefCell<..>>` handles: the simulation is single-threaded, and the
@@ -38,9 +38,11 @@ pub mod can;
 pub mod clock;
 pub mod contact;
 pub mod spi;
+pub mod spool;
 
-pub use actuator::{ActuatorLink, SimActuator};
+pub use actuator::{ActuatorLink, AnkleActuator, SimActuator};
 pub use can::{CanLink, SimCan, SimCanError, SimFrame};
 pub use clock::SimClock;
 pub use contact::SimContactPin;
 pub use spi::{Shaft, SimSpi, SimSpiError};
+pub use spool::{PlantLink, SimBridges, SimCurrentSense, SimSpoolEncoder, SimSpoolMotor};

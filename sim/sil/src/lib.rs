@@ -43,6 +43,7 @@ pub mod report;
 pub mod scene_profile;
 pub mod sensors;
 pub mod side;
+pub mod spool_plant;
 pub mod swing;
 mod tick;
 
@@ -50,8 +51,10 @@ mod tick;
 mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
-pub use config::{HostCommand, SilConfig, READ_BACK_PARAMS};
+pub use config::{ActuatorChoice, HostCommand, SilConfig, SupplyDropInHold, READ_BACK_PARAMS};
 pub use error::SilError;
+/// What the firmware's spool-motor driver set the power stage to.
+pub use firmware::drivers::spool_motor::StageOutput;
 pub use firmware_param::{FirmwareParam, FirmwareParamError};
 pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
@@ -64,4 +67,5 @@ pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,
 };
 pub use side::Side;
+pub use spool_plant::{SpoolPlant, SpoolPlantParams, SpoolPlantStats};
 pub use swing::{SwingAnkle, SwingAnkleModel};

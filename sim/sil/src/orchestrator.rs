@@ -97,6 +97,17 @@ impl FirmwareInTheLoop {
         self.bus.socketcand_addr()
     }
 
+    /// What `side`'s power stage did in the last tick, with the motor plant
+    /// ([`crate::ActuatorChoice::SpoolMotor`]); `None` with the servo.
+    pub fn stage_output(&self, side: Side) -> Option<firmware::drivers::spool_motor::StageOutput> {
+        self.ankles[side.index()].stage_output()
+    }
+
+    /// `side`'s spool encoder count now, with the motor plant.
+    pub fn spool_counts(&self, side: Side) -> Option<i32> {
+        self.ankles[side.index()].spool_counts()
+    }
+
     /// The report so far.
     pub fn report(&self) -> SilReport {
         let nodes = Side::BOTH

@@ -162,8 +162,10 @@ pub struct NodeReport {
     pub max_rx_backlog: usize,
     /// Messages the node's transmit list could not hold (firmware counter, should stay 0).
     pub firmware_dropped_tx: u32,
-    /// The string actuator of this ankle.
+    /// The string actuator of this ankle: the servo model's figures (zero with the motor).
     pub actuator: ActuatorStats,
+    /// The motor plant's figures (`null` with the servo model).
+    pub spool_plant: Option<crate::spool_plant::SpoolPlantStats>,
     /// The extension profile's parameters in force, as the node reported them.
     pub parameters: NodeParameters,
 }

@@ -66,6 +66,11 @@ pub struct SilArgs {
     /// memory and output stay bounded.
     #[arg(long, value_name = "N")]
     pub keep_steps: Option<usize>,
+    /// The ankles' actuator: `servo` (default: a position servo that follows the setpoint)
+    /// or `motor` (the firmware's own spool-motor driver over a DC gear motor, spool and
+    /// string model; the nominal walk falls after 45 steps with it). docs/sil.md.
+    #[arg(long, value_name = "MODEL", default_value = "servo")]
+    pub actuator: String,
 }
 
 /// The `walker sil --json` object. `Bus` is the bus statistics' type (the `canbus` crate's,
@@ -104,6 +109,8 @@ struct SilWalkReport<'a, Bus: Serialize> {
     steps: &'a [StepSummary],
     /// Injected encoder faults that took effect: `[{side, kind, t_s}]`.
     sensor_faults_applied: &'a [sil::AppliedSensorFault],
+    /// The ankles' actuator (`motor`, `servo`).
+    actuator: &'static str,
 }
 
 /// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
@@ -120,7 +127,14 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         realtime,
         keep_steps,
         firmware_params,
+        actuator,
     } = args;
+    let Some(actuator_choice) = sil::ActuatorChoice::from_name(&actuator) else {
+        return Err(InputError::Other(format!(
+            "--actuator `{actuator}`: expected `motor` or `servo`"
+        ))
+        .into());
+    };
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     if let Some(t) = estop_at {
         if !(t.is_finite() && t >= 0.0) {
@@ -147,7 +161,10 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         .into());
     };
     // The firmware's own parameters unless some are written.
-    let mut config = sil::config::SilConfig::default();
+    let mut config = sil::config::SilConfig {
+        actuator_choice,
+        ..sil::config::SilConfig::default()
+    };
     for p in &firmware_params {
         config = config
             .with_firmware_param_str(p)
@@ -265,6 +282,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         frames: firmware.frames_delivered,
         steps: steps_kept,
         sensor_faults_applied: &firmware.sensor_faults_applied,
+        actuator: actuator_choice.name(),
     };
     if common.json {
         print_json(&report)?;

@@ -10,6 +10,8 @@
 //! `Actuator` gets — the command (setpoint or release) and the measured angle — records both,
 //! and integrates the servo over the tick; the orchestrator takes the tick's
 //! [`ActuatorSegment`] afterwards. It never fails (`actuator_error` stays false).
+//! The board's own driver over a motor plant is the alternative
+//! ([`AnkleActuator::SpoolMotor`]); [`AnkleActuator`] is either.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -122,6 +124,43 @@ impl Actuator for SimActuator {
 
     fn string_moving(&self) -> bool {
         self.0.borrow().moving
+    }
+}
+
+/// The actuator of a simulated ankle: the firmware's spool-motor driver over the motor
+/// plant, or the servo model.
+pub enum AnkleActuator {
+    /// The board's driver ([`firmware::drivers::spool_motor::SpoolMotor`]) over
+    /// [`crate::spool_plant::SpoolPlant`].
+    SpoolMotor(Box<crate::hal::spool::SimSpoolMotor>),
+    /// The position servo ([`SimActuator`]).
+    Servo(SimActuator),
+}
+
+impl Actuator for AnkleActuator {
+    fn apply(
+        &mut self,
+        command: ActuatorCommand,
+        measured_angle_rad: Option<f32>,
+    ) -> Result<(), ActuatorError> {
+        match self {
+            AnkleActuator::SpoolMotor(m) => m.apply(command, measured_angle_rad),
+            AnkleActuator::Servo(s) => s.apply(command, measured_angle_rad),
+        }
+    }
+
+    fn string_moving(&self) -> bool {
+        match self {
+            AnkleActuator::SpoolMotor(m) => m.string_moving(),
+            AnkleActuator::Servo(s) => s.string_moving(),
+        }
+    }
+
+    fn stop(&mut self) -> Result<(), ActuatorError> {
+        match self {
+            AnkleActuator::SpoolMotor(m) => m.stop(),
+            AnkleActuator::Servo(s) => s.stop(),
+        }
     }
 }
 
