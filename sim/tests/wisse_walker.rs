@@ -29,18 +29,18 @@ const TABLE_ONE: [(&str, f64); 22] = [
     ("thigh_mass_kg", 0.5),
     ("shank_mass_kg", 0.4),
     ("pelvis_mass_kg", 1.0),
-    ("thigh_inertia_kg_m2", 0.01),       // Ixx thigh
-    ("thigh_inertia_kg_m2", 0.01),       // Iyy thigh
-    ("thigh_axial_inertia_kg_m2", 0.0),  // Izz thigh
-    ("shank_inertia_kg_m2", 0.01),       // Ixx shank
-    ("shank_inertia_kg_m2", 0.01),       // Iyy shank
-    ("shank_axial_inertia_kg_m2", 0.0),  // Izz shank
+    ("thigh_inertia_kg_m2", 0.01),      // Ixx thigh
+    ("thigh_inertia_kg_m2", 0.01),      // Iyy thigh
+    ("thigh_axial_inertia_kg_m2", 0.0), // Izz thigh
+    ("shank_inertia_kg_m2", 0.01),      // Ixx shank
+    ("shank_inertia_kg_m2", 0.01),      // Iyy shank
+    ("shank_axial_inertia_kg_m2", 0.0), // Izz shank
     ("thigh_length_m", 0.5),
     ("shank_length_m", 0.5),
     ("foot_length_m", 0.05),
     ("hip_width_m", 0.2),
-    ("pelvic_axle_height_m", 0.18),            // hip axle to pelvic axle
-    ("pelvis_com_below_pelvic_axle_m", 0.25),  // pelvic axle to pelvic c.m.
+    ("pelvic_axle_height_m", 0.18), // hip axle to pelvic axle
+    ("pelvis_com_below_pelvic_axle_m", 0.25), // pelvic axle to pelvic c.m.
     ("hip_to_thigh_com_m", 0.1),
     ("knee_to_shank_com_m", 0.1),
     ("pelvic_ring_radius_m", 0.42),
@@ -77,8 +77,18 @@ fn the_paper_scenes_use_every_table_one_value() {
     };
     // Legs: mass, c.m. 0.1 m from the joint axle, moments I - m d² across, 0 axial.
     for (l, mass, com, i_across) in [
-        ("stance_ankle", 0.4, [0.0, 0.5 - 0.1, 0.0], 0.01 - 0.4 * 0.01),
-        ("stance_thigh", 0.5, [0.0, 0.5 - 0.1, 0.0], 0.01 - 0.5 * 0.01),
+        (
+            "stance_ankle",
+            0.4,
+            [0.0, 0.5 - 0.1, 0.0],
+            0.01 - 0.4 * 0.01,
+        ),
+        (
+            "stance_thigh",
+            0.5,
+            [0.0, 0.5 - 0.1, 0.0],
+            0.01 - 0.5 * 0.01,
+        ),
         ("swing_hip", 0.5, [0.0, -0.1, 0.0], 0.01 - 0.5 * 0.01),
         ("swing_knee", 0.4, [0.0, -0.1, 0.0], 0.01 - 0.4 * 0.01),
     ] {
@@ -91,12 +101,36 @@ fn the_paper_scenes_use_every_table_one_value() {
         assert_eq!(j[(1, 1)], 0.0, "{l}: Izz");
     }
     // Lengths: shank and thigh (joint origins), hip width, pelvic axle, foot.
-    vec(link("stance_thigh").p_parent_joint_m, [0.0, 0.5, 0.0], "shank length");
-    vec(link("swing_knee").p_parent_joint_m, [0.0, -0.5, 0.0], "thigh length");
-    vec(link("swing_hip").p_parent_joint_m, [0.0, 0.5, -0.2], "hip width");
-    vec(link("pelvis_pitch").p_parent_joint_m, [0.0, 0.5, -0.1], "hip centre");
-    vec(link("pelvis_roll").p_parent_joint_m, [0.0, 0.18, 0.0], "pelvic axle");
-    vec(link("stance_toe_pitch").p_parent_joint_m, [0.025, 0.0, 0.0], "foot length");
+    vec(
+        link("stance_thigh").p_parent_joint_m,
+        [0.0, 0.5, 0.0],
+        "shank length",
+    );
+    vec(
+        link("swing_knee").p_parent_joint_m,
+        [0.0, -0.5, 0.0],
+        "thigh length",
+    );
+    vec(
+        link("swing_hip").p_parent_joint_m,
+        [0.0, 0.5, -0.2],
+        "hip width",
+    );
+    vec(
+        link("pelvis_pitch").p_parent_joint_m,
+        [0.0, 0.5, -0.1],
+        "hip centre",
+    );
+    vec(
+        link("pelvis_roll").p_parent_joint_m,
+        [0.0, 0.18, 0.0],
+        "pelvic axle",
+    );
+    vec(
+        link("stance_toe_pitch").p_parent_joint_m,
+        [0.025, 0.0, 0.0],
+        "foot length",
+    );
     // Pelvic body: 1 kg on the ring, c.m. 0.25 m below the pelvic axle, m r² about yaw.
     let pelvis = &link("pelvis_roll").body;
     close(pelvis.mass_kg, 1.0, "pelvis mass");
@@ -108,7 +142,11 @@ fn the_paper_scenes_use_every_table_one_value() {
     close(j[(2, 2)], ring / 2.0, "ring pitch");
     // Spring and damper.
     close(link("pelvis_yaw").joint_force.stiffness, 1.2, "yaw spring");
-    close(link("stance_foot_yaw").joint_force.damping, 0.1, "foot yaw damping");
+    close(
+        link("stance_foot_yaw").joint_force.damping,
+        0.1,
+        "foot yaw damping",
+    );
 }
 
 /// Table I's leg moments about the joint axles: the links carry I − m d² about the c.m., and

@@ -264,8 +264,8 @@ mod tests {
                 .starts_with("taut_angle_rad = -0.03 conflicts with extended_angle_rad = 0 "),
             "{e}"
         );
-        let e = check_writes(&[w("taut_angle_rad=-0.01"), w("extended_angle_rad=0.0")])
-            .unwrap_err();
+        let e =
+            check_writes(&[w("taut_angle_rad=-0.01"), w("extended_angle_rad=0.0")]).unwrap_err();
         assert!(
             e.to_string()
                 .starts_with("extended_angle_rad = 0 conflicts with taut_angle_rad = -0.01 "),
