@@ -22,25 +22,131 @@ fn the_2d_and_3d_walkers_have_stable_gaits() {
     }
 }
 
-/// The scene at its defaults is Table I exactly, ankle string included.
+/// Table I of the paper (section 2.5), all 22 rows, as the scene parameters that carry them:
+/// (parameter, value). Ixx = Iyy is one parameter per segment (the across-leg moments), Izz
+/// the axial one.
+const TABLE_ONE: [(&str, f64); 22] = [
+    ("thigh_mass_kg", 0.5),
+    ("shank_mass_kg", 0.4),
+    ("pelvis_mass_kg", 1.0),
+    ("thigh_inertia_kg_m2", 0.01),      // Ixx thigh
+    ("thigh_inertia_kg_m2", 0.01),      // Iyy thigh
+    ("thigh_axial_inertia_kg_m2", 0.0), // Izz thigh
+    ("shank_inertia_kg_m2", 0.01),      // Ixx shank
+    ("shank_inertia_kg_m2", 0.01),      // Iyy shank
+    ("shank_axial_inertia_kg_m2", 0.0), // Izz shank
+    ("thigh_length_m", 0.5),
+    ("shank_length_m", 0.5),
+    ("foot_length_m", 0.05),
+    ("hip_width_m", 0.2),
+    ("pelvic_axle_height_m", 0.18), // hip axle to pelvic axle
+    ("pelvis_com_below_pelvic_axle_m", 0.25), // pelvic axle to pelvic c.m.
+    ("hip_to_thigh_com_m", 0.1),
+    ("knee_to_shank_com_m", 0.1),
+    ("pelvic_ring_radius_m", 0.42),
+    ("pelvis_yaw_stiffness_n_m_per_rad", 1.2),
+    ("foot_yaw_damping_n_m_s_per_rad", 0.1),
+    ("ankle_engage_rad", -0.08), // ankle actuation start angle
+    ("ankle_final_rad", 0.2),    // ankle actuation final angle
+];
+
+/// The scenes at their defaults are Table I exactly (every row), and the built 3D model
+/// carries those values: masses, lengths, c.m. offsets, the ring's moments (m r² about the
+/// yaw axis, m r²/2 across), the leg moments (Table I about the joint axles, `Izz` = 0), the
+/// yaw spring, the foot's yaw damper and the ankle string.
 #[test]
 fn the_paper_scenes_use_every_table_one_value() {
     for name in ["wisse3d", "wisse2d", "wisse3d-uncompensated"] {
         let (scene, _) = common::walker(name);
         let v = &scene.values;
-        for (param, table_one) in [
-            ("ankle_engage_rad", -0.08),
-            ("ankle_final_rad", 0.2),
-            ("thigh_inertia_kg_m2", 0.01),
-            ("shank_inertia_kg_m2", 0.01),
-            ("thigh_mass_kg", 0.5),
-            ("shank_mass_kg", 0.4),
-            ("hip_to_thigh_com_m", 0.1),
-            ("knee_to_shank_com_m", 0.1),
-        ] {
+        for (param, table_one) in TABLE_ONE {
             assert_eq!(v[param], table_one, "{name}: {param}");
         }
+        assert_eq!(v["leg_inertia_about_joint"], 1.0, "{name}");
+        let ankle = common::walker(name).1.walker.ankle.unwrap();
+        assert_eq!((ankle.engage_rad, ankle.final_rad), (-0.08, 0.2), "{name}");
     }
+    let (_, w) = common::walker("wisse3d");
+    let m = &w.walker.model;
+    let link = |n: &str| m.links.iter().find(|l| l.name == n).unwrap();
+    let close = |a: f64, b: f64, what: &str| assert!((a - b).abs() < 1e-15, "{what}: {a} vs {b}");
+    let vec = |a: nalgebra::Vector3<f64>, b: [f64; 3], what: &str| {
+        for k in 0..3 {
+            close(a[k], b[k], what);
+        }
+    };
+    // Legs: mass, c.m. 0.1 m from the joint axle, moments I - m d² across, 0 axial.
+    for (l, mass, com, i_across) in [
+        (
+            "stance_ankle",
+            0.4,
+            [0.0, 0.5 - 0.1, 0.0],
+            0.01 - 0.4 * 0.01,
+        ),
+        (
+            "stance_thigh",
+            0.5,
+            [0.0, 0.5 - 0.1, 0.0],
+            0.01 - 0.5 * 0.01,
+        ),
+        ("swing_hip", 0.5, [0.0, -0.1, 0.0], 0.01 - 0.5 * 0.01),
+        ("swing_knee", 0.4, [0.0, -0.1, 0.0], 0.01 - 0.4 * 0.01),
+    ] {
+        let b = &link(l).body;
+        close(b.mass_kg, mass, l);
+        vec(b.p_link_com_m, com, l);
+        let j = b.inertia_com_kg_m2;
+        close(j[(0, 0)], i_across, l);
+        close(j[(2, 2)], i_across, l);
+        assert_eq!(j[(1, 1)], 0.0, "{l}: Izz");
+    }
+    // Lengths: shank and thigh (joint origins), hip width, pelvic axle, foot.
+    vec(
+        link("stance_thigh").p_parent_joint_m,
+        [0.0, 0.5, 0.0],
+        "shank length",
+    );
+    vec(
+        link("swing_knee").p_parent_joint_m,
+        [0.0, -0.5, 0.0],
+        "thigh length",
+    );
+    vec(
+        link("swing_hip").p_parent_joint_m,
+        [0.0, 0.5, -0.2],
+        "hip width",
+    );
+    vec(
+        link("pelvis_pitch").p_parent_joint_m,
+        [0.0, 0.5, -0.1],
+        "hip centre",
+    );
+    vec(
+        link("pelvis_roll").p_parent_joint_m,
+        [0.0, 0.18, 0.0],
+        "pelvic axle",
+    );
+    vec(
+        link("stance_toe_pitch").p_parent_joint_m,
+        [0.025, 0.0, 0.0],
+        "foot length",
+    );
+    // Pelvic body: 1 kg on the ring, c.m. 0.25 m below the pelvic axle, m r² about yaw.
+    let pelvis = &link("pelvis_roll").body;
+    close(pelvis.mass_kg, 1.0, "pelvis mass");
+    vec(pelvis.p_link_com_m, [0.0, -0.25, 0.0], "pelvic c.m.");
+    let ring = 1.0 * 0.42 * 0.42;
+    let j = pelvis.inertia_com_kg_m2;
+    close(j[(1, 1)], ring, "ring yaw");
+    close(j[(0, 0)], ring / 2.0, "ring roll");
+    close(j[(2, 2)], ring / 2.0, "ring pitch");
+    // Spring and damper.
+    close(link("pelvis_yaw").joint_force.stiffness, 1.2, "yaw spring");
+    close(
+        link("stance_foot_yaw").joint_force.damping,
+        0.1,
+        "foot yaw damping",
+    );
 }
 
 /// Table I's leg moments about the joint axles: the links carry I − m d² about the c.m., and
@@ -79,6 +185,30 @@ fn a_negative_moment_about_the_centre_of_mass_is_refused() {
     assert!(e.contains("cannot be negative"), "{e}");
     scene.set("leg_inertia_about_joint", 0.0).unwrap();
     assert!(scene.setup().is_ok());
+}
+
+/// Claim (2), Fig. 13: with the compensator the 3D walker is stable, and the six multipliers
+/// nearest the unit circle are all dominated by 3D freedoms (pelvis yaw and roll, the stance
+/// foot's yaw: `Walker::three_d_freedoms`).
+#[test]
+fn the_six_multipliers_nearest_the_circle_of_the_3d_walker_are_3d_modes() {
+    let (_, w) = common::walker("wisse3d");
+    let g = common::gait(&w);
+    assert!(g.max_abs_eigenvalue() < 1.0, "{}", g.max_abs_eigenvalue());
+    let mut m = sim::stability::modes(
+        &g.jacobian,
+        &g.eigenvalues,
+        &w.walker.map_names(),
+        &w.walker.three_d_freedoms,
+    );
+    assert_eq!(m.len(), g.eigenvalues.len());
+    // All inside the circle: nearest to it is largest in modulus.
+    m.sort_by(|a, b| b.abs.total_cmp(&a.abs));
+    for mode in &m[..6] {
+        assert!(mode.abs < 1.0 && mode.three_d, "{mode:?}");
+    }
+    // The sixth and the seventh differ (0.415 and 0.408): the six do not split a pair.
+    assert!(m[6].abs < m[5].abs, "{:?}", &m[..7]);
 }
 
 /// The earlier reading (leg moments about the c.m.) with a 0.2 s extension at Table I's

@@ -55,7 +55,8 @@ pub fn floor_paths(walks: &[(&str, &Walk)], title: &str) -> Plot {
         .enumerate()
         .map(|(i, (label, w))| Series {
             label: match &w.failure {
-                Some(f) => format!("{label} (fails in step {}: {:?})", f.step + 1, f.kind),
+                // Steps counted from 0, as `walker walk` prints them ("in step 1" is the second).
+                Some(f) => format!("{label} (fails in step {}: {:?})", f.step, f.kind),
                 None => format!("{label} ({} steps)", w.steps_completed),
             },
             points: w

@@ -79,18 +79,18 @@ pub enum FirmwareParamError {
     /// extended angle would not exceed the taut angle by the firmware's minimum extension
     /// (the node would answer `Inconsistent`).
     #[error(
-        "{name} = {value}: the extended angle must exceed the taut angle by at least {min_extension} rad \
-         (taut {taut} rad, extended {extended} rad with the parameters before it)"
+        "{name} = {value} conflicts with {other} = {other_value} (in force: a default or written \
+         before it): the extended angle must exceed the taut angle by at least {min_extension} rad"
     )]
     Inconsistent {
         /// The parameter's name.
         name: &'static str,
-        /// The value given.
+        /// The value requested [rad].
         value: f32,
-        /// The taut angle in force before it [rad].
-        taut: f32,
-        /// The extended angle in force before it [rad].
-        extended: f32,
+        /// The parameter it conflicts with (the other of the taut and extended angles).
+        other: &'static str,
+        /// That parameter's value in force when the write comes [rad].
+        other_value: f32,
         /// The firmware's minimum extension [rad].
         min_extension: f32,
     },
@@ -175,15 +175,24 @@ pub fn check_writes(writes: &[FirmwareParam]) -> Result<(), FirmwareParamError> 
         FirmwareParam::new(w.id, w.value_si)?;
         let wire = protocol::ParamValue::saturating_from_si(w.value_si);
         let before = params;
-        params
-            .set(w.id, wire)
-            .map_err(|_| FirmwareParamError::Inconsistent {
+        params.set(w.id, wire).map_err(|_| {
+            // Only the taut and extended angles constrain each other.
+            let (other, other_value) = if w.id == ParamId::TautAngle {
+                (
+                    param_name(ParamId::ExtendedAngle),
+                    before.extended_angle_rad(),
+                )
+            } else {
+                (param_name(ParamId::TautAngle), before.taut_angle_rad())
+            };
+            FirmwareParamError::Inconsistent {
                 name,
                 value: w.value_si,
-                taut: before.taut_angle_rad(),
-                extended: before.extended_angle_rad(),
+                other,
+                other_value,
                 min_extension: firmware::params::MIN_EXTENSION_RAD,
-            })?;
+            }
+        })?;
     }
     Ok(())
 }
@@ -249,5 +258,18 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("at least 0.05 rad"), "{e}");
+        // The message names the value requested and the one in force it conflicts with.
+        assert!(
+            e.to_string()
+                .starts_with("taut_angle_rad = -0.03 conflicts with extended_angle_rad = 0 "),
+            "{e}"
+        );
+        let e =
+            check_writes(&[w("taut_angle_rad=-0.01"), w("extended_angle_rad=0.0")]).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("extended_angle_rad = 0 conflicts with taut_angle_rad = -0.01 "),
+            "{e}"
+        );
     }
 }

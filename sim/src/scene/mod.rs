@@ -87,7 +87,7 @@ pub enum SceneError {
         value: String,
     },
     /// A parameter outside its physical range.
-    #[error("parameter `{name}` = {value} {unit} is outside its allowed range [{min}, {max}]")]
+    #[error("parameter `{name}` = {value}{} is outside its allowed range [{min}, {max}]", unit_suffix(.unit))]
     OutOfRange {
         /// Parameter.
         name: String,
@@ -739,5 +739,14 @@ fn direction(s: &str) -> Result<Direction, SceneError> {
         o => Err(SceneError::Invalid(format!(
             "direction `{o}` is not rising or falling"
         ))),
+    }
+}
+
+/// The unit after a value in a message: nothing for a dimensionless parameter (unit `1` or
+/// empty), else a space and the unit.
+fn unit_suffix(unit: &str) -> String {
+    match unit {
+        "" | "1" => String::new(),
+        u => format!(" {u}"),
     }
 }
