@@ -95,6 +95,11 @@ pub enum CorrectorError {
     /// The augmented Jacobian is singular.
     #[error("the augmented Jacobian is singular")]
     Singular,
+    /// A bifurcation's test function has the same sign at both ends of the step, so there is
+    /// no single crossing to locate between them (two crossings, or a crossing pair that could
+    /// not be followed).
+    #[error("the test function has the same sign at both ends of the step: no single crossing to locate")]
+    NoSignChange,
 }
 
 /// Step sizes of the continuation (arclength in `(v, p)`).

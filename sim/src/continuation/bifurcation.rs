@@ -4,11 +4,12 @@
 //! - fold (a real multiplier through +1): `det(M − I) = Π(λᵢ − 1)`; a fold proper is where
 //!   the branch also turns (`dp/ds` changes sign); otherwise the crossing is a branch point;
 //! - period doubling (a real multiplier through −1): `det(M + I) = Π(λᵢ + 1)`;
-//! - Neimark–Sacker (a complex pair through the unit circle): a complex pair at both points
-//!   and `|λ_c| − 1` of the pair nearest the circle of opposite signs
-//!   ([`neimark_sacker_crossed`]; two real multipliers merging into a complex pair outside
-//!   the circle change the count of complex multipliers outside it, but are no
-//!   Neimark–Sacker bifurcation); located on `|λ_c| − 1`.
+//! - Neimark–Sacker (a complex pair through the unit circle): each complex pair of one point
+//!   matched one to one with the nearest pair of the next, and `|λ_c| − 1` of a matched pair
+//!   changing sign ([`neimark_sacker_crossings`]; two real multipliers merging into a complex
+//!   pair outside the circle change the count of complex multipliers outside it, but are no
+//!   Neimark–Sacker bifurcation); located on `|λ_c| − 1` of that pair, followed from trial
+//!   to trial by the same matching.
 //!
 //! Between two points whose test function has opposite signs the zero is located on the
 //! arclength by the Illinois variant of regula falsi, with the corrector at every trial,
@@ -122,25 +123,58 @@ pub fn neimark_sacker_test(m: &[Complex<f64>]) -> Option<f64> {
     any.then_some(product)
 }
 
-/// How many complex pairs crossed the unit circle between multipliers `ma` and `mb`: each
-/// pair of `ma` is matched to the nearest pair of `mb` (a short continuation step moves a
-/// multiplier little) and counted when `|λ| − 1` changed sign. Where pairs formed or split
-/// in between (their numbers differ), a change of the count of all multipliers outside the
-/// circle by an even number, while no real multiplier passed ±1 (the fold and
-/// period-doubling functions keep their signs), counts as one crossing: two real
-/// multipliers merging into a pair outside leave that count unchanged and are none.
-pub fn neimark_sacker_crossings(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> usize {
+/// Each pair of `pa` matched one to one with a pair of `pb`, greedily by distance (a short
+/// continuation step moves a multiplier little); `None` when the counts differ.
+fn matched<'a>(
+    pa: &[&'a Complex<f64>],
+    pb: &[&'a Complex<f64>],
+) -> Option<Vec<(&'a Complex<f64>, &'a Complex<f64>)>> {
+    if pa.len() != pb.len() {
+        return None;
+    }
+    let mut candidates: Vec<(f64, usize, usize)> = Vec::with_capacity(pa.len() * pb.len());
+    for (i, za) in pa.iter().enumerate() {
+        for (j, zb) in pb.iter().enumerate() {
+            candidates.push(((**za - **zb).norm(), i, j));
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let (mut used_a, mut used_b) = (vec![false; pa.len()], vec![false; pb.len()]);
+    let mut out = Vec::with_capacity(pa.len());
+    for (_, i, j) in candidates {
+        if !used_a[i] && !used_b[j] {
+            used_a[i] = true;
+            used_b[j] = true;
+            out.push((pa[i], pb[j]));
+        }
+    }
+    Some(out)
+}
+
+/// The matched pairs of `ma` and `mb` (upper members) whose `|λ| − 1` changed sign.
+fn crossing_pairs(
+    ma: &[Complex<f64>],
+    mb: &[Complex<f64>],
+) -> Option<Vec<(Complex<f64>, Complex<f64>)>> {
     let (pa, pb): (Vec<_>, Vec<_>) = (pairs(ma).collect(), pairs(mb).collect());
-    if pa.len() == pb.len() {
-        return pa
-            .iter()
-            .filter(|za| {
-                let nearest = pb
-                    .iter()
-                    .min_by(|x, y| (**x - **za).norm().total_cmp(&(**y - **za).norm()));
-                nearest.is_some_and(|zb| (za.norm() > 1.0) != (zb.norm() > 1.0))
-            })
-            .count();
+    matched(&pa, &pb).map(|m| {
+        m.into_iter()
+            .filter(|(za, zb)| (za.norm() > 1.0) != (zb.norm() > 1.0))
+            .map(|(za, zb)| (*za, *zb))
+            .collect()
+    })
+}
+
+/// How many complex pairs crossed the unit circle between multipliers `ma` and `mb`: the
+/// pairs of `ma` matched one to one with those of `mb` and counted when `|λ| − 1` changed
+/// sign. Where pairs formed or split in between (their numbers differ), a change of the
+/// count of all multipliers outside the circle by an even number, while no real multiplier
+/// passed ±1 (the fold and period-doubling functions keep their signs), counts as one
+/// crossing: two real multipliers merging into a pair outside leave that count unchanged and
+/// are none.
+pub fn neimark_sacker_crossings(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> usize {
+    if let Some(c) = crossing_pairs(ma, mb) {
+        return c.len();
     }
     let all = outside(mb) as i64 - outside(ma) as i64;
     usize::from(
@@ -149,6 +183,18 @@ pub fn neimark_sacker_crossings(ma: &[Complex<f64>], mb: &[Complex<f64>]) -> usi
             && fold_test(ma).signum() == fold_test(mb).signum()
             && period_doubling_test(ma).signum() == period_doubling_test(mb).signum(),
     )
+}
+
+/// `|λ| − 1` of the complex pair of `m` nearest `reference` (`NaN` without a pair).
+fn pair_test(m: &[Complex<f64>], reference: Complex<f64>) -> (f64, Option<Complex<f64>>) {
+    let nearest = pairs(m)
+        .min_by(|x, y| {
+            (**x - reference)
+                .norm()
+                .total_cmp(&(**y - reference).norm())
+        })
+        .copied();
+    (nearest.map_or(f64::NAN, |z| z.norm() - 1.0), nearest)
 }
 
 /// Whether a complex pair crossed the unit circle between multipliers `ma` and `mb`
@@ -201,8 +247,39 @@ pub fn locate(
     b: &BranchPoint,
 ) -> Result<Bifurcation, CorrectorError> {
     let s_b = a.tangent.dot(&(b.x() - a.x()));
-    let (mut s_lo, mut f_lo) = (0.0, test(kind, a));
-    let (mut s_hi, mut f_hi) = (s_b, test(kind, b));
+    // A Neimark–Sacker point is located on the crossing pair itself, followed from trial to
+    // trial (the product over all pairs also changes sign where a pair forms or splits).
+    let mut pair = match kind {
+        BifurcationKind::NeimarkSacker => {
+            match crossing_pairs(&a.multipliers, &b.multipliers).as_deref() {
+                Some([(za, _)]) => Some(*za),
+                _ => return Err(CorrectorError::NoSignChange),
+            }
+        }
+        _ => None,
+    };
+    let eval = |p: &BranchPoint, pair: &mut Option<Complex<f64>>| -> f64 {
+        match pair {
+            Some(z) => {
+                let (f, next) = pair_test(&p.multipliers, *z);
+                if let Some(n) = next {
+                    *z = n;
+                }
+                f
+            }
+            None => test(kind, p),
+        }
+    };
+    let f_a = eval(a, &mut pair.clone());
+    let f_b = match crossing_pairs(&a.multipliers, &b.multipliers).as_deref() {
+        Some([(_, zb)]) if pair.is_some() => zb.norm() - 1.0,
+        _ => test(kind, b),
+    };
+    if !(f_a.is_finite() && f_b.is_finite()) || f_a.signum() == f_b.signum() {
+        return Err(CorrectorError::NoSignChange);
+    }
+    let (mut s_lo, mut f_lo) = (0.0, f_a);
+    let (mut s_hi, mut f_hi) = (s_b, f_b);
     let mut best = b.clone();
     let mut best_f = f_hi;
     let mut side = 0i8;
@@ -222,7 +299,7 @@ pub fn locate(
             s = 0.5 * (s_lo + s_hi);
         }
         let (p, _) = cont.at_arclength(a, a_lin, s, true)?;
-        let f = test(kind, &p);
+        let f = eval(&p, &mut pair);
         if f.abs() < best_f.abs() || !best_f.is_finite() {
             best = p.clone();
             best_f = f;
@@ -351,5 +428,21 @@ mod tests {
             neimark_sacker_test(&f).map(f64::signum),
             neimark_sacker_test(&g).map(f64::signum)
         );
+    }
+
+    #[test]
+    fn pairs_are_matched_one_to_one_and_the_crossing_pair_is_followed() {
+        // Two pairs of `a` close together, both nearest the same pair of `b`: one to one, the
+        // second is matched with the other pair of `b`, so one crossing, not two.
+        let a = [polar(0.99, 0.50).as_slice(), polar(0.995, 0.52).as_slice()].concat();
+        let b = [polar(1.01, 0.51).as_slice(), polar(0.97, 0.9).as_slice()].concat();
+        assert_eq!(neimark_sacker_crossings(&a, &b), 1);
+        let c = crossing_pairs(&a, &b).unwrap_or_default();
+        assert_eq!(c.len(), 1);
+        // The followed pair's |λ| − 1, not the product over all pairs.
+        let (f, z) = pair_test(&b, c[0].0);
+        assert!((f - 0.01).abs() < 1e-12, "{f}");
+        assert!(z.is_some());
+        assert!(pair_test(&[Complex::new(0.5, 0.0)], c[0].0).0.is_nan());
     }
 }
