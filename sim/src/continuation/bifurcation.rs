@@ -401,7 +401,7 @@ mod tests {
 
     #[test]
     fn two_pairs_trading_places_near_the_circle_are_no_crossing() {
-        // The roll pair stays outside (1.003 → 1.002) while another pair approaches the circle
+        // One pair stays outside (1.003 → 1.002) while another pair approaches the circle
         // from inside (0.990 → 0.999): the pair nearest the circle changes, no pair crosses.
         // (The modulus of the nearest pair, the test before, changed sign here.)
         let a = [polar(1.003, 2.0).as_slice(), polar(0.990, 0.5).as_slice()].concat();
