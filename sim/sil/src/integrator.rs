@@ -5,7 +5,7 @@ use sim::integrators::IntegratorChoice;
 /// The integrator of a firmware-in-the-loop walk: DOPRI5 at rtol = atol = 1e-6.
 ///
 /// The control ticks cut every integration step to at most one tick (1 ms), so the tolerance
-/// rarely shortens a step further. Over the first step of `wisse3d` (Table I reading) with the
+/// rarely shortens a step further. Over the first step of `wisse3d` (Table I, the chosen reading) with the
 /// firmware in the loop, against DOPRI5 at 1e-12 (relative differences): step period, speed and
 /// step length agree to 2e-8, the impact loss to 7e-9, the actuator work and the cost of
 /// transport to 2.4e-7 (test `hil-tests/tests/sil_integrator.rs`, bounds 1.5e-7, 5e-7 and

@@ -488,7 +488,7 @@ fn candump_log_and_socketcand_server_see_the_traffic() {
 
 #[test]
 fn a_fixed_swing_ankle_angle_trips_the_rate_check_at_heel_strike() {
-    // The brief's fixed neutral reading: the stance ankle holds 0.2 rad when the other foot
+    // A fixed neutral reading (the sensor model's default): the stance ankle holds 0.2 rad when the other foot
     // lands; its reading then steps to 0 (200 rad/s) and the new stance ankle's from 0 to
     // 0.1 rad (100 rad/s), both above the firmware's 40 rad/s plausibility limit.
     let config = SilConfig {
