@@ -5,7 +5,7 @@
 
 use crate::kinematics::KinematicsOf;
 use crate::model::{JointKind, LinkIndex, Model};
-use crate::singular_limit::{solve_limit, LimitSolveError};
+use crate::singular_limit::{solve_limit, LimitSolveError, NULL_EIGENVALUE_REL_TOL};
 use nalgebra::{DMatrix, DVector, Matrix3, RealField, Scalar, Vector3};
 
 /// Why the accelerations could not be computed.
@@ -271,7 +271,7 @@ impl Dynamics {
                 .select_rows(&idx)
                 .select_columns(&idx);
             let f1 = self.force_infinitesimal.select_rows(&idx);
-            let x = solve_limit(&m0, &m1, &f0, &f1, 1e-12)?;
+            let x = solve_limit(&m0, &m1, &f0, &f1, NULL_EIGENVALUE_REL_TOL)?;
             for (k, &i) in idx.iter().enumerate() {
                 qdd[i] = x[k];
             }

@@ -16,7 +16,9 @@
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::model::{JointKind, Model};
-use crate::singular_limit::LimitSolveError;
+use crate::singular_limit::{
+    cholesky_solve, solve_limit_fixed, LimitSolveError, NULL_EIGENVALUE_REL_TOL,
+};
 use nalgebra::{DVector, SMatrix, SVector};
 
 /// Most coordinates a tree may have to take the fast path.
@@ -257,7 +259,12 @@ impl PlanarTree {
             qdd[d.coordinate] = d.acceleration_rad_s2;
         }
         let a = self.assemble::<N>(&qs, &qds);
-        if self.has_infinitesimal {
+        if self.has_infinitesimal && drive.is_none() && active.iter().all(|&a| a) {
+            // Every coordinate free: the vanishing-mass limit on the fixed-size matrices.
+            let qdd = solve_limit_fixed(&a.m, &a.m_eps, &a.f, &a.f_eps, NULL_EIGENVALUE_REL_TOL)
+                .map_err(DynamicsError::Singular)?;
+            out.copy_from_slice(qdd.as_slice());
+        } else if self.has_infinitesimal {
             limit.mass_matrix.copy_from(&a.m);
             limit.mass_matrix_infinitesimal.copy_from(&a.m_eps);
             limit.force.copy_from(&a.f);
@@ -386,43 +393,4 @@ fn solve_active<const N: usize>(
     }
     *qdd = b;
     Ok(())
-}
-
-/// Solves `A x = b` in place for a symmetric positive definite `A` (its lower triangle
-/// overwritten with the Cholesky factor, `b` with `x`); false if `A` is not positive definite.
-fn cholesky_solve<const N: usize>(a: &mut SMatrix<f64, N, N>, b: &mut SVector<f64, N>) -> bool {
-    for j in 0..N {
-        let mut d = a[(j, j)];
-        for p in 0..j {
-            d -= a[(j, p)] * a[(j, p)];
-        }
-        // Also rejects NaN (which is not greater than zero).
-        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return false;
-        }
-        let d = d.sqrt();
-        a[(j, j)] = d;
-        for i in j + 1..N {
-            let mut v = a[(i, j)];
-            for p in 0..j {
-                v -= a[(i, p)] * a[(j, p)];
-            }
-            a[(i, j)] = v / d;
-        }
-    }
-    for i in 0..N {
-        let mut v = b[i];
-        for p in 0..i {
-            v -= a[(i, p)] * b[p];
-        }
-        b[i] = v / a[(i, i)];
-    }
-    for i in (0..N).rev() {
-        let mut v = b[i];
-        for p in i + 1..N {
-            v -= a[(p, i)] * b[p];
-        }
-        b[i] = v / a[(i, i)];
-    }
-    true
 }
