@@ -5,7 +5,7 @@
 
 use crate::kinematics::KinematicsOf;
 use crate::model::{JointKind, LinkIndex, Model};
-use crate::singular_limit::{solve_limit, LimitSolveError};
+use crate::singular_limit::{solve_limit, LimitSolveError, NULL_EIGENVALUE_REL_TOL};
 use nalgebra::{DMatrix, DVector, Matrix3, RealField, Scalar, Vector3};
 
 /// Why the accelerations could not be computed.
@@ -43,7 +43,11 @@ pub struct DynamicsOf<T: Scalar> {
     /// Scratch for the active-set solve (row-major k × k, then k).
     work_m: Vec<T>,
     work_b: Vec<T>,
+    /// Scratch: the active coordinates of the solve.
+    work_idx: Vec<usize>,
     has_infinitesimal: bool,
+    /// For each link, whether its body has a nonzero inertia tensor.
+    rotational: Vec<bool>,
 }
 
 impl<T: RealField + Copy> DynamicsOf<T> {
@@ -68,7 +72,13 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             cols: Vec::with_capacity(n),
             work_m: vec![T::zero(); n * n],
             work_b: vec![T::zero(); n],
+            work_idx: Vec::with_capacity(n),
             has_infinitesimal: model.has_infinitesimal_bodies(),
+            rotational: model
+                .links
+                .iter()
+                .map(|l| l.body.inertia_com_kg_m2.iter().any(|v| *v != 0.0))
+                .collect(),
         }
     }
 
@@ -81,15 +91,18 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         tau_extra: Option<&DVector<T>>,
     ) {
         self.kin.update(model, q, qd);
-        self.mass_matrix.fill(T::zero());
-        self.mass_matrix_infinitesimal.fill(T::zero());
-        self.force.fill(T::zero());
-        self.force_infinitesimal.fill(T::zero());
+        // On the contiguous storage: nalgebra's `fill` walks a strided iterator per entry.
+        self.mass_matrix.as_mut_slice().fill(T::zero());
+        self.mass_matrix_infinitesimal
+            .as_mut_slice()
+            .fill(T::zero());
+        self.force.as_mut_slice().fill(T::zero());
+        self.force_infinitesimal.as_mut_slice().fill(T::zero());
         let c = |x: f64| -> T { nalgebra::convert(x) };
         let g: Vector3<T> = model.gravity_floor_m_s2.map(c);
         for (i, link) in model.links.iter().enumerate() {
             let b = &link.body;
-            let has_rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
+            let has_rot = self.rotational[i];
             if b.mass_kg == 0.0 && !has_rot {
                 continue;
             }
@@ -132,10 +145,10 @@ impl<T: RealField + Copy> DynamicsOf<T> {
                 (Matrix3::zeros(), Vector3::zeros())
             };
             for (x, &(ci, jvi, jwi)) in self.cols.iter().enumerate() {
-                ff[ci] += jvi.dot(&f_lin) + jwi.dot(&torque);
+                ff[ci] += dot3(&jvi, &f_lin) + dot3(&jwi, &torque);
                 let iw_jwi = i_w * jwi;
                 for &(cj, jvj, jwj) in &self.cols[..=x] {
-                    let v = mass * jvi.dot(&jvj) + jwj.dot(&iw_jwi);
+                    let v = mass * dot3(&jvi, &jvj) + dot3(&jwj, &iw_jwi);
                     mm[(ci, cj)] += v;
                     if ci != cj {
                         mm[(cj, ci)] += v;
@@ -179,36 +192,40 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             Some(p) => p.clone(),
             None => DVector::zeros(n),
         };
-        // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers.
-        let mut k = 0;
-        for i in 0..n {
-            if !active[i] {
-                continue;
-            }
+        // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers;
+        // the active coordinates listed once, `M̄` read from its column-major storage.
+        self.work_idx.clear();
+        self.work_idx.extend((0..n).filter(|&j| active[j]));
+        let k = self.work_idx.len();
+        let (m, rows) = (self.mass_matrix.as_slice(), self.mass_matrix.nrows());
+        for (r, &i) in self.work_idx.iter().enumerate() {
             let mut b = self.force[i];
             if qdd_prescribed.is_some() {
                 for j in (0..n).filter(|&j| !active[j]) {
-                    b -= self.mass_matrix[(i, j)] * qdd[j];
+                    b -= m[j * rows + i] * qdd[j];
                 }
             }
-            self.work_b[k] = b;
-            for (l, j) in (0..n).filter(|&j| active[j]).enumerate() {
-                self.work_m[k * n + l] = self.mass_matrix[(i, j)];
+            self.work_b[r] = b;
+            let row = &mut self.work_m[r * n..r * n + k];
+            for (x, &j) in row.iter_mut().zip(&self.work_idx) {
+                *x = m[j * rows + i];
             }
-            k += 1;
         }
         if !cholesky_solve_in_place(&mut self.work_m, n, k, &mut self.work_b) {
             return Err(LimitSolveError::Degenerate { nullity: 1 }.into());
         }
-        let mut r = 0;
-        for i in 0..n {
-            if active[i] {
-                qdd[i] = self.work_b[r];
-                r += 1;
-            }
+        for (r, &i) in self.work_idx.iter().enumerate() {
+            qdd[i] = self.work_b[r];
         }
         Ok(qdd)
     }
+}
+
+/// `a · b` written out: nalgebra's generic `dot` does not reduce to three products on every
+/// scalar, and the assembly's inner loop runs it for every pair of joints of every body.
+#[inline(always)]
+fn dot3<T: RealField + Copy>(a: &Vector3<T>, b: &Vector3<T>) -> T {
+    a.x * b.x + a.y * b.y + a.z * b.z
 }
 
 /// A model constant in the scalar `T`.
@@ -271,7 +288,7 @@ impl Dynamics {
                 .select_rows(&idx)
                 .select_columns(&idx);
             let f1 = self.force_infinitesimal.select_rows(&idx);
-            let x = solve_limit(&m0, &m1, &f0, &f1, 1e-12)?;
+            let x = solve_limit(&m0, &m1, &f0, &f1, NULL_EIGENVALUE_REL_TOL)?;
             for (k, &i) in idx.iter().enumerate() {
                 qdd[i] = x[k];
             }

@@ -16,7 +16,9 @@
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::model::{JointKind, Model};
-use crate::singular_limit::LimitSolveError;
+use crate::singular_limit::{
+    cholesky_solve, solve_limit_fixed, LimitSolveError, NULL_EIGENVALUE_REL_TOL,
+};
 use nalgebra::{DVector, SMatrix, SVector};
 
 /// Most coordinates a tree may have to take the fast path.
@@ -35,15 +37,23 @@ pub enum EvaluationPath {
     General,
 }
 
-/// One link of a planar tree, with what the evaluation needs of it.
-#[derive(Clone, Debug)]
+/// One link of a planar tree, with what its kinematics needs. Links are stored parents first;
+/// index 0 of the evaluation's link state is the ground, link `i` is slot `i + 1`.
+#[derive(Clone, Copy, Debug)]
 struct PlanarLink {
-    /// Parent link (`None`: the ground).
-    parent: Option<usize>,
+    /// Slot of the parent in the evaluation's link state (0: the ground).
+    parent_slot: usize,
     /// Joint origin in the parent frame, x and y [m].
     joint_xy_m: [f64; 2],
     /// The coordinate this joint owns and the sign of its axis along z (`None`: a weld).
     coordinate: Option<(usize, f64)>,
+}
+
+/// One body that carries mass or inertia, with its chain of joints down to the ground.
+#[derive(Clone, Copy, Debug)]
+struct PlanarBody {
+    /// Slot of its link in the evaluation's link state.
+    slot: usize,
     /// Mass [kg] (of the `ε` part for an infinitesimal body).
     mass_kg: f64,
     /// Centre of mass in the link frame, x and y [m].
@@ -52,8 +62,11 @@ struct PlanarLink {
     izz_kg_m2: f64,
     /// The body is infinitesimal (its terms go to the `ε` part).
     infinitesimal: bool,
-    /// The body carries neither mass nor inertia (skipped, as the general engine does).
-    empty: bool,
+    /// `(coordinate, slot of the owning link, axis sign)` along its ancestry; the first
+    /// `chain_len` entries are used.
+    chain: [(usize, usize, f64); MAX_COORDINATES],
+    /// Number of joints in the chain.
+    chain_len: usize,
 }
 
 /// Per-link state of one evaluation: angle's cos and sin, angular rate, origin and its bias
@@ -67,12 +80,22 @@ struct LinkState {
     a_bias_m_s2: [f64; 2],
 }
 
+impl LinkState {
+    /// The ground: at rest, unrotated, at the origin.
+    const GROUND: Self = Self {
+        cos: 1.0,
+        sin: 0.0,
+        omega_rad_s: 0.0,
+        origin_m: [0.0; 2],
+        a_bias_m_s2: [0.0; 2],
+    };
+}
+
 /// A small planar tree, ready for fast evaluations: built once from a [`Model`] that qualifies.
 #[derive(Clone, Debug)]
 pub struct PlanarTree {
     links: Vec<PlanarLink>,
-    /// For each link, `(coordinate, owning link, axis sign)` along its ancestry.
-    chains: Vec<Vec<(usize, usize, f64)>>,
+    bodies: Vec<PlanarBody>,
     /// Joint spring and damper per coordinate: stiffness, rest position, damping.
     springs: Vec<(f64, f64, f64)>,
     gravity_m_s2: [f64; 2],
@@ -101,8 +124,9 @@ impl PlanarTree {
             return None;
         }
         let mut links = Vec::with_capacity(model.links.len());
+        let mut bodies = Vec::new();
         let mut springs = vec![(0.0, 0.0, 0.0); dof];
-        for link in &model.links {
+        for (i, link) in model.links.iter().enumerate() {
             let coordinate = match (&link.joint, link.coordinate) {
                 (JointKind::Weld, _) => None,
                 (JointKind::Revolute { axis_parent }, Some(c)) => {
@@ -117,35 +141,46 @@ impl PlanarTree {
                 let jf = &link.joint_force;
                 springs[c.0] = (jf.stiffness, jf.rest_position, jf.damping);
             }
-            let b = &link.body;
-            let rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
+            let parent_slot = match link.parent {
+                // One pass over the links needs parents first.
+                Some(p) if p.0 >= i => return None,
+                Some(p) => p.0 + 1,
+                None => 0,
+            };
             links.push(PlanarLink {
-                parent: link.parent.map(|p| p.0),
+                parent_slot,
                 joint_xy_m: [link.p_parent_joint_m.x, link.p_parent_joint_m.y],
                 coordinate,
+            });
+            let b = &link.body;
+            let rot = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
+            if b.mass_kg == 0.0 && !rot {
+                // Neither mass nor inertia: skipped, as the general engine does.
+                continue;
+            }
+            let mut chain = [(0, 0, 0.0); MAX_COORDINATES];
+            let mut chain_len = 0;
+            let mut cur = Some(i);
+            while let Some(l) = cur {
+                if let Some((c, sign)) = links[l].coordinate {
+                    *chain.get_mut(chain_len)? = (c, l + 1, sign);
+                    chain_len += 1;
+                }
+                cur = model.links[l].parent.map(|p| p.0);
+            }
+            bodies.push(PlanarBody {
+                slot: i + 1,
                 mass_kg: b.mass_kg,
                 com_xy_m: [b.p_link_com_m.x, b.p_link_com_m.y],
                 izz_kg_m2: b.inertia_com_kg_m2[(2, 2)],
                 infinitesimal: b.infinitesimal,
-                empty: b.mass_kg == 0.0 && !rot,
+                chain,
+                chain_len,
             });
         }
-        let chains = (0..links.len())
-            .map(|i| {
-                let mut chain = Vec::new();
-                let mut cur = Some(i);
-                while let Some(l) = cur {
-                    if let Some((c, sign)) = links[l].coordinate {
-                        chain.push((c, l, sign));
-                    }
-                    cur = links[l].parent;
-                }
-                chain
-            })
-            .collect();
         Some(Self {
             links,
-            chains,
+            bodies,
             springs,
             gravity_m_s2: [model.gravity_floor_m_s2.x, model.gravity_floor_m_s2.y],
             dof,
@@ -224,7 +259,12 @@ impl PlanarTree {
             qdd[d.coordinate] = d.acceleration_rad_s2;
         }
         let a = self.assemble::<N>(&qs, &qds);
-        if self.has_infinitesimal {
+        if self.has_infinitesimal && drive.is_none() && active.iter().all(|&a| a) {
+            // Every coordinate free: the vanishing-mass limit on the fixed-size matrices.
+            let qdd = solve_limit_fixed(&a.m, &a.m_eps, &a.f, &a.f_eps, NULL_EIGENVALUE_REL_TOL)
+                .map_err(DynamicsError::Singular)?;
+            out.copy_from_slice(qdd.as_slice());
+        } else if self.has_infinitesimal {
             limit.mass_matrix.copy_from(&a.m);
             limit.mass_matrix_infinitesimal.copy_from(&a.m_eps);
             limit.force.copy_from(&a.f);
@@ -244,23 +284,11 @@ impl PlanarTree {
     /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and
     /// dampers, body by body, over the planar kinematics.
     fn assemble<const N: usize>(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Assembled<N> {
-        let mut st = [LinkState::default(); MAX_LINKS];
-        let st = &mut st[..self.links.len()];
-        let mut out = Assembled {
-            m: SMatrix::zeros(),
-            m_eps: SMatrix::zeros(),
-            f: SVector::zeros(),
-            f_eps: SVector::zeros(),
-        };
-        let [gx, gy] = self.gravity_m_s2;
+        // All zeros (a memset) but the ground's cos.
+        let mut st = [LinkState::default(); MAX_LINKS + 1];
+        st[0] = LinkState::GROUND;
         for (i, link) in self.links.iter().enumerate() {
-            let parent = match link.parent {
-                Some(p) => st[p],
-                None => LinkState {
-                    cos: 1.0,
-                    ..LinkState::default()
-                },
-            };
+            let parent = st[link.parent_slot];
             let [jx, jy] = link.joint_xy_m;
             let (dx, dy) = (
                 parent.cos * jx - parent.sin * jy,
@@ -281,43 +309,55 @@ impl PlanarTree {
                 s.sin = parent.sin * cos_q + parent.cos * sin_q;
                 s.omega_rad_s = parent.omega_rad_s + sign * qd[c];
             }
-            st[i] = s;
-            if link.empty {
-                continue;
-            }
-            let [cx, cy] = link.com_xy_m;
+            st[i + 1] = s;
+        }
+        // Lower triangles of M̄ and M̄_ε (mirrored at the end), and f̄, f̄_ε.
+        let mut m = [[[0.0; N]; N]; 2];
+        let mut f = [[0.0; N]; 2];
+        let [gx, gy] = self.gravity_m_s2;
+        for body in &self.bodies {
+            let s = st[body.slot];
+            let [cx, cy] = body.com_xy_m;
             let (rx, ry) = (s.cos * cx - s.sin * cy, s.sin * cx + s.cos * cy);
             let (px, py) = (s.origin_m[0] + rx, s.origin_m[1] + ry);
             let w2 = s.omega_rad_s * s.omega_rad_s;
             let (ax, ay) = (s.a_bias_m_s2[0] - w2 * rx, s.a_bias_m_s2[1] - w2 * ry);
-            let (m, izz) = (link.mass_kg, link.izz_kg_m2);
-            let (fx, fy) = (m * (gx - ax), m * (gy - ay));
-            let (mm, ff) = if link.infinitesimal {
-                (&mut out.m_eps, &mut out.f_eps)
-            } else {
-                (&mut out.m, &mut out.f)
-            };
-            let chain = &self.chains[i];
-            for (x, &(ci, li, si)) in chain.iter().enumerate() {
-                let o = st[li].origin_m;
-                // Jv = sign · z × (p − o), Jw = sign.
-                let (vix, viy) = (-si * (py - o[1]), si * (px - o[0]));
-                ff[ci] += vix * fx + viy * fy;
-                for &(cj, lj, sj) in &chain[..=x] {
-                    let o = st[lj].origin_m;
-                    let (vjx, vjy) = (-sj * (py - o[1]), sj * (px - o[0]));
-                    let v = m * (vix * vjx + viy * vjy) + izz * si * sj;
-                    mm[(ci, cj)] += v;
-                    if ci != cj {
-                        mm[(cj, ci)] += v;
+            let (mass, izz) = (body.mass_kg, body.izz_kg_m2);
+            let (fx, fy) = (mass * (gx - ax), mass * (gy - ay));
+            let part = usize::from(body.infinitesimal);
+            let chain = &body.chain[..body.chain_len];
+            // Jv = sign · z × (p − o), Jw = sign, per joint of the chain.
+            let mut jv = [(0.0, 0.0); MAX_COORDINATES];
+            for (v, &(_, slot, sign)) in jv.iter_mut().zip(chain) {
+                let o = st[slot].origin_m;
+                *v = (-sign * (py - o[1]), sign * (px - o[0]));
+            }
+            for (x, &(ci, _, si)) in chain.iter().enumerate() {
+                let (vix, viy) = jv[x];
+                f[part][ci] += vix * fx + viy * fy;
+                for (y, &(cj, _, sj)) in chain[..=x].iter().enumerate() {
+                    let (vjx, vjy) = jv[y];
+                    let v = mass * (vix * vjx + viy * vjy) + izz * si * sj;
+                    // Along a chain to the ground, nearer joints own smaller or larger
+                    // coordinates alike: keep the lower triangle.
+                    if ci >= cj {
+                        m[part][ci][cj] += v;
+                    } else {
+                        m[part][cj][ci] += v;
                     }
                 }
             }
         }
         for (c, &(k, rest, d)) in self.springs.iter().enumerate() {
-            out.f[c] -= (q[c] - rest) * k + qd[c] * d;
+            f[0][c] -= (q[c] - rest) * k + qd[c] * d;
         }
-        out
+        let full = |m: &[[f64; N]; N]| SMatrix::<f64, N, N>::from_fn(|i, j| m[i.max(j)][i.min(j)]);
+        Assembled {
+            m: full(&m[0]),
+            m_eps: full(&m[1]),
+            f: SVector::from(f[0]),
+            f_eps: SVector::from(f[1]),
+        }
     }
 }
 
@@ -353,43 +393,4 @@ fn solve_active<const N: usize>(
     }
     *qdd = b;
     Ok(())
-}
-
-/// Solves `A x = b` in place for a symmetric positive definite `A` (its lower triangle
-/// overwritten with the Cholesky factor, `b` with `x`); false if `A` is not positive definite.
-fn cholesky_solve<const N: usize>(a: &mut SMatrix<f64, N, N>, b: &mut SVector<f64, N>) -> bool {
-    for j in 0..N {
-        let mut d = a[(j, j)];
-        for p in 0..j {
-            d -= a[(j, p)] * a[(j, p)];
-        }
-        // Also rejects NaN (which is not greater than zero).
-        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return false;
-        }
-        let d = d.sqrt();
-        a[(j, j)] = d;
-        for i in j + 1..N {
-            let mut v = a[(i, j)];
-            for p in 0..j {
-                v -= a[(i, p)] * a[(j, p)];
-            }
-            a[(i, j)] = v / d;
-        }
-    }
-    for i in 0..N {
-        let mut v = b[i];
-        for p in 0..i {
-            v -= a[(i, p)] * b[p];
-        }
-        b[i] = v / a[(i, i)];
-    }
-    for i in (0..N).rev() {
-        let mut v = b[i];
-        for p in i + 1..N {
-            v -= a[(p, i)] * b[p];
-        }
-        b[i] = v / a[(i, i)];
-    }
-    true
 }

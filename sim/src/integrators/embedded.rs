@@ -82,14 +82,14 @@ impl Stages {
         let (q, v) = (self.q.as_mut_slice(), self.v.as_mut_slice());
         q.copy_from_slice(q0.as_slice());
         v.copy_from_slice(v0.as_slice());
+        let n = q.len().min(v.len());
         for &(j, a) in row {
             let ha = h * a;
-            let (kq, kv) = (self.kq[j].as_slice(), self.kv[j].as_slice());
-            for (x, k) in q.iter_mut().zip(kq) {
-                *x += ha * k;
-            }
-            for (x, k) in v.iter_mut().zip(kv) {
-                *x += ha * k;
+            let (kq, kv) = (&self.kq[j].as_slice()[..n], &self.kv[j].as_slice()[..n]);
+            // One pass over both halves (small n: the loop's overhead counts).
+            for k in 0..n {
+                q[k] += ha * kq[k];
+                v[k] += ha * kv[k];
             }
         }
     }
