@@ -107,11 +107,9 @@ pub fn locate(
         None => (root_on_hermite(a, b, ga, g, tol), None),
     };
     // Refinement: Illinois regula falsi on the exact flow, bracketed by [a, b].
-    let (mut t0, mut g0) = (a.t_s, ga);
-    let (mut t1, mut g1) = (b.t_s, gb);
+    let mut bracket = Illinois::new((a.t_s, ga), (b.t_s, gb));
     let mut best = b.clone();
     let mut t = guess;
-    let mut side = 0i8;
     for it in 0..tol.max_iterations {
         let s = if (t - b.t_s).abs() == 0.0 {
             b.clone()
@@ -120,49 +118,31 @@ pub fn locate(
         };
         let gt = g(&s);
         best = s;
-        if gt.abs() <= tol.witness || (t1 - t0).abs() <= tol.time_s {
+        if gt.abs() <= tol.witness || bracket.width() <= tol.time_s {
             return Ok(best);
         }
         let t_prev = t;
-        if (gt <= 0.0) == (g0 <= 0.0) {
-            t0 = t;
-            g0 = gt;
-            if side == -1 {
-                g1 *= 0.5;
-            }
-            side = -1;
-        } else {
-            t1 = t;
-            g1 = gt;
-            if side == 1 {
-                g0 *= 0.5;
-            }
-            side = 1;
-        }
-        t = if g1 != g0 {
-            t0 - g0 * (t1 - t0) / (g1 - g0)
-        } else {
-            0.5 * (t0 + t1)
-        };
+        bracket.update(t, gt);
+        t = bracket.secant();
         // After the dense estimate: one Newton correction with the dense output's slope.
         if let (0, Some(d)) = (it, slope) {
             if d != 0.0 && d.is_finite() {
                 t = t_prev - gt / d;
             }
         }
-        if !(t > t0.min(t1) && t < t0.max(t1)) {
-            t = 0.5 * (t0 + t1);
+        if !bracket.strictly_inside(t) {
+            t = bracket.midpoint();
         }
         if it + 1 == tol.max_iterations {
             break;
         }
     }
-    if (t1 - t0).abs() <= 1e3 * tol.time_s {
+    if bracket.width() <= 1e3 * tol.time_s {
         return Ok(best);
     }
     Err(EventError::NotLocated {
         iterations: tol.max_iterations,
-        bracket_s: (t1 - t0).abs(),
+        bracket_s: bracket.width(),
     })
 }
 
@@ -200,45 +180,92 @@ fn root_on_hermite(
 /// slope there along the dense output (central difference).
 fn root_on_dense(
     dense: &DenseOutput,
-    (mut t0, mut g0): (f64, f64),
-    (mut t1, mut g1): (f64, f64),
+    start: (f64, f64),
+    end: (f64, f64),
     g: &mut dyn FnMut(&Sample) -> f64,
     tol: &EventTolerance,
 ) -> (f64, f64) {
-    let mut side = 0i8;
-    let mut t = 0.5 * (t0 + t1);
+    let mut bracket = Illinois::new(start, end);
+    let mut t = bracket.midpoint();
     for _ in 0..60 {
-        t = if g1 != g0 {
-            t0 - g0 * (t1 - t0) / (g1 - g0)
-        } else {
-            0.5 * (t0 + t1)
-        };
-        if !(t > t0.min(t1) && t < t0.max(t1)) {
-            t = 0.5 * (t0 + t1);
+        t = bracket.secant();
+        if !bracket.strictly_inside(t) {
+            t = bracket.midpoint();
         }
         let gt = g(&dense.eval(t));
-        if gt.abs() <= tol.witness || (t1 - t0).abs() <= tol.time_s {
+        if gt.abs() <= tol.witness || bracket.width() <= tol.time_s {
             break;
         }
-        if (gt <= 0.0) == (g0 <= 0.0) {
-            t0 = t;
-            g0 = gt;
-            if side == -1 {
-                g1 *= 0.5;
-            }
-            side = -1;
-        } else {
-            t1 = t;
-            g1 = gt;
-            if side == 1 {
-                g0 *= 0.5;
-            }
-            side = 1;
-        }
+        bracket.update(t, gt);
     }
     let e = 1e-6 * dense.h_s;
     let slope = (g(&dense.eval(t + e)) - g(&dense.eval(t - e))) / (2.0 * e);
     (t, slope)
+}
+
+/// A sign-change bracket `[(t0, g0), (t1, g1)]` of the witness, narrowed by the Illinois
+/// variant of regula falsi: the end that stays twice in a row has its witness value halved.
+struct Illinois {
+    t0: f64,
+    g0: f64,
+    t1: f64,
+    g1: f64,
+    /// Which end moved last (−1: `t0`, 1: `t1`, 0: none yet).
+    side: i8,
+}
+
+impl Illinois {
+    fn new((t0, g0): (f64, f64), (t1, g1): (f64, f64)) -> Self {
+        Illinois {
+            t0,
+            g0,
+            t1,
+            g1,
+            side: 0,
+        }
+    }
+
+    /// `|t1 − t0|`.
+    fn width(&self) -> f64 {
+        (self.t1 - self.t0).abs()
+    }
+
+    fn midpoint(&self) -> f64 {
+        0.5 * (self.t0 + self.t1)
+    }
+
+    /// Whether `t` lies strictly between the ends.
+    fn strictly_inside(&self, t: f64) -> bool {
+        t > self.t0.min(self.t1) && t < self.t0.max(self.t1)
+    }
+
+    /// The regula falsi point (the midpoint when the ends' values are equal).
+    fn secant(&self) -> f64 {
+        if self.g1 != self.g0 {
+            self.t0 - self.g0 * (self.t1 - self.t0) / (self.g1 - self.g0)
+        } else {
+            self.midpoint()
+        }
+    }
+
+    /// Replaces the end on the side of `gt`'s sign by `(t, gt)`.
+    fn update(&mut self, t: f64, gt: f64) {
+        if (gt <= 0.0) == (self.g0 <= 0.0) {
+            self.t0 = t;
+            self.g0 = gt;
+            if self.side == -1 {
+                self.g1 *= 0.5;
+            }
+            self.side = -1;
+        } else {
+            self.t1 = t;
+            self.g1 = gt;
+            if self.side == 1 {
+                self.g0 *= 0.5;
+            }
+            self.side = 1;
+        }
+    }
 }
 
 #[cfg(test)]
