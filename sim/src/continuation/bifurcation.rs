@@ -249,15 +249,20 @@ pub fn locate(
     let s_b = a.tangent.dot(&(b.x() - a.x()));
     // A Neimark–Sacker point is located on the crossing pair itself, followed from trial to
     // trial (the product over all pairs also changes sign where a pair forms or splits).
-    let mut pair = match kind {
+    let crossing = match kind {
         BifurcationKind::NeimarkSacker => {
             match crossing_pairs(&a.multipliers, &b.multipliers).as_deref() {
-                Some([(za, _)]) => Some(*za),
+                Some([(za, zb)]) => Some((*za, *zb)),
                 _ => return Err(CorrectorError::NoSignChange),
             }
         }
         _ => None,
     };
+    let (f_a, f_b) = match crossing {
+        Some((za, zb)) => (za.norm() - 1.0, zb.norm() - 1.0),
+        None => (test(kind, a), test(kind, b)),
+    };
+    let mut pair = crossing.map(|(za, _)| za);
     let eval = |p: &BranchPoint, pair: &mut Option<Complex<f64>>| -> f64 {
         match pair {
             Some(z) => {
@@ -269,11 +274,6 @@ pub fn locate(
             }
             None => test(kind, p),
         }
-    };
-    let f_a = eval(a, &mut pair.clone());
-    let f_b = match crossing_pairs(&a.multipliers, &b.multipliers).as_deref() {
-        Some([(_, zb)]) if pair.is_some() => zb.norm() - 1.0,
-        _ => test(kind, b),
     };
     if !(f_a.is_finite() && f_b.is_finite()) || f_a.signum() == f_b.signum() {
         return Err(CorrectorError::NoSignChange);
