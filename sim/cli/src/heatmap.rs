@@ -2,7 +2,8 @@
 //! line (linear interpolation, marching squares over the cell centres), hatched cells where
 //! there is no value, a colour bar and labelled axes.
 
-use crate::plot::{escape, fmt_tick, frame, nice_step, Rect};
+use crate::axis::{self, fmt_tick, nice_step, Edge, Rect, Scale};
+use crate::plot::{escape, frame, header};
 use std::fmt::Write as _;
 
 /// A heat map: `z[j][i]` at `(x[i], y[j])`, `None` where there is no value.
@@ -143,15 +144,10 @@ impl HeatMap {
         let px = |x: f64| ml + (x - x0) / (x1 - x0) * pw;
         let py = |y: f64| mt + ph - (y - y0) / (y1 - y0) * ph;
         let mut o = String::new();
-        let _ = write!(
+        header(&mut o, (width, height), &self.title, None);
+        let _ = writeln!(
             o,
-            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="DejaVu Sans, Arial, sans-serif" font-size="13">
-<rect width="100%" height="100%" fill="white"/>
-<defs><pattern id="nogait" width="8" height="8" patternUnits="userSpaceOnUse" patternTransform="rotate(45)"><rect width="8" height="8" fill="#d0d0d0"/><line x1="0" y1="0" x2="0" y2="8" stroke="#8a8a8a" stroke-width="2"/></pattern></defs>
-<text x="{:.1}" y="22" text-anchor="middle" font-size="15" font-weight="bold">{}</text>
-"##,
-            ml + pw / 2.0,
-            escape(&self.title)
+            r##"<defs><pattern id="nogait" width="8" height="8" patternUnits="userSpaceOnUse" patternTransform="rotate(45)"><rect width="8" height="8" fill="#d0d0d0"/><line x1="0" y1="0" x2="0" y2="8" stroke="#8a8a8a" stroke-width="2"/></pattern></defs>"##
         );
         // Legend under the title: the contour and the missing cells.
         let _ = writeln!(
@@ -196,41 +192,17 @@ impl HeatMap {
             );
         }
         // Axes, ticks and labels.
-        let xstep = nice_step(x1 - x0, 7);
-        let ystep = nice_step(y1 - y0, 6);
-        let mut t = (x0 / xstep).ceil() * xstep;
-        while t <= x1 + 1e-12 * xstep.abs().max(1.0) {
-            let x = px(t);
-            let _ = writeln!(
-                o,
-                r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#333"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
-                mt + ph,
-                mt + ph + 5.0,
-                mt + ph + 19.0,
-                fmt_tick(t, xstep)
-            );
-            t += xstep;
-        }
-        let mut t = (y0 / ystep).ceil() * ystep;
-        while t <= y1 + 1e-12 * ystep.abs().max(1.0) {
-            let y = py(t);
-            let _ = writeln!(
-                o,
-                r##"<line x1="{:.1}" y1="{y:.1}" x2="{ml}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
-                ml - 5.0,
-                ml - 8.0,
-                y + 4.0,
-                fmt_tick(t, ystep)
-            );
-            t += ystep;
-        }
-        frame(
-            &mut o,
-            Rect { ml, mt, pw, ph },
-            height,
-            &self.x_label,
-            &self.y_label,
-        );
+        let area = Rect {
+            x: ml,
+            y: mt,
+            w: pw,
+            h: ph,
+        };
+        let x_ticks = axis::ticks(Scale::Linear, x0, x1, 7);
+        let y_ticks = axis::ticks(Scale::Linear, y0, y1, 6);
+        axis::draw(&mut o, Edge::Bottom, area, &x_ticks, px, false);
+        axis::draw(&mut o, Edge::Left, area, &y_ticks, py, false);
+        frame(&mut o, area, mt + ph + 44.0, &self.x_label, &self.y_label);
         // Colour bar: level − span to level + span.
         let (bx, bw) = (ml + pw + 24.0, 18.0);
         let steps = 40;

@@ -6,16 +6,20 @@
 //! pipe on standard output ends the command quietly with code 0, any other write error with
 //! code 1 and a message. Each subcommand lives in its own module under [`commands`].
 
+mod axis;
 mod commands;
+mod export;
 mod figures;
 mod heatmap;
 mod input_error;
+mod labels;
 mod limits;
 mod options;
 mod output;
 mod param_range;
 mod plot;
 mod progress;
+mod sweep_figures;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};

@@ -1,6 +1,7 @@
 //! `walker accuracy`: speed against error of every integrator, against a tight reference.
 
 use super::print_json;
+use crate::export;
 use crate::figures;
 use crate::options::Common;
 use crate::output;
@@ -15,7 +16,7 @@ use std::process::ExitCode;
 pub struct AccuracyArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Write `accuracy.md` and log-log SVG plots into this folder.
+    /// Write `accuracy.md` and log-log plots (SVG, PNG and PDF) into this folder.
     #[arg(long, value_name = "DIR")]
     pub out: Option<std::path::PathBuf>,
 }
@@ -63,21 +64,22 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     if let Some(dir) = out {
         output::write_file("--out", &dir.join("accuracy.md"), &table)?;
         let panels: [(&str, &str, ErrorOf); 3] = [
-            ("fixed_point_error.svg", "fixed-point error [-]", |p| {
+            ("fixed_point_error.svg", "fixed-point error", |p| {
                 p.fixed_point_error
             }),
-            ("eigenvalue_error.svg", "eigenvalue error [-]", |p| {
+            ("eigenvalue_error.svg", "eigenvalue error", |p| {
                 p.eigenvalue_error
             }),
             (
                 "heel_strike_time_error.svg",
-                "heel-strike time error [s]",
+                "heel-strike time error (s)",
                 |p| p.heel_strike_time_error_s,
             ),
         ];
         for (file, what, f) in panels {
-            let plot = figures::accuracy(&study, f, what);
-            output::write_file("--out", &dir.join(file), &plot.to_svg(720.0, 480.0))?;
+            let plot = figures::accuracy(&scene, &study, f, what);
+            let name = file.trim_end_matches(".svg");
+            export::write_figure("--out", &dir, name, &plot.to_svg(760.0, 480.0))?;
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -5,6 +5,7 @@
 //! long-period gait comes back wherever its branch reaches (`walker gaits` lists them all).
 
 use super::{print_json, shown};
+use crate::export;
 use crate::figures;
 use crate::options::Common;
 use crate::output;
@@ -23,7 +24,8 @@ use std::process::ExitCode;
 pub struct GaitArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Write SVG figures (eigenvalues, joint angles over a stride) into this folder.
+    /// Write figures (eigenvalues, joint angles over a stride) into this folder, each as SVG,
+    /// PNG and PDF.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
 }
@@ -49,30 +51,13 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     let (mut report, figures_stride) = report(&scene, &setup, &result, plot.is_some());
     report.gait_source = source;
     if let (Some(dir), Ok(g)) = (&plot, &result) {
-        let name = scene.name();
-        let eig = figures::eigenvalues(
-            walker,
-            g,
-            &format!("{name}: eigenvalues of the stride Jacobian"),
-        );
-        output::write_file(
-            "--plot",
-            &dir.join("eigenvalues.svg"),
-            &eig.to_svg(640.0, 600.0),
-        )?;
+        let eig = figures::eigenvalues(&scene, walker, g);
+        export::write_figure("--plot", dir, "eigenvalues", &eig.to_svg(720.0, 560.0))?;
         let samples = figures_stride
             .as_ref()
             .map_or(&[][..], |r| r.trajectory.as_slice());
-        let ang = figures::joint_angles(
-            walker,
-            samples,
-            &format!("{name}: joint angles over one step"),
-        );
-        output::write_file(
-            "--plot",
-            &dir.join("joint_angles.svg"),
-            &ang.to_svg(820.0, 480.0),
-        )?;
+        let ang = figures::joint_angles(&scene, walker, samples);
+        export::write_figure("--plot", dir, "joint_angles", &ang.to_svg(860.0, 480.0))?;
     }
     if common.json {
         print_json(&report)?;

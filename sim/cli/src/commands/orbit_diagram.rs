@@ -2,6 +2,7 @@
 //! ([`sim::orbit_diagram`]), as text, JSON or the classic figure.
 
 use super::print_json;
+use crate::export;
 use crate::figures;
 use crate::input_error::InputError;
 use crate::limits;
@@ -34,7 +35,7 @@ pub struct OrbitDiagramArgs {
     /// the first stride-map entry).
     #[arg(long)]
     pub coordinate: Option<String>,
-    /// Write the figure (orbit_diagram.svg) into this folder.
+    /// Write the figure (orbit_diagram.svg, .png and .pdf) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
 }
@@ -104,12 +105,8 @@ pub fn run(args: OrbitDiagramArgs) -> Result<ExitCode> {
     progress.finish();
     let report = OrbitDiagramReport::new(&scene, &setup.walker, &param, &found, &settings);
     if let Some(dir) = &plot {
-        let fig = figures::orbit_diagram(&report, &coordinate);
-        output::write_file(
-            "--plot",
-            &dir.join("orbit_diagram.svg"),
-            &fig.to_svg(900.0, 560.0),
-        )?;
+        let fig = figures::orbit_diagram(&scene, &report, &coordinate);
+        export::write_figure("--plot", dir, "orbit_diagram", &fig.to_svg(900.0, 560.0))?;
     }
     if common.json {
         print_json(&report)?;

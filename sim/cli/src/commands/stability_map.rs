@@ -2,8 +2,10 @@
 //! two parameters ([`sim::stability_map`]), as text, JSON or a heat map.
 
 use super::print_json;
+use crate::export;
 use crate::heatmap::HeatMap;
 use crate::input_error::InputError;
+use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
@@ -101,10 +103,13 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     let report = StabilityMapReport::new(scene.name(), &x, &y, &map);
     if let Some(dir) = &plot {
         let fig = HeatMap {
-            title: format!("{}: stability map of the long-period gait", scene.name()),
-            x_label: x.name.clone(),
-            y_label: y.name.clone(),
-            z_label: "max |λ| of the stride Jacobian".into(),
+            title: format!(
+                "{}: stability of the long-period gait",
+                labels::walker_name(&scene)
+            ),
+            x_label: labels::parameter_label(&scene, &x.name),
+            y_label: labels::parameter_label(&scene, &y.name),
+            z_label: "largest |λ| of the stride map".into(),
             x: x.values.clone(),
             y: y.values.clone(),
             z: report.max_abs_eigenvalue.clone(),
@@ -112,11 +117,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
             contour_label: "|λ| = 1: stability boundary".into(),
             missing_label: "no gait found".into(),
         };
-        output::write_file(
-            "--plot",
-            &dir.join("stability_map.svg"),
-            &fig.to_svg(820.0, 620.0),
-        )?;
+        export::write_figure("--plot", dir, "stability_map", &fig.to_svg(820.0, 620.0))?;
     }
     if common.json {
         print_json(&report)?;

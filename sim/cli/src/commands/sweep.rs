@@ -3,12 +3,14 @@
 //! branches (docs/bifurcations.md).
 
 use super::print_json;
+use crate::export;
 use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
 use crate::param_range::ParamRange;
 use crate::progress::Progress;
+use crate::sweep_figures::sweep_figures;
 use anyhow::Result;
 use clap::Args;
 use sim::continuation::{continuation, ContinuationSettings, SweepError};
@@ -34,6 +36,14 @@ pub struct SweepArgs {
     /// period-doubled branches up to this).
     #[arg(long, default_value_t = 8)]
     pub max_period: usize,
+    /// Write the bifurcation diagram (bifurcation_diagram: a state at heel strike against the
+    /// parameter) and max |λ| against the parameter (max_multiplier) into this folder, each as
+    /// SVG, PNG and PDF.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+    /// The stride-map entry the bifurcation diagram plots (default: the first).
+    #[arg(long, value_name = "NAME")]
+    pub coordinate: Option<String>,
 }
 
 /// Runs `walker sweep`.
@@ -43,12 +53,28 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         range,
         points,
         max_period,
+        plot,
+        coordinate,
     } = args;
     let (param, from, to) = range.checked("a sweep")?;
     let scene = common.scene()?;
     let base = common.setup(&scene)?;
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
     let max_period = limits::count("--max-period", max_period, 1, 64)?;
+    let names = base.walker.map_names();
+    let coordinate_index = match &coordinate {
+        None => 0,
+        Some(c) => names.iter().position(|n| n == c).ok_or_else(|| {
+            InputError::Other(format!(
+                "--coordinate `{c}`: expected one of {}",
+                names.join(", ")
+            ))
+        })?,
+    };
+    // The figures' folder before the sweep: a path that cannot be used fails at once.
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
     let newton = common.newton();
     // The command line's integrator choices apply at every parameter value.
     let overridden =
@@ -73,6 +99,22 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     )
     .map_err(scene_error)?;
     progress.finish();
+    if let Some(dir) = &plot {
+        let name = names.get(coordinate_index).cloned().unwrap_or_default();
+        let [diagram, modulus] = sweep_figures(&scene, &result, &name, coordinate_index);
+        export::write_figure(
+            "--plot",
+            dir,
+            "bifurcation_diagram",
+            &diagram.to_svg(900.0, 560.0),
+        )?;
+        export::write_figure(
+            "--plot",
+            dir,
+            "max_multiplier",
+            &modulus.to_svg(900.0, 560.0),
+        )?;
+    }
     let report = SweepReport::from_continuation(&result);
     if common.json {
         print_json(&report)?;

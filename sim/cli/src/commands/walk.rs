@@ -3,6 +3,7 @@
 mod start;
 
 use super::{print_json, walk_exit_code};
+use crate::export;
 use crate::figures;
 use crate::input_error::InputError;
 use crate::limits;
@@ -45,7 +46,7 @@ pub struct WalkArgs {
     /// Write the trajectory (every integrator sample) as CSV.
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<std::path::PathBuf>,
-    /// Write the floor path of the hip-axle centre as SVG into this folder.
+    /// Write the floor path of the hip-axle centre into this folder (SVG, PNG and PDF).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
     /// Also walk this scene (with its own parameters) from its own gait, the same number of
@@ -134,7 +135,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
     let walk = sim::walk::walk(walker, &q, &qd, request);
     if let Some(dir) = &plot {
-        let mut walks = vec![(scene.name().to_string(), walk.clone())];
+        let mut walks = vec![(scene.clone(), walk.clone())];
         if let Some(other) = &plot_with {
             // The other scene walks with its own defaults, from its own gait.
             let os = Scene::load(other)?;
@@ -147,19 +148,13 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
                 .unwrap_or(v0);
             let (oq, oqd) = ow.unpack(&start);
             let request = WalkRequest::new(&oset.settings, steps).recording(true);
-            walks.push((
-                os.name().to_string(),
-                sim::walk::walk(ow, &oq, &oqd, request),
-            ));
+            let other_walk = sim::walk::walk(ow, &oq, &oqd, request);
+            walks.push((os, other_walk));
         }
-        let refs: Vec<(&str, &sim::walk::Walk)> =
-            walks.iter().map(|(n, w)| (n.as_str(), w)).collect();
-        let fig = figures::floor_paths(&refs, "path of the hip-axle centre on the floor");
-        output::write_file(
-            "--plot",
-            &dir.join("floor_path.svg"),
-            &fig.to_svg(820.0, 420.0),
-        )?;
+        let refs: Vec<(&Scene, &sim::walk::Walk)> = walks.iter().map(|(s, w)| (s, w)).collect();
+        let size = (860.0, 480.0);
+        let fig = figures::floor_paths(&refs, size);
+        export::write_figure("--plot", dir, "floor_path", &fig.to_svg(size.0, size.1))?;
     }
     if let Some((path, file)) = csv {
         write_csv(file, walker, &walk).map_err(|e| PathError::new("--out", path, e))?;

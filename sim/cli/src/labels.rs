@@ -1,0 +1,117 @@
+//! People's words for what the figures show: walkers by name instead of scene ids, parameters
+//! by their description and unit, coordinates and failures in plain words.
+
+use sim::scene::Scene;
+use sim::stride::FailureKind;
+
+/// The walker of a scene in words, for titles and legends: the scenes shipped with the
+/// project by name, any other by its summary up to the first comma (or its id).
+pub fn walker_name(scene: &Scene) -> String {
+    let shipped = match scene.name() {
+        "simplest" => Some("simplest walker (Garcia et al.)"),
+        "compass" => Some("compass-gait walker (Goswami et al.)"),
+        "kneed2d" => Some("kneed 2D walker"),
+        "wisse2d" => Some("2D walker (Wisse et al., yaw and roll fixed)"),
+        "wisse2d-tuned" => Some("2D walker, tuned reading"),
+        "wisse2d-uncompensated" => Some("2D walker without pelvic body"),
+        "wisse3d" => Some("3D walker with pelvic compensator"),
+        "wisse3d-tuned" => Some("3D walker, tuned reading"),
+        "wisse3d-uncompensated" => Some("3D walker without compensator"),
+        "wisse3d-locked-compensator" => Some("3D walker, compensator locked to the hip axle"),
+        _ => None,
+    };
+    match shipped {
+        Some(n) => n.to_string(),
+        None => {
+            let summary = scene.file.scene.summary.trim();
+            let first = summary.split([',', ';']).next().unwrap_or("").trim();
+            if first.is_empty() {
+                scene.name().replace(['_', '-'], " ")
+            } else {
+                first.to_string()
+            }
+        }
+    }
+}
+
+/// A unit written for people (`m/s^2` → `m/s²`).
+fn unit_text(unit: &str) -> String {
+    unit.replace("^2", "²").replace("^3", "³")
+}
+
+/// An axis label for the scene parameter `name`: its description up to the first
+/// parenthesis, colon or semicolon, lower-cased, with its unit (`slope_rad` → "floor slope
+/// (rad)"); the name in words if the scene does not describe it.
+pub fn parameter_label(scene: &Scene, name: &str) -> String {
+    let Some(def) = scene.file.parameters.get(name) else {
+        return name.replace('_', " ");
+    };
+    let doc = def.doc.split(['(', ':', ';']).next().unwrap_or("").trim();
+    let words = if doc.is_empty() {
+        name.replace('_', " ")
+    } else {
+        lower_first(doc)
+    };
+    if def.unit.is_empty() || def.unit == "-" || def.unit == "1" {
+        words
+    } else {
+        format!("{words} ({})", unit_text(&def.unit))
+    }
+}
+
+/// The first letter lower-cased unless the word is an abbreviation (`Floor slope` → `floor
+/// slope`, `CPU time` stays).
+fn lower_first(s: &str) -> String {
+    let mut c = s.chars();
+    match (c.next(), c.next()) {
+        (Some(a), Some(b)) if a.is_uppercase() && !b.is_uppercase() => {
+            a.to_lowercase().chain(s.chars().skip(1)).collect()
+        }
+        _ => s.to_string(),
+    }
+}
+
+/// A coordinate in words: underscores as spaces, Greek names as letters (`swing_hip` →
+/// "swing hip", `theta` → "θ").
+pub fn coordinate_label(name: &str) -> String {
+    match name {
+        "theta" => "θ".into(),
+        "phi" => "φ".into(),
+        "psi" => "ψ".into(),
+        _ => name.replace('_', " "),
+    }
+}
+
+/// A failure in words (`HeelStrikeBeforeKneeLock` → "heel strike before knee lock").
+pub fn failure_label(kind: FailureKind) -> String {
+    match serde_json::to_value(kind) {
+        Ok(serde_json::Value::String(s)) => s.replace('_', " "),
+        _ => format!("{kind:?}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_are_words_with_units() {
+        let scene = Scene::load("wisse3d").expect("shipped scene");
+        assert_eq!(parameter_label(&scene, "slope_rad"), "floor slope (rad)");
+        assert_eq!(
+            parameter_label(&scene, "gravity_m_s2"),
+            "gravitational acceleration (m/s²)"
+        );
+        assert_eq!(
+            parameter_label(&scene, "ankle_extension_duration_s"),
+            "duration of the smooth extension profile (s)"
+        );
+        assert_eq!(walker_name(&scene), "3D walker with pelvic compensator");
+        assert_eq!(coordinate_label("swing_hip"), "swing hip");
+        assert_eq!(
+            failure_label(FailureKind::HeelStrikeBeforeKneeLock),
+            "heel strike before knee lock"
+        );
+        assert_eq!(failure_label(FailureKind::FellForward), "fell forward");
+    }
+}
