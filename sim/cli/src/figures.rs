@@ -4,7 +4,9 @@
 //! [`crate::sweep_figures`]. Labels are words with units ([`crate::labels`]).
 
 use crate::axis::Scale;
-use crate::labels::{coordinate_label, failure_label, parameter_label, walker_name};
+use crate::labels::{
+    coordinate_label, failure_label, integrator_label, parameter_label, walker_name,
+};
 use crate::plot::{Aspect, Marker, Note, Plot, Series, Style, PALETTE};
 use sim::integrators::Sample;
 use sim::limit_cycle::Gait;
@@ -314,7 +316,7 @@ pub fn accuracy(
         .iter()
         .enumerate()
         .map(|(i, f)| Series {
-            label: f.clone(),
+            label: integrator_label(f),
             points: study
                 .points
                 .iter()
@@ -371,9 +373,9 @@ pub fn orbit_diagram(scene: &Scene, r: &sim::report::OrbitDiagramReport, coordin
             color: PALETTE[1],
         },
         Series {
-            label: "fell".into(),
+            label: "fell (no attractor)".into(),
             points: fell_at.into_iter().map(|x| (x, bottom)).collect(),
-            style: Style::markers(Marker::Triangle),
+            style: Style::markers(Marker::Dot),
             color: "#555555",
         },
     ];

@@ -175,7 +175,7 @@ impl HeatMap {
                 };
                 let _ = writeln!(
                     o,
-                    r#"<rect x="{l:.2}" y="{t:.2}" width="{:.2}" height="{:.2}" fill="{fill}"/>"#,
+                    r#"<rect x="{l:.2}" y="{t:.2}" width="{:.2}" height="{:.2}" fill="{fill}" shape-rendering="crispEdges"/>"#,
                     r - l + 0.3,
                     b - t + 0.3
                 );

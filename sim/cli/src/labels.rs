@@ -43,7 +43,10 @@ fn unit_text(unit: &str) -> String {
 /// parenthesis, colon or semicolon, lower-cased, with its unit (`slope_rad` → "floor slope
 /// (rad)"); the name in words if the scene does not describe it.
 pub fn parameter_label(scene: &Scene, name: &str) -> String {
-    let Some(def) = scene.file.parameters.get(name) else {
+    let canonical = scene
+        .parameter_name(name)
+        .unwrap_or_else(|_| name.to_string());
+    let Some(def) = scene.file.parameters.get(&canonical) else {
         return name.replace('_', " ");
     };
     let doc = def.doc.split(['(', ':', ';']).next().unwrap_or("").trim();
@@ -82,6 +85,17 @@ pub fn coordinate_label(name: &str) -> String {
     }
 }
 
+/// An integrator family in words (`dop853` → "DOP853 (adaptive)").
+pub fn integrator_label(name: &str) -> String {
+    match name {
+        "meijaard" => "Meijaard (fixed step)".into(),
+        "rk4" => "RK4 (fixed step)".into(),
+        "dopri5" => "DOPRI5 (adaptive)".into(),
+        "dop853" => "DOP853 (adaptive)".into(),
+        other => other.to_string(),
+    }
+}
+
 /// A failure in words (`HeelStrikeBeforeKneeLock` → "heel strike before knee lock").
 pub fn failure_label(kind: FailureKind) -> String {
     match serde_json::to_value(kind) {
@@ -98,6 +112,11 @@ mod tests {
     fn labels_are_words_with_units() {
         let scene = Scene::load("wisse3d").expect("shipped scene");
         assert_eq!(parameter_label(&scene, "slope_rad"), "floor slope (rad)");
+        assert_eq!(
+            parameter_label(&scene, "slope"),
+            "floor slope (rad)",
+            "an alias"
+        );
         assert_eq!(
             parameter_label(&scene, "gravity_m_s2"),
             "gravitational acceleration (m/s²)"

@@ -503,7 +503,15 @@ impl Plot {
                     s.color
                 );
             }
-            let m = marker_svg(s.style.marker, (lg.x + 20.0, y), s.color);
+            // A dot is drawn larger in the legend, to be seen.
+            let m = match s.style.marker {
+                Marker::Dot => format!(
+                    r#"<circle cx="{:.1}" cy="{y:.1}" r="3" fill="{}"/>"#,
+                    lg.x + 20.0,
+                    s.color
+                ),
+                other => marker_svg(other, (lg.x + 20.0, y), s.color),
+            };
             let _ = writeln!(
                 o,
                 r#"{m}<text x="{:.1}" y="{:.1}">{}</text>"#,

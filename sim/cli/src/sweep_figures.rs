@@ -4,6 +4,7 @@
 //! bifurcations, solid where the gait is stable and dashed where it is not; folds, period
 //! doublings, Neimark–Sacker points and branch points are marked and named in the legend.
 
+use crate::axis::Scale;
 use crate::figures::state_label;
 use crate::labels::{parameter_label, walker_name};
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
@@ -94,6 +95,24 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             .collect();
         let slot = slots(&grid, &bifs);
         let mut nodes: Vec<Node> = Vec::new();
+        // A branch switched onto at a bifurcation starts there (its parent's point: a
+        // period-2k orbit born from a period-k one repeats its states).
+        let birth = b.parent.and_then(|(parent, value)| {
+            c.branches.iter().find(|p| p.id == parent).and_then(|p| {
+                p.bifurcations
+                    .iter()
+                    .min_by(|x, y| (x.value - value).abs().total_cmp(&(y.value - value).abs()))
+            })
+        });
+        if let (Some(x), Some(first)) = (birth, b.grid.first()) {
+            let s = first.point.stable();
+            nodes.push(Node {
+                value: x.value,
+                point: &x.point,
+                stable_from_previous: s,
+                stable_to_next: s,
+            });
+        }
         let mut next_bif = 0;
         for i in 0..=b.grid.len() {
             while next_bif < slot.len() && slot[next_bif] == i {
@@ -134,9 +153,9 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
                 if seg_stable == stable {
                     for (k, pts) in by_phase.iter_mut().enumerate() {
                         let y = |n: &Node| {
-                            n.point
-                                .orbit
-                                .get(k)
+                            let orbit = &n.point.orbit;
+                            orbit
+                                .get(k % orbit.len().max(1))
                                 .and_then(|s| s.get(index))
                                 .copied()
                                 .unwrap_or(f64::NAN)
@@ -236,7 +255,24 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             color,
         });
     }
-    let (lo, hi) = (c.grid.from.min(c.grid.to), c.grid.from.max(c.grid.to));
+    // The boundary across the values the branches reach; a log axis when max |λ| spans more
+    // than a decade.
+    let finite = |f: fn(&(f64, f64)) -> f64| {
+        modulus
+            .iter()
+            .flat_map(|s| s.points.iter().map(f))
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    let (lo, hi) = finite(|p| p.0);
+    let (lam_lo, lam_hi) = finite(|p| p.1);
+    let y_scale = if lam_lo > 0.0 && lam_hi > 10.0 * lam_lo {
+        Scale::Log10
+    } else {
+        Scale::Linear
+    };
     modulus.push(Series {
         label: "|λ| = 1: stability boundary".into(),
         points: vec![(lo, 1.0), (hi, 1.0)],
@@ -261,6 +297,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             title: format!("{name}: stability against the {}", param_words(&param)),
             x_label: param,
             y_label: "largest |λ| of the stride map".into(),
+            y_scale,
             series: modulus,
             ..Plot::default()
         },
