@@ -48,17 +48,22 @@ fn near_zero_caption(modes: &[sim::stability::EigenMode]) -> Option<String> {
     if near.len() < 2 {
         return None;
     }
+    // Zero to the three decimals the caption gives.
+    const ZERO: f64 = 5e-4;
     let zeros = near
         .iter()
-        .filter(|e| e.eigenvalue[0].hypot(e.eigenvalue[1]) < 1e-9)
+        .filter(|e| e.eigenvalue[0].hypot(e.eigenvalue[1]) < ZERO)
         .count();
+    if zeros == near.len() {
+        return Some(format!("{zeros} eigenvalues at 0"));
+    }
     let mut parts = Vec::new();
     if zeros > 0 {
         parts.push(format!("{zeros} at 0"));
     }
     for e in near
         .iter()
-        .filter(|e| e.eigenvalue[0].hypot(e.eigenvalue[1]) >= 1e-9)
+        .filter(|e| e.eigenvalue[0].hypot(e.eigenvalue[1]) >= ZERO)
     {
         let [re, im] = e.eigenvalue;
         let v = if im.abs() < 1e-12 {
@@ -90,7 +95,9 @@ pub fn eigenvalues(scene: &Scene, walker: &Walker, gait: &Gait) -> Plot {
     let point = |e: &&sim::stability::EigenMode| (e.eigenvalue[0], e.eigenvalue[1]);
     let mut series = Vec::new();
     let mut notes = Vec::new();
-    let groups: [(&str, Vec<(f64, f64)>, Marker, (f64, f64)); 2] = [
+    // Legend label, points, marker, offset of a count note [px].
+    type Group<'a> = (&'a str, Vec<(f64, f64)>, Marker, (f64, f64));
+    let groups: [Group; 2] = [
         (
             if three_d.is_empty() {
                 "eigenvalue"
@@ -328,7 +335,11 @@ pub fn accuracy(
         })
         .collect();
     Plot {
-        title: format!("{}: {what} against CPU time", walker_name(scene)),
+        title: format!(
+            "{}: {} against CPU time",
+            walker_name(scene),
+            what.split(" (").next().unwrap_or(what)
+        ),
         x_label: "CPU time per stride (µs)".into(),
         y_label: what.into(),
         x_scale: Scale::Log10,
@@ -450,6 +461,35 @@ mod tests {
         ]);
         assert_eq!(c.len(), 3);
         assert_eq!(c[0], ((0.0, 0.0), 3));
+    }
+
+    #[test]
+    fn eigenvalues_crowding_the_origin_are_named_in_the_caption() {
+        let mode = |re: f64, three_d: bool| sim::stability::EigenMode {
+            eigenvalue: [re, 0.0],
+            abs: re.abs(),
+            dominant: Vec::new(),
+            three_d,
+        };
+        let all = [mode(0.0, false), mode(-4e-8, false), mode(0.9, false)];
+        assert_eq!(
+            near_zero_caption(&all).as_deref(),
+            Some("2 eigenvalues at 0")
+        );
+        let mixed = [
+            mode(0.0, false),
+            mode(-0.029, true),
+            mode(0.038, true),
+            mode(0.5, true),
+        ];
+        assert_eq!(
+            near_zero_caption(&mixed).as_deref(),
+            Some("3 eigenvalues near the origin: 1 at 0, −0.029 (3D), 0.038 (3D)")
+        );
+        assert_eq!(
+            near_zero_caption(&[mode(0.0, false), mode(0.5, false)]),
+            None
+        );
     }
 
     #[test]

@@ -171,7 +171,7 @@ pub struct Layout {
 
 impl Layout {
     /// The pixel of a data point, `None` if its scale cannot show it.
-    pub fn to_px(&self, plot: &Plot, (x, y): (f64, f64)) -> Option<(f64, f64)> {
+    pub fn pixel(&self, plot: &Plot, (x, y): (f64, f64)) -> Option<(f64, f64)> {
         let (ax, ay) = (plot.x_scale.to_axis(x)?, plot.y_scale.to_axis(y)?);
         Some((self.px_x(ax), self.px_y(ay)))
     }
@@ -436,7 +436,7 @@ impl Plot {
             );
         }
         for s in &self.series {
-            let px: Vec<Option<(f64, f64)>> = s.points.iter().map(|&p| l.to_px(self, p)).collect();
+            let px: Vec<Option<(f64, f64)>> = s.points.iter().map(|&p| l.pixel(self, p)).collect();
             if s.style.line != Line::None {
                 let dash = if s.style.line == Line::Dashed {
                     r#" stroke-dasharray="7,4""#
@@ -463,7 +463,7 @@ impl Plot {
         }
         let _ = writeln!(o, "</g>");
         for n in &self.notes {
-            if let Some((x, y)) = l.to_px(self, n.at) {
+            if let Some((x, y)) = l.pixel(self, n.at) {
                 let _ = writeln!(
                     o,
                     r##"<text x="{:.1}" y="{:.1}" font-size="12" fill="#222">{}</text>"##,
@@ -587,7 +587,7 @@ mod tests {
                 );
                 for s in &p.series {
                     for &pt in &s.points {
-                        let px = l.to_px(&p, pt).expect("shown");
+                        let px = l.pixel(&p, pt).expect("shown");
                         assert!(l.area.contains(px), "{px:?} outside {:?}", l.area);
                         assert!(!lg.contains(px), "{px:?} under the legend");
                     }
@@ -606,7 +606,7 @@ mod tests {
             let px_per_y = l.area.h / (l.y_range.1 - l.y_range.0);
             assert!((px_per_y / px_per_x - f).abs() < 1e-9 * f, "{f}");
             for &pt in &p.series[0].points {
-                assert!(l.area.contains(l.to_px(&p, pt).expect("shown")));
+                assert!(l.area.contains(l.pixel(&p, pt).expect("shown")));
             }
         }
     }
@@ -625,12 +625,12 @@ mod tests {
             ..Plot::default()
         };
         let l = p.layout(720.0, 480.0);
-        let a = l.to_px(&p, (10.0, 1e-3)).expect("shown");
-        let b = l.to_px(&p, (100.0, 1e-5)).expect("shown");
-        let c = l.to_px(&p, (1000.0, 1e-7)).expect("shown");
+        let a = l.pixel(&p, (10.0, 1e-3)).expect("shown");
+        let b = l.pixel(&p, (100.0, 1e-5)).expect("shown");
+        let c = l.pixel(&p, (1000.0, 1e-7)).expect("shown");
         assert!(((b.0 - a.0) - (c.0 - b.0)).abs() < 1e-9);
         assert!(((b.1 - a.1) - (c.1 - b.1)).abs() < 1e-9);
-        assert_eq!(l.to_px(&p, (50.0, 0.0)), None);
+        assert_eq!(l.pixel(&p, (50.0, 0.0)), None);
         let svg = p.to_svg(720.0, 480.0);
         assert!(svg.contains(">10¹<") && svg.contains(">10⁻⁵<"));
         assert_eq!(
