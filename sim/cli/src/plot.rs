@@ -151,7 +151,7 @@ const CHAR_PX: f64 = 7.6;
 /// Height of one legend row [px].
 const LEGEND_ROW_PX: f64 = 19.0;
 /// Longest legend label (characters) still placed to the right of the plot area; longer ones
-/// go below it.
+/// (or a legend taller than the plot area) go below it.
 const RIGHT_LEGEND_MAX_CHARS: usize = 30;
 
 /// Where a plot's parts go, in pixels, and the data ranges (axis units) its area shows.
@@ -309,7 +309,7 @@ impl Plot {
             .unwrap_or(0);
         let lw = 44.0 + CHAR_PX * longest as f64;
         let lh = 8.0 + LEGEND_ROW_PX * entries as f64;
-        let right = entries > 0 && longest <= RIGHT_LEGEND_MAX_CHARS;
+        let right = entries > 0 && longest <= RIGHT_LEGEND_MAX_CHARS && lh <= height - top - mb;
         let (area, legend) = if entries == 0 {
             (
                 Rect {

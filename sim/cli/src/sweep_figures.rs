@@ -273,15 +273,19 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
     } else {
         Scale::Linear
     };
-    modulus.push(Series {
-        label: "|λ| = 1: stability boundary".into(),
-        points: vec![(lo, 1.0), (hi, 1.0)],
-        style: Style {
-            line: crate::plot::Line::Solid,
-            marker: Marker::None,
+    // Drawn first, under the curves.
+    modulus.insert(
+        0,
+        Series {
+            label: "|λ| = 1: stability boundary".into(),
+            points: vec![(lo, 1.0), (hi, 1.0)],
+            style: Style {
+                line: crate::plot::Line::Solid,
+                marker: Marker::None,
+            },
+            color: "#999999",
         },
-        color: "#999999",
-    });
+    );
     [
         Plot {
             title: format!("{name}: gaits against the {}", param_words(&param)),
