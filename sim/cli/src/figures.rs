@@ -492,6 +492,62 @@ mod tests {
         );
     }
 
+    fn walk(points: &[(f64, f64)], failure: Option<(usize, sim::stride::FailureKind)>) -> Walk {
+        Walk {
+            steps_completed: 3,
+            steps: Vec::new(),
+            failure: failure.map(|(step, kind)| sim::walk::WalkFailure {
+                kind,
+                step,
+                t_walk_s: 1.0,
+                detail: String::new(),
+            }),
+            path: points
+                .iter()
+                .map(|&(x, z)| sim::walk::PathSample {
+                    step: 0,
+                    t_walk_s: 0.0,
+                    q: DVector::zeros(1),
+                    qd: DVector::zeros(1),
+                    hip_floor_m: nalgebra::Vector3::new(x, 0.0, z),
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_floor_path_is_true_to_scale_or_says_how_much_it_is_magnified() {
+        let scene = Scene::load("wisse3d").expect("shipped scene");
+        let size = (860.0, 480.0);
+        // 11 m forward, 0.27 m sideways: magnified by a round factor, stated twice.
+        let flat = walk(&[(0.0, -0.1), (5.0, 0.0), (11.0, 0.17)], None);
+        let p = floor_paths(&[(&scene, &flat)], size);
+        let Aspect::Scaled { y_over_x } = p.aspect else {
+            panic!("a scaled aspect")
+        };
+        assert_eq!(y_over_x, 10.0);
+        assert!(
+            p.y_label.contains("×10") && p.caption.as_deref().is_some_and(|c| c.contains("×10"))
+        );
+        let l = p.layout(size.0, size.1);
+        let ppu_x = l.area.w / (l.x_range.1 - l.x_range.0);
+        let ppu_y = l.area.h / (l.y_range.1 - l.y_range.0);
+        assert!((ppu_y / ppu_x - 10.0).abs() < 1e-9);
+        // A path as wide as it is long: true to scale, no magnification mentioned.
+        let square = walk(
+            &[(0.0, 0.0), (1.0, 1.0)],
+            Some((4, sim::stride::FailureKind::FellForward)),
+        );
+        let p = floor_paths(&[(&scene, &square)], size);
+        assert_eq!(p.aspect, Aspect::EQUAL);
+        assert!(p.caption.is_none() && !p.y_label.contains('×'));
+        // The fall is told in words, its step counted from 1.
+        assert_eq!(
+            p.series[0].label,
+            "3D walker with pelvic compensator (falls in step 5: fell forward)"
+        );
+    }
+
     #[test]
     fn state_labels_are_words_with_units() {
         assert_eq!(
