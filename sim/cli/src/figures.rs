@@ -260,9 +260,40 @@ pub fn dense(samples: &[Sample], per_s: f64) -> Vec<Sample> {
     out
 }
 
-/// Every joint coordinate over one step, from that step's recorded `samples` made dense
-/// ([`dense`]); coordinates that stay at zero are left out.
-pub fn joint_angles(scene: &Scene, walker: &Walker, samples: &[Sample]) -> Plot {
+/// `samples` (a stride's recording, which holds the state after each impact) with the state
+/// just before each impact of `events` (`(before, after)` pairs, as
+/// [`sim::stride::StrideResult::event_states`]) inserted before the sample at its time, so that
+/// no interval of [`dense`] ends on a velocity from after an impact.
+pub fn with_pre_impact_states(samples: &[Sample], events: &[(Sample, Sample)]) -> Vec<Sample> {
+    let mut out: Vec<Sample> = Vec::with_capacity(samples.len() + events.len());
+    for s in samples {
+        let at_event = events
+            .iter()
+            .find(|(before, _)| (before.t_s - s.t_s).abs() <= 1e-12 * s.t_s.abs().max(1.0));
+        if let Some((before, _)) = at_event {
+            let already = out
+                .last()
+                .is_some_and(|p| p.t_s == before.t_s && p.qd == before.qd);
+            if !already && s.qd != before.qd {
+                out.push(before.clone());
+            }
+        }
+        out.push(s.clone());
+    }
+    out
+}
+
+/// Every joint coordinate over one step, from that step's recorded `samples` and the states
+/// before and after its impacts (`events`), made dense ([`dense`]); coordinates that stay at
+/// zero are left out.
+pub fn joint_angles(
+    scene: &Scene,
+    walker: &Walker,
+    samples: &[Sample],
+    events: &[(Sample, Sample)],
+) -> Plot {
+    let samples = with_pre_impact_states(samples, events);
+    let samples = &samples[..];
     let duration_s = match (samples.first(), samples.last()) {
         (Some(a), Some(b)) if b.t_s > a.t_s => b.t_s - a.t_s,
         _ => 1.0,
@@ -441,13 +472,37 @@ mod tests {
         for c in &coarse {
             assert!(fine.iter().any(|f| f.t_s == c.t_s && f.q == c.q));
         }
-        // An impact (two samples at one time) is not interpolated across.
-        let mut jump = coarse.clone();
+        // An impact at t = 1 (the rate jumps to 0, as at a knee lock): the recording holds
+        // only the state after it; with the state before it put back, the interval ending at
+        // the impact follows the motion, not a hook towards the new rate.
+        let mut recorded: Vec<Sample> = (0..5).map(|k| s(0.2 * k as f64)).collect();
         let mut after = s(1.0);
-        after.qd[0] = -5.0;
-        jump.push(after);
-        let d = dense(&jump, 100.0);
+        after.qd[0] = 0.0;
+        recorded.push(after.clone());
+        recorded.push(Sample {
+            t_s: 1.2,
+            q: after.q.clone(),
+            qd: after.qd.clone(),
+        });
+        let events = [(s(1.0), after)];
+        let fixed = with_pre_impact_states(&recorded, &events);
+        assert_eq!(fixed.len(), recorded.len() + 1);
+        let d = dense(&fixed, 100.0);
         assert_eq!(d.iter().filter(|p| p.t_s == 1.0).count(), 2);
+        for p in d.iter().filter(|p| p.t_s > 0.8 && p.t_s < 1.0) {
+            assert!(
+                (p.q[0] - p.t_s.sin()).abs() < 2e-5,
+                "{} at {}",
+                p.q[0],
+                p.t_s
+            );
+        }
+        // Without it the last interval bends away from the motion.
+        let hooked = dense(&recorded, 100.0);
+        assert!(hooked
+            .iter()
+            .filter(|p| p.t_s > 0.8 && p.t_s < 1.0)
+            .any(|p| (p.q[0] - p.t_s.sin()).abs() > 1e-3));
     }
 
     #[test]

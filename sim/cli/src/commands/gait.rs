@@ -53,10 +53,10 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let eig = figures::eigenvalues(&scene, walker, g);
         export::write_figure("--plot", dir, "eigenvalues", &eig.to_svg(720.0, 560.0))?;
-        let samples = figures_stride
-            .as_ref()
-            .map_or(&[][..], |r| r.trajectory.as_slice());
-        let ang = figures::joint_angles(&scene, walker, samples);
+        let (samples, events) = figures_stride.as_ref().map_or((&[][..], &[][..]), |r| {
+            (r.trajectory.as_slice(), r.event_states.as_slice())
+        });
+        let ang = figures::joint_angles(&scene, walker, samples, events);
         export::write_figure("--plot", dir, "joint_angles", &ang.to_svg(860.0, 480.0))?;
     }
     if common.json {
