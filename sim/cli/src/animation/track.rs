@@ -44,6 +44,15 @@ pub struct Track {
 /// step's first and last sample, and encodes the figure's key points. `None` for an empty
 /// path.
 pub fn sample(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Option<Track> {
+    let frames = frames(walker, figure, path, fps);
+    if frames.is_empty() {
+        return None;
+    }
+    Some(encode(&frames))
+}
+
+/// The frames of [`sample`], before encoding.
+fn frames(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Vec<Frame> {
     let mut kin = Kinematics::new(&walker.model);
     let hip = &walker.model.points[walker.fall.hip.0];
     let mut frames: Vec<Frame> = Vec::new();
@@ -90,10 +99,7 @@ pub fn sample(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -
             k += 1;
         }
     }
-    if frames.is_empty() {
-        return None;
-    }
-    Some(encode(&frames))
+    frames
 }
 
 fn encode(frames: &[Frame]) -> Track {
@@ -128,5 +134,141 @@ fn encode(frames: &[Frame]) -> Track {
         origin_m: super::base64::encode(&origin),
         rel: super::base64::encode(&rel),
         quantum_m,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::geometry::Part;
+    use super::*;
+    use sim::scene::Scene;
+    use sim::walk::{walk, WalkRequest};
+
+    /// A recorded walk of `steps` steps of `scene` from its gait, with its figure's frames.
+    fn walked(scene: &str, steps: usize) -> (Scene, Walker, sim::walk::Walk, Figure, Vec<Frame>) {
+        let scene = Scene::load(scene).unwrap();
+        let setup = scene.setup().unwrap();
+        let gait = setup.find_gait(&Default::default()).unwrap();
+        let (q, qd) = setup.walker.unpack(&gait.fixed_point);
+        let w = walk(
+            &setup.walker,
+            &q,
+            &qd,
+            WalkRequest::new(&setup.settings, steps).recording(true),
+        );
+        let figure = Figure::of(&scene, &setup.walker.model).unwrap();
+        let f = frames(&setup.walker, &figure, &w.path, 30.0);
+        (scene, setup.walker, w, figure, f)
+    }
+
+    fn key(figure: &Figure, walker: &Walker, point: &str) -> usize {
+        let p = &walker.model.points[walker.model.point_index(point).unwrap().0];
+        figure
+            .points
+            .iter()
+            .position(|k| k.link == p.link && (k.p_link_m - p.p_link_m).norm() < 1e-12)
+            .unwrap()
+    }
+
+    #[test]
+    fn compass_frames_keep_the_legs_and_land_each_foot_on_the_floor() {
+        let (scene, walker, w, figure, f) = walked("compass", 4);
+        assert_eq!(w.steps_completed, 4);
+        let leg = scene.values["leg_length_m"];
+        let (stance, swing, hip) = (
+            key(&figure, &walker, "stance_foot"),
+            key(&figure, &walker, "swing_foot"),
+            key(&figure, &walker, "hip"),
+        );
+        // Time runs forward at 30 frames per second at least, from 0 to the walk's end.
+        assert_eq!(f[0].t_walk_s, 0.0);
+        let end = w.path.last().unwrap().t_walk_s;
+        assert_eq!(f.last().unwrap().t_walk_s, end);
+        assert!(f.len() as f64 >= 30.0 * end);
+        for pair in f.windows(2) {
+            assert!(pair[1].t_walk_s >= pair[0].t_walk_s);
+            assert!(pair[1].t_walk_s - pair[0].t_walk_s <= 1.0 / 30.0 + 1e-12);
+        }
+        for fr in &f {
+            // The true leg length in every frame, interpolated ones included.
+            for foot in [stance, swing] {
+                let l = (fr.points_m[hip] - fr.points_m[foot]).norm();
+                assert!((l - leg).abs() < 1e-9, "leg {l} m at t = {}", fr.t_walk_s);
+            }
+            // The stance foot stays on the floor (slope frame: y = 0).
+            assert!(fr.points_m[stance].y.abs() < 1e-9);
+        }
+        // At each heel strike the swing foot is on the floor and becomes the next stance foot
+        // at the same place: the floor frames compose.
+        for pair in f.windows(2) {
+            if pair[1].step == pair[0].step + 1 {
+                let (a, b) = (&pair[0], &pair[1]);
+                assert_eq!(a.t_walk_s, b.t_walk_s);
+                assert!(a.points_m[swing].y.abs() < 1e-7, "{}", a.points_m[swing].y);
+                assert!((a.points_m[swing] - b.points_m[stance]).norm() < 1e-7);
+                assert!((a.points_m[hip] - b.points_m[hip]).norm() < 1e-7);
+            }
+        }
+        // The walker walks forward, down the slope.
+        assert!(f.last().unwrap().origin_m.x > 0.5);
+    }
+
+    #[test]
+    fn wisse3d_parts_have_the_scene_dimensions_and_encoding_keeps_them() {
+        let (scene, _walker, _w, figure, f) = walked("wisse3d", 2);
+        let v = |k: &str| scene.values[k];
+        let rod = |name: &str| {
+            figure
+                .parts
+                .iter()
+                .find_map(|p| match p {
+                    Part::Rod { name: n, a, b, .. } if n == name => Some((*a, *b)),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        let length = |name: &str, fr: &Frame| {
+            let (a, b) = rod(name);
+            (fr.points_m[a] - fr.points_m[b]).norm()
+        };
+        let track = encode(&f);
+        let rel = decode_i16(&track.rel);
+        for (i, fr) in f.iter().enumerate() {
+            assert!((length("hip axle", fr) - v("hip_width_m")).abs() < 1e-9);
+            assert!((length("swing shank", fr) - v("shank_length_m")).abs() < 1e-9);
+            assert!((length("stance foot", fr) - v("foot_length_m")).abs() < 1e-9);
+            // Decoded positions within half a quantum (and float32 rounding of the origin).
+            for (k, p) in fr.points_m.iter().enumerate() {
+                for c in 0..3 {
+                    let got = f64::from(rel[3 * (i * track.points + k) + c]) * track.quantum_m
+                        + fr.origin_m[c];
+                    assert!((got - p[c]).abs() <= 0.5 * track.quantum_m + 1e-6);
+                }
+            }
+        }
+        assert!(figure.parts.iter().any(|p| matches!(p,
+            Part::Ring { radius_m, .. } if *radius_m == v("pelvic_ring_radius_m"))));
+    }
+
+    /// The inverse of the encoder's base64 of little-endian int16s.
+    fn decode_i16(b64: &str) -> Vec<i16> {
+        let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut bytes = Vec::new();
+        for chunk in b64.as_bytes().chunks(4) {
+            let mut n = 0u32;
+            let mut valid = 0;
+            for &c in chunk {
+                n <<= 6;
+                if c != b'=' {
+                    n |= alphabet.iter().position(|&a| a == c).unwrap() as u32;
+                    valid += 1;
+                }
+            }
+            bytes.extend(&n.to_be_bytes()[1..valid]);
+        }
+        bytes
+            .chunks(2)
+            .map(|b| i16::from_le_bytes([b[0], b[1]]))
+            .collect()
     }
 }
