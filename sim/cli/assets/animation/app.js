@@ -58,8 +58,9 @@ const floor = new THREE.Mesh(
 floor.rotation.x = -Math.PI / 2;
 floor.position.set(cx, -0.0005, cz);
 world.add(floor);
-const grid = new THREE.GridHelper(span, Math.round(span / data.grid_m), 0x9aa3ad, 0xc3c9d0);
-grid.position.set(cx, 0, cz);
+// A grid around the walker, moved in whole metres so its lines stay put on the floor.
+const GRID_SIZE_M = 12;
+const grid = new THREE.GridHelper(GRID_SIZE_M, Math.round(GRID_SIZE_M / data.grid_m), 0x9aa3ad, 0xc3c9d0);
 world.add(grid);
 const pathPositions = new Float32Array(3 * N);
 for (let i = 0; i < N; i++) {
@@ -132,6 +133,7 @@ function pose(frame) {
     }
   }
   pathGeometry.setDrawRange(0, frame + 1);
+  grid.position.set(Math.round(origin[3 * frame]), 0, Math.round(origin[3 * frame + 2]));
   // The camera follows the hip (in world coordinates), keeping the user's view angle.
   const o = 3 * frame;
   const next = world.localToWorld(new THREE.Vector3(origin[o], viewHeight, origin[o + 2]));

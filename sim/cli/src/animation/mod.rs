@@ -93,13 +93,14 @@ struct PageData<'a> {
 impl Animation<'_> {
     /// The title.
     pub fn title(&self) -> String {
-        let steps = self.walk.steps_completed;
+        let n = self.walk.steps_completed;
+        let steps = format!("{n} step{}", if n == 1 { "" } else { "s" });
         let what = match (self.command, &self.walk.failure) {
-            ("gait", _) => format!("{steps} strides of its gait"),
-            ("sil", None) => format!("{steps} steps, firmware in the loop"),
-            ("sil", Some(_)) => format!("{steps} steps, firmware in the loop, then the fall"),
-            (_, None) => format!("{steps} steps"),
-            (_, Some(_)) => format!("{steps} steps, then the fall"),
+            ("gait", _) => format!("{n} strides of its gait"),
+            ("sil", None) => format!("{steps}, firmware in the loop"),
+            ("sil", Some(_)) => format!("{steps}, firmware in the loop, then the fall"),
+            (_, None) => steps,
+            (_, Some(_)) => format!("{steps}, then the fall"),
         };
         format!("{}: {what}", self.scene.name())
     }

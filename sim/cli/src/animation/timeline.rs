@@ -49,8 +49,13 @@ pub fn walk_events(walk: &Walk) -> Vec<Event> {
             t_s: f.t_walk_s,
             kind: "fall",
             side: None,
-            value: format!("{:?}", f.kind),
-            text: format!("step {}: {:?}: {}", f.step + 1, f.kind, f.detail),
+            value: words(&format!("{:?}", f.kind)),
+            text: format!(
+                "step {}: {}: {}",
+                f.step + 1,
+                words(&format!("{:?}", f.kind)),
+                f.detail
+            ),
         });
     }
     sorted(out)
@@ -129,6 +134,18 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
         });
     }
     sorted(out)
+}
+
+/// A type name in words: `FellForward` → `fell forward`.
+fn words(camel: &str) -> String {
+    let mut out = String::new();
+    for c in camel.chars() {
+        if c.is_uppercase() && !out.is_empty() {
+            out.push(' ');
+        }
+        out.extend(c.to_lowercase());
+    }
+    out
 }
 
 fn sorted(mut events: Vec<Event>) -> Vec<Event> {
