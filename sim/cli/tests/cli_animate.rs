@@ -1,6 +1,7 @@
 //! `--animate FILE.html` on `walk`, `gait` and `sil`: a self-contained page, the commands'
 //! other outputs unchanged, bad paths and step counts refused. (The page in a browser:
 //! scripts/browser-tier.)
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::path::PathBuf;
 use std::process::{Command, Output};

@@ -239,3 +239,93 @@ fn role(link_name: &str) -> Role {
         Role::Body
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn figure(scene: &Scene) -> Result<Figure, SceneError> {
+        Figure::of(scene, &scene.setup()?.walker.model)
+    }
+
+    fn names(f: &Figure) -> Vec<&str> {
+        f.parts
+            .iter()
+            .filter_map(|p| match p {
+                Part::Rod { name, .. } | Part::Ring { name, .. } => Some(name.as_str()),
+                Part::Mass { .. } => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_variant_drops_the_shapes_of_the_bodies_it_removes() {
+        let with = figure(&Scene::load("wisse3d").unwrap()).unwrap();
+        let without = figure(&Scene::load("wisse3d-uncompensated").unwrap()).unwrap();
+        assert!(names(&with).contains(&"pelvic ring"));
+        assert!(!names(&without).contains(&"pelvic ring"));
+        assert!(names(&without).contains(&"hip axle"));
+        // Welded freedoms keep their bodies (and shapes).
+        let planar = figure(&Scene::load("wisse2d").unwrap()).unwrap();
+        assert_eq!(names(&planar), names(&with));
+    }
+
+    #[test]
+    fn a_scene_without_shapes_is_its_skeleton_and_its_masses() {
+        let scene = Scene::load("compass").unwrap();
+        let f = figure(&scene).unwrap();
+        let rods = f
+            .parts
+            .iter()
+            .filter(|p| matches!(p, Part::Rod { .. }))
+            .count();
+        // Stance leg (foot to hip) and swing leg (hip to foot).
+        assert_eq!(rods, 2);
+        let masses: Vec<f64> = f
+            .parts
+            .iter()
+            .filter_map(|p| match p {
+                Part::Mass { mass_kg, .. } => Some(*mass_kg),
+                _ => None,
+            })
+            .collect();
+        let v = |k: &str| scene.values[k];
+        let mut expected = vec![v("leg_mass_kg"), v("hip_mass_kg"), v("leg_mass_kg")];
+        expected.sort_by(f64::total_cmp);
+        let mut got = masses.clone();
+        got.sort_by(f64::total_cmp);
+        assert_eq!(got, expected);
+    }
+
+    #[test]
+    fn a_bad_shape_is_refused() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenes/compass.toml"
+        ))
+        .unwrap();
+        for (shape, message) in [
+            (
+                "kind = \"rod\"\nname = \"leg\"\nlink = \"stance_leg\"\nfrom_m = [0, 0, 0]\nto_m = [0, 1, 0]\nradius_m = 0",
+                "not positive",
+            ),
+            (
+                "kind = \"ring\"\nname = \"r\"\nlink = \"stance_leg\"\ncentre_m = [0, 0, 0]\nnormal = [0, 0, 0]\nradius_m = 0.1",
+                "normal is zero",
+            ),
+            (
+                "kind = \"rod\"\nname = \"leg\"\nlink = \"no_such_link\"\nfrom_m = [0, 0, 0]\nto_m = [0, 1, 0]\nradius_m = 0.01",
+                "unknown link",
+            ),
+        ] {
+            let scene = Scene::parse("test", &format!("{text}\n[[shape]]\n{shape}\n")).unwrap();
+            let err = figure(&scene).unwrap_err().to_string();
+            assert!(err.contains(message), "{err}");
+        }
+        // An unknown field is a scene-file error.
+        let typo = format!(
+            "{text}\n[[shape]]\nkind = \"rod\"\nname = \"l\"\nlink = \"stance_leg\"\nfrom_m = [0, 0, 0]\nto_m = [0, 1, 0]\nradius = 0.01\n"
+        );
+        assert!(Scene::parse("test", &typo).is_err());
+    }
+}

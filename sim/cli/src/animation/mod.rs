@@ -108,8 +108,16 @@ impl Animation<'_> {
     /// The page.
     pub fn html(&self) -> Result<String, AnimationError> {
         let figure = geometry::Figure::of(self.scene, &self.walker.model)?;
-        let track = track::sample(self.walker, &figure, &self.walk.path, FRAMES_PER_S)
-            .ok_or(AnimationError::NothingRecorded)?;
+        let mut instants: Vec<f64> = self.events.iter().map(|e| e.t_s).collect();
+        instants.sort_by(f64::total_cmp);
+        let track = track::sample(
+            self.walker,
+            &figure,
+            &self.walk.path,
+            FRAMES_PER_S,
+            &instants,
+        )
+        .ok_or(AnimationError::NothingRecorded)?;
         let g = self.walker.model.gravity_floor_m_s2;
         let title = self.title();
         let data = PageData {

@@ -40,11 +40,17 @@ pub struct Track {
     pub quantum_m: f64,
 }
 
-/// Samples `path` (a recorded walk) at `fps` frames per second of walk time and at each
-/// step's first and last sample, and encodes the figure's key points. `None` for an empty
-/// path.
-pub fn sample(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Option<Track> {
-    let frames = frames(walker, figure, path, fps);
+/// Samples `path` (a recorded walk) at `fps` frames per second of walk time, at each step's
+/// first and last sample and at the walk times `instants_s` (events; sorted), and encodes the
+/// figure's key points. `None` for an empty path.
+pub fn sample(
+    walker: &Walker,
+    figure: &Figure,
+    path: &[PathSample],
+    fps: f64,
+    instants_s: &[f64],
+) -> Option<Track> {
+    let frames = frames(walker, figure, path, fps, instants_s);
     if frames.is_empty() {
         return None;
     }
@@ -52,7 +58,13 @@ pub fn sample(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -
 }
 
 /// The frames of [`sample`], before encoding.
-fn frames(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Vec<Frame> {
+fn frames(
+    walker: &Walker,
+    figure: &Figure,
+    path: &[PathSample],
+    fps: f64,
+    instants_s: &[f64],
+) -> Vec<Frame> {
     let mut kin = Kinematics::new(&walker.model);
     let hip = &walker.model.points[walker.fall.hip.0];
     let mut frames: Vec<Frame> = Vec::new();
@@ -72,15 +84,19 @@ fn frames(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Ve
         }
     };
     let dt = 1.0 / fps;
-    let mut k: u64 = 0;
+    let (mut k, mut e): (u64, usize) = (0, 0);
     let grid = |k: u64| k as f64 * dt;
+    let instant = |e: usize| instants_s.get(e).copied().unwrap_or(f64::INFINITY);
     for (i, s) in path.iter().enumerate() {
         let prev = i.checked_sub(1).map(|j| &path[j]);
         let first_of_step = prev.is_none_or(|p| p.step != s.step);
         let last_of_step = path.get(i + 1).is_none_or(|n| n.step != s.step);
         if let (Some(p), false) = (prev, first_of_step) {
-            while grid(k) < s.t_walk_s {
-                let t = grid(k);
+            // The next grid time before this sample, or the next instant up to it (one at a
+            // step's last sample is that sample's own frame, below).
+            let until_s = |t: f64| t < s.t_walk_s || (t == s.t_walk_s && !last_of_step);
+            while grid(k) < s.t_walk_s || until_s(instant(e)) {
+                let t = grid(k).min(instant(e));
                 let span = s.t_walk_s - p.t_walk_s;
                 let w = if span > 0.0 {
                     ((t - p.t_walk_s) / span).clamp(0.0, 1.0)
@@ -89,7 +105,12 @@ fn frames(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Ve
                 };
                 let q = &p.q * (1.0 - w) + &s.q * w;
                 frames.push(pose(&q, &s.floor, t, s.step));
-                k += 1;
+                if grid(k) <= t {
+                    k += 1;
+                }
+                if instant(e) <= t {
+                    e += 1;
+                }
             }
         }
         if first_of_step || last_of_step {
@@ -97,6 +118,9 @@ fn frames(walker: &Walker, figure: &Figure, path: &[PathSample], fps: f64) -> Ve
         }
         while grid(k) <= s.t_walk_s {
             k += 1;
+        }
+        while instant(e) <= s.t_walk_s {
+            e += 1;
         }
     }
     frames
@@ -157,7 +181,11 @@ mod tests {
             WalkRequest::new(&setup.settings, steps).recording(true),
         );
         let figure = Figure::of(&scene, &setup.walker.model).unwrap();
-        let f = frames(&setup.walker, &figure, &w.path, 30.0);
+        let instants: Vec<f64> = super::super::timeline::walk_events(&w)
+            .iter()
+            .map(|e| e.t_s)
+            .collect();
+        let f = frames(&setup.walker, &figure, &w.path, 30.0, &instants);
         (scene, setup.walker, w, figure, f)
     }
 
@@ -215,7 +243,18 @@ mod tests {
 
     #[test]
     fn wisse3d_parts_have_the_scene_dimensions_and_encoding_keeps_them() {
-        let (scene, _walker, _w, figure, f) = walked("wisse3d", 2);
+        let (scene, _walker, w, figure, f) = walked("wisse3d", 2);
+        // A frame at each event (knee lock, string engagement, heel strike).
+        let events = super::super::timeline::walk_events(&w);
+        assert!(events.iter().any(|e| e.kind == "knee_lock"));
+        for ev in &events {
+            assert!(
+                f.iter().any(|fr| (fr.t_walk_s - ev.t_s).abs() < 1e-12),
+                "no frame at {} s ({})",
+                ev.t_s,
+                ev.text
+            );
+        }
         let v = |k: &str| scene.values[k];
         let rod = |name: &str| {
             figure
