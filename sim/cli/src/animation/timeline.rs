@@ -121,7 +121,7 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
             kind: "command",
             side: None,
             value: command.clone(),
-            text: format!("host sent {command}"),
+            text: format!("host sent {}", command_words(command)),
         });
     }
     for a in &r.sensor_faults_applied {
@@ -134,6 +134,21 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
         });
     }
     sorted(out)
+}
+
+/// A host command as the run's report writes it (`Command(Command { target: Broadcast, kind:
+/// EmergencyStop })`) shortened to `EmergencyStop to Broadcast`; any other form as it is.
+fn command_words(debug: &str) -> String {
+    let target = debug
+        .split_once("target: ")
+        .and_then(|(_, rest)| rest.split(',').next());
+    let kind = debug
+        .split_once("kind: ")
+        .and_then(|(_, rest)| rest.strip_suffix(" })"));
+    match (target, kind) {
+        (Some(target), Some(kind)) => format!("{kind} to {target}"),
+        _ => debug.to_string(),
+    }
 }
 
 /// A type name in words: `FellForward` → `fell forward`.
@@ -151,4 +166,25 @@ fn words(camel: &str) -> String {
 fn sorted(mut events: Vec<Event>) -> Vec<Event> {
     events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
     events
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_read_as_words() {
+        assert_eq!(words("FellForward"), "fell forward");
+        assert_eq!(
+            command_words("Command(Command { target: Broadcast, kind: EmergencyStop })"),
+            "EmergencyStop to Broadcast"
+        );
+        assert_eq!(
+            command_words(
+                "Command(Command { target: Broadcast, kind: GetParam { param: TautAngle } })"
+            ),
+            "GetParam { param: TautAngle } to Broadcast"
+        );
+        assert_eq!(command_words("something else"), "something else");
+    }
 }
