@@ -138,7 +138,7 @@ fn a_path_that_cannot_be_written_is_exit_1_naming_it() {
 }
 
 #[test]
-fn zero_steps_leave_nothing_to_animate() {
+fn zero_steps_or_too_many_are_refused() {
     let page = tmp("zero.html");
     let out = walker(&[
         "walk",
@@ -151,4 +151,16 @@ fn zero_steps_leave_nothing_to_animate() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--animate"));
+    // Too many steps for a page: refused before the walk (which would record every sample).
+    let out = walker(&[
+        "walk",
+        "--scene",
+        "compass",
+        "--steps",
+        "100000",
+        "--animate",
+        page.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 to 2000 steps"));
 }

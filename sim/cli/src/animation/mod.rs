@@ -17,6 +17,10 @@ use sim::walker::Walker;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The most steps a page animates: about 9 kB of page per step of `wisse3d`, and the walk
+/// keeps every integrator sample in memory while it runs.
+pub const MAX_ANIMATED_STEPS: usize = 2_000;
+
 /// Frames per second of walk time.
 pub const FRAMES_PER_S: f64 = 30.0;
 
@@ -154,15 +158,17 @@ pub enum AnimationError {
 }
 
 /// The page file of `--animate PATH` for a run of `steps` steps, created now; `None` without
-/// the option. Zero steps leave nothing to animate: bad input.
+/// the option. Zero steps leave nothing to animate, more than [`MAX_ANIMATED_STEPS`] make too
+/// big a page: bad input.
 pub fn open(path: Option<&Path>, steps: usize) -> anyhow::Result<Option<AnimationFile>> {
     let Some(path) = path else {
         return Ok(None);
     };
-    if steps == 0 {
-        return Err(crate::input_error::InputError::Other(
-            "--animate needs at least one step (--steps)".into(),
-        )
+    if steps == 0 || steps > MAX_ANIMATED_STEPS {
+        return Err(crate::input_error::InputError::Other(format!(
+            "--animate needs 1 to {MAX_ANIMATED_STEPS} steps (the page holds every frame; \
+             the walk records every sample), got --steps {steps}"
+        ))
         .into());
     }
     Ok(Some(AnimationFile::create(path)?))
