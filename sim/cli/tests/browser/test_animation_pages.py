@@ -64,6 +64,10 @@ def test_page_loads_and_shows_the_walker_moving(browser, path):
     state = page.evaluate("({ready: walker.ready, error: walker.error, d: walker.duration_s, n: walker.frames})")
     assert state["error"] is None, state["error"]
     assert state["ready"] and state["d"] > 0 and state["n"] > 1, state
+    # It plays by itself: walk time advances.
+    start = page.evaluate("walker.time()")
+    page.wait_for_timeout(700)
+    assert page.evaluate("walker.time()") > start, "the page does not play"
     t1 = 0.3 * state["d"]
     t2 = t1 + min(0.4, 0.5 * state["d"])
     masks = []
