@@ -117,6 +117,9 @@ pub struct PathSample {
     pub qd: DVector<f64>,
     /// Hip in the floor frame [m].
     pub hip_floor_m: Vector3<f64>,
+    /// The stance frame of its step in the floor frame: maps the sample's link poses
+    /// ([`Kinematics`] of `q`) to the floor frame.
+    pub floor: FloorFrame,
 }
 
 /// What a walk keeps.
@@ -317,6 +320,7 @@ fn path_sample(
         q: s.q.clone(),
         qd: s.qd.clone(),
         hip_floor_m: frame.apply(&kin.position_of(hip.link, &hip.p_link_m)),
+        floor: frame.clone(),
     }
 }
 

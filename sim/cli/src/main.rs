@@ -6,6 +6,7 @@
 //! pipe on standard output ends the command quietly with code 0, any other write error with
 //! code 1 and a message. Each subcommand lives in its own module under [`commands`].
 
+mod animation;
 mod axis;
 mod commands;
 mod export;

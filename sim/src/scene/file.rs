@@ -57,6 +57,52 @@ pub struct SceneFile {
     /// Derived outputs in a publication's own convention.
     #[serde(default)]
     pub convention: Option<ConventionDef>,
+    /// How the bodies look (`walker … --animate`); no effect on the dynamics. A scene
+    /// without shapes is drawn as the skeleton of its links.
+    #[serde(rename = "shape", default)]
+    pub shapes: Vec<ShapeDef>,
+}
+
+/// A drawn part of the walker, fixed in a link (for animations only: masses and inertias
+/// come from the links).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeDef {
+    /// A cylinder between two points of the link (a leg segment, an axle, a flat foot).
+    Rod {
+        /// What it is (`stance thigh`, `hip axle`).
+        name: String,
+        /// The link carrying it.
+        link: String,
+        /// One end in the link frame [m].
+        from_m: [Num; 3],
+        /// The other end in the link frame [m].
+        to_m: [Num; 3],
+        /// Radius [m].
+        radius_m: Num,
+    },
+    /// A thin circular ring (the pelvic ring).
+    Ring {
+        /// What it is.
+        name: String,
+        /// The link carrying it.
+        link: String,
+        /// Centre in the link frame [m].
+        centre_m: [Num; 3],
+        /// Normal of its plane in the link frame (any length but zero).
+        normal: [Num; 3],
+        /// Radius [m].
+        radius_m: Num,
+    },
+}
+
+impl ShapeDef {
+    /// The link that carries the shape.
+    pub fn link(&self) -> &str {
+        match self {
+            ShapeDef::Rod { link, .. } | ShapeDef::Ring { link, .. } => link,
+        }
+    }
 }
 
 /// Scene header.

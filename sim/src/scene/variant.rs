@@ -130,6 +130,10 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             keep
         });
     }
+    // Shapes (drawing only) on removed links go with them.
+    if let Some(shapes) = out.get_mut("shape").and_then(Value::as_array_mut) {
+        shapes.retain(|s| !gone.contains(s.get("link").and_then(Value::as_str).unwrap_or("")));
+    }
     let keep_str =
         |v: &Value, dead: &BTreeSet<String>| v.as_str().is_none_or(|s| !dead.contains(s));
     if let Some(r) = out.get_mut("relabel").and_then(Value::as_table_mut) {

@@ -6,6 +6,7 @@
 
 use super::{print_json, shown};
 use crate::export;
+use crate::animation::{self, timeline, Animation};
 use crate::figures;
 use crate::options::Common;
 use crate::output;
@@ -16,6 +17,7 @@ use sim::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
 use sim::stride::{StrideOptions, StrideRequest, StrideResult};
+use sim::walk::WalkRequest;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -28,17 +30,29 @@ pub struct GaitArgs {
     /// PNG and PDF.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
+    /// Write a self-contained HTML page that plays strides of the gait in 3D
+    /// (docs/animation.md).
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<std::path::PathBuf>,
 }
+
+/// Strides of the gait an animation shows (two of each leg for a mirrored walker).
+const ANIMATED_STRIDES: usize = 4;
 
 /// Runs `walker gait`: exit code 1 if no gait is found.
 pub fn run(args: GaitArgs) -> Result<ExitCode> {
-    let GaitArgs { common, plot } = args;
+    let GaitArgs {
+        common,
+        plot,
+        animate,
+    } = args;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
     // The figures' folder before the gait search: a path that cannot be used fails at once.
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }
+    let animation = animation::open(animate.as_deref(), ANIMATED_STRIDES)?;
     let walker = &setup.walker;
     let sourced = nominal_gait(
         &scene,
@@ -58,6 +72,24 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
         });
         let ang = figures::joint_angles(&scene, walker, samples, events);
         export::write_figure("--plot", dir, "joint_angles", &ang.to_svg(860.0, 480.0))?;
+    }
+    match (animation, &result) {
+        (Some(file), Ok(g)) => {
+            // Strides of the limit cycle: a walk from its fixed point.
+            let (q, qd) = walker.unpack(&g.fixed_point);
+            let request = WalkRequest::new(&setup.settings, ANIMATED_STRIDES).recording(true);
+            let walk = sim::walk::walk(walker, &q, &qd, request);
+            file.write(&Animation {
+                scene: &scene,
+                walker,
+                walk: &walk,
+                command: "gait",
+                events: timeline::walk_events(&walk),
+                firmware: false,
+            })?;
+        }
+        (Some(file), Err(_)) => file.discard(),
+        (None, _) => {}
     }
     if common.json {
         print_json(&report)?;

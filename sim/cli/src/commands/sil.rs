@@ -2,6 +2,7 @@
 //! actuates the walker; its gait is compared with the ideal-actuator gait.
 
 use super::{print_json, shown, walk_exit_code};
+use crate::animation::{self, timeline, Animation};
 use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
@@ -71,6 +72,10 @@ pub struct SilArgs {
     /// string model; the nominal walk falls after 45 steps with it). docs/sil.md.
     #[arg(long, value_name = "MODEL", default_value = "servo")]
     pub actuator: String,
+    /// Write a self-contained HTML page that plays the walk in 3D with the ankle nodes'
+    /// states and the bus events as they happen (docs/animation.md).
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<std::path::PathBuf>,
 }
 
 /// The `walker sil --json` object. `Bus` is the bus statistics' type (the `canbus` crate's,
@@ -128,6 +133,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         keep_steps,
         firmware_params,
         actuator,
+        animate,
     } = args;
     let Some(actuator_choice) = sil::ActuatorChoice::from_name(&actuator) else {
         return Err(InputError::Other(format!(
@@ -147,6 +153,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     if let Some(r) = realtime {
         limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
     }
+    let animation = animation::open(animate.as_deref(), steps)?;
     let scene = common.scene()?;
     let Setup {
         walker,
@@ -229,7 +236,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     // The gait figures average the last 10 steps: keep at least those; keeping more than
     // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
     let options = sim::walk::WalkOptions {
-        record: false,
+        record: animation.is_some(),
         keep_steps: keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
     let walk = match realtime {
@@ -262,6 +269,19 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         InputError::Other(m) => anyhow::anyhow!(m),
         other => anyhow::Error::from(other),
     })?;
+    if let Some(file) = animation {
+        let mut events = timeline::walk_events(&walk);
+        events.extend(timeline::firmware_events(&firmware));
+        events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        file.write(&Animation {
+            scene: &scene,
+            walker: &walker,
+            walk: &walk,
+            command: "sil",
+            events,
+            firmware: true,
+        })?;
+    }
     let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
     for w in &warnings {
         output::note(format_args!("warning: {w}"));

@@ -4,6 +4,7 @@ mod start;
 
 use super::{print_json, walk_exit_code};
 use crate::export;
+use crate::animation::{self, timeline, Animation};
 use crate::figures;
 use crate::input_error::InputError;
 use crate::limits;
@@ -54,6 +55,9 @@ pub struct WalkArgs {
     /// uncompensated one).
     #[arg(long, value_name = "SCENE")]
     pub plot_with: Option<String>,
+    /// Write a self-contained HTML page that plays the walk in 3D (docs/animation.md).
+    #[arg(long, value_name = "FILE.html")]
+    pub animate: Option<std::path::PathBuf>,
 }
 
 /// Runs `walker walk`: exit code 1 if there is no gait to start from, 3 if the walker fell
@@ -69,6 +73,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         out,
         plot,
         plot_with,
+        animate,
     } = args;
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     let scene = common.scene()?;
@@ -78,6 +83,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }
+    let animation = animation::open(animate.as_deref(), steps)?;
     let csv = match &out {
         Some(path) => Some((
             path,
@@ -131,8 +137,8 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         v[i] += d;
     }
     let (q, qd) = walker.unpack(&v);
-    let request =
-        WalkRequest::new(&setup.settings, steps).recording(out.is_some() || plot.is_some());
+    let request = WalkRequest::new(&setup.settings, steps)
+        .recording(out.is_some() || plot.is_some() || animation.is_some());
     let walk = sim::walk::walk(walker, &q, &qd, request);
     if let Some(dir) = &plot {
         let mut walks = vec![(scene.clone(), walk.clone())];
@@ -158,6 +164,16 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     }
     if let Some((path, file)) = csv {
         write_csv(file, walker, &walk).map_err(|e| PathError::new("--out", path, e))?;
+    }
+    if let Some(file) = animation {
+        file.write(&Animation {
+            scene: &scene,
+            walker,
+            walk: &walk,
+            command: "walk",
+            events: timeline::walk_events(&walk),
+            firmware: false,
+        })?;
     }
     let report = WalkReport::new(&scene, &walk);
     if common.json {

@@ -1,0 +1,257 @@
+// The animation page's drawing code. Everything it shows comes from the data the walker
+// binary computed (the key points' floor-frame positions per frame, from the engine's forward
+// kinematics); this file only decodes and draws them. The page API for tests and scripts:
+// window.walker = { ready, error, duration_s, frames, seek(t_s), play(), pause(), time() }.
+import * as THREE from "three";
+
+const data = JSON.parse(document.getElementById("walker-data").textContent);
+const api = window.walker;
+
+function bytes(b64) {
+  const s = atob(b64);
+  const out = new Uint8Array(s.length);
+  for (let i = 0; i < s.length; i++) out[i] = s.charCodeAt(i);
+  return out.buffer;
+}
+// Little-endian arrays (as the binary wrote them; every browser's typed arrays are too).
+const tr = data.track;
+const times = new Float32Array(bytes(tr.t_s));
+const stepOf = new Uint16Array(bytes(tr.step));
+const origin = new Float32Array(bytes(tr.origin_m));
+const rel = new Int16Array(bytes(tr.rel));
+const K = tr.points;
+const N = tr.frames;
+const duration = times[N - 1];
+
+// Scene, lights, camera.
+const canvas = document.getElementById("view");
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xf4f6f8);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x99a0aa, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(2, 5, 3);
+scene.add(sun);
+const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 500);
+const controls = new THREE.OrbitControls(camera, canvas);
+controls.enableDamping = false;
+
+// The floor frame (x forward down the slope, y normal to the floor, z to the right), turned
+// so that gravity points down the screen.
+const world = new THREE.Group();
+world.rotation.z = data.world_rotation_z_rad;
+scene.add(world);
+
+// Floor: a plane and a grid over the walk's extent, and the path of the hip on it.
+let lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
+for (let i = 0; i < N; i++) {
+  lo = [Math.min(lo[0], origin[3 * i]), Math.min(lo[1], origin[3 * i + 2])];
+  hi = [Math.max(hi[0], origin[3 * i]), Math.max(hi[1], origin[3 * i + 2])];
+}
+const span = Math.ceil(Math.max(hi[0] - lo[0], hi[1] - lo[1]) + 16);
+const cx = (lo[0] + hi[0]) / 2, cz = (lo[1] + hi[1]) / 2;
+const floor = new THREE.Mesh(
+  new THREE.PlaneGeometry(span, span),
+  new THREE.MeshStandardMaterial({ color: 0xdfe3e8, side: THREE.DoubleSide, roughness: 1 }),
+);
+floor.rotation.x = -Math.PI / 2;
+floor.position.set(cx, -0.0005, cz);
+world.add(floor);
+// A grid around the walker, moved in whole metres so its lines stay put on the floor.
+const GRID_SIZE_M = 12;
+const grid = new THREE.GridHelper(GRID_SIZE_M, Math.round(GRID_SIZE_M / data.grid_m), 0x9aa3ad, 0xc3c9d0);
+world.add(grid);
+const pathPositions = new Float32Array(3 * N);
+for (let i = 0; i < N; i++) {
+  pathPositions.set([origin[3 * i], 0.001, origin[3 * i + 2]], 3 * i);
+}
+const pathGeometry = new THREE.BufferGeometry();
+pathGeometry.setAttribute("position", new THREE.BufferAttribute(pathPositions, 3));
+world.add(new THREE.Line(pathGeometry, new THREE.LineBasicMaterial({ color: 0x2a9d4a })));
+
+// The walker's parts.
+const colours = { stance: 0x1f5fa8, swing: 0xe07b1a, body: 0x5a5f66 };
+const material = {};
+for (const [role, c] of Object.entries(colours)) {
+  material[role] = new THREE.MeshStandardMaterial({ color: c, roughness: 0.5, metalness: 0.1 });
+}
+const yAxis = new THREE.Vector3(0, 1, 0), zAxis = new THREE.Vector3(0, 0, 1);
+const parts = data.parts.map((p) => {
+  let mesh;
+  if (p.kind === "rod") {
+    mesh = new THREE.Mesh(new THREE.CylinderGeometry(p.radius_m, p.radius_m, 1, 16), material[p.role]);
+  } else if (p.kind === "ring") {
+    const tube = Math.max(0.004, p.radius_m * 0.02);
+    mesh = new THREE.Mesh(new THREE.TorusGeometry(p.radius_m, tube, 10, 96), material[p.role]);
+  } else {
+    const r = p.mass_kg > 0 ? data.mass_sphere_m * Math.cbrt(p.mass_kg) : data.mass_sphere_m * 0.4;
+    mesh = new THREE.Mesh(new THREE.SphereGeometry(r, 20, 14), material[p.role]);
+  }
+  world.add(mesh);
+  return { p, mesh };
+});
+
+const a = new THREE.Vector3(), b = new THREE.Vector3(), d = new THREE.Vector3();
+function point(frame, k, out) {
+  const o = 3 * frame, r = 3 * (frame * K + k), q = tr.quantum_m;
+  return out.set(origin[o] + rel[r] * q, origin[o + 1] + rel[r + 1] * q, origin[o + 2] + rel[r + 2] * q);
+}
+
+// Frame lookup: the last frame at or before t.
+function frameAt(t) {
+  let lo = 0, hi = N - 1;
+  if (t <= times[0]) return 0;
+  if (t >= times[hi]) return hi;
+  while (hi - lo > 1) {
+    const mid = (lo + hi) >> 1;
+    if (times[mid] <= t) lo = mid; else hi = mid;
+  }
+  return lo;
+}
+
+const target = new THREE.Vector3();
+const viewHeight = 0.5 * origin[1];
+function pose(frame) {
+  for (const { p, mesh } of parts) {
+    if (p.kind === "rod") {
+      point(frame, p.a, a);
+      point(frame, p.b, b);
+      d.subVectors(b, a);
+      const len = d.length();
+      mesh.position.addVectors(a, b).multiplyScalar(0.5);
+      mesh.scale.set(1, Math.max(len, 1e-6), 1);
+      if (len > 1e-9) mesh.quaternion.setFromUnitVectors(yAxis, d.normalize());
+    } else if (p.kind === "ring") {
+      point(frame, p.centre, a);
+      point(frame, p.normal_tip, b);
+      mesh.position.copy(a);
+      mesh.quaternion.setFromUnitVectors(zAxis, d.subVectors(b, a).normalize());
+    } else {
+      point(frame, p.at, a);
+      mesh.position.copy(a);
+    }
+  }
+  pathGeometry.setDrawRange(0, frame + 1);
+  grid.position.set(Math.round(origin[3 * frame]), 0, Math.round(origin[3 * frame + 2]));
+  // The camera follows the hip (in world coordinates), keeping the user's view angle.
+  const o = 3 * frame;
+  const next = world.localToWorld(new THREE.Vector3(origin[o], viewHeight, origin[o + 2]));
+  camera.position.add(d.subVectors(next, target));
+  target.copy(next);
+  controls.target.copy(target);
+  controls.update();
+}
+
+// Controls: play/pause, speed, time slider; the overlay: time, step, events, ankle nodes.
+const ui = {
+  play: document.getElementById("play"),
+  speed: document.getElementById("speed"),
+  slider: document.getElementById("time"),
+  clock: document.getElementById("clock"),
+  events: document.getElementById("events"),
+  nodes: document.getElementById("nodes"),
+  banner: document.getElementById("banner"),
+  marks: document.getElementById("marks"),
+};
+ui.slider.max = String(duration);
+let t = 0, playing = true, last = null;
+const events = data.events;
+for (const e of events) {
+  if (!["heel_strike", "fall", "fault", "command", "bus_off", "sensor_fault"].includes(e.kind)) continue;
+  const m = document.createElement("div");
+  m.className = "mark " + e.kind;
+  m.style.left = (100 * Math.min(e.t_s / duration, 1)) + "%";
+  m.title = e.text;
+  ui.marks.appendChild(m);
+}
+
+function overlay(frame) {
+  ui.clock.textContent = `t = ${t.toFixed(3)} s of ${duration.toFixed(3)} s · step ${stepOf[frame] + 1}`;
+  const past = [];
+  const nodes = {};
+  // At the last frame every event has happened (a fall is located just after the last
+  // recorded sample).
+  const until = t >= duration ? Infinity : t + 1e-9;
+  for (const e of events) {
+    if (e.t_s > until) break;
+    past.push(e);
+    if (e.side && (e.kind === "state" || e.kind === "phase")) {
+      nodes[e.side] = nodes[e.side] || { state: "", phase: "" };
+      nodes[e.side][e.kind] = e.value;
+    }
+  }
+  const shown = past.slice(-8).reverse();
+  ui.events.replaceChildren(...shown.map((e, i) => {
+    const li = document.createElement("li");
+    li.className = e.kind + (i === 0 && t - e.t_s < 0.3 ? " fresh" : "");
+    li.textContent = `${e.t_s.toFixed(3)} s  ${e.text}`;
+    return li;
+  }));
+  if (data.firmware) {
+    ui.nodes.replaceChildren(...["Left", "Right"].map((side) => {
+      const n = nodes[side] || { state: "–", phase: "–" };
+      const div = document.createElement("div");
+      div.className = "node " + (n.phase || "").toLowerCase();
+      div.textContent = `${side} ankle: ${n.state || "–"} · ${n.phase || "–"}`;
+      return div;
+    }));
+  }
+  const fall = events.find((e) => e.kind === "fall");
+  ui.banner.textContent = fall && until >= fall.t_s ? `fell at t = ${fall.t_s.toFixed(3)} s: ${fall.value}` : "";
+}
+
+function render() {
+  const frame = frameAt(t);
+  pose(frame);
+  overlay(frame);
+  ui.slider.value = String(t);
+  renderer.render(scene, camera);
+}
+
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+
+function tick(now) {
+  if (playing && last !== null) {
+    t += ((now - last) / 1000) * Number(ui.speed.value);
+    if (t >= duration) { t = duration; setPlaying(false); }
+  }
+  last = now;
+  render();
+  requestAnimationFrame(tick);
+}
+
+function setPlaying(p) {
+  playing = p;
+  ui.play.textContent = p ? "pause" : "play";
+}
+ui.play.addEventListener("click", () => {
+  if (!playing && t >= duration) t = 0;
+  setPlaying(!playing);
+});
+ui.slider.addEventListener("input", () => { t = Number(ui.slider.value); setPlaying(false); render(); });
+window.addEventListener("resize", () => { resize(); render(); });
+
+// Initial view: ahead of the walker and to its right, about 3.3 m away, looking at the
+// middle of its height (the camera follows the hip over the floor, not up and down).
+target.copy(world.localToWorld(new THREE.Vector3(origin[0], viewHeight, origin[2])));
+camera.position.copy(target).add(new THREE.Vector3(2.0, 0.9, 2.3));
+controls.target.copy(target);
+resize();
+
+api.duration_s = duration;
+api.frames = N;
+api.time = () => t;
+api.seek = (s) => { t = Math.min(Math.max(Number(s), 0), duration); setPlaying(false); render(); return frameAt(t); };
+api.play = () => setPlaying(true);
+api.pause = () => setPlaying(false);
+const hash = /^#t=([0-9.]+)$/.exec(window.location.hash);
+if (hash) api.seek(Number(hash[1]));
+render();
+api.ready = true;
+requestAnimationFrame(tick);

@@ -1,0 +1,175 @@
+//! `walker walk|gait|sil … --animate FILE.html`: a self-contained HTML page that plays the
+//! walk in 3D in a browser (three.js inlined; no network when viewed). The binary computes
+//! every drawn point's floor-frame position per frame with the engine's forward kinematics
+//! ([`track`]); the page only draws ([`page`]). docs/animation.md.
+
+mod base64;
+pub mod geometry;
+mod page;
+pub mod timeline;
+pub mod track;
+
+use crate::output::PathError;
+use serde::Serialize;
+use sim::scene::{Scene, SceneError};
+use sim::walk::Walk;
+use sim::walker::Walker;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The most steps a page animates: about 9 kB of page per step of `wisse3d`, and the walk
+/// keeps every integrator sample in memory while it runs.
+pub const MAX_ANIMATED_STEPS: usize = 2_000;
+
+/// Frames per second of walk time.
+pub const FRAMES_PER_S: f64 = 30.0;
+
+/// The page's file, opened before the run so that a path that cannot be written fails at once
+/// (exit code 1, naming `--animate` and the path).
+pub struct AnimationFile {
+    path: PathBuf,
+    file: std::fs::File,
+}
+
+impl AnimationFile {
+    /// Creates (truncates) `path`.
+    pub fn create(path: &Path) -> Result<Self, PathError> {
+        let file = std::fs::File::create(path).map_err(|e| PathError::new("--animate", path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+        })
+    }
+
+    /// Removes the file (nothing to animate: no gait found); a file that cannot be removed
+    /// stays, empty.
+    pub fn discard(self) {
+        drop(self.file);
+        let _ = std::fs::remove_file(&self.path);
+    }
+
+    /// Writes the page of `animation`.
+    pub fn write(self, animation: &Animation<'_>) -> anyhow::Result<()> {
+        let html = animation.html()?;
+        let mut w = std::io::BufWriter::new(self.file);
+        w.write_all(html.as_bytes())
+            .and_then(|()| w.flush())
+            .map_err(|e| PathError::new("--animate", &self.path, e))?;
+        Ok(())
+    }
+}
+
+/// What a page shows: a recorded walk of a scene's walker, and its events.
+pub struct Animation<'a> {
+    /// The scene (its shapes and name).
+    pub scene: &'a Scene,
+    /// The walker that walked.
+    pub walker: &'a Walker,
+    /// The walk, recorded (`WalkRequest::recording(true)`).
+    pub walk: &'a Walk,
+    /// The command that made it, for the title (`walk`, `gait`, `sil`).
+    pub command: &'static str,
+    /// The events shown as they happen.
+    pub events: Vec<timeline::Event>,
+    /// The firmware was in the loop (the page shows the ankle nodes).
+    pub firmware: bool,
+}
+
+/// The page's data.
+#[derive(Serialize)]
+struct PageData<'a> {
+    format: u32,
+    title: &'a str,
+    scene: &'a str,
+    command: &'a str,
+    firmware: bool,
+    /// Turn of the floor frame about its z axis that makes gravity point down [rad].
+    world_rotation_z_rad: f64,
+    /// Floor grid spacing [m].
+    grid_m: f64,
+    /// Radius of the sphere drawn for 1 kg [m].
+    mass_sphere_m: f64,
+    parts: &'a [geometry::Part],
+    track: track::Track,
+    events: &'a [timeline::Event],
+}
+
+impl Animation<'_> {
+    /// The title.
+    pub fn title(&self) -> String {
+        let n = self.walk.steps_completed;
+        let steps = format!("{n} step{}", if n == 1 { "" } else { "s" });
+        let what = match (self.command, &self.walk.failure) {
+            ("gait", _) => format!("{n} strides of its gait"),
+            ("sil", None) => format!("{steps}, firmware in the loop"),
+            ("sil", Some(_)) => format!("{steps}, firmware in the loop, then the fall"),
+            (_, None) => steps,
+            (_, Some(_)) => format!("{steps}, then the fall"),
+        };
+        format!("{}: {what}", self.scene.name())
+    }
+
+    /// The page.
+    pub fn html(&self) -> Result<String, AnimationError> {
+        let figure = geometry::Figure::of(self.scene, &self.walker.model)?;
+        let mut instants: Vec<f64> = self.events.iter().map(|e| e.t_s).collect();
+        instants.sort_by(f64::total_cmp);
+        let track = track::sample(
+            self.walker,
+            &figure,
+            &self.walk.path,
+            FRAMES_PER_S,
+            &instants,
+        )
+        .ok_or(AnimationError::NothingRecorded)?;
+        let g = self.walker.model.gravity_floor_m_s2;
+        let title = self.title();
+        let data = PageData {
+            format: 1,
+            title: &title,
+            scene: self.scene.name(),
+            command: self.command,
+            firmware: self.firmware,
+            // Rz(θ) g points along −y: θ = −atan2(g_x, −g_y) (−slope for a slope's gravity).
+            world_rotation_z_rad: -g.x.atan2(-g.y),
+            grid_m: 0.25,
+            mass_sphere_m: 0.04,
+            parts: &figure.parts,
+            track,
+            events: &self.events,
+        };
+        let json = serde_json::to_string(&data).map_err(AnimationError::Json)?;
+        Ok(page::html(&title, &json))
+    }
+}
+
+/// Why a page could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum AnimationError {
+    /// The scene's shapes are invalid.
+    #[error("--animate: {0}")]
+    Scene(#[from] SceneError),
+    /// The walk recorded no sample (zero steps asked).
+    #[error("--animate: the walk recorded nothing to animate (ask for at least one step)")]
+    NothingRecorded,
+    /// The data could not be serialised (a non-finite number).
+    #[error("--animate: {0}")]
+    Json(#[source] serde_json::Error),
+}
+
+/// The page file of `--animate PATH` for a run of `steps` steps, created now; `None` without
+/// the option. Zero steps leave nothing to animate, more than [`MAX_ANIMATED_STEPS`] make too
+/// big a page: bad input.
+pub fn open(path: Option<&Path>, steps: usize) -> anyhow::Result<Option<AnimationFile>> {
+    let Some(path) = path else {
+        return Ok(None);
+    };
+    if steps == 0 || steps > MAX_ANIMATED_STEPS {
+        return Err(crate::input_error::InputError::Other(format!(
+            "--animate needs 1 to {MAX_ANIMATED_STEPS} steps (the page holds every frame; \
+             the walk records every sample), got --steps {steps}"
+        ))
+        .into());
+    }
+    Ok(Some(AnimationFile::create(path)?))
+}
