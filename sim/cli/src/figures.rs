@@ -565,6 +565,7 @@ mod tests {
                     q: DVector::zeros(1),
                     qd: DVector::zeros(1),
                     hip_floor_m: nalgebra::Vector3::new(x, 0.0, z),
+                    floor: sim::walk::FloorFrame::default(),
                 })
                 .collect(),
         }
