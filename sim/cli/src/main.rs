@@ -8,6 +8,7 @@
 
 mod commands;
 mod figures;
+mod gait_text;
 mod heatmap;
 mod input_error;
 mod limits;

@@ -6,12 +6,19 @@
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 /// A progress bar (or nothing, when silent). Shared between threads: [`Self::tick`] may be
 /// called from any of them.
 pub struct Progress {
     bar: ProgressBar,
     len: u64,
+    /// A bar made with [`Self::after`] that is not drawn yet: drawn from the first tick at or
+    /// after this instant.
+    shown_from: Option<Instant>,
+    /// Whether the delayed bar is already drawn.
+    drawn: AtomicBool,
 }
 
 impl Progress {
@@ -31,12 +38,38 @@ impl Progress {
         } else {
             ProgressBar::hidden()
         };
-        Self { bar, len }
+        Self {
+            bar,
+            len,
+            shown_from: None,
+            drawn: AtomicBool::new(true),
+        }
+    }
+
+    /// As [`Self::new`], but the bar appears only once the work has lasted `delay` (at its
+    /// first tick after that): work that ends sooner leaves the terminal untouched. For walks
+    /// (`walker walk`, `walker sil`), whose length is only known as they go.
+    pub fn after(delay: Duration, len: usize, label: &str, visible: bool) -> Self {
+        let mut p = Self::new(len, label, visible);
+        if !p.bar.is_hidden() {
+            p.bar.set_draw_target(ProgressDrawTarget::hidden());
+            p.shown_from = Instant::now().checked_add(delay);
+            p.drawn = AtomicBool::new(false);
+        }
+        p
     }
 
     /// One more piece done.
     pub fn tick(&self) {
         self.bar.inc(1);
+        if let Some(from) = self.shown_from {
+            if !self.drawn.load(Ordering::Relaxed)
+                && Instant::now() >= from
+                && !self.drawn.swap(true, Ordering::Relaxed)
+            {
+                self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+        }
     }
 
     /// Sets the count done to `fraction` (0 to 1) of the length, for work that reports a
@@ -73,6 +106,15 @@ mod tests {
         assert!(p.bar.is_hidden());
         assert_eq!(p.bar.position(), 5);
         p.finish();
+    }
+
+    #[test]
+    fn a_delayed_silent_bar_stays_hidden_and_counts() {
+        let p = Progress::after(Duration::ZERO, 4, "walk", false);
+        p.tick();
+        p.tick();
+        assert!(p.bar.is_hidden());
+        assert_eq!(p.bar.position(), 2);
     }
 
     #[test]
