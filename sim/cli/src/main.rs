@@ -68,8 +68,11 @@ enum Command {
     /// the walker; compared with the ideal-actuator gait.
     #[command(after_help = WALK_EXIT_CODES)]
     Sil(sil::SilArgs),
-    /// List the scenes and their parameters.
+    /// List the scenes (one line each), or with NAME one scene's parameters (units,
+    /// defaults, ranges).
     Scenes {
+        /// A scene's name (or a scene file's path): show its parameters in full.
+        name: Option<String>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -83,7 +86,7 @@ const WALK_EXIT_CODES: &str = "Exit codes: 0 every step walked; 1 no gait to sta
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Scenes { json } => scenes::run(json),
+        Command::Scenes { name, json } => scenes::run(name.as_deref(), json),
         Command::Gait(args) => gait::run(args),
         Command::Gaits(args) => gaits::run(args),
         Command::Walk(args) => walk::run(args),
