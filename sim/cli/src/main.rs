@@ -17,6 +17,8 @@ mod output;
 mod param_range;
 mod plot;
 mod progress;
+#[cfg(test)]
+mod readme_commands;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
