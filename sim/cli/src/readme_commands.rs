@@ -65,7 +65,9 @@ fn every_walker_command_of_the_readme_parses() {
     // that finds nothing must not pass.
     for needed in ["gait --scene wisse3d", "scenes", "sil --scene wisse3d"] {
         assert!(
-            commands.iter().any(|(_, _, w)| w.join(" ").starts_with(needed)),
+            commands
+                .iter()
+                .any(|(_, _, w)| w.join(" ").starts_with(needed)),
             "no README command `walker {needed} …` found in its code blocks"
         );
     }
@@ -89,7 +91,11 @@ fn a_renamed_flag_fails_and_names_its_line() {
     assert_eq!(commands.len(), 2);
     assert_eq!(commands[0].0, 3);
     assert_eq!(commands[0].2, ["gait", "--scene", "compass", "--json"]);
-    let argv = |w: &[String]| std::iter::once("walker".to_owned()).chain(w.iter().cloned()).collect::<Vec<_>>();
+    let argv = |w: &[String]| {
+        std::iter::once("walker".to_owned())
+            .chain(w.iter().cloned())
+            .collect::<Vec<_>>()
+    };
     assert!(Cli::try_parse_from(argv(&commands[0].2)).is_ok());
     assert_eq!(commands[1].0, 4);
     assert!(Cli::try_parse_from(argv(&commands[1].2)).is_err());
@@ -102,7 +108,10 @@ fn continuations_and_cargo_run_lines_are_read() {
     let words: Vec<String> = commands.iter().map(|c| c.2.join(" ")).collect();
     assert_eq!(
         words,
-        ["gait --scene wisse3d", "sil --scene wisse3d --steps 3 --json"]
+        [
+            "gait --scene wisse3d",
+            "sil --scene wisse3d --steps 3 --json"
+        ]
     );
     assert_eq!(commands[1].0, 3);
 }

@@ -81,12 +81,17 @@ fn print_scene(out: &mut dyn Write, s: &SceneEntry) -> std::io::Result<()> {
             } else {
                 format!("{} (also: {})", p.doc, p.aliases.join(", "))
             };
-            [p.name.clone(), number(p.default), p.unit.clone(), range, doc]
+            [
+                p.name.clone(),
+                number(p.default),
+                p.unit.clone(),
+                range,
+                doc,
+            ]
         })
         .collect();
     let header = ["parameter", "default", "unit", "range", "description"];
-    let width =
-        |i: usize| column_width(header[i], rows.iter().map(|r| r[i].as_str()));
+    let width = |i: usize| column_width(header[i], rows.iter().map(|r| r[i].as_str()));
     let (w0, w1, w2, w3) = (width(0), width(1), width(2), width(3));
     writeln!(
         out,
