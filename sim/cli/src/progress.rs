@@ -25,9 +25,28 @@ impl Progress {
     /// A bar of `len` pieces labelled `label`, shown only when `visible` and standard error is
     /// a terminal (pass `!json`).
     pub fn new(len: usize, label: &str, visible: bool) -> Self {
+        Self::build(len, label, visible, None)
+    }
+
+    /// As [`Self::new`], but the bar appears only once the work has lasted `delay` (at its
+    /// first tick after that): work that ends sooner leaves the terminal untouched. For walks
+    /// (`walker walk`, `walker sil`), whose length is only known as they go.
+    pub fn after(delay: Duration, len: usize, label: &str, visible: bool) -> Self {
+        Self::build(len, label, visible, Some(delay))
+    }
+
+    /// The bar, drawn on standard error at once (`delay` `None`) or from its first tick after
+    /// `delay`, or hidden when not `visible` or standard error is not a terminal.
+    fn build(len: usize, label: &str, visible: bool, delay: Option<Duration>) -> Self {
         let len = u64::try_from(len).unwrap_or(u64::MAX);
-        let bar = if visible && std::io::stderr().is_terminal() {
-            let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+        let shown = visible && std::io::stderr().is_terminal();
+        let bar = if shown {
+            // A delayed bar starts without a target: nothing is drawn before its time.
+            let target = match delay {
+                None => ProgressDrawTarget::stderr(),
+                Some(_) => ProgressDrawTarget::hidden(),
+            };
+            let bar = ProgressBar::with_draw_target(Some(len), target);
             if let Ok(style) = ProgressStyle::with_template(
                 "{msg} [{bar:32}] {pos}/{len} ({elapsed} taken, about {eta} left)",
             ) {
@@ -38,25 +57,15 @@ impl Progress {
         } else {
             ProgressBar::hidden()
         };
+        let shown_from = delay
+            .filter(|_| shown)
+            .and_then(|d| Instant::now().checked_add(d));
         Self {
             bar,
             len,
-            shown_from: None,
-            drawn: AtomicBool::new(true),
+            drawn: AtomicBool::new(shown_from.is_none()),
+            shown_from,
         }
-    }
-
-    /// As [`Self::new`], but the bar appears only once the work has lasted `delay` (at its
-    /// first tick after that): work that ends sooner leaves the terminal untouched. For walks
-    /// (`walker walk`, `walker sil`), whose length is only known as they go.
-    pub fn after(delay: Duration, len: usize, label: &str, visible: bool) -> Self {
-        let mut p = Self::new(len, label, visible);
-        if !p.bar.is_hidden() {
-            p.bar.set_draw_target(ProgressDrawTarget::hidden());
-            p.shown_from = Instant::now().checked_add(delay);
-            p.drawn = AtomicBool::new(false);
-        }
-        p
     }
 
     /// One more piece done.
