@@ -109,22 +109,6 @@ impl ServerConfig {
     }
 }
 
-/// Longest wait for a client that `--wait-client` accepts [s] (a day), in `canbus-demo` and
-/// `walker sil`.
-pub const MAX_WAIT_CLIENT_S: f64 = 86_400.0;
-
-/// The wait for a client that `--wait-client SECONDS` asks for: finite, from 0 to
-/// [`MAX_WAIT_CLIENT_S`]; else a message naming the option and the value. Written once for
-/// `canbus-demo` and `walker sil`.
-pub fn wait_client_timeout(seconds: f64) -> Result<Duration, String> {
-    Some(seconds)
-        .filter(|w| (0.0..=MAX_WAIT_CLIENT_S).contains(w))
-        .and_then(|w| Duration::try_from_secs_f64(w).ok())
-        .ok_or_else(|| {
-            format!("--wait-client {seconds:?}: expected seconds in [0, {MAX_WAIT_CLIENT_S}]")
-        })
-}
-
 /// Server errors.
 #[derive(Debug, Error)]
 pub enum ServerError {
@@ -847,23 +831,6 @@ mod tests {
         assert!(server.publish(&f, 10).is_ok());
         let e = server.publish(&f, 11).unwrap_err();
         assert_eq!((e.origin_ns, e.t_ns), (u64::MAX - 10, 11));
-    }
-
-    #[test]
-    fn wait_client_timeouts_are_bounded() {
-        assert_eq!(wait_client_timeout(0.0), Ok(Duration::ZERO));
-        assert_eq!(wait_client_timeout(2.5), Ok(Duration::from_millis(2500)));
-        assert!(wait_client_timeout(MAX_WAIT_CLIENT_S).is_ok());
-        for bad in [
-            -1.0,
-            -0.0 - 1e-9,
-            f64::NAN,
-            f64::INFINITY,
-            MAX_WAIT_CLIENT_S + 1.0,
-        ] {
-            let e = wait_client_timeout(bad).unwrap_err();
-            assert!(e.contains("--wait-client"), "{e}");
-        }
     }
 
     #[test]

@@ -14,8 +14,9 @@ use anyhow::{bail, Context, Result};
 use canbus::candump::CandumpWriter;
 use canbus::demo::{Demo, TICK_NS};
 use canbus::protocol_ids::check_fault_id;
-use canbus::socketcand::{wait_client_timeout, ServerConfig, SocketcandServer};
+use canbus::socketcand::{ServerConfig, SocketcandServer};
 use canbus::timestamp::stamp_ns;
+use canbus::wait_client::wait_client_timeout;
 use canbus::{BusConfig, BusEvent, FaultSpec, Stuffing};
 use clap::{Parser, ValueEnum};
 
