@@ -5,8 +5,12 @@ Run: scripts/python-venv && .venv/bin/python -m pytest python/
 """
 
 import json
+import logging
 import pathlib
+import socket
 import sys
+import threading
+import time
 
 import can
 import cantools
@@ -155,3 +159,100 @@ def test_identity_and_fault_history_are_decoded_per_node(db):
     assert left["fault_history"][0]["uptime"] == pytest.approx(12.345)
     assert left["command_acks"][0]["result"] == "Done"
     assert mon.summary()["nodes"]["RIGHT_ANKLE"]["identity"] == {}
+
+
+# --- live socketcand: the host row, partial reads, the end of the run -------------------
+
+def test_a_node_without_heartbeats_shows_what_it_sent_not_a_dead_node(db):
+    mon = wm.Monitor(db)
+    cmd = db.get_message_by_name("Command_ALL")
+    data = cmd.encode({s.name: 0 for s in cmd.signals}, strict=False)
+    for t in (0.0, 0.1):
+        mon.feed(can.Message(timestamp=t, arbitration_id=cmd.frame_id, data=data,
+                             is_extended_id=False))
+    s = mon.summary()
+    host = s["nodes"]["HOST"]
+    assert host["sends_heartbeats"] is False
+    assert host["frames_sent"] == 2
+    assert host["messages_sent"] == {"Command_ALL": 2}
+    row = [r for r in wm.render(s).splitlines() if r.startswith("HOST")][0]
+    assert "host without heartbeat" in row and "Command_ALL x2" in row
+    assert "NO" not in row and "None" not in row
+    # a silent ankle is still shown as not alive
+    left = [r for r in wm.render(s).splitlines() if r.startswith("LEFT_ANKLE")][0]
+    assert "NO" in left
+
+
+def test_partial_read_warnings_are_dropped_and_others_kept():
+    f = wm._DropPartialReadWarnings()
+
+    def rec(msg):
+        return logging.LogRecord("can.interfaces.socketcand.socketcand", logging.WARNING,
+                                 __file__, 1, msg, None, None)
+
+    assert not f.filter(rec("Got incomplete message => waiting for more data"))
+    assert f.filter(rec("Invalid Frame: < nonsense >"))
+
+
+def test_connection_closed_tells_the_end_of_the_stream_from_a_quiet_bus():
+    class FakeBus:
+        pass
+
+    a, b = socket.socketpair()
+    bus = FakeBus()
+    setattr(bus, "_SocketCanDaemonBus__socket", a)
+    try:
+        assert not wm.connection_closed(bus)  # open and quiet
+        b.sendall(b"< frame 022 1.0 00 >")
+        assert not wm.connection_closed(bus)  # data waiting
+        a.recv(1024)
+        b.close()
+        assert wm.connection_closed(bus)  # closed by the peer
+    finally:
+        a.close()
+    assert not wm.connection_closed(FakeBus())  # not a socketcand bus
+
+
+def _serve_one_run(listener, frames_text, pieces):
+    """A minimal socketcand server: the handshake python-can expects, then `frames_text` in
+    `pieces` writes (cut inside frames), then it closes the connection."""
+    conn, _ = listener.accept()
+    with conn:
+        conn.sendall(b"< hi >")
+        conn.recv(256)  # < open vcan0 >
+        conn.sendall(b"< ok >")
+        conn.recv(256)  # < rawmode >
+        conn.sendall(b"< ok >")
+        time.sleep(0.2)
+        data = frames_text.encode()
+        step = max(1, len(data) // pieces)
+        for i in range(0, len(data), step):
+            conn.sendall(data[i:i + step])
+            time.sleep(0.02)
+
+
+def test_the_monitor_ends_when_the_server_closes_and_reads_split_frames_quietly(
+        db, capsys, caplog):
+    hb = db.get_message_by_name("Heartbeat_LEFT_ANKLE")
+    payload = hb.encode({s.name: 0 for s in hb.signals}, strict=False).hex().upper()
+    frames = "".join(f"< frame {hb.frame_id:03X} {100 + i * 0.05:.6f} {payload} >"
+                     for i in range(200))
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    port = listener.getsockname()[1]
+    server = threading.Thread(target=_serve_one_run, args=(listener, frames, 37))
+    server.start()
+    t0 = time.monotonic()
+    with caplog.at_level(logging.WARNING):
+        rc = wm.main(["--interface", "socketcand", "--host", "127.0.0.1", "--port", str(port),
+                      "--channel", "vcan0", "--json"])
+    server.join(10)
+    listener.close()
+    assert rc == 0
+    assert time.monotonic() - t0 < 10, "the monitor did not end with the run"
+    out, err = capsys.readouterr()
+    assert json.loads(out)["messages"]["Heartbeat_LEFT_ANKLE"]["count"] == 200
+    assert "closed the connection" in err
+    assert "incomplete message" not in err
+    assert not [r for r in caplog.records if "incomplete message" in r.getMessage()]

@@ -7,7 +7,7 @@ frames, undecodable frames) and the bus load; can record what it sees to a candu
 
     # the simulated bus (canbus-demo or walker sil with --socketcand 127.0.0.1:PORT)
     .venv/bin/python python/walker_monitor.py --interface socketcand --channel vcan0 \
-        --host 127.0.0.1 --port PORT --duration 10
+        --host 127.0.0.1 --port PORT --idle-exit 2   # ends when the run ends
     # the robot
     .venv/bin/python python/walker_monitor.py --interface socketcan --channel can0
     .venv/bin/python python/walker_monitor.py --interface slcan --channel /dev/ttyACM0
@@ -34,8 +34,11 @@ import argparse
 import collections
 import io
 import json
+import logging
 import math
 import pathlib
+import select
+import socket
 import sys
 import time
 from dataclasses import dataclass, field
@@ -50,6 +53,10 @@ import candump_grammar  # noqa: E402
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DEFAULT_DBC = ROOT / "protocol" / "walker.dbc"
 NODES = ("HOST", "LEFT_ANKLE", "RIGHT_ANKLE")
+#: Nodes that need not send heartbeats: the host (a PC, or the simulator's host in `walker sil`,
+#: which sends commands only). Without heartbeats the table shows what they sent instead of a
+#: state; an ankle without heartbeats is shown as not alive.
+HEARTBEAT_OPTIONAL = ("HOST",)
 #: Malformed log lines quoted in `bad_lines` and on stderr; the rest are only counted.
 MAX_QUOTED_LINES = 5
 #: Fault-history entries and command acknowledgements kept per node.
@@ -131,6 +138,8 @@ class NodeStatus:
     identity: dict = field(default_factory=dict)
     fault_history: dict = field(default_factory=dict)
     acks: list = field(default_factory=list)
+    #: Frames this node sent (any message the DBC gives it as sender), by message name.
+    sent: dict = field(default_factory=dict)
 
 
 class Monitor:
@@ -199,6 +208,9 @@ class Monitor:
         st.last = ts
         st.signals = sig
         sender = m.senders[0] if m.senders else None
+        if sender in self.nodes:
+            sent = self.nodes[sender].sent
+            sent[m.name] = sent.get(m.name, 0) + 1
         kind = m.name.split("_", 1)[0]
         if kind == "Heartbeat" and sender in self.nodes:
             n = self.nodes[sender]
@@ -296,6 +308,11 @@ class Monitor:
                 # newest first, as the node numbers them
                 "fault_history": [n.fault_history[k] for k in sorted(n.fault_history)],
                 "command_acks": n.acks,
+                # what the node sent; a node without heartbeats (the simulator's host in
+                # `walker sil`) is shown by these instead of its state
+                "sends_heartbeats": n.heartbeats > 0,
+                "frames_sent": sum(n.sent.values()),
+                "messages_sent": dict(sorted(n.sent.items())),
             }
         return {
             "span_s": span,
@@ -328,14 +345,26 @@ def render(summary: dict) -> str:
         out.write(f"{name:<28}{m['id']:>#6x}{m['count']:>8}{m['rate_hz']:>10.2f}  {last}\n")
     out.write("node         state          alive  heartbeats  faults\n")
     for name, n in s["nodes"].items():
-        out.write(f"{name:<13}{str(n['state']):<15}{'yes' if n['alive'] else 'NO':<7}"
-                  f"{n['heartbeats']:>10}  {','.join(n['faults']) or '-'}\n")
+        out.write(node_row(name, n))
     f = s["faults"]
     out.write(f"fault events {f['events_total']}  error frames {f['error_frames']}  "
               f"unknown ids {f['unknown_ids'] or '-'}  undecodable {f['undecodable']}\n")
     if s.get("malformed_lines"):
         out.write(f"malformed log lines {s['malformed_lines']}\n")
     return out.getvalue()
+
+
+def node_row(name: str, n: dict) -> str:
+    """One node's row of the table: its state, whether it is alive and its faults. The host
+    without heartbeats (the simulator's host in `walker sil` sends commands only) is no
+    heartbeat node: its row shows what it sent instead of a state that would read as dead."""
+    if name not in HEARTBEAT_OPTIONAL or n["heartbeats"] > 0:
+        return (f"{name:<13}{str(n['state']):<15}{'yes' if n['alive'] else 'NO':<7}"
+                f"{n['heartbeats']:>10}  {','.join(n['faults']) or '-'}\n")
+    sent = n.get("messages_sent") or {}
+    what = ", ".join(f"{k} x{v}" for k, v in sent.items()) if sent else "nothing seen"
+    return (f"{name:<13}{'-':<15}{'-':<7}{'-':>10}  host without heartbeat (the simulator's "
+            f"host sends commands only); sent: {what}\n")
 
 
 # --- sources ----------------------------------------------------------------------------
@@ -377,7 +406,47 @@ def read_log(path: Union[str, BinaryIO], bad_lines: list,
               f"{len(bad_lines)} named)", file=sys.stderr)
 
 
-def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float]) -> Iterator[can.Message]:
+class _DropPartialReadWarnings(logging.Filter):
+    """python-can's socketcand interface logs a warning ("Got incomplete message => waiting for
+    more data") whenever one read from the TCP stream ends inside a frame's text. TCP keeps no
+    message boundaries, so that is an ordinary partial read, not an error (the interface keeps
+    the rest and parses it with the next read): these records are dropped, the interface's
+    other warnings kept."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("Got incomplete message")
+
+
+def quiet_partial_reads() -> None:
+    """Installs the filter on python-can's socketcand logger (once)."""
+    logger = logging.getLogger("can.interfaces.socketcand.socketcand")
+    if not any(isinstance(f, _DropPartialReadWarnings) for f in logger.filters):
+        logger.addFilter(_DropPartialReadWarnings())
+
+
+def connection_closed(bus: can.BusABC) -> bool:
+    """Whether a socketcand bus's server closed the connection (the run ended). python-can's
+    socketcand interface reads an empty string then and returns no message, as on a quiet bus;
+    this peeks at its socket: readable with nothing to read is the end of the stream. Other
+    interfaces: False."""
+    sock = getattr(bus, "_SocketCanDaemonBus__socket", None)
+    if not isinstance(sock, socket.socket):
+        return False
+    try:
+        readable, _, _ = select.select([sock], [], [], 0)
+        if not readable:
+            return False
+        return sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+    except (BlockingIOError, InterruptedError):
+        return False
+    except (OSError, ValueError):
+        return True
+
+
+def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float],
+         closed: Optional[list] = None) -> Iterator[can.Message]:
+    """Messages from `bus` until `duration` passed, nothing arrived for `idle_exit` after the
+    first frame, or the server closed the connection (then `closed` gets True appended)."""
     start = time.monotonic()
     last_rx = None
     while True:
@@ -388,6 +457,10 @@ def live(bus: can.BusABC, duration: Optional[float], idle_exit: Optional[float])
             return
         msg = bus.recv(timeout=0.1)
         if msg is None:
+            if connection_closed(bus):
+                if closed is not None:
+                    closed.append(True)
+                return
             time.sleep(0.005)
             continue
         last_rx = time.monotonic()
@@ -510,14 +583,16 @@ def main(argv: Optional[list] = None) -> int:
     stats = ReadStats()
     bus = None
     failed = None
+    closed: list = []
     try:
         if log_file is not None:
             source: Iterable[can.Message] = read_log(log_file, bad_lines, stats)
         else:
+            quiet_partial_reads()
             bus = open_bus(args)
             for m in args.send:
                 bus.send(m)
-            source = live(bus, args.duration, args.idle_exit)
+            source = live(bus, args.duration, args.idle_exit, closed)
         next_print = time.monotonic() + args.interval
         for msg in source:
             if args.log and args.duration is not None and mon.first is not None \
@@ -540,6 +615,8 @@ def main(argv: Optional[list] = None) -> int:
             writer.stop()
         if log_file is not None:
             log_file.close()
+    if closed:
+        print("walker_monitor: the server closed the connection (the run ended)", file=sys.stderr)
     summary = mon.summary()
     summary["bad_lines"] = bad_lines
     summary["malformed_lines"] = stats.malformed

@@ -10,6 +10,7 @@
 //!   connects to it) that serves delivered frames and accepts frames from clients.
 //! * [`spec`] — the `kind:key=value,...` text form of faults, parsed once for every kind.
 //! * [`timestamp`] — origin plus simulated time, checked (a far origin is an error).
+//! * [`wait_client`] — the bound of `--wait-client` (canbus-demo, `walker sil`), checked once.
 //! * [`demo`] — two fake ankle nodes and a host sending the protocol's messages at their
 //!   nominal rates (the `canbus-demo` binary).
 //!
@@ -26,6 +27,7 @@ pub mod rng;
 pub mod socketcand;
 pub mod spec;
 pub mod timestamp;
+pub mod wait_client;
 
 pub use bus::{
     Bus, BusConfig, BusError, BusEvent, BusStats, Delivered, ErrorState, NodeHandle, SendOutcome,

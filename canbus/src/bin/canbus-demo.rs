@@ -16,6 +16,7 @@ use canbus::demo::{Demo, TICK_NS};
 use canbus::protocol_ids::check_fault_id;
 use canbus::socketcand::{ServerConfig, SocketcandServer};
 use canbus::timestamp::stamp_ns;
+use canbus::wait_client::wait_client_timeout;
 use canbus::{BusConfig, BusEvent, FaultSpec, Stuffing};
 use clap::{Parser, ValueEnum};
 
@@ -80,8 +81,6 @@ fn input(msg: String) -> anyhow::Error {
     InputError(msg).into()
 }
 
-/// Longest --wait-client [s] (a day).
-const MAX_WAIT_CLIENT_S: f64 = 86_400.0;
 /// Slowest and fastest --speed other than 0.
 const SPEED_RANGE: (f64, f64) = (1e-3, 1e6);
 /// How long the end of a run waits for socketcand clients to read what is queued.
@@ -163,16 +162,7 @@ fn check(cli: &Cli) -> Result<Checked> {
     }
     let wait_client = match cli.wait_client {
         None => None,
-        Some(w) => Some(
-            Some(w)
-                .filter(|w| (0.0..=MAX_WAIT_CLIENT_S).contains(w))
-                .and_then(|w| Duration::try_from_secs_f64(w).ok())
-                .ok_or_else(|| {
-                    input(format!(
-                        "--wait-client {w:?}: expected seconds in [0, {MAX_WAIT_CLIENT_S}]"
-                    ))
-                })?,
-        ),
+        Some(w) => Some(wait_client_timeout(w).map_err(input)?),
     };
     let end_ns = (cli.seconds * 1e9).round() as u64;
     let origin_ns = origin_ns(&cli.origin)?;

@@ -11,6 +11,7 @@ mod axis;
 mod commands;
 mod export;
 mod figures;
+mod gait_text;
 mod heatmap;
 mod input_error;
 mod labels;
@@ -21,6 +22,8 @@ mod param_range;
 mod plot;
 mod progress;
 mod sweep_figures;
+#[cfg(test)]
+mod readme_commands;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -72,8 +75,11 @@ enum Command {
     /// the walker; compared with the ideal-actuator gait.
     #[command(after_help = WALK_EXIT_CODES)]
     Sil(sil::SilArgs),
-    /// List the scenes and their parameters.
+    /// List the scenes (one line each), or with NAME one scene's parameters (units,
+    /// defaults, ranges).
     Scenes {
+        /// A scene's name (or a scene file's path): show its parameters in full.
+        name: Option<String>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -87,7 +93,7 @@ const WALK_EXIT_CODES: &str = "Exit codes: 0 every step walked; 1 no gait to sta
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Scenes { json } => scenes::run(json),
+        Command::Scenes { name, json } => scenes::run(name.as_deref(), json),
         Command::Gait(args) => gait::run(args),
         Command::Gaits(args) => gaits::run(args),
         Command::Walk(args) => walk::run(args),

@@ -82,3 +82,89 @@ fn python_monitor_decodes_a_running_firmware_in_the_loop_walk() {
         .sum();
     assert!(strikes >= 2, "{}", m["messages"]);
 }
+
+/// The README's live pair: `walker sil --wait-client` waits for the monitor, which then sees
+/// the host's first commands (the host shown by what it sent, not as a dead node), prints no
+/// "Got incomplete message" lines, and ends by itself when the walk ends (no `--duration`).
+#[test]
+fn the_monitor_sees_the_walk_from_its_start_and_ends_with_it() {
+    let venv = PythonVenv::for_test("monitor_watches_sil").unwrap_or_else(|e| panic!("{e}"));
+    let Some(venv) = venv else { return };
+    let mut sim = Command::new(env!("CARGO_BIN_EXE_walker"))
+        .args([
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "3",
+            "--realtime",
+            "1",
+        ])
+        .args([
+            "--socketcand",
+            "127.0.0.1:0",
+            "--wait-client",
+            "60",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(sim.stderr.take().unwrap());
+    let addr: std::net::SocketAddr = announced_address(
+        &mut err,
+        "socketcand: serving the bus on ",
+        Duration::from_secs(60),
+    )
+    .expect("the simulation announces its socketcand address")
+    .parse()
+    .unwrap();
+    let mut monitor = venv
+        .monitor()
+        .args(["--interface", "socketcand", "--channel", "vcan0"])
+        .args([
+            "--host",
+            &addr.ip().to_string(),
+            "--port",
+            &addr.port().to_string(),
+        ])
+        .arg("--json")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // A budget: the walk is about 2.4 s of real time.
+    let t0 = std::time::Instant::now();
+    while monitor.try_wait().unwrap().is_none() {
+        if t0.elapsed() > Duration::from_secs(60) {
+            let _ = monitor.kill();
+            let _ = sim.kill();
+            panic!("the monitor did not end with the walk");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let monitor = monitor.wait_with_output().unwrap();
+    let sim_out = sim.wait_with_output().unwrap();
+    let monitor_err = String::from_utf8_lossy(&monitor.stderr);
+    assert!(monitor.status.success(), "monitor: {monitor_err}");
+    assert!(sim_out.status.success());
+    assert!(
+        monitor_err.contains("closed the connection"),
+        "{monitor_err}"
+    );
+    assert!(!monitor_err.contains("incomplete message"), "{monitor_err}");
+    let m: serde_json::Value = serde_json::from_slice(&monitor.stdout).unwrap();
+    let host = &m["nodes"]["HOST"];
+    assert_eq!(host["sends_heartbeats"], false, "{host}");
+    assert!(
+        host["messages_sent"]["Command_ALL"].as_u64().unwrap_or(0) >= 1,
+        "the monitor missed the host's first commands: {host}"
+    );
+    assert!(
+        m["messages"]["HeelStrike_LEFT_ANKLE"]["count"]
+            .as_u64()
+            .unwrap_or(0)
+            >= 1
+    );
+}

@@ -184,6 +184,12 @@ impl BusSide {
         self.server.as_ref().map(SocketcandServer::local_addr)
     }
 
+    /// Wait until a socketcand client is in rawmode, at most `timeout`: whether one is
+    /// (`None` when no server runs).
+    pub fn wait_for_socketcand_client(&self, timeout: std::time::Duration) -> Option<bool> {
+        self.server.as_ref().map(|s| s.wait_for_client(timeout))
+    }
+
     /// Frames delivered so far.
     pub fn frames_delivered(&self) -> u64 {
         self.frames_delivered

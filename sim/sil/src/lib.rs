@@ -51,6 +51,7 @@ mod tick;
 mod tests;
 
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
+pub use canbus::wait_client::{wait_client_timeout, MAX_WAIT_CLIENT_S};
 pub use config::{ActuatorChoice, HostCommand, SilConfig, SupplyDropInHold, READ_BACK_PARAMS};
 pub use error::SilError;
 /// What the firmware's spool-motor driver set the power stage to.

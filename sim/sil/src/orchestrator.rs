@@ -97,6 +97,13 @@ impl FirmwareInTheLoop {
         self.bus.socketcand_addr()
     }
 
+    /// Wait until a socketcand client is in rawmode (and past its grace time), at most
+    /// `timeout`: whether one is; `None` when no server runs. For `walker sil --wait-client`,
+    /// before the walk starts.
+    pub fn wait_for_socketcand_client(&self, timeout: std::time::Duration) -> Option<bool> {
+        self.bus.wait_for_socketcand_client(timeout)
+    }
+
     /// What `side`'s power stage did in the last tick, with the motor plant
     /// ([`crate::ActuatorChoice::SpoolMotor`]); `None` with the servo.
     pub fn stage_output(&self, side: Side) -> Option<firmware::drivers::spool_motor::StageOutput> {

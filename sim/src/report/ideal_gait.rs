@@ -16,6 +16,8 @@ pub struct IdealGaitRecord {
     pub step_length_m: f64,
     /// Forward speed [m/s].
     pub speed_m_s: f64,
+    /// Work of the ankle actuator per step [J].
+    pub actuator_work_j_per_step: f64,
     /// Actuator work per unit mass and forward distance, under the keys
     /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
     /// `cost_of_transport_j_per_kg_m`.
@@ -38,6 +40,7 @@ impl IdealGaitRecord {
             step_period_s: n.step_period_s,
             step_length_m: n.step_length_m,
             speed_m_s: n.speed_m_s,
+            actuator_work_j_per_step: gait.stride.actuator_work_j,
             cost_of_transport: CostOfTransport { j_per_kg_m: cost },
             progress_m_per_step: n.progress_m,
             heading_change_rad_per_step: gait.stride.heading_change_rad.abs(),

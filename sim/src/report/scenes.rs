@@ -19,6 +19,10 @@ pub struct SceneEntry {
     pub summary: String,
     /// Where the model comes from.
     pub reference: String,
+    /// Degrees of freedom of the walker in single support: its generalised coordinates.
+    pub degrees_of_freedom: usize,
+    /// The generalised coordinates, in the model's order.
+    pub coordinates: Vec<String>,
     /// Its parameters, by name.
     pub parameters: Vec<ParameterEntry>,
 }
@@ -45,30 +49,47 @@ pub struct ParameterEntry {
 impl SceneCatalogue {
     /// The built-in scenes.
     pub fn builtin() -> Result<Self, SceneError> {
-        let mut scenes = Vec::new();
-        for (name, _) in BUILTIN {
-            let s = Scene::load(name)?;
-            let parameters = s
-                .file
-                .parameters
-                .iter()
-                .map(|(k, p)| ParameterEntry {
-                    name: k.clone(),
-                    default: p.default,
-                    unit: p.unit.clone(),
-                    doc: p.doc.clone(),
-                    min: p.min,
-                    max: p.max,
-                    aliases: p.aliases.clone(),
-                })
-                .collect();
-            scenes.push(SceneEntry {
-                name: name.to_string(),
-                summary: s.file.scene.summary.clone(),
-                reference: s.file.scene.reference.clone(),
-                parameters,
-            });
-        }
+        let scenes = BUILTIN
+            .iter()
+            .map(|(name, _)| SceneEntry::of(&Scene::load(name)?))
+            .collect::<Result<_, _>>()?;
         Ok(Self { scenes })
+    }
+}
+
+impl SceneEntry {
+    /// The entry of `scene` (built-in or from a file), its walker built at its defaults to
+    /// count the freedoms.
+    pub fn of(scene: &Scene) -> Result<Self, SceneError> {
+        let parameters = scene
+            .file
+            .parameters
+            .iter()
+            .map(|(k, p)| ParameterEntry {
+                name: k.clone(),
+                default: p.default,
+                unit: p.unit.clone(),
+                doc: p.doc.clone(),
+                min: p.min,
+                max: p.max,
+                aliases: p.aliases.clone(),
+            })
+            .collect();
+        let coordinates: Vec<String> = scene
+            .setup()?
+            .walker
+            .model
+            .coordinates
+            .iter()
+            .map(|c| c.name.clone())
+            .collect();
+        Ok(Self {
+            name: scene.name().to_string(),
+            summary: scene.file.scene.summary.clone(),
+            reference: scene.file.scene.reference.clone(),
+            degrees_of_freedom: coordinates.len(),
+            coordinates,
+            parameters,
+        })
     }
 }

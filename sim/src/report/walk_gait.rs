@@ -21,6 +21,8 @@ pub struct WalkGaitRecord {
     pub progress_m_per_step: f64,
     /// `progress_m_per_step / step_period_s` [m/s].
     pub speed_m_s: f64,
+    /// Mean work of the ankle actuator per step [J] (0 for a passive walker).
+    pub actuator_work_j_per_step: f64,
     /// Actuator work per unit mass and forward distance, under the keys
     /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
     /// `cost_of_transport_j_per_kg_m`.
@@ -66,6 +68,7 @@ impl WalkGaitRecord {
             step_length_m: length,
             progress_m_per_step: progress,
             speed_m_s: progress / period,
+            actuator_work_j_per_step: work,
             cost_of_transport: CostOfTransport { j_per_kg_m: cost },
             heading_change_rad_per_step: mean(&|s| s.heading_change_rad.abs()),
             heading_rad: heading,

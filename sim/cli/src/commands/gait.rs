@@ -8,6 +8,7 @@ use super::{print_json, shown};
 use crate::export;
 use crate::animation::{self, timeline, Animation};
 use crate::figures;
+use crate::gait_text::GaitFigures;
 use crate::options::Common;
 use crate::output;
 use anyhow::Result;
@@ -161,14 +162,12 @@ fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {
     }
     writeln!(
         out,
-        "max |λ| = {:.8} ({}), period {:.6} s, step {:.6} m, speed {:.6} m/s, {} Newton iterations",
+        "max |λ| = {:.8} ({}), {} Newton iterations",
         shown(g.max_abs_eigenvalue),
         if g.stable { "stable" } else { "unstable" },
-        shown(g.step_period_s),
-        shown(g.step_length_m),
-        shown(g.speed_m_s),
         g.newton_iterations,
     )?;
+    GaitFigures::of_found(g).write(out, "")?;
     if let Some(x) = &g.ankle_extension {
         print_ankle_extension(out, x)?;
     }

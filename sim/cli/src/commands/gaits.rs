@@ -63,8 +63,8 @@ fn print_text(out: &mut dyn Write, r: &GaitsReport) -> std::io::Result<()> {
     )?;
     writeln!(
         out,
-        "{:>3} {:>12} {:>10} {:>10} {:>12} {:>9}  fixed point",
-        "#", "period [s]", "step [m]", "speed", "max|λ|", "stable"
+        "{:>3} {:>12} {:>12} {:>10} {:>11} {:>12} {:>9}  fixed point",
+        "#", "period [s]", "progress [m]", "step [m]", "speed [m/s]", "max|λ|", "stable"
     )?;
     for (i, g) in r.gaits.iter().enumerate() {
         let GaitOutcome::Found(g) = &g.outcome else {
@@ -78,9 +78,10 @@ fn print_text(out: &mut dyn Write, r: &GaitsReport) -> std::io::Result<()> {
             .collect();
         writeln!(
             out,
-            "{:>3} {:>12.6} {:>10.6} {:>10.6} {:>12.6} {:>9}  {}",
+            "{:>3} {:>12.6} {:>12.6} {:>10.6} {:>11.6} {:>12.6} {:>9}  {}",
             i + 1,
             shown(g.step_period_s),
+            shown(g.progress_m_per_step),
             shown(g.step_length_m),
             shown(g.speed_m_s),
             shown(g.max_abs_eigenvalue),
@@ -88,5 +89,9 @@ fn print_text(out: &mut dyn Write, r: &GaitsReport) -> std::io::Result<()> {
             fixed.join(" ")
         )?;
     }
-    Ok(())
+    writeln!(
+        out,
+        "progress: distance walked forward per step (speed = progress / period); step: \
+         distance between the feet at heel strike"
+    )
 }

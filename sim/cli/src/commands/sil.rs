@@ -1,12 +1,15 @@
 //! `walker sil`: software in the loop. The ankle firmware (two nodes on a simulated CAN bus)
 //! actuates the walker; its gait is compared with the ideal-actuator gait.
 
+use super::walk::{failure_text, PROGRESS_DELAY};
 use super::{print_json, shown, walk_exit_code};
 use crate::animation::{self, timeline, Animation};
+use crate::gait_text::GaitFigures;
 use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
@@ -46,6 +49,11 @@ pub struct SilArgs {
     /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
     #[arg(long, value_name = "ADDR")]
     pub socketcand: Option<String>,
+    /// With `--socketcand`: before the walk starts, wait up to this long [s] for a client
+    /// (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk starts
+    /// anyway and says so on standard error.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub wait_client: Option<f64>,
     /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor; 0.001 to
     /// 1000); by default it runs as fast as it can.
     #[arg(long, value_name = "FACTOR", allow_negative_numbers = true)]
@@ -129,6 +137,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         estop_at,
         candump,
         socketcand,
+        wait_client,
         realtime,
         keep_steps,
         firmware_params,
@@ -154,6 +163,15 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
     }
     let animation = animation::open(animate.as_deref(), steps)?;
+    let wait_client = match wait_client {
+        None => None,
+        Some(_) if socketcand.is_none() => {
+            return Err(
+                InputError::Other("--wait-client needs --socketcand ADDR".to_owned()).into(),
+            )
+        }
+        Some(w) => Some(sil::wait_client_timeout(w).map_err(InputError::Other)?),
+    };
     let scene = common.scene()?;
     let Setup {
         walker,
@@ -232,6 +250,21 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             "socketcand: serving the bus on {addr} (channel vcan0)"
         ));
     }
+    if let Some(timeout) = wait_client {
+        output::note(format_args!(
+            "socketcand: waiting up to {} s for a client",
+            timeout.as_secs_f64()
+        ));
+        match ctl.wait_for_socketcand_client(timeout) {
+            Some(true) => output::note(format_args!(
+                "socketcand: client connected; the walk starts"
+            )),
+            _ => output::note(format_args!(
+                "socketcand: no client within {} s; the walk starts without one",
+                timeout.as_secs_f64()
+            )),
+        }
+    }
     let (q, qd) = walker.unpack(&ideal.fixed_point);
     // The gait figures average the last 10 steps: keep at least those; keeping more than
     // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
@@ -239,6 +272,8 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         record: animation.is_some(),
         keep_steps: keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
+    let progress = Progress::after(PROGRESS_DELAY, steps, "sil walk (steps)", !common.json);
+    let mut tick = |_: &StepSummary| progress.tick();
     let walk = match realtime {
         None => sim::walk::walk(
             &walker,
@@ -246,7 +281,8 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             &qd,
             WalkRequest::new(&stride_settings, steps)
                 .options(options)
-                .controlled(&mut ctl),
+                .controlled(&mut ctl)
+                .on_step(&mut tick),
         ),
         Some(factor) => {
             // Step by step, sleeping so that walk time keeps pace with wall time.
@@ -258,10 +294,12 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
                 &qd,
                 WalkRequest::new(&stride_settings, steps)
                     .options(options)
-                    .controlled(&mut paced),
+                    .controlled(&mut paced)
+                    .on_step(&mut tick),
             )
         }
     };
+    progress.finish();
     let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
     let steps_kept = &walk.steps[walk.steps.len() - kept..];
     let firmware = ctl.finish().map_err(|e| match candump_error(&candump, e) {
@@ -334,36 +372,25 @@ fn print_text<Bus: Serialize>(
         r.scene, r.steps_completed
     )?;
     if let Some(f) = r.failure {
-        writeln!(
-            out,
-            "failure: {:?} in step {} at t = {:.4} s: {}",
-            f.kind, f.step, f.t_walk_s, f.detail
-        )?;
+        writeln!(out, "failure: {}", failure_text(f))?;
     }
-    // The four figures of each gait; all NaN for a walk without a completed step.
-    let figures =
-        |period: f64, length: f64, speed: f64, cost: f64| [period, length, speed, cost].map(shown);
-    let firmware = r.gait.as_ref().map_or([f64::NAN; 4], |g| {
-        figures(
-            g.step_period_s,
-            g.step_length_m,
-            g.speed_m_s,
-            g.cost_of_transport.j_per_kg_m,
-        )
-    });
-    let i = &r.ideal_gait;
-    let ideal = figures(
-        i.step_period_s,
-        i.step_length_m,
-        i.speed_m_s,
-        i.cost_of_transport.j_per_kg_m,
-    );
-    for (label, [period, length, speed, cost]) in [("firmware", firmware), ("ideal", ideal)] {
-        writeln!(
-            out,
-            "{label:>9}: period {period:.5} s, step {length:.5} m, speed {speed:.5} m/s, cost of transport {cost:.5} J/(kg m)"
-        )?;
+    match &r.gait {
+        Some(g) => {
+            writeln!(
+                out,
+                "firmware's gait, mean over the last {} steps:",
+                g.steps_averaged
+            )?;
+            GaitFigures::of_walk(g, true).write(out, "    ")?;
+        }
+        None => writeln!(out, "firmware's gait: no step completed")?,
     }
+    writeln!(
+        out,
+        "ideal actuator's gait (max |λ| = {:.6}):",
+        shown(r.ideal_gait.max_abs_eigenvalue)
+    )?;
+    GaitFigures::of_ideal(&r.ideal_gait).write(out, "    ")?;
     for (side, n) in r.nodes {
         let p = &n.parameters;
         let shown_opt =

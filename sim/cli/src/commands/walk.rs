@@ -6,13 +6,15 @@ use super::{print_json, walk_exit_code};
 use crate::export;
 use crate::animation::{self, timeline, Animation};
 use crate::figures;
+use crate::gait_text::GaitFigures;
 use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::report::WalkReport;
+use sim::report::{WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::walk::WalkRequest;
 use sim::walker::Walker;
@@ -137,9 +139,13 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         v[i] += d;
     }
     let (q, qd) = walker.unpack(&v);
+    let progress = Progress::after(PROGRESS_DELAY, steps, "walk (steps)", !common.json);
+    let mut tick = |_: &sim::walk::StepSummary| progress.tick();
     let request = WalkRequest::new(&setup.settings, steps)
-        .recording(out.is_some() || plot.is_some() || animation.is_some());
+        .recording(out.is_some() || plot.is_some() || animation.is_some())
+        .on_step(&mut tick);
     let walk = sim::walk::walk(walker, &q, &qd, request);
+    progress.finish();
     if let Some(dir) = &plot {
         let mut walks = vec![(scene.clone(), walk.clone())];
         if let Some(other) = &plot_with {
@@ -179,12 +185,34 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     if common.json {
         print_json(&report)?;
     } else {
-        output::text(|out| print_text(out, &report, steps))?;
+        let gait = WalkGaitRecord::of(walker, &walk, GAIT_STEPS)
+            .map(|g| GaitFigures::of_walk(&g, walker.ankle.is_some()));
+        output::text(|out| print_text(out, &report, steps, gait.as_ref()))?;
     }
     Ok(walk_exit_code(&walk))
 }
 
-fn print_text(out: &mut dyn Write, r: &WalkReport, steps: usize) -> std::io::Result<()> {
+/// Steps the text output's gait figures average over (the last ones), as `walker sil`'s.
+const GAIT_STEPS: usize = 10;
+
+/// A walk that lasts longer than this shows a progress bar (on a terminal, without `--json`).
+pub const PROGRESS_DELAY: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// The legend of the walk table (also in docs/engine.md): the step numbering and what each
+/// column means, `deviation` above all.
+pub const TABLE_LEGEND: &str = "\
+steps are numbered from 1; start_s: walk time at the step's start; length_m: distance between
+the feet at heel strike; deviation: the largest difference (∞-norm) between the state after the
+step and the walk's start state, over every coordinate [rad, m] and rate [rad/s, m/s] of the
+stride map: near 0 while the walker repeats its start state (a gait's fixed point), growing as
+it drifts away from it";
+
+fn print_text(
+    out: &mut dyn Write,
+    r: &WalkReport,
+    steps: usize,
+    gait: Option<&GaitFigures>,
+) -> std::io::Result<()> {
     writeln!(
         out,
         "scene {}: {} of {steps} steps",
@@ -193,23 +221,43 @@ fn print_text(out: &mut dyn Write, r: &WalkReport, steps: usize) -> std::io::Res
     writeln!(
         out,
         "{:>5} {:>10} {:>10} {:>10} {:>12}",
-        "step", "t_s", "period_s", "length_m", "deviation"
+        "step", "start_s", "period_s", "length_m", "deviation"
     )?;
     for s in &r.steps {
         writeln!(
             out,
             "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
-            s.step, s.start_t_walk_s, s.duration_s, s.step_length_m, s.state_deviation
+            s.step + 1,
+            s.start_t_walk_s,
+            s.duration_s,
+            s.step_length_m,
+            s.state_deviation
         )?;
+    }
+    writeln!(out, "{TABLE_LEGEND}")?;
+    if let Some(g) = gait {
+        match r.steps.len().min(GAIT_STEPS) {
+            1 => writeln!(out, "gait of the one step walked:")?,
+            n => writeln!(out, "gait, mean over the last {n} steps:")?,
+        }
+        g.write(out, "    ")?;
     }
     match &r.failure {
         None => writeln!(out, "no failure"),
-        Some(f) => writeln!(
-            out,
-            "failure: {:?} in step {} at t = {:.4} s: {}",
-            f.kind, f.step, f.t_walk_s, f.detail
-        ),
+        Some(f) => writeln!(out, "failure: {}", failure_text(f)),
     }
+}
+
+/// A walk's failure for people: its kind, the step (numbered from 1), the walk time and the
+/// engine's detail. `walker sil` prints it so too.
+pub fn failure_text(f: &sim::walk::WalkFailure) -> String {
+    format!(
+        "{:?} in step {} at t = {:.4} s: {}",
+        f.kind,
+        f.step + 1,
+        f.t_walk_s,
+        f.detail
+    )
 }
 
 /// The walk's trajectory as CSV: step, time, coordinates, rates and the hip-axle centre in the
