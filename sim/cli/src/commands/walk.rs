@@ -3,8 +3,8 @@
 mod start;
 
 use super::{print_json, walk_exit_code};
-use crate::export;
 use crate::animation::{self, timeline, Animation};
+use crate::export;
 use crate::figures;
 use crate::gait_text::GaitFigures;
 use crate::input_error::InputError;
