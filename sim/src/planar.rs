@@ -359,6 +359,81 @@ impl PlanarTree {
         self.springs.get(c).map_or(0.0, |s| s.2)
     }
 
+    /// Whether the tree has infinitesimal bodies (the vanishing-mass limit).
+    pub fn has_infinitesimal(&self) -> bool {
+        self.has_infinitesimal
+    }
+
+    /// Number of links (welds included).
+    pub fn link_count(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Link `i`'s parent slot (0: the ground, link `j`: `j + 1`) and the coordinate its joint
+    /// owns with the sign of its axis along z (`None`: a weld).
+    pub fn link_joint(&self, i: usize) -> Option<(usize, Option<(usize, f64)>)> {
+        self.links.get(i).map(|l| (l.parent_slot, l.coordinate))
+    }
+
+    /// The mass matrix `M̄` at `q` (finite bodies; for the impacts of a fixed-size stride).
+    pub fn mass_matrix<const N: usize>(&self, q: &SVector<f64, N>) -> SMatrix<f64, N, N> {
+        self.assemble::<N>(q, &SVector::zeros()).m
+    }
+
+    /// The whole tree's mass [kg] and the Jacobian of its linear momentum `Σ m Jv` (x and y
+    /// rows) at `q`: the coupling of a translation of the root with the coordinates (finite
+    /// bodies).
+    pub fn momentum_jacobian<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+    ) -> (f64, SMatrix<f64, 2, N>) {
+        let fr = self.frames(q, &SVector::zeros());
+        let mut total = 0.0;
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        for body in self.bodies.iter().filter(|b| !b.infinitesimal) {
+            total += body.mass_kg;
+            let (p, _) = fr[body.slot].point(body.com_xy_m);
+            for &(c, slot, sign) in &body.chain[..body.chain_len] {
+                let o = fr[slot].origin_m;
+                if c < N {
+                    jac[(0, c)] -= body.mass_kg * sign * (p[1] - o[1]);
+                    jac[(1, c)] += body.mass_kg * sign * (p[0] - o[0]);
+                }
+            }
+        }
+        (total, jac)
+    }
+
+    /// The Jacobian (x and y rows) of the point `p_link_m` fixed in link `link` (model index)
+    /// at the frames `fr`: column `c` is `sign · z × (p − o)` for each joint up the chain.
+    pub fn point_jacobian<const N: usize>(
+        &self,
+        fr: &[LinkFrame; MAX_LINKS + 1],
+        link: usize,
+        p_link_m: [f64; 2],
+    ) -> SMatrix<f64, 2, N> {
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        let Some(frame) = fr.get(link + 1) else {
+            return jac;
+        };
+        let (p, _) = frame.point(p_link_m);
+        let mut cur = link;
+        while let Some(l) = self.links.get(cur) {
+            if let Some((c, sign)) = l.coordinate {
+                let o = fr[cur + 1].origin_m;
+                if c < N {
+                    jac[(0, c)] = -sign * (p[1] - o[1]);
+                    jac[(1, c)] = sign * (p[0] - o[0]);
+                }
+            }
+            match l.parent_slot {
+                0 => break,
+                s => cur = s - 1,
+            }
+        }
+        jac
+    }
+
     /// Every link's frame at `q`, `q̇` (for the witnesses of a fixed-size stride): slot 0 is
     /// the ground, link `i` of the model slot `i + 1`.
     pub fn frames<const N: usize>(

@@ -32,7 +32,7 @@ fn noise(k: &mut u64) -> f64 {
 }
 
 /// Largest difference between two strides: heel-strike state, next state, stride time, event
-/// times (the events' names must be the same).
+/// times and states, step, lift velocity, impact loss (the events' names must be the same).
 fn difference(a: &StrideResult, b: &StrideResult) -> f64 {
     let names = |r: &StrideResult| r.events.iter().map(|e| e.name.clone()).collect::<Vec<_>>();
     assert_eq!(names(a), names(b));
@@ -47,6 +47,9 @@ fn difference(a: &StrideResult, b: &StrideResult) -> f64 {
     for ((x0, x1), (y0, y1)) in a.event_states.iter().zip(&b.event_states) {
         d = d.max((&x0.q - &y0.q).amax()).max((&x1.qd - &y1.qd).amax());
     }
+    d = d.max((a.step_m - b.step_m).amax());
+    d = d.max((a.lift_velocity_m_s - b.lift_velocity_m_s).abs());
+    d = d.max((a.heading_change_rad - b.heading_change_rad).abs());
     d.max((a.impact_energy_loss_j - b.impact_energy_loss_j).abs())
 }
 
@@ -119,6 +122,7 @@ fn strides_from_perturbed_starts_equal_the_general_loop() {
              fast − general engine {worst_general:e}"
         );
         assert!(compared >= 12, "{name}: {compared}");
+        // The same loop and evaluation: equal but for the heel strike's rounding.
         assert!(worst_loop < 1e-12, "{name}: {worst_loop:e}");
         assert!(worst_general < 1e-11, "{name}: {worst_general:e}");
     }
@@ -198,9 +202,10 @@ fn gaits_equal_the_general_loop() {
             .fold(0.0f64, f64::max);
         eprintln!("{name}: fixed point {fp:e}, eigenvalues {ev:e}");
         assert!(fp < 1e-12, "{name}: {fp:e}");
-        // Replayed schedules: the perturbed strides differ from the general loop's by
-        // rounding (1e-15), divided by the difference step 1e-6.
-        assert!(ev < 1e-8, "{name}: {ev:e}");
+        // The fixed-size heel strike (closed-form relabelling, one KKT solve) differs from the
+        // general one by rounding (1e-14): the central differences (δ = 1e-6) move the
+        // eigenvalues by about 1e-14 / 1e-6 · |J|, their own noise (docs/accuracy.md).
+        assert!(ev < 1e-7, "{name}: {ev:e}");
         let _ = DVector::<f64>::zeros(0);
     }
 }

@@ -15,6 +15,7 @@
 //! the general loop, which runs it again from its start ([`Outcome::Fallback`]).
 
 mod dop853;
+mod heel_strike;
 mod run;
 mod witness;
 

@@ -4,6 +4,7 @@
 //! mirrors; anything else is a fallback.
 
 use super::dop853::{FixedDop853, FixedSystem, State};
+use super::heel_strike::heel_strike;
 use super::witness::PlanarWitnesses;
 use super::Outcome;
 use crate::dynamics::{Dynamics, DynamicsError};
@@ -17,7 +18,7 @@ use crate::stride::request::StrideOptions;
 use crate::stride::schedule::{Schedule, ScheduleCursor};
 use crate::stride::settings::StrideSettings;
 use crate::stride::witnesses::{Watch, WitnessValues};
-use crate::stride::{StrideEvent, StrideFailure, StrideResult};
+use crate::stride::{ContactSummary, StrideEvent, StrideFailure, StrideResult};
 use crate::walker::Walker;
 use nalgebra::{DVector, SVector};
 
@@ -459,9 +460,27 @@ impl<const N: usize> Run<'_, N> {
         }
         self.evaluations += self.integrator.evaluations();
         let events = std::mem::take(&mut self.events);
-        let r = w
-            .finish_stride(at_s, &active, events, self.energy_loss_j)
-            .map(|mut r| {
+        let r = match heel_strike::<N>(w, self.tree, at, &active) {
+            Some(h) => Ok(StrideResult {
+                q_next: h.q_next,
+                qd_next: h.qd_next,
+                duration_s: at.t_s,
+                step_m: h.step_m,
+                heading_change_rad: 0.0,
+                events,
+                pre_impact: at_s,
+                lift_velocity_m_s: h.lift_velocity_m_s,
+                impact_energy_loss_j: self.energy_loss_j + h.energy_loss_j,
+                evaluations: 0,
+                trajectory: Vec::new(),
+                event_states: Vec::new(),
+                actuator_work_j: 0.0,
+                damping_dissipation_j: 0.0,
+                contact: ContactSummary::default(),
+            }),
+            None => w.finish_stride(at_s, &active, events, self.energy_loss_j),
+        };
+        let r = r.map(|mut r| {
                 r.event_states = std::mem::take(&mut self.event_states);
                 r.evaluations = self.evaluations;
                 r.damping_dissipation_j = self.dissipation_j;
