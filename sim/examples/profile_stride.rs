@@ -17,7 +17,10 @@ fn main() {
         _ => {}
     }
     if let Some(rtol) = args.next().and_then(|s| s.parse().ok()) {
-        let i = setup.settings.integrator.with_tolerance_or_step(Some(rtol), None);
+        let i = setup
+            .settings
+            .integrator
+            .with_tolerance_or_step(Some(rtol), None);
         setup.settings = setup.settings.with_integrator(i);
     }
     let g = setup.find_gait(&Default::default()).expect("gait");

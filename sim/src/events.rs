@@ -101,13 +101,7 @@ pub fn locate(
     };
     let (guess, slope) = match dense {
         Some(d) => {
-            let (t, slope) = root_on_dense(
-                |t| g(&d.eval(t)),
-                (a.t_s, ga),
-                (b.t_s, gb),
-                d.h_s,
-                tol,
-            );
+            let (t, slope) = root_on_dense(|t| g(&d.eval(t)), (a.t_s, ga), (b.t_s, gb), d.h_s, tol);
             (t, Some(slope))
         }
         None => (root_on_hermite(a, b, ga, g, tol), None),

@@ -133,7 +133,10 @@ impl LinkFrame {
         let w = self.omega_rad_s;
         (
             [self.origin_m[0] + r[0], self.origin_m[1] + r[1]],
-            [self.velocity_m_s[0] - w * r[1], self.velocity_m_s[1] + w * r[0]],
+            [
+                self.velocity_m_s[0] - w * r[1],
+                self.velocity_m_s[1] + w * r[0],
+            ],
         )
     }
 }

@@ -8,7 +8,9 @@ use nalgebra::DVector;
 use sim::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::planar::EvaluationPath;
 use sim::scene::{Scene, Setup};
-use sim::stride::{StepSchedule, Schedule, StrideOptions, StrideRequest, StrideResult, StrideSettings};
+use sim::stride::{
+    Schedule, StepSchedule, StrideOptions, StrideRequest, StrideResult, StrideSettings,
+};
 
 /// The scenes the fixed-size stride covers.
 const COVERED: [&str; 3] = ["compass", "simplest", "kneed2d"];
@@ -58,23 +60,40 @@ fn the_covered_scenes_take_it_and_the_others_do_not() {
     for name in COVERED {
         let s = setup(name);
         let w = &s.walker;
-        assert!(w.takes_fixed_size_stride(&s.settings, StrideOptions::default()), "{name}");
+        assert!(
+            w.takes_fixed_size_stride(&s.settings, StrideOptions::default()),
+            "{name}"
+        );
         for path in [EvaluationPath::General, EvaluationPath::GeneralLoop] {
-            assert!(!w.takes_fixed_size_stride(&with_path(&s.settings, path), StrideOptions::default()));
+            assert!(
+                !w.takes_fixed_size_stride(&with_path(&s.settings, path), StrideOptions::default())
+            );
         }
-        let contact = StrideOptions { contact: true, ..Default::default() };
+        let contact = StrideOptions {
+            contact: true,
+            ..Default::default()
+        };
         assert!(!w.takes_fixed_size_stride(&s.settings, contact), "{name}");
-        let dopri = s.settings.with_integrator(sim::integrators::IntegratorChoice::Dopri5 {
-            rtol: 1e-10,
-            atol: 1e-10,
-            h_max_s: 0.05,
-        });
-        assert!(!w.takes_fixed_size_stride(&dopri, StrideOptions::default()), "{name}");
+        let dopri = s
+            .settings
+            .with_integrator(sim::integrators::IntegratorChoice::Dopri5 {
+                rtol: 1e-10,
+                atol: 1e-10,
+                h_max_s: 0.05,
+            });
+        assert!(
+            !w.takes_fixed_size_stride(&dopri, StrideOptions::default()),
+            "{name}"
+        );
     }
     // The ankle string (wisse2d) and the 3D walker are left to the general loop.
     for name in ["wisse2d", "wisse3d"] {
         let s = setup(name);
-        assert!(!s.walker.takes_fixed_size_stride(&s.settings, StrideOptions::default()), "{name}");
+        assert!(
+            !s.walker
+                .takes_fixed_size_stride(&s.settings, StrideOptions::default()),
+            "{name}"
+        );
     }
 }
 
@@ -98,7 +117,11 @@ fn strides_from_perturbed_starts_equal_the_general_loop() {
                 qd[c.0] += 5.0 * scale * noise(&mut seed);
             }
             for rtol in [1e-12, 1e-10, 1e-8] {
-                let fast = s.settings.with_integrator(s.settings.integrator.with_tolerance_or_step(Some(rtol), None));
+                let fast = s.settings.with_integrator(
+                    s.settings
+                        .integrator
+                        .with_tolerance_or_step(Some(rtol), None),
+                );
                 let general_loop = with_path(&fast, EvaluationPath::GeneralLoop);
                 let general = with_path(&fast, EvaluationPath::General);
                 let a = w.stride(&q, &qd, StrideRequest::new(&fast));
@@ -108,12 +131,19 @@ fn strides_from_perturbed_starts_equal_the_general_loop() {
                     (Ok(a), Ok(b), Ok(c)) => {
                         worst_loop = worst_loop.max(difference(&a, &b));
                         worst_general = worst_general.max(difference(&a, &c));
-                        assert_eq!(a.evaluations, b.evaluations, "{name} trial {trial} {rtol:e}");
+                        assert_eq!(
+                            a.evaluations, b.evaluations,
+                            "{name} trial {trial} {rtol:e}"
+                        );
                         assert_eq!(a.damping_dissipation_j, b.damping_dissipation_j);
                         compared += 1;
                     }
                     (Err(a), Err(b), _) => assert_eq!(a.kind, b.kind, "{name}"),
-                    (a, b, _) => panic!("{name} trial {trial}: fast {:?} against {:?}", a.err(), b.err()),
+                    (a, b, _) => panic!(
+                        "{name} trial {trial}: fast {:?} against {:?}",
+                        a.err(),
+                        b.err()
+                    ),
                 }
             }
         }
@@ -136,24 +166,59 @@ fn schedules_and_recorded_samples_equal_the_general_loop() {
         let reference = with_path(&s.settings, EvaluationPath::GeneralLoop);
         let (q, qd) = (&s.guess.q, &s.guess.qd);
         let (mut ra, mut rb) = (StepSchedule::default(), StepSchedule::default());
-        let a = w.stride(q, qd, StrideRequest::new(&s.settings).schedule(Schedule::Record(&mut ra)).recording()).unwrap();
-        let b = w.stride(q, qd, StrideRequest::new(&reference).schedule(Schedule::Record(&mut rb)).recording()).unwrap();
+        let a = w
+            .stride(
+                q,
+                qd,
+                StrideRequest::new(&s.settings)
+                    .schedule(Schedule::Record(&mut ra))
+                    .recording(),
+            )
+            .unwrap();
+        let b = w
+            .stride(
+                q,
+                qd,
+                StrideRequest::new(&reference)
+                    .schedule(Schedule::Record(&mut rb))
+                    .recording(),
+            )
+            .unwrap();
         assert_eq!(ra.phases.len(), rb.phases.len(), "{name}");
         for (x, y) in ra.phases.iter().zip(&rb.phases) {
             assert_eq!(x.len(), y.len(), "{name}");
-            let d = x.iter().zip(y).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max);
+            let d = x
+                .iter()
+                .zip(y)
+                .map(|(u, v)| (u - v).abs())
+                .fold(0.0, f64::max);
             assert!(d < 1e-14, "{name}: steps {d:e}");
         }
         assert_eq!(a.trajectory.len(), b.trajectory.len(), "{name}");
         assert!(a.trajectory.len() > 5);
         for (x, y) in a.trajectory.iter().zip(&b.trajectory) {
-            assert!((x.t_s - y.t_s).abs() < 1e-13 && (&x.q - &y.q).amax() < 1e-12, "{name}");
+            assert!(
+                (x.t_s - y.t_s).abs() < 1e-13 && (&x.q - &y.q).amax() < 1e-12,
+                "{name}"
+            );
         }
         // Replayed from a perturbed start, as the stride Jacobian does.
         let mut qp = q.clone();
         qp[0] += 1e-6;
-        let c = w.stride(&qp, qd, StrideRequest::new(&s.settings).schedule(Schedule::Replay(&ra))).unwrap();
-        let d = w.stride(&qp, qd, StrideRequest::new(&reference).schedule(Schedule::Replay(&ra))).unwrap();
+        let c = w
+            .stride(
+                &qp,
+                qd,
+                StrideRequest::new(&s.settings).schedule(Schedule::Replay(&ra)),
+            )
+            .unwrap();
+        let d = w
+            .stride(
+                &qp,
+                qd,
+                StrideRequest::new(&reference).schedule(Schedule::Replay(&ra)),
+            )
+            .unwrap();
         let diff = difference(&c, &d);
         assert!(diff < 1e-13, "{name}: replayed {diff:e}");
     }
@@ -168,13 +233,25 @@ fn a_fall_is_handed_back_to_the_general_loop() {
     let mut qd = s.guess.qd.clone();
     qd *= -1.0;
     let reference = with_path(&s.settings, EvaluationPath::GeneralLoop);
-    let a = w.stride(&s.guess.q, &qd, StrideRequest::new(&s.settings)).unwrap_err();
-    let b = w.stride(&s.guess.q, &qd, StrideRequest::new(&reference)).unwrap_err();
+    let a = w
+        .stride(&s.guess.q, &qd, StrideRequest::new(&s.settings))
+        .unwrap_err();
+    let b = w
+        .stride(&s.guess.q, &qd, StrideRequest::new(&reference))
+        .unwrap_err();
     assert_eq!(a, b);
     // A recorded sink keeps the general loop's samples only.
     let (mut sa, mut sb) = (Vec::new(), Vec::new());
-    let _ = w.stride(&s.guess.q, &qd, StrideRequest::new(&s.settings).recording().sink(&mut sa));
-    let _ = w.stride(&s.guess.q, &qd, StrideRequest::new(&reference).recording().sink(&mut sb));
+    let _ = w.stride(
+        &s.guess.q,
+        &qd,
+        StrideRequest::new(&s.settings).recording().sink(&mut sa),
+    );
+    let _ = w.stride(
+        &s.guess.q,
+        &qd,
+        StrideRequest::new(&reference).recording().sink(&mut sb),
+    );
     assert_eq!(sa, sb);
     assert!(!sa.is_empty());
 }

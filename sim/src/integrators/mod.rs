@@ -11,8 +11,8 @@ mod meijaard;
 mod rk4;
 
 pub use dense::{DenseCoefficients, DenseOutput};
-pub use dop853::{Dop853, Dop853Pair};
 pub(crate) use dop853::{combined_error, component_error};
+pub use dop853::{Dop853, Dop853Pair};
 pub use dopri5::{Dopri5, Dopri5Pair};
 pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
 pub use meijaard::{Meijaard, StabilityLimit};

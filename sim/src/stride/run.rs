@@ -62,9 +62,18 @@ impl Walker {
                 Schedule::Record(s) => Schedule::Record(s),
                 Schedule::Replay(s) => Schedule::Replay(s),
             };
-            match super::fast::stride(self, &tree, settings, options, fast_schedule, trajectory, q0, qd0) {
+            match super::fast::stride(
+                self,
+                &tree,
+                settings,
+                options,
+                fast_schedule,
+                trajectory,
+                q0,
+                qd0,
+            ) {
                 Outcome::Done(r) => {
-                    let mut r = r?;
+                    let mut r = (*r)?;
                     if keep_in_result {
                         r.trajectory = own;
                     }

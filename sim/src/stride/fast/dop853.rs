@@ -283,9 +283,7 @@ impl<const N: usize> FixedDop853<N> {
         to: &State<N>,
     ) -> Option<Result<Dense<N>, IntegrationError>> {
         let last = self.last;
-        let same = last.valid
-            && last.from == *from
-            && last.from.t_s + last.h_s == to.t_s;
+        let same = last.valid && last.from == *from && last.from.t_s + last.h_s == to.t_s;
         same.then(|| self.build_dense(sys, &last))
     }
 

@@ -30,16 +30,18 @@ pub(super) struct Relabelled {
 /// Whether the walker's heel strike is one this module covers.
 fn covered(walker: &Walker, tree: &PlanarTree) -> bool {
     let hs = &walker.heel_strike;
-    let axis = |k: &JointKind, x: f64, y: f64| {
-        matches!(k, JointKind::Prismatic { axis_parent } if axis_parent.x == x && axis_parent.y == y && axis_parent.z == 0.0)
-    };
-    let release_xy = hs.release.len() == 2
-        && axis(&hs.release[0], 1.0, 0.0)
-        && axis(&hs.release[1], 0.0, 1.0);
-    let rows = hs
-        .constraints
-        .iter()
-        .all(|c| matches!(c, ContactConstraint::X | ContactConstraint::Y | ContactConstraint::Z | ContactConstraint::Yaw));
+    let axis = |k: &JointKind, x: f64, y: f64| matches!(k, JointKind::Prismatic { axis_parent } if axis_parent.x == x && axis_parent.y == y && axis_parent.z == 0.0);
+    let release_xy =
+        hs.release.len() == 2 && axis(&hs.release[0], 1.0, 0.0) && axis(&hs.release[1], 0.0, 1.0);
+    let rows = hs.constraints.iter().all(|c| {
+        matches!(
+            c,
+            ContactConstraint::X
+                | ContactConstraint::Y
+                | ContactConstraint::Z
+                | ContactConstraint::Yaw
+        )
+    });
     let r = &walker.relabel;
     !tree.has_infinitesimal() && release_xy && rows && !r.mirror && r.cyclic.is_empty()
 }
@@ -91,7 +93,13 @@ pub(super) fn heel_strike<const N: usize>(
     let m_q = tree.mass_matrix(&at.q);
     let (mass, b) = tree.momentum_jacobian(&at.q);
     let m_imp = DMatrix::from_fn(n, n, |i, j| match (i < 2, j < 2) {
-        (true, true) => if i == j { mass } else { 0.0 },
+        (true, true) => {
+            if i == j {
+                mass
+            } else {
+                0.0
+            }
+        }
         (true, false) => b[(i, j - 2)],
         (false, true) => b[(j, i - 2)],
         (false, false) => m_q[(i - 2, j - 2)],
@@ -111,7 +119,11 @@ pub(super) fn heel_strike<const N: usize>(
     let g = DMatrix::from_fn(rows.len(), n, |r, j| {
         let d = rows[r];
         if j < 2 {
-            if j == d { 1.0 } else { 0.0 }
+            if j == d {
+                1.0
+            } else {
+                0.0
+            }
         } else {
             jf[(d, j - 2)]
         }

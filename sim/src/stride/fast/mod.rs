@@ -31,7 +31,7 @@ use nalgebra::DVector;
 /// What the fixed-size stride made of a stride.
 pub(super) enum Outcome {
     /// The stride, completed or failed as the general loop would have it.
-    Done(Result<StrideResult, StrideFailure>),
+    Done(Box<Result<StrideResult, StrideFailure>>),
     /// Not covered (from the start or on the way): the general loop runs it.
     Fallback,
 }
@@ -61,7 +61,11 @@ impl Walker {
     /// the fixed-size stride (`stride::fast`) from its start, rather than the general loop. It
     /// may still hand the stride back to the general loop on the way (two events in one step,
     /// a fall, a budget used up).
-    pub fn takes_fixed_size_stride(&self, settings: &StrideSettings, options: StrideOptions) -> bool {
+    pub fn takes_fixed_size_stride(
+        &self,
+        settings: &StrideSettings,
+        options: StrideOptions,
+    ) -> bool {
         covers(self, settings, options, false).is_some_and(|t| (1..=6).contains(&t.dof()))
     }
 }

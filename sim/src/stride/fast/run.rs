@@ -92,7 +92,7 @@ enum HeelOutcome {
     /// A mid-swing scuff the scene ignores.
     Ignored,
     /// Heel strike: the stride's end.
-    Done(Result<StrideResult, StrideFailure>),
+    Done(Box<Result<StrideResult, StrideFailure>>),
 }
 
 /// Runs one stride from `q0`, `qd0` on `N`-sized states.
@@ -219,7 +219,7 @@ impl<const N: usize> Run<'_, N> {
                 },
                 Watch::Knee(k) => {
                     if let Err(e) = self.knee_lock(k, &at) {
-                        return Outcome::Done(Err(e));
+                        return Outcome::Done(Box::new(Err(e)));
                     }
                 }
                 _ => return Outcome::Fallback,
@@ -286,7 +286,12 @@ impl<const N: usize> Run<'_, N> {
     }
 
     /// The events the step `cur` → `next` triggered (`Witnesses::triggered`, no string).
-    fn triggered(&self, next: &State<N>, w_cur: &WitnessValues, w_next: &WitnessValues) -> Triggered {
+    fn triggered(
+        &self,
+        next: &State<N>,
+        w_cur: &WitnessValues,
+        w_next: &WitnessValues,
+    ) -> Triggered {
         let mut found = Triggered::None;
         let mut add = |w: Watch| {
             found = match found {
@@ -329,7 +334,11 @@ impl<const N: usize> Run<'_, N> {
         let cur = self.cur;
         let (tree, wit) = (self.tree, self.wit);
         let knee = match watch {
-            Watch::Knee(k) => self.walker.knees.get(k).map(|k| (k.coordinate.0, k.stop_rad)),
+            Watch::Knee(k) => self
+                .walker
+                .knees
+                .get(k)
+                .map(|k| (k.coordinate.0, k.stop_rad)),
             _ => None,
         };
         let g = |s: &State<N>| match (watch, knee) {
@@ -443,10 +452,16 @@ impl<const N: usize> Run<'_, N> {
         let w = self.walker;
         let ahead = self.wit.eval(self.tree, at).foot_ahead_m;
         if ahead < w.heel_strike.min_ahead_m {
-            return w.heel_strike.ignore_scuffing.then_some(HeelOutcome::Ignored);
+            return w
+                .heel_strike
+                .ignore_scuffing
+                .then_some(HeelOutcome::Ignored);
         }
         let active = self.sys.active;
-        if w.knees.iter().any(|k| active.get(k.coordinate.0) == Some(&true)) {
+        if w.knees
+            .iter()
+            .any(|k| active.get(k.coordinate.0) == Some(&true))
+        {
             return None;
         }
         self.events.push(StrideEvent {
@@ -481,11 +496,11 @@ impl<const N: usize> Run<'_, N> {
             None => w.finish_stride(at_s, &active, events, self.energy_loss_j),
         };
         let r = r.map(|mut r| {
-                r.event_states = std::mem::take(&mut self.event_states);
-                r.evaluations = self.evaluations;
-                r.damping_dissipation_j = self.dissipation_j;
-                r
-            });
-        Some(HeelOutcome::Done(r))
+            r.event_states = std::mem::take(&mut self.event_states);
+            r.evaluations = self.evaluations;
+            r.damping_dissipation_j = self.dissipation_j;
+            r
+        });
+        Some(HeelOutcome::Done(Box::new(r)))
     }
 }
