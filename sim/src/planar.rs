@@ -378,22 +378,32 @@ impl PlanarTree {
         self.links.get(i).map(|l| (l.parent_slot, l.coordinate))
     }
 
-    /// The mass matrix `M̄` at `q` (finite bodies; for the impacts of a fixed-size stride).
-    pub fn mass_matrix<const N: usize>(&self, q: &SVector<f64, N>) -> SMatrix<f64, N, N> {
-        self.assemble::<N>(q, &SVector::zeros()).m
+    /// The mass matrix `M̄` at `q`, finite and infinitesimal parts (for the impacts of a
+    /// fixed-size stride).
+    pub fn mass_matrices<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+    ) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
+        let a = self.assemble::<N>(q, &SVector::zeros());
+        (a.m, a.m_eps)
     }
 
     /// The whole tree's mass [kg] and the Jacobian of its linear momentum `Σ m Jv` (x and y
-    /// rows) at `q`: the coupling of a translation of the root with the coordinates (finite
-    /// bodies).
+    /// rows) at `q`: the coupling of a translation of the root with the coordinates; over the
+    /// finite bodies, or the infinitesimal ones (`infinitesimal`, their `ε` parts).
     pub fn momentum_jacobian<const N: usize>(
         &self,
         q: &SVector<f64, N>,
+        infinitesimal: bool,
     ) -> (f64, SMatrix<f64, 2, N>) {
         let fr = self.frames(q, &SVector::zeros());
         let mut total = 0.0;
         let mut jac = SMatrix::<f64, 2, N>::zeros();
-        for body in self.bodies.iter().filter(|b| !b.infinitesimal) {
+        for body in self
+            .bodies
+            .iter()
+            .filter(|b| b.infinitesimal == infinitesimal)
+        {
             total += body.mass_kg;
             let (p, _) = fr[body.slot].point(body.com_xy_m);
             for &(c, slot, sign) in &body.chain[..body.chain_len] {

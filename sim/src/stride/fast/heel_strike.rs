@@ -1,16 +1,19 @@
 //! Heel strike on the planar tree: the general `finish_stride` (impact on the impact model with
-//! the stance contact released, lift check, relabelling) for planar walkers with finite
-//! bodies, the stance contact released in x and y, and a relabelling by link pairs without
-//! mirror or cyclic coordinates. The impact is eq. (21) with the root's translation `v0`
-//! added to the coordinates (`M_imp = [[m I, Σ m Jv], [·ᵀ, M̄]]`), solved as one small KKT
-//! system; the relabelling is closed-form (each new link takes its old twin's angle and
+//! the stance contact released, lift check, relabelling) for planar walkers with the stance
+//! contact released in x and y and a relabelling by link pairs without mirror or cyclic
+//! coordinates. The impact is eq. (21) with the root's translation `v0` added to the
+//! coordinates (`M_imp = [[m I, Σ m Jv], [·ᵀ, M̄]]`, finite and infinitesimal parts from the
+//! planar tree), solved by the general impact's KKT system and vanishing-mass limit; the
+//! relabelling is closed-form (each new link takes its old twin's angle and
 //! angular velocity, the joint coordinates are the differences along the tree) and then
 //! checked against every pair as the general Gauss-Newton is. Anything else, or a check that
 //! does not hold, is left to the general `finish_stride` (`None`).
 
 use super::dop853::State;
+use crate::hybrid::impact::{kkt_system, scatter};
 use crate::model::{JointKind, Model, PointIndex};
 use crate::planar::{LinkFrame, PlanarTree, MAX_LINKS};
+use crate::singular_limit::solve_limit;
 use crate::walker::{ContactConstraint, Walker};
 use nalgebra::{DMatrix, DVector, SVector, Vector3};
 
@@ -28,7 +31,7 @@ pub(super) struct Relabelled {
 }
 
 /// Whether the walker's heel strike is one this module covers.
-fn covered(walker: &Walker, tree: &PlanarTree) -> bool {
+fn covered(walker: &Walker) -> bool {
     let hs = &walker.heel_strike;
     let axis = |k: &JointKind, x: f64, y: f64| matches!(k, JointKind::Prismatic { axis_parent } if axis_parent.x == x && axis_parent.y == y && axis_parent.z == 0.0);
     let release_xy =
@@ -43,7 +46,7 @@ fn covered(walker: &Walker, tree: &PlanarTree) -> bool {
         )
     });
     let r = &walker.relabel;
-    !tree.has_infinitesimal() && release_xy && rows && !r.mirror && r.cyclic.is_empty()
+    release_xy && rows && !r.mirror && r.cyclic.is_empty()
 }
 
 /// A point's x-y in its link frame and its height along z (constant on a planar tree: every
@@ -79,7 +82,7 @@ pub(super) fn heel_strike<const N: usize>(
     at: &State<N>,
     active: &[bool; N],
 ) -> Option<Relabelled> {
-    if !covered(walker, tree) {
+    if !covered(walker) {
         return None;
     }
     let hs = &walker.heel_strike;
@@ -90,20 +93,24 @@ pub(super) fn heel_strike<const N: usize>(
     let (p_foot, _) = fr.get(foot_link + 1)?.point(foot_p);
     // The impact model's velocities u = (v0, q̇): the root's translation first, at rest.
     let n = N + 2;
-    let m_q = tree.mass_matrix(&at.q);
-    let (mass, b) = tree.momentum_jacobian(&at.q);
-    let m_imp = DMatrix::from_fn(n, n, |i, j| match (i < 2, j < 2) {
-        (true, true) => {
-            if i == j {
-                mass
-            } else {
-                0.0
+    let (m_q, m_q_eps) = tree.mass_matrices(&at.q);
+    let impact_matrix = |m_q: &nalgebra::SMatrix<f64, N, N>, infinitesimal: bool| {
+        let (mass, b) = tree.momentum_jacobian(&at.q, infinitesimal);
+        DMatrix::from_fn(n, n, |i, j| match (i < 2, j < 2) {
+            (true, true) => {
+                if i == j {
+                    mass
+                } else {
+                    0.0
+                }
             }
-        }
-        (true, false) => b[(i, j - 2)],
-        (false, true) => b[(j, i - 2)],
-        (false, false) => m_q[(i - 2, j - 2)],
-    });
+            (true, false) => b[(i, j - 2)],
+            (false, true) => b[(j, i - 2)],
+            (false, false) => m_q[(i - 2, j - 2)],
+        })
+    };
+    let m_imp = impact_matrix(&m_q, false);
+    let m_imp_eps = impact_matrix(&m_q_eps, true);
     let jf = tree.point_jacobian::<N>(&fr, foot_link, foot_p);
     // Constraint rows of the contact: x and y (z and yaw rows vanish on a planar tree, and the
     // general rows drop them).
@@ -132,32 +139,14 @@ pub(super) fn heel_strike<const N: usize>(
     u_minus.rows_mut(2, N).copy_from(&at.qd);
     let target = &g * &u_minus * (-hs.restitution);
     let free: Vec<usize> = (0..n).filter(|&i| i < 2 || active[i - 2]).collect();
-    let (nf, k) = (free.len(), rows.len());
-    // [M_FF  G_Fᵀ; G_F  0] [u⁺_F; −λ] = [M_FF u⁻_F; target − G_L u⁻_L].
-    let mut a = DMatrix::zeros(nf + k, nf + k);
-    let mut rhs = DVector::zeros(nf + k);
-    for (x, &i) in free.iter().enumerate() {
-        for (y, &j) in free.iter().enumerate() {
-            a[(x, y)] = m_imp[(i, j)];
-            rhs[x] += m_imp[(i, j)] * u_minus[j];
-        }
-        for r in 0..k {
-            a[(x, nf + r)] = g[(r, i)];
-            a[(nf + r, x)] = g[(r, i)];
-        }
-    }
-    for r in 0..k {
-        let locked: f64 = (0..n)
-            .filter(|i| !free.contains(i))
-            .map(|i| g[(r, i)] * u_minus[i])
-            .sum();
-        rhs[nf + r] = target[r] - locked;
-    }
-    let x = a.lu().solve(&rhs)?;
-    let mut u_plus = u_minus.clone();
-    for (xi, &i) in free.iter().enumerate() {
-        u_plus[i] = x[xi];
-    }
+    // The general impact's equations and solve (`impact::resolve_to`): the KKT system of the
+    // finite part and of the infinitesimal one, and their vanishing-mass limit.
+    let (a0, b0) = kkt_system(&m_imp, &free, &u_minus, &g, &target);
+    let no_rows = DMatrix::zeros(g.nrows(), n);
+    let no_target = DVector::zeros(target.len());
+    let (a1, b1) = kkt_system(&m_imp_eps, &free, &u_minus, &no_rows, &no_target);
+    let x = solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?;
+    let u_plus = scatter(&u_minus, &free, &x).qd_plus;
     if u_plus.iter().any(|v| !v.is_finite()) {
         return None;
     }
