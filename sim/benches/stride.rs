@@ -91,6 +91,20 @@ fn benches(c: &mut Criterion) {
                     walker.stride(black_box(&q), black_box(&qd), request)
                 })
             });
+            if (label == "default" || label == "dop853_1e-10")
+                && walker.takes_fixed_size_stride(&settings, Default::default())
+            {
+                // The same stride in the general loop (the planar evaluation, no fixed-size
+                // stride): what the fixed-size stride buys.
+                let mut general_loop = settings.clone();
+                general_loop.evaluation = EvaluationPath::GeneralLoop;
+                group.bench_function(format!("{label}_general_loop"), |b| {
+                    b.iter(|| {
+                        let request = StrideRequest::new(&general_loop);
+                        walker.stride(black_box(&q), black_box(&qd), request)
+                    })
+                });
+            }
         }
         group.finish();
         let mut group = c.benchmark_group(format!("gait/{name}"));

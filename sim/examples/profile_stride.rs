@@ -1,6 +1,8 @@
 //! Runs strides of a scene from its fixed point in a loop, for profilers
-//! (`cargo run --release -p sim --example profile_stride -- compass 200 [general]`; `general`
-//! forces the general engine instead of the planar fast path).
+//! (`cargo run --release -p sim --example profile_stride -- compass 200 [general|loop] [rtol]`;
+//! `general` forces the general engine instead of the planar fast path, `loop` the planar
+//! evaluation inside the general stride loop instead of the fixed-size stride; `rtol` replaces
+//! the scene's DOP853 tolerance).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 fn main() {
@@ -9,8 +11,17 @@ fn main() {
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100);
     let scene = sim::scene::Scene::load(&name).expect("scene");
     let mut setup = scene.setup().expect("build");
-    if args.next().as_deref() == Some("general") {
-        setup.settings.evaluation = sim::planar::EvaluationPath::General;
+    match args.next().as_deref() {
+        Some("general") => setup.settings.evaluation = sim::planar::EvaluationPath::General,
+        Some("loop") => setup.settings.evaluation = sim::planar::EvaluationPath::GeneralLoop,
+        _ => {}
+    }
+    if let Some(rtol) = args.next().and_then(|s| s.parse().ok()) {
+        let i = setup
+            .settings
+            .integrator
+            .with_tolerance_or_step(Some(rtol), None);
+        setup.settings = setup.settings.with_integrator(i);
     }
     let g = setup.find_gait(&Default::default()).expect("gait");
     let w = &setup.walker;
@@ -24,7 +35,8 @@ fn main() {
         std::hint::black_box(r);
     }
     println!(
-        "{name}: {:.1} µs per stride, {evals} evaluations",
-        start.elapsed().as_secs_f64() * 1e6 / n as f64
+        "{name}: {:.1} µs per stride, {evals} evaluations, fixed-size stride: {}",
+        start.elapsed().as_secs_f64() * 1e6 / n as f64,
+        w.takes_fixed_size_stride(&setup.settings, Default::default())
     );
 }

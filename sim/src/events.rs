@@ -2,7 +2,7 @@
 //! where it has one (DOP853), otherwise by cubic Hermite interpolation (eq. 14), and refined by
 //! exact integrator steps.
 
-use crate::integrators::{DenseOutput, IntegrationError, Integrator, Sample, SecondOrderSystem};
+use crate::integrators::{IntegrationError, Integrator, Sample, SecondOrderSystem};
 use nalgebra::DVector;
 use serde::Serialize;
 
@@ -101,22 +101,42 @@ pub fn locate(
     };
     let (guess, slope) = match dense {
         Some(d) => {
-            let (t, slope) = root_on_dense(&d, (a.t_s, ga), (b.t_s, gb), g, tol);
+            let (t, slope) = root_on_dense(|t| g(&d.eval(t)), (a.t_s, ga), (b.t_s, gb), d.h_s, tol);
             (t, Some(slope))
         }
         None => (root_on_hermite(a, b, ga, g, tol), None),
     };
+    refine((a.t_s, ga), (b, b.t_s, gb), (guess, slope), tol, |t| {
+        let s = integrator.step_exact(sys, a, t - a.t_s)?;
+        let gt = g(&s);
+        Ok((s, gt))
+    })
+}
+
+/// The refinement of an event's estimate `guess` (with the witness's slope there when it came
+/// from a dense output): the Illinois method on exact steps (`exact(t)`: the sample at `t` and
+/// its witness value), bracketed by the step's start `(t_a, g_a)` and its end `b` (at `t_b`,
+/// witness `g_b`). Written once for [`locate`] and the fixed-size stride.
+///
+/// # Errors
+/// [`EventError`]: a failed step, or no convergence within the tolerance's budget.
+pub(crate) fn refine<S: Clone>(
+    (t_a, ga): (f64, f64),
+    (b, t_b, gb): (&S, f64, f64),
+    (guess, slope): (f64, Option<f64>),
+    tol: &EventTolerance,
+    mut exact: impl FnMut(f64) -> Result<(S, f64), IntegrationError>,
+) -> Result<S, EventError> {
     // Refinement: Illinois regula falsi on the exact flow, bracketed by [a, b].
-    let mut bracket = Illinois::new((a.t_s, ga), (b.t_s, gb));
+    let mut bracket = Illinois::new((t_a, ga), (t_b, gb));
     let mut best = b.clone();
     let mut t = guess;
     for it in 0..tol.max_iterations {
-        let s = if (t - b.t_s).abs() == 0.0 {
-            b.clone()
+        let (s, gt) = if (t - t_b).abs() == 0.0 {
+            (b.clone(), gb)
         } else {
-            integrator.step_exact(sys, a, t - a.t_s)?
+            exact(t)?
         };
-        let gt = g(&s);
         best = s;
         if gt.abs() <= tol.witness || bracket.width() <= tol.time_s {
             return Ok(best);
@@ -174,15 +194,16 @@ fn root_on_hermite(
     0.5 * (lo + hi)
 }
 
-/// The crossing's estimate on the dense output of the step: the Illinois method (no
-/// evaluation of the equations of motion per iteration, at most 60), until the witness is
-/// within its tolerance or the bracket narrower than the time tolerance; and the witness's
-/// slope there along the dense output (central difference).
-fn root_on_dense(
-    dense: &DenseOutput,
+/// The crossing's estimate on the dense output of a step of `h_s` [s] (`g_at(t)`: the witness
+/// on the dense output at `t`): the Illinois method (no evaluation of the equations of motion
+/// per iteration, at most 60), until the witness is within its tolerance or the bracket
+/// narrower than the time tolerance; and the witness's slope there along the dense output
+/// (central difference).
+pub(crate) fn root_on_dense(
+    mut g_at: impl FnMut(f64) -> f64,
     start: (f64, f64),
     end: (f64, f64),
-    g: &mut dyn FnMut(&Sample) -> f64,
+    h_s: f64,
     tol: &EventTolerance,
 ) -> (f64, f64) {
     let mut bracket = Illinois::new(start, end);
@@ -192,14 +213,14 @@ fn root_on_dense(
         if !bracket.strictly_inside(t) {
             t = bracket.midpoint();
         }
-        let gt = g(&dense.eval(t));
+        let gt = g_at(t);
         if gt.abs() <= tol.witness || bracket.width() <= tol.time_s {
             break;
         }
         bracket.update(t, gt);
     }
-    let e = 1e-6 * dense.h_s;
-    let slope = (g(&dense.eval(t + e)) - g(&dense.eval(t - e))) / (2.0 * e);
+    let e = 1e-6 * h_s;
+    let slope = (g_at(t + e) - g_at(t - e)) / (2.0 * e);
     (t, slope)
 }
 

@@ -30,9 +30,13 @@ pub const MAX_LINKS: usize = 12;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EvaluationPath {
-    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the general one.
+    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the general one;
+    /// and the fixed-size stride loop where it covers the stride (`crate::stride`'s `fast`).
     #[default]
     Auto,
+    /// The planar fast path when the model qualifies, inside the general stride loop (no
+    /// fixed-size stride): the reference the fixed-size stride is measured against.
+    GeneralLoop,
     /// Always the general 3D engine (the reference the fast path is tested against).
     General,
 }
@@ -89,6 +93,52 @@ impl LinkState {
         origin_m: [0.0; 2],
         a_bias_m_s2: [0.0; 2],
     };
+}
+
+/// One link's frame in the floor's x-y plane: its angle's cos and sin, angular rate, origin
+/// and the origin's velocity ([`PlanarTree::frames`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkFrame {
+    /// Cosine of the link's angle.
+    pub cos: f64,
+    /// Sine of the link's angle.
+    pub sin: f64,
+    /// Angular rate about the floor's z axis [rad/s].
+    pub omega_rad_s: f64,
+    /// Origin in the floor frame, x and y [m].
+    pub origin_m: [f64; 2],
+    /// Velocity of the origin, x and y [m/s].
+    pub velocity_m_s: [f64; 2],
+}
+
+impl LinkFrame {
+    /// The ground: at rest, unrotated, at the origin.
+    const GROUND: Self = Self {
+        cos: 1.0,
+        sin: 0.0,
+        omega_rad_s: 0.0,
+        origin_m: [0.0; 2],
+        velocity_m_s: [0.0; 2],
+    };
+
+    /// `p` (link frame, x and y) turned into the floor frame.
+    fn turn(&self, [x, y]: [f64; 2]) -> [f64; 2] {
+        [self.cos * x - self.sin * y, self.sin * x + self.cos * y]
+    }
+
+    /// Position and velocity in the floor frame (x and y) of the point `p_link_m` (x and y)
+    /// fixed in this link [m, m/s].
+    pub fn point(&self, p_link_m: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let r = self.turn(p_link_m);
+        let w = self.omega_rad_s;
+        (
+            [self.origin_m[0] + r[0], self.origin_m[1] + r[1]],
+            [
+                self.velocity_m_s[0] - w * r[1],
+                self.velocity_m_s[1] + w * r[0],
+            ],
+        )
+    }
 }
 
 /// A small planar tree, ready for fast evaluations: built once from a [`Model`] that qualifies.
@@ -244,14 +294,37 @@ impl PlanarTree {
         qd: &DVector<f64>,
         out: &mut DVector<f64>,
     ) -> Result<(), DynamicsError> {
-        if q.len() != N || qd.len() != N || active.len() != N || out.len() != N {
+        if q.len() != N || qd.len() != N || out.len() != N {
+            return Err(DynamicsError::NonFinite);
+        }
+        let qs = SVector::<f64, N>::from_iterator(q.iter().copied());
+        let qds = SVector::<f64, N>::from_iterator(qd.iter().copied());
+        let qdd = self.accelerations_fixed(move || limit, active, drive, &qs, &qds)?;
+        out.copy_from_slice(qdd.as_slice());
+        Ok(())
+    }
+
+    /// [`Self::accelerations`] on fixed-size states (`N` must be [`Self::dof`]): the fixed-size
+    /// stride's entry point. `limit` hands out the general workspace, asked for only when a
+    /// model with infinitesimal bodies has a coordinate locked or driven.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`]; also `N` or `active`'s length not the model's.
+    pub fn accelerations_fixed<'d, const N: usize>(
+        &self,
+        limit: impl FnOnce() -> &'d mut Dynamics,
+        active: &[bool],
+        drive: Option<&DriveValues<f64>>,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, DynamicsError> {
+        if N != self.dof || active.len() != N {
             return Err(DynamicsError::NonFinite);
         }
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
-        let mut qs = SVector::<f64, N>::from_iterator(q.iter().copied());
-        let mut qds = SVector::<f64, N>::from_iterator(qd.iter().copied());
+        let (mut qs, mut qds) = (*q, *qd);
         let mut qdd = SVector::<f64, N>::zeros();
         if let Some(d) = drive {
             qs[d.coordinate] = d.angle_rad;
@@ -261,24 +334,148 @@ impl PlanarTree {
         let a = self.assemble::<N>(&qs, &qds);
         if self.has_infinitesimal && drive.is_none() && active.iter().all(|&a| a) {
             // Every coordinate free: the vanishing-mass limit on the fixed-size matrices.
-            let qdd = solve_limit_fixed(&a.m, &a.m_eps, &a.f, &a.f_eps, NULL_EIGENVALUE_REL_TOL)
+            qdd = solve_limit_fixed(&a.m, &a.m_eps, &a.f, &a.f_eps, NULL_EIGENVALUE_REL_TOL)
                 .map_err(DynamicsError::Singular)?;
-            out.copy_from_slice(qdd.as_slice());
         } else if self.has_infinitesimal {
+            let limit = limit();
             limit.mass_matrix.copy_from(&a.m);
             limit.mass_matrix_infinitesimal.copy_from(&a.m_eps);
             limit.force.copy_from(&a.f);
             limit.force_infinitesimal.copy_from(&a.f_eps);
             let prescribed = drive.map(|_| DVector::from_iterator(N, qdd.iter().copied()));
-            *out = limit.solve_assembled_limit(active, prescribed.as_ref())?;
+            let solved = limit.solve_assembled_limit(active, prescribed.as_ref())?;
+            if solved.len() != N {
+                return Err(DynamicsError::NonFinite);
+            }
+            qdd = SVector::from_iterator(solved.iter().copied());
         } else {
             solve_active(&a.m, &a.f, active, &mut qdd)?;
-            out.copy_from_slice(qdd.as_slice());
         }
-        if out.iter().any(|v| !v.is_finite()) {
+        if qdd.iter().any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
-        Ok(())
+        Ok(qdd)
+    }
+
+    /// The damping coefficient of coordinate `c`'s joint [N·m·s/rad] (zero when undamped).
+    pub fn damping(&self, c: usize) -> f64 {
+        self.springs.get(c).map_or(0.0, |s| s.2)
+    }
+
+    /// Whether the tree has infinitesimal bodies (the vanishing-mass limit).
+    pub fn has_infinitesimal(&self) -> bool {
+        self.has_infinitesimal
+    }
+
+    /// Number of links (welds included).
+    pub fn link_count(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Link `i`'s parent slot (0: the ground, link `j`: `j + 1`) and the coordinate its joint
+    /// owns with the sign of its axis along z (`None`: a weld).
+    pub fn link_joint(&self, i: usize) -> Option<(usize, Option<(usize, f64)>)> {
+        self.links.get(i).map(|l| (l.parent_slot, l.coordinate))
+    }
+
+    /// The mass matrix `M̄` at `q`, finite and infinitesimal parts (for the impacts of a
+    /// fixed-size stride).
+    pub fn mass_matrices<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+    ) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
+        let a = self.assemble::<N>(q, &SVector::zeros());
+        (a.m, a.m_eps)
+    }
+
+    /// The whole tree's mass [kg] and the Jacobian of its linear momentum `Σ m Jv` (x and y
+    /// rows) at `q`: the coupling of a translation of the root with the coordinates; over the
+    /// finite bodies, or the infinitesimal ones (`infinitesimal`, their `ε` parts).
+    pub fn momentum_jacobian<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        infinitesimal: bool,
+    ) -> (f64, SMatrix<f64, 2, N>) {
+        let fr = self.frames(q, &SVector::zeros());
+        let mut total = 0.0;
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        for body in self
+            .bodies
+            .iter()
+            .filter(|b| b.infinitesimal == infinitesimal)
+        {
+            total += body.mass_kg;
+            let (p, _) = fr[body.slot].point(body.com_xy_m);
+            for &(c, slot, sign) in &body.chain[..body.chain_len] {
+                let o = fr[slot].origin_m;
+                if c < N {
+                    jac[(0, c)] -= body.mass_kg * sign * (p[1] - o[1]);
+                    jac[(1, c)] += body.mass_kg * sign * (p[0] - o[0]);
+                }
+            }
+        }
+        (total, jac)
+    }
+
+    /// The Jacobian (x and y rows) of the point `p_link_m` fixed in link `link` (model index)
+    /// at the frames `fr`: column `c` is `sign · z × (p − o)` for each joint up the chain.
+    pub fn point_jacobian<const N: usize>(
+        &self,
+        fr: &[LinkFrame; MAX_LINKS + 1],
+        link: usize,
+        p_link_m: [f64; 2],
+    ) -> SMatrix<f64, 2, N> {
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        let Some(frame) = fr.get(link + 1) else {
+            return jac;
+        };
+        let (p, _) = frame.point(p_link_m);
+        let mut cur = link;
+        while let Some(l) = self.links.get(cur) {
+            if let Some((c, sign)) = l.coordinate {
+                let o = fr[cur + 1].origin_m;
+                if c < N {
+                    jac[(0, c)] = -sign * (p[1] - o[1]);
+                    jac[(1, c)] = sign * (p[0] - o[0]);
+                }
+            }
+            match l.parent_slot {
+                0 => break,
+                s => cur = s - 1,
+            }
+        }
+        jac
+    }
+
+    /// Every link's frame at `q`, `q̇` (for the witnesses of a fixed-size stride): slot 0 is
+    /// the ground, link `i` of the model slot `i + 1`.
+    pub fn frames<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> [LinkFrame; MAX_LINKS + 1] {
+        let mut fr = [LinkFrame::GROUND; MAX_LINKS + 1];
+        for (i, link) in self.links.iter().enumerate() {
+            let parent = fr[link.parent_slot];
+            let d = parent.turn(link.joint_xy_m);
+            let w = parent.omega_rad_s;
+            let mut f = LinkFrame {
+                origin_m: [parent.origin_m[0] + d[0], parent.origin_m[1] + d[1]],
+                velocity_m_s: [
+                    parent.velocity_m_s[0] - w * d[1],
+                    parent.velocity_m_s[1] + w * d[0],
+                ],
+                ..parent
+            };
+            if let Some((c, sign)) = link.coordinate {
+                let (sin_q, cos_q) = (sign * q[c]).sin_cos();
+                f.cos = parent.cos * cos_q - parent.sin * sin_q;
+                f.sin = parent.sin * cos_q + parent.cos * sin_q;
+                f.omega_rad_s = parent.omega_rad_s + sign * qd[c];
+            }
+            fr[i + 1] = f;
+        }
+        fr
     }
 
     /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and

@@ -262,35 +262,51 @@ impl EmbeddedPair for Dop853Pair {
         kv: &[DVector<f64>],
     ) -> f64 {
         let n = s.q.len();
-        // Hairer's combined estimate: the fifth-order difference, damped where the
-        // third-order one is much larger.
         let (mut err5, mut err3) = (0.0, 0.0);
         let mut add = |k: &[DVector<f64>], y0: &DVector<f64>, y1: &DVector<f64>, i: usize| {
             let sk = tol.atol + tol.rtol * y0[i].abs().max(y1[i].abs());
-            let mut e5 = 0.0;
-            let mut e3 = 0.0;
-            for &(j, b) in &B {
-                e3 += b * k[j][i];
-            }
-            for &(j, c) in &BHH {
-                e3 -= c * k[j][i];
-            }
-            for &(j, c) in &ER {
-                e5 += c * k[j][i];
-            }
-            err5 += (e5 / sk).powi(2);
-            err3 += (e3 / sk).powi(2);
+            let (e5, e3) = component_error(|j| k[j][i], sk);
+            err5 += e5;
+            err3 += e3;
         };
         for i in 0..n {
             add(kq, &s.q, q_new, i);
             add(kv, &s.qd, v_new, i);
         }
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        h.abs() * err5 * (1.0 / ((2 * n).max(1) as f64 * deno)).sqrt()
+        combined_error(h, err5, err3, 2 * n)
     }
+}
+
+/// One state component's squared scaled errors `((e5/sk)², (e3/sk)²)` from its stage
+/// derivatives `k(j)` and its scale `sk = atol + rtol·max(|y0|, |y1|)`: the fifth-order
+/// difference and the third-order one of Hairer's combined estimate (written once for the
+/// general integrator and the fixed-size stride).
+#[inline]
+pub(crate) fn component_error(k: impl Fn(usize) -> f64, sk: f64) -> (f64, f64) {
+    let mut e5 = 0.0;
+    let mut e3 = 0.0;
+    for &(j, b) in &B {
+        e3 += b * k(j);
+    }
+    for &(j, c) in &BHH {
+        e3 -= c * k(j);
+    }
+    for &(j, c) in &ER {
+        e5 += c * k(j);
+    }
+    ((e5 / sk).powi(2), (e3 / sk).powi(2))
+}
+
+/// Hairer's combined error norm of a step of size `h` from the sums of [`component_error`]
+/// over the `len` state components: the fifth-order difference, damped where the third-order
+/// one is much larger.
+#[inline]
+pub(crate) fn combined_error(h: f64, err5: f64, err3: f64, len: usize) -> f64 {
+    let mut deno = err5 + 0.01 * err3;
+    if deno <= 0.0 {
+        deno = 1.0;
+    }
+    h.abs() * err5 * (1.0 / (len.max(1) as f64 * deno)).sqrt()
 }
 
 /// Adaptive Dormand-Prince 8(5,3) with Hairer's step-size controller (exponent 1/8).

@@ -11,6 +11,7 @@ mod meijaard;
 mod rk4;
 
 pub use dense::{DenseCoefficients, DenseOutput};
+pub(crate) use dop853::{combined_error, component_error};
 pub use dop853::{Dop853, Dop853Pair};
 pub use dopri5::{Dopri5, Dopri5Pair};
 pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
@@ -143,12 +144,12 @@ pub enum IntegratorError {
 /// accept it when its scaled error is at most 1 and propose the next step
 /// `h · clamp(0.9 · err^(−exponent), min, max)` (at most `h_max_s`); otherwise shrink and retry,
 /// down to `h_min_s`. Returns the accepted sample and the proposal.
-pub(crate) fn adaptive_step(
+pub(crate) fn adaptive_step<S>(
     mut h: f64,
     limits: StepLimits,
     t_s: f64,
-    mut try_step: impl FnMut(f64) -> Result<(Sample, f64), IntegrationError>,
-) -> Result<(Sample, f64), IntegrationError> {
+    mut try_step: impl FnMut(f64) -> Result<(S, f64), IntegrationError>,
+) -> Result<(S, f64), IntegrationError> {
     loop {
         let (next, err) = try_step(h)?;
         let factor = if err == 0.0 {

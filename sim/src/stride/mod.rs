@@ -15,6 +15,8 @@
 //! - `energy`: actuator work and damper dissipation;
 //! - `contact_figures`: [`ContactSummary`];
 //! - `run`: the loop ([`Walker::stride`]);
+//! - `fast`: the same loop on fixed-size states for the planar walkers it covers (selected
+//!   automatically, the general loop its reference and fallback);
 //! - `result`: [`StrideResult`], [`StrideFailure`], [`FailureKind`], [`StrideEvent`].
 //!
 //! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
@@ -26,6 +28,7 @@
 
 mod contact_figures;
 mod energy;
+mod fast;
 mod impacts;
 mod phase;
 mod request;

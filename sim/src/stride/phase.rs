@@ -53,7 +53,7 @@ impl<'a> Phase<'a> {
             model,
             dynamics: Dynamics::new(model),
             planar: match path {
-                EvaluationPath::Auto => PlanarTree::of(model),
+                EvaluationPath::Auto | EvaluationPath::GeneralLoop => PlanarTree::of(model),
                 EvaluationPath::General => None,
             },
             active: vec![true; model.dof()],

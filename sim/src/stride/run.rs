@@ -8,10 +8,11 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
+use super::fast::Outcome;
 use super::phase::{Drive, Phase};
 use super::request::{StrideControl, StrideOptions, StrideRequest};
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
-use super::schedule::ScheduleCursor;
+use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
 use crate::control::{ActuatorSegment, AnkleSensing};
@@ -37,7 +38,7 @@ impl Walker {
         let StrideRequest {
             settings,
             options,
-            schedule,
+            mut schedule,
             control,
             sink,
         } = request;
@@ -54,6 +55,33 @@ impl Walker {
             Some(s) => s,
             None => &mut own,
         };
+        if let Some(tree) = super::fast::covers(self, settings, options, control.is_some()) {
+            let recorded = trajectory.len();
+            let fast_schedule = match &mut schedule {
+                Schedule::Free => Schedule::Free,
+                Schedule::Record(s) => Schedule::Record(s),
+                Schedule::Replay(s) => Schedule::Replay(s),
+            };
+            match super::fast::stride(
+                self,
+                &tree,
+                settings,
+                options,
+                fast_schedule,
+                trajectory,
+                q0,
+                qd0,
+            ) {
+                Outcome::Done(r) => {
+                    let mut r = (*r)?;
+                    if keep_in_result {
+                        r.trajectory = own;
+                    }
+                    return Ok(r);
+                }
+                Outcome::Fallback => trajectory.truncate(recorded),
+            }
+        }
         let cur = Sample {
             t_s: 0.0,
             q: q0.clone(),
