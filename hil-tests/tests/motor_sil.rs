@@ -120,6 +120,10 @@ fn with_the_motor_a_still_hold_leaves_a_frozen_reading_right_and_raises_nothing(
         .windows(2)
         .filter(|w| w[0].left_spool != w[1].left_spool)
         .count();
+    eprintln!(
+        "frozen {frozen_at:.3} s at {first:.4} rad, hold {} ticks, drift {drift:.2e} rad, spool turned in {spool_ticks} ticks",
+        during.len()
+    );
     assert!(spool_ticks < 10, "the spool turned in {spool_ticks} ticks");
     assert_eq!(r.first_raise(Side::Left, "EncoderStuck"), None);
     assert!(r.faults.is_empty(), "{:?}", r.faults);
