@@ -32,7 +32,10 @@
 //!   angle): the string then becomes taut again `slack_counts` below the angle where the
 //!   push began, whether the push was cut short or reached its hold (a fixed pay-out from the
 //!   last hold would leave the string too long after a short push and too short after a full
-//!   one). A bounded move at `release_max_duty`, then the power stage switches off. Without a
+//!   one). The default slack is 0: the walker falls onto the resting string, and every
+//!   count of slack delays the catch (and so the push's real start) behind the setpoint
+//!   profile, which starts when the taut angle is measured; a rest a little above the taut
+//!   angle is harmless on a back-drivable gearbox (the load pays the string out to it). A bounded move at `release_max_duty`, then the power stage switches off. Without a
 //!   previous drive (power-up) there is nothing to pay out: off. A PD move (error and
 //!   spool rate) at up to `release_max_duty`, done when the spool is at the target and at
 //!   rest — then the stage switches off (switched off while still turning, the motor would
@@ -112,7 +115,9 @@ pub struct SpoolMotorConfig {
     /// Ticks of `Released` that clear the over-current latch.
     pub overcurrent_cooldown_ticks: u16,
     /// On release, the string is re-spooled this many counts below the geometry in which it
-    /// was taut at the angle where the last push began.
+    /// was taut at the angle where the last push began. Default 0 (see the module
+    /// documentation); a gearbox that cannot be back-driven would need the pay-out's
+    /// tolerance here, so that a rest above the taut angle cannot hold the ankle off it.
     pub slack_counts: i32,
     /// Duty per count of pay-out error.
     pub release_kp_per_count: f32,
@@ -138,7 +143,7 @@ impl Default for SpoolMotorConfig {
     /// PD 40 /rad and 0.5 s/rad up to 80 % duty at 1 kHz; 16 297 counts per ankle radian (the
     /// assumed build: 1024 counts per motor turn, gear 25:1, lever arm 20 mm, spool radius
     /// 5 mm, docs/firmware.md); 4 A limit (5 ticks to latch, 0.5 s to clear); release
-    /// re-spools to 49 counts (3 mrad) below the push's start at up to 30 % duty within
+    /// re-spools to the push's start geometry (no slack) at up to 30 % duty within
     /// 0.3 s (done within 16 counts, at rest), aborted after 50 ms without progress; a hold pays out at most 2000 counts
     /// (0.12 rad); soft limits ±60 000 counts (±3.7 rad of ankle).
     fn default() -> Self {
@@ -151,7 +156,7 @@ impl Default for SpoolMotorConfig {
             current_limit_a: 4.0,
             overcurrent_ticks: 5,
             overcurrent_cooldown_ticks: 500,
-            slack_counts: 49,
+            slack_counts: 0,
             release_kp_per_count: 0.003,
             release_kd_per_count_per_tick: 0.02,
             release_max_duty: 0.3,
@@ -511,6 +516,19 @@ mod tests {
         ankle_angle_rad: 0.2,
     };
 
+    /// A push that wound the taut string 1000 counts from the spool's position now, starting
+    /// at the taut angle (−0.08 rad): a release then has 1000 counts to pay out.
+    fn push_1000_counts(
+        m: &mut SpoolMotor<&mut Bridge, Spool<'_>, Amps<'_>>,
+        spool: &Cell<Option<i32>>,
+    ) {
+        let k = m.config.counts_per_ankle_rad;
+        let s0 = spool.get().unwrap();
+        m.apply(HOLD, Some(-0.08)).unwrap();
+        spool.set(Some(s0 + 1000));
+        m.apply(HOLD, Some(-0.08 + 1000.0 / k)).unwrap();
+    }
+
     #[test]
     fn off_at_power_up_and_when_released_without_a_hold() {
         let mut b = Bridge::default();
@@ -545,15 +563,15 @@ mod tests {
             "still: proportional only: {d}"
         );
         // Release: back to where the string was taut at −0.08 rad (4400 counts below the last
-        // hold), less the 49-count slack: 9951; at most 30 %.
+        // hold, no slack): 10 000; at most 30 %.
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert_eq!(m.output(), StageOutput::Duty(-0.3));
         // Past the target and still turning fast: the rate term brakes (clamped).
-        spool.set(Some(9_900));
+        spool.set(Some(9_950));
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert_eq!(m.output(), StageOutput::Duty(0.3), "braking");
         // Within the tolerance (16 counts) but still moving: not done.
-        spool.set(Some(9_945));
+        spool.set(Some(9_995));
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert!(
             matches!(m.output(), StageOutput::Duty(_)),
@@ -592,6 +610,79 @@ mod tests {
         }
     }
 
+    /// The DC gear motor of the simulator's plant (`sim/sil/src/spool_plant.rs`, docs/sil.md)
+    /// reduced to the spool encoder: driven at duty `d` its rate relaxes towards 157.5·d
+    /// counts per tick with the 25 ms electrical-mechanical time constant; switched off it
+    /// coasts against its Coulomb friction (0.163 counts per tick², about 1000 rad/s² at
+    /// the motor).
+    struct MotorCounts {
+        counts: f64,
+        rate: f64,
+    }
+    impl MotorCounts {
+        fn tick(&mut self, stage: StageOutput) {
+            match stage {
+                StageOutput::Duty(d) => {
+                    let target = 157.5 * f64::from(d);
+                    self.rate = target + (self.rate - target) * (-1.0f64 / 25.0).exp();
+                }
+                StageOutput::Off => {
+                    let slowed = self.rate.abs() - 0.163;
+                    self.rate = self.rate.signum() * slowed.max(0.0);
+                }
+            }
+            self.counts += self.rate;
+        }
+    }
+
+    #[test]
+    fn the_re_spool_leaves_the_string_taut_at_the_push_start_within_its_tolerance() {
+        // The walker falls onto the resting string at about 0.53 rad/s (8.6 counts per
+        // tick, `wisse3d` at the taut angle): every count the string rests below the angle
+        // where the push begins delays the catch, and a catch late by 8 ms (the former 49
+        // counts of slack, landing 20–30 counts lower still) made the walk's slow pelvic
+        // roll grow until it fell (docs/sil.md, "The motor plant"). A full push from the
+        // taut angle (−0.08 rad at spool 10 000, taut) to 0.2 rad, released while the motor
+        // still winds at the push's end rate; the pay-out runs on the motor above until the
+        // stage is off: the string rests where it was taut at the push's start, within the
+        // pay-out's tolerance (16 counts, 1 mrad: under 2 ms of the walker's fall).
+        let cfg = SpoolMotorConfig::default();
+        let k = f64::from(cfg.counts_per_ankle_rad);
+        let mut b = Bridge::default();
+        let spool = Cell::new(Some(10_000));
+        let amps = Cell::new(Some(1.0));
+        let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
+        let start = -0.08f32;
+        m.apply(HOLD, Some(start)).unwrap();
+        let end = 0.2f64;
+        let s_end = 10_000.0 + k * (end + 0.08);
+        spool.set(Some(s_end as i32));
+        m.apply(HOLD, Some(end as f32)).unwrap();
+        // 1.5 rad/s of ankle at the push's end: 24 counts per tick.
+        let mut motor = MotorCounts {
+            counts: s_end,
+            rate: 1.5 * k * 1e-3,
+        };
+        let mut ticks = 0;
+        loop {
+            spool.set(Some(motor.counts.floor() as i32));
+            m.apply(ActuatorCommand::Released, None).unwrap();
+            let stage = m.output();
+            if stage == StageOutput::Off {
+                break;
+            }
+            motor.tick(stage);
+            ticks += 1;
+            assert!(ticks < cfg.release_timeout_ticks, "pay-out unfinished");
+        }
+        let rest = spool.get().unwrap();
+        assert!(
+            (rest - 10_000).abs() <= cfg.release_tolerance_counts,
+            "the string rests {} counts from where it was taut at the push's start (after {ticks} ticks)",
+            rest - 10_000
+        );
+    }
+
     #[test]
     fn a_jammed_pay_out_is_aborted_off_after_the_stall_time() {
         let mut b = Bridge::default();
@@ -599,7 +690,7 @@ mod tests {
         let amps = Cell::new(Some(0.5));
         let cfg = SpoolMotorConfig::default();
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
-        m.apply(HOLD, Some(0.2)).unwrap();
+        push_1000_counts(&mut m, &spool);
         let mut ticks = 0;
         let result = loop {
             ticks += 1;
@@ -626,7 +717,7 @@ mod tests {
         let amps = Cell::new(Some(0.5));
         let cfg = SpoolMotorConfig::default();
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
-        m.apply(HOLD, Some(0.2)).unwrap();
+        push_1000_counts(&mut m, &spool);
         // Reversed motor: the negative duty winds in; the error grows tick by tick and never
         // shrinks: aborted at the stall time.
         let mut result = Ok(());
@@ -638,7 +729,7 @@ mod tests {
                 break;
             }
             assert!(matches!(m.output(), StageOutput::Duty(d) if d < 0.0));
-            spool.set(Some(10_000 + 20 * k));
+            spool.set(Some(11_000 + 20 * k));
         }
         assert_eq!(result, Err(ActuatorError::ReleaseStalled));
         assert_eq!(ticks, i32::from(cfg.release_stall_ticks) + 1);
@@ -652,9 +743,9 @@ mod tests {
         let amps = Cell::new(Some(0.5));
         let cfg = SpoolMotorConfig::default();
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), cfg);
-        m.apply(HOLD, Some(0.2)).unwrap();
+        push_1000_counts(&mut m, &spool);
         // The motor winds on for a few ticks after the release (decelerating), then pays out.
-        for (k, s) in [10_030, 10_050, 10_060, 10_062, 10_050, 10_000, 9_900]
+        for (k, s) in [11_030, 11_050, 11_060, 11_062, 11_050, 11_000, 10_900]
             .into_iter()
             .enumerate()
         {
@@ -669,7 +760,7 @@ mod tests {
         let spool = Cell::new(Some(10_000));
         let amps = Cell::new(Some(0.5));
         let mut m = SpoolMotor::new(&mut b, Spool(&spool), Amps(&amps), Default::default());
-        m.apply(HOLD, Some(0.0)).unwrap();
+        push_1000_counts(&mut m, &spool);
         m.apply(ActuatorCommand::Released, None).unwrap();
         assert!(
             matches!(m.output(), StageOutput::Duty(d) if d < 0.0),

@@ -75,9 +75,10 @@ pub struct SpoolPlantParams {
     /// nominal walk shows (`SpoolPlantStats::max_seen_inertia_kg_m2`, 0.0017: driving the
     /// ankle angle mostly turns the light foot about its toe, the heavy leg is free).
     pub walker_inertia_kg_m2: f64,
-    /// The string's limit at power-up, as an ankle angle [rad]. Default −0.10: the
-    /// firmware's taut angle (−0.08) less its re-spool slack (0.02 rad), as the firmware
-    /// leaves it after every release.
+    /// The string's limit at power-up, as an ankle angle [rad]. Default −0.081: the
+    /// firmware's taut angle (−0.08) less its pay-out's tolerance (16 counts, 1 mrad), as the
+    /// firmware leaves it after a release (it re-spools to the push's start geometry, no
+    /// slack; the nominal walk's rests lie 1.1–2.9 mrad below the taut angle, docs/sil.md).
     pub initial_limit_rad: f64,
 }
 
@@ -96,7 +97,7 @@ impl Default for SpoolPlantParams {
             counts_per_motor_turn: 1024.0,
             current_lsb_a: 0.0294,
             walker_inertia_kg_m2: 0.005,
-            initial_limit_rad: -0.083,
+            initial_limit_rad: -0.081,
         }
     }
 }
