@@ -1,8 +1,9 @@
 //! Runs strides of a scene from its fixed point in a loop, for profilers
-//! (`cargo run --release -p sim --example profile_stride -- compass 200 [general|loop] [rtol]`;
-//! `general` forces the general engine instead of the planar fast path, `loop` the planar
-//! evaluation inside the general stride loop instead of the fixed-size stride; `rtol` replaces
-//! the scene's DOP853 tolerance).
+//! (`cargo run --release -p sim --example profile_stride -- compass 200 [general|loop|linkpass]
+//! [rtol]`; `general` forces the general engine instead of the planar fast path, `loop` the
+//! planar evaluation inside the general stride loop instead of the fixed-size stride,
+//! `linkpass` the fixed-size stride with the planar link pass instead of a closed form; any
+//! other word the default; `rtol` replaces the scene's DOP853 tolerance).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 fn main() {
@@ -14,6 +15,7 @@ fn main() {
     match args.next().as_deref() {
         Some("general") => setup.settings.evaluation = sim::planar::EvaluationPath::General,
         Some("loop") => setup.settings.evaluation = sim::planar::EvaluationPath::GeneralLoop,
+        Some("linkpass") => setup.settings.evaluation = sim::planar::EvaluationPath::LinkPass,
         _ => {}
     }
     if let Some(rtol) = args.next().and_then(|s| s.parse().ok()) {

@@ -21,6 +21,8 @@ use crate::singular_limit::{
 };
 use nalgebra::{DVector, SMatrix, SVector};
 
+mod two_link;
+
 /// Most coordinates a tree may have to take the fast path.
 pub const MAX_COORDINATES: usize = 6;
 /// Most links (welds included) a tree may have to take the fast path.
@@ -39,6 +41,10 @@ pub enum EvaluationPath {
     GeneralLoop,
     /// Always the general 3D engine (the reference the fast path is tested against).
     General,
+    /// As [`Self::Auto`] (the fixed-size stride where it covers the stride), but the planar
+    /// evaluation always by its link pass, without the closed forms of particular trees (the
+    /// two-link chain's, `planar/two_link.rs`): what those are measured and tested against.
+    LinkPass,
 }
 
 /// One link of a planar tree, with what its kinematics needs. Links are stored parents first;
@@ -151,6 +157,8 @@ pub struct PlanarTree {
     gravity_m_s2: [f64; 2],
     dof: usize,
     has_infinitesimal: bool,
+    /// The closed form of a two-link chain (compass, simplest), when the tree is one.
+    two_link: Option<two_link::TwoLink>,
 }
 
 /// `M̄` and `f̄` of one evaluation, finite and infinitesimal parts.
@@ -228,14 +236,40 @@ impl PlanarTree {
                 chain_len,
             });
         }
-        Some(Self {
+        let mut tree = Self {
             links,
             bodies,
             springs,
             gravity_m_s2: [model.gravity_floor_m_s2.x, model.gravity_floor_m_s2.y],
             dof,
             has_infinitesimal: model.has_infinitesimal_bodies(),
-        })
+            two_link: None,
+        };
+        tree.two_link = two_link::TwoLink::of(&tree);
+        Some(tree)
+    }
+
+    /// The planar tree `path` asks for: `None` for [`EvaluationPath::General`] (or when the
+    /// model does not qualify), the link pass alone for [`EvaluationPath::LinkPass`], else
+    /// [`Self::of`] (with the closed form when the tree has one).
+    pub fn for_path(model: &Model, path: EvaluationPath) -> Option<Self> {
+        match path {
+            EvaluationPath::General => None,
+            EvaluationPath::LinkPass => Self::of(model).map(Self::link_pass_only),
+            EvaluationPath::Auto | EvaluationPath::GeneralLoop => Self::of(model),
+        }
+    }
+
+    /// The same tree without its closed form: every evaluation by the link pass.
+    pub fn link_pass_only(mut self) -> Self {
+        self.two_link = None;
+        self
+    }
+
+    /// Whether the tree evaluates by a closed form (a two-link chain: the compass, the
+    /// simplest walker) rather than by its link pass.
+    pub fn has_closed_form(&self) -> bool {
+        self.two_link.is_some()
     }
 
     /// Number of coordinates.
@@ -323,6 +357,17 @@ impl PlanarTree {
         }
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
+        }
+        if let Some(t) = &self.two_link {
+            if N == 2 && drive.is_none() && t.finite_only() && active.iter().all(|&a| a) {
+                // Both free, finite bodies: the closed form and the 2 × 2 inverse.
+                if let Some(qdd) = t.free_accelerations(q, qd) {
+                    if qdd.iter().all(|v| v.is_finite()) {
+                        return Ok(qdd);
+                    }
+                    return Err(DynamicsError::NonFinite);
+                }
+            }
         }
         let (mut qs, mut qds) = (*q, *qd);
         let mut qdd = SVector::<f64, N>::zeros();
@@ -481,6 +526,19 @@ impl PlanarTree {
     /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and
     /// dampers, body by body, over the planar kinematics.
     fn assemble<const N: usize>(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Assembled<N> {
+        match &self.two_link {
+            Some(t) if N == 2 => t.assemble(q, qd),
+            _ => self.assemble_link_pass(q, qd),
+        }
+    }
+
+    /// [`Self::assemble`] by the link pass: the links' kinematics parents first, then each
+    /// body's terms over its chain of joints.
+    fn assemble_link_pass<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Assembled<N> {
         // All zeros (a memset) but the ground's cos.
         let mut st = [LinkState::default(); MAX_LINKS + 1];
         st[0] = LinkState::GROUND;

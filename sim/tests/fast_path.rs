@@ -209,3 +209,151 @@ fn events_located_on_the_dense_output_agree_with_exact_step_refinement() {
         }
     }
 }
+
+/// `q̈` of `model` by the planar tree `tree` and by the general engine over random states,
+/// every phase (all free, each coordinate locked, one driven): the largest difference
+/// relative to `1 + |q̈|`, and the number of states compared.
+fn compare_with_general(
+    model: &sim::model::Model,
+    tree: &PlanarTree,
+    center: (&DVector<f64>, &DVector<f64>),
+    seed: &mut u64,
+) -> (f64, usize) {
+    let n = model.dof();
+    let mut general = Phase::with_path(model, EvaluationPath::General);
+    let mut dynamics = sim::dynamics::Dynamics::new(model);
+    let (mut worst, mut compared) = (0.0f64, 0);
+    let mut masks = vec![vec![true; n]];
+    for i in 0..n {
+        let mut m = vec![true; n];
+        m[i] = false;
+        masks.push(m);
+    }
+    for (mi, mask) in masks.iter().enumerate() {
+        for trial in 0..50 {
+            let q = DVector::from_fn(n, |i, _| center.0[i] + 0.8 * noise(seed));
+            let qd = DVector::from_fn(n, |i, _| center.1[i] + 3.0 * noise(seed));
+            general.active.clone_from(mask);
+            let driven = mi > 0 && trial % 2 == 1;
+            let c = mask.iter().position(|a| !a).unwrap_or(0);
+            let seg = sim::control::ActuatorSegment {
+                t0_s: 0.0,
+                t1_s: 1.0,
+                p0_rad: 0.2,
+                v0_rad_s: -1.0,
+                p1_rad: 0.5,
+                v1_rad_s: 2.0,
+                released: false,
+            };
+            general.prescribed = driven.then_some((sim::model::CoordIndex(c), Drive::Segment(seg)));
+            let t = 0.3;
+            let values = driven.then(|| {
+                let (angle_rad, rate_rad_s, acceleration_rad_s2) = seg.eval(t);
+                sim::hybrid::phase::DriveValues {
+                    coordinate: c,
+                    angle_rad,
+                    rate_rad_s,
+                    acceleration_rad_s2,
+                }
+            });
+            let a = tree.accelerations(&mut dynamics, mask, values.as_ref(), &q, &qd);
+            match (a, general.accelerations(t, &q, &qd)) {
+                (Ok(a), Ok(b)) => {
+                    worst = worst.max((&a - &b).amax() / (1.0 + b.amax()));
+                    compared += 1;
+                }
+                (Err(a), Err(b)) => assert_eq!(a, b, "both paths fail alike"),
+                (a, b) => panic!("planar {a:?} against general {b:?}"),
+            }
+        }
+    }
+    (worst, compared)
+}
+
+#[test]
+fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
+    // Which trees have it: the two-link chains (compass, simplest), found from the model.
+    for (name, closed) in [
+        ("compass", true),
+        ("simplest", true),
+        ("kneed2d", false),
+        ("wisse2d", false),
+    ] {
+        let s = setup(name);
+        let tree = PlanarTree::of(&s.walker.model).unwrap();
+        assert_eq!(tree.has_closed_form(), closed, "{name}");
+        assert!(!tree.link_pass_only().has_closed_form());
+        let path = PlanarTree::for_path(&s.walker.model, EvaluationPath::LinkPass).unwrap();
+        assert!(!path.has_closed_form());
+    }
+    // The scenes as they are, then variants the scene files cannot express: distributed
+    // masses (I_zz), centres of mass off the legs' axes, an axis along −z, a spring and a
+    // damper at the hip, other masses and lengths.
+    let mut seed = 23u64;
+    for name in ["compass", "simplest"] {
+        for variant in 0..4 {
+            let mut s = Scene::load(name).unwrap();
+            if variant >= 2 && name == "compass" {
+                s.set("leg_com_from_hip_m", 0.3).unwrap();
+                s.set("hip_mass_kg", 2.5).unwrap();
+            }
+            if variant >= 2 && name == "simplest" {
+                s.set("leg_length_m", 1.7).unwrap();
+                s.set("hip_mass_kg", 3.0).unwrap();
+            }
+            let s = s.setup().unwrap();
+            let mut model = s.walker.model.clone();
+            if variant % 2 == 1 {
+                for (i, link) in model.links.iter_mut().enumerate() {
+                    let k = i as f64 + 1.0;
+                    link.body.p_link_com_m.x += 0.07 * k;
+                    if !link.body.infinitesimal && link.body.mass_kg > 0.0 {
+                        link.body.inertia_com_kg_m2[(2, 2)] = 0.05 * k;
+                        link.body.inertia_com_kg_m2[(0, 0)] = 0.02 * k;
+                    }
+                    link.p_parent_joint_m.x += 0.03 * k;
+                }
+                let swing = model.links.len() - 1;
+                if let sim::model::JointKind::Revolute { axis_parent } =
+                    &mut model.links[swing].joint
+                {
+                    axis_parent.z = -1.0;
+                }
+                if name == "compass" {
+                    // (A spring on the simplest walker's massless swing leg has no limit.)
+                    model.links[swing].joint_force.stiffness = 3.0;
+                    model.links[swing].joint_force.rest_position = 0.1;
+                    model.links[swing].joint_force.damping = 0.4;
+                }
+            }
+            let closed = PlanarTree::of(&model).unwrap();
+            assert!(closed.has_closed_form(), "{name} {variant}");
+            let link_pass = closed.clone().link_pass_only();
+            let center = (&s.guess.q, &s.guess.qd);
+            let (to_general, n1) = compare_with_general(&model, &closed, center, &mut seed);
+            let (pass_to_general, _) = compare_with_general(&model, &link_pass, center, &mut seed);
+            // The closed form against the link pass on the same states, all phases.
+            let mut sd = seed;
+            let (mut to_pass, mut dyn_a, mut dyn_b) = (
+                0.0f64,
+                sim::dynamics::Dynamics::new(&model),
+                sim::dynamics::Dynamics::new(&model),
+            );
+            for _ in 0..200 {
+                let q = DVector::from_fn(2, |i, _| s.guess.q[i] + 0.8 * noise(&mut sd));
+                let qd = DVector::from_fn(2, |i, _| s.guess.qd[i] + 3.0 * noise(&mut sd));
+                let a = closed.accelerations(&mut dyn_a, &[true, true], None, &q, &qd);
+                let b = link_pass.accelerations(&mut dyn_b, &[true, true], None, &q, &qd);
+                let (a, b) = (a.unwrap(), b.unwrap());
+                to_pass = to_pass.max((&a - &b).amax() / (1.0 + b.amax()));
+            }
+            eprintln!(
+                "{name} variant {variant}: closed form − link pass {to_pass:e}, closed form − \
+                 general {to_general:e} ({n1} states), link pass − general {pass_to_general:e}"
+            );
+            assert!(n1 >= 100, "{name} {variant}: {n1}");
+            assert!(to_pass <= 1e-13, "{name} {variant}: {to_pass:e}");
+            assert!(to_general <= 1e-13, "{name} {variant}: {to_general:e}");
+        }
+    }
+}

@@ -286,3 +286,74 @@ fn gaits_equal_the_general_loop() {
         let _ = DVector::<f64>::zeros(0);
     }
 }
+
+#[test]
+fn the_closed_form_strides_and_gaits_equal_the_link_pass() {
+    // The two-link chains (compass, simplest) evaluate by their closed form
+    // (`planar/two_link.rs`); `LinkPass` runs the same fixed-size stride on the planar link
+    // pass: strides from perturbed starts at three tolerances, then whole gaits.
+    let mut seed = 29u64;
+    for name in ["compass", "simplest"] {
+        let s = setup(name);
+        let w = &s.walker;
+        assert!(w.takes_fixed_size_stride(
+            &with_path(&s.settings, EvaluationPath::LinkPass),
+            StrideOptions::default()
+        ));
+        let (mut worst, mut compared) = (0.0f64, 0);
+        for trial in 0..8 {
+            let size = if name == "simplest" { 1e-3 } else { 1e-2 };
+            let scale = if trial == 0 { 0.0 } else { size };
+            let (mut q, mut qd) = (s.guess.q.clone(), s.guess.qd.clone());
+            for c in &w.map_coordinates() {
+                q[c.0] += scale * noise(&mut seed);
+                qd[c.0] += 5.0 * scale * noise(&mut seed);
+            }
+            for rtol in [1e-12, 1e-10, 1e-8] {
+                let closed = s.settings.with_integrator(
+                    s.settings
+                        .integrator
+                        .with_tolerance_or_step(Some(rtol), None),
+                );
+                let link_pass = with_path(&closed, EvaluationPath::LinkPass);
+                match (
+                    w.stride(&q, &qd, StrideRequest::new(&closed)),
+                    w.stride(&q, &qd, StrideRequest::new(&link_pass)),
+                ) {
+                    (Ok(a), Ok(b)) => {
+                        worst = worst.max(difference(&a, &b));
+                        assert_eq!(a.evaluations, b.evaluations, "{name} {trial} {rtol:e}");
+                        compared += 1;
+                    }
+                    (Err(a), Err(b)) => assert_eq!(a.kind, b.kind, "{name}"),
+                    (a, b) => panic!("{name} {trial}: {:?} against {:?}", a.err(), b.err()),
+                }
+            }
+        }
+        let newton = NewtonSettings::default();
+        let v0 = w.pack(&s.guess.q, &s.guess.qd);
+        let link_pass = with_path(&s.settings, EvaluationPath::LinkPass);
+        let ga = GaitSearch::new(w, &s.settings, &newton).find(&v0).unwrap();
+        let gb = GaitSearch::new(w, &link_pass, &newton).find(&v0).unwrap();
+        let fp = (&ga.fixed_point - &gb.fixed_point).amax();
+        let ev = ga
+            .eigenvalues
+            .iter()
+            .map(|x| {
+                gb.eigenvalues
+                    .iter()
+                    .map(|y| (x - y).norm())
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0f64, f64::max);
+        eprintln!(
+            "{name}: {compared} strides, closed form − link pass {worst:e}; gait: fixed point \
+             {fp:e}, eigenvalues {ev:e}"
+        );
+        assert!(compared >= 12, "{name}: {compared}");
+        assert!(worst < 1e-12, "{name}: {worst:e}");
+        assert!(fp < 1e-12, "{name}: {fp:e}");
+        // Central differences (δ = 1e-6) of strides that differ by rounding: their own noise.
+        assert!(ev < 1e-7, "{name}: {ev:e}");
+    }
+}

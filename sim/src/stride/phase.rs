@@ -52,10 +52,7 @@ impl<'a> Phase<'a> {
         Self {
             model,
             dynamics: Dynamics::new(model),
-            planar: match path {
-                EvaluationPath::Auto | EvaluationPath::GeneralLoop => PlanarTree::of(model),
-                EvaluationPath::General => None,
-            },
+            planar: PlanarTree::for_path(model, path),
             active: vec![true; model.dof()],
             prescribed: None,
         }

@@ -9,7 +9,7 @@
 //!
 //! Selected automatically ([`covers`]): a walker on the planar fast path
 //! ([`PlanarTree::of`]) without an ankle string, DOP853 with its dense output for events, no
-//! controller, no contact figures, and [`EvaluationPath::Auto`]. Whatever it meets on the way
+//! controller, no contact figures, and [`EvaluationPath::Auto`] (or `LinkPass`). Whatever it meets on the way
 //! that the general loop handles and it does not — a step that triggers two events, a fall, a
 //! scuff the scene does not ignore, a budget used up, a failed step — hands the stride back to
 //! the general loop, which runs it again from its start ([`Outcome::Fallback`]).
@@ -44,8 +44,10 @@ pub(super) fn covers(
     options: StrideOptions,
     controlled: bool,
 ) -> Option<PlanarTree> {
-    let eligible = settings.evaluation == EvaluationPath::Auto
-        && matches!(settings.integrator, IntegratorChoice::Dop853 { .. })
+    let eligible = matches!(
+        settings.evaluation,
+        EvaluationPath::Auto | EvaluationPath::LinkPass
+    ) && matches!(settings.integrator, IntegratorChoice::Dop853 { .. })
         && settings.event_tolerance.dense_output
         && !controlled
         && walker.ankle.is_none()
@@ -53,7 +55,7 @@ pub(super) fn covers(
     if !eligible {
         return None;
     }
-    PlanarTree::of(&walker.model)
+    PlanarTree::for_path(&walker.model, settings.evaluation)
 }
 
 impl Walker {

@@ -1,0 +1,312 @@
+//! The equations of motion of a planar two-link tree in closed form: a stance leg on the
+//! ground and a swing leg on a hip (the compass gait, the simplest walker), with point and
+//! distributed masses, welds anywhere. Built once from the planar tree's own data
+//! ([`TwoLink::of`], structurally: two coordinates, the second joint below the first link);
+//! the link pass of [`super::PlanarTree`] and the general engine stay the reference it is
+//! tested against (`sim/tests/fast_path.rs`).
+//!
+//! # Derivation
+//!
+//! Group 1 is every body rigid with the first joint's link (link `A`, coordinate `a`, axis
+//! sign `s₁`, welds below it included), group 2 every body rigid with the second joint's link
+//! (`B`, coordinate `b`, sign `s₂`). With every rotation the identity at `q = 0` (the planar
+//! tree's convention), link angles are `θ₁ = s₁ q_a` and `θ₂ = θ₁ + φ`, `φ = s₂ q_b`, and
+//! rates `ω₁ = s₁ q̇_a`, `ω₂ = ω₁ + s₂ q̇_b`, i.e. `ω = S q̇` with `S = [[s₁, 0], [s₁, s₂]]`.
+//! `O₁` is the first joint's (fixed) origin, `O₂ = O₁ + R₁ d` the second's, `d` fixed in link
+//! `A`. Each group lumps into its mass `mᵢ`, first moment `hᵢ = Σ m r` and rotational inertia
+//! `Jᵢ = Σ (I_zz + m |r|²)` about its joint, `r` the centre of mass from the joint in the
+//! group's frame (read off the planar frames at `q = 0`).
+//!
+//! The engine's TMT method assembles `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and
+//! `f̄ = Σ Jvᵀ m (g − a_bias)`, which is Lagrange's equations of `T − V` written body by body
+//! (`Jv`, `Jw` the partial velocities, `a_bias` the convective acceleration `J̇ q̇`). Summing
+//! the bodies of each group first: with `v_{O₂} = ω₁ ẑ × R₁ d`,
+//!
+//! `T = ½ (J₁ + m₂ |d|²) ω₁² + ω₁ ω₂ c(φ) + ½ J₂ ω₂²`,
+//! `c(φ) = (R₁ d) · (R₂ h₂) = d · R(φ) h₂ = A cos φ + B sin φ`,
+//! `A = d · h₂`, `B = d_y h₂ₓ − dₓ h₂_y`,
+//!
+//! `V = −g · (R₁ (h₁ + m₂ d) + R₂ h₂) + const`.
+//!
+//! Lagrange's equations in `θ₁`, `θ₂` (with `∂c/∂θ₂ = −∂c/∂θ₁ = c′(φ) = −A sin φ + B cos φ`):
+//!
+//! `J₁′ ω̇₁ + c ω̇₂ = Q₁ − c′ ω₂²`, `c ω̇₁ + J₂ ω̇₂ = Q₂ + c′ ω₁²`,
+//! `J₁′ = J₁ + m₂ |d|²`, `Q₁ = (R₁ H₁) × g`, `H₁ = h₁ + m₂ d`, `Q₂ = (R₂ h₂) × g`
+//!
+//! (`u × g = uₓ g_y − u_y gₓ`, the moment of gravity). In the coordinates, `ω̇ = S q̈` and the
+//! generalised forces are `Sᵀ` times these (`s₁² = s₂² = 1`):
+//!
+//! `M̄_aa = J₁′ + 2c + J₂`, `M̄_ab = s₁ s₂ (c + J₂)`, `M̄_bb = J₂`,
+//! `f̄_a = s₁ (Q₁ + Q₂ − c′ (ω₂² − ω₁²))`, `f̄_b = s₂ (Q₂ + c′ ω₁²)`,
+//!
+//! less the joint springs and dampers (`k (q − q_rest) + d q̇`), as in the link pass. Finite
+//! and infinitesimal bodies lump separately (the `ε` parts of `M̄`, `f̄`).
+
+use super::{Assembled, LinkFrame, PlanarTree, MAX_LINKS};
+use nalgebra::{SMatrix, SVector};
+
+/// One group's lumped mass properties about its joint, in its link's frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Lumped {
+    /// Mass [kg].
+    mass_kg: f64,
+    /// First moment `Σ m r` about the joint [kg·m].
+    moment_kg_m: [f64; 2],
+    /// Rotational inertia `Σ (I_zz + m |r|²)` about the joint [kg·m²].
+    inertia_kg_m2: f64,
+}
+
+/// The constants of `M̄` and `f̄` for one part (finite or infinitesimal bodies).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct PartConstants {
+    /// `J₁′ + J₂` [kg·m²].
+    j_sum_kg_m2: f64,
+    /// `J₂` [kg·m²].
+    j2_kg_m2: f64,
+    /// `A = d · h₂` and `B = d_y h₂ₓ − dₓ h₂_y` [kg·m²].
+    a_kg_m2: f64,
+    b_kg_m2: f64,
+    /// `H₁ = h₁ + m₂ d` (link A's frame) [kg·m].
+    h1_kg_m: [f64; 2],
+    /// `h₂` (link B's frame) [kg·m].
+    h2_kg_m: [f64; 2],
+    /// The part has any mass or inertia.
+    present: bool,
+}
+
+impl PartConstants {
+    fn of(g1: &Lumped, g2: &Lumped, d: [f64; 2]) -> Self {
+        let j1p = g1.inertia_kg_m2 + g2.mass_kg * (d[0] * d[0] + d[1] * d[1]);
+        let h2 = g2.moment_kg_m;
+        Self {
+            j_sum_kg_m2: j1p + g2.inertia_kg_m2,
+            j2_kg_m2: g2.inertia_kg_m2,
+            a_kg_m2: d[0] * h2[0] + d[1] * h2[1],
+            b_kg_m2: d[1] * h2[0] - d[0] * h2[1],
+            h1_kg_m: [
+                g1.moment_kg_m[0] + g2.mass_kg * d[0],
+                g1.moment_kg_m[1] + g2.mass_kg * d[1],
+            ],
+            h2_kg_m: h2,
+            present: *g1 != Lumped::default() || *g2 != Lumped::default(),
+        }
+    }
+}
+
+/// The trigonometry and rates of one evaluation.
+struct Angles {
+    /// `cos θ₁`, `sin θ₁`.
+    c1: f64,
+    s1: f64,
+    /// `cos θ₂`, `sin θ₂`.
+    c2: f64,
+    s2: f64,
+    /// `cos φ`, `sin φ`.
+    cp: f64,
+    sp: f64,
+    /// `ω₁²` and `ω₂²`.
+    w1_sq: f64,
+    w2_sq: f64,
+}
+
+/// A planar two-link tree's equations of motion in closed form (see the module's derivation).
+#[derive(Clone, Debug)]
+pub(super) struct TwoLink {
+    /// Coordinate of the first joint (on the ground) and its axis sign.
+    a: (usize, f64),
+    /// Coordinate of the second joint (below link A) and its axis sign.
+    b: (usize, f64),
+    /// Finite bodies' constants.
+    finite: PartConstants,
+    /// Infinitesimal bodies' constants.
+    eps: PartConstants,
+    /// Gravity in the floor's x-y plane [m/s²].
+    gravity_m_s2: [f64; 2],
+    /// Joint spring and damper per coordinate: stiffness, rest position, damping.
+    springs: [(f64, f64, f64); 2],
+}
+
+impl TwoLink {
+    /// The closed form of `tree`, or `None` when it is not a two-link chain: two coordinates,
+    /// the first joint's link on the ground through welds only, the second joint's link below
+    /// the first's, every body with mass on one of the two.
+    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
+        if tree.dof != 2 || tree.links.len() > MAX_LINKS {
+            return None;
+        }
+        // The joints: each link's nearest joint above it (itself included), as a link index.
+        let mut owner = [None::<usize>; MAX_LINKS];
+        let mut joints = Vec::with_capacity(2);
+        for (i, link) in tree.links.iter().enumerate() {
+            let parent_owner = match link.parent_slot {
+                0 => None,
+                s => owner[s - 1],
+            };
+            owner[i] = match link.coordinate {
+                Some(_) => {
+                    joints.push((i, parent_owner));
+                    Some(i)
+                }
+                None => parent_owner,
+            };
+        }
+        let [(link_a, None), (link_b, Some(above_b))] = joints[..] else {
+            return None;
+        };
+        if above_b != link_a {
+            return None;
+        }
+        let (a, b) = (
+            tree.links[link_a].coordinate?,
+            tree.links[link_b].coordinate?,
+        );
+        // Frames at q = 0: every rotation the identity, so origins give the offsets.
+        let fr: [LinkFrame; MAX_LINKS + 1] =
+            tree.frames(&SVector::<f64, 2>::zeros(), &SVector::zeros());
+        let (o1, o2) = (fr[link_a + 1].origin_m, fr[link_b + 1].origin_m);
+        let d = [o2[0] - o1[0], o2[1] - o1[1]];
+        let mut groups = [[Lumped::default(); 2]; 2];
+        for body in &tree.bodies {
+            let (group, origin) = match owner.get(body.slot - 1).copied().flatten() {
+                Some(l) if l == link_a => (0, o1),
+                Some(l) if l == link_b => (1, o2),
+                _ => return None,
+            };
+            let o = fr[body.slot].origin_m;
+            let r = [
+                o[0] - origin[0] + body.com_xy_m[0],
+                o[1] - origin[1] + body.com_xy_m[1],
+            ];
+            let g = &mut groups[usize::from(body.infinitesimal)][group];
+            let m = body.mass_kg;
+            g.mass_kg += m;
+            g.moment_kg_m[0] += m * r[0];
+            g.moment_kg_m[1] += m * r[1];
+            g.inertia_kg_m2 += body.izz_kg_m2 + m * (r[0] * r[0] + r[1] * r[1]);
+        }
+        let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
+        Some(Self {
+            a,
+            b,
+            finite: PartConstants::of(&groups[0][0], &groups[0][1], d),
+            eps: PartConstants::of(&groups[1][0], &groups[1][1], d),
+            gravity_m_s2: tree.gravity_m_s2,
+            springs: [spring(a.0), spring(b.0)],
+        })
+    }
+
+    fn angles(&self, q: [f64; 2], qd: [f64; 2]) -> Angles {
+        let (s1, c1) = (self.a.1 * q[0]).sin_cos();
+        let (sp, cp) = (self.b.1 * q[1]).sin_cos();
+        let w1 = self.a.1 * qd[0];
+        let w2 = w1 + self.b.1 * qd[1];
+        Angles {
+            c1,
+            s1,
+            c2: c1 * cp - s1 * sp,
+            s2: s1 * cp + c1 * sp,
+            cp,
+            sp,
+            w1_sq: w1 * w1,
+            w2_sq: w2 * w2,
+        }
+    }
+
+    /// `M̄` (lower triangle `[aa, ba, bb]`) and `f̄` (`[a, b]`) of one part, springs excluded.
+    fn part(&self, k: &PartConstants, t: &Angles) -> ([f64; 3], [f64; 2]) {
+        let [gx, gy] = self.gravity_m_s2;
+        let (sa, sb) = (self.a.1, self.b.1);
+        let c = k.a_kg_m2 * t.cp + k.b_kg_m2 * t.sp;
+        let c_prime = k.b_kg_m2 * t.cp - k.a_kg_m2 * t.sp;
+        // R₁ H₁ and R₂ h₂ in the floor frame, and their moments of gravity.
+        let [h1x, h1y] = k.h1_kg_m;
+        let [h2x, h2y] = k.h2_kg_m;
+        let (u1x, u1y) = (t.c1 * h1x - t.s1 * h1y, t.s1 * h1x + t.c1 * h1y);
+        let (u2x, u2y) = (t.c2 * h2x - t.s2 * h2y, t.s2 * h2x + t.c2 * h2y);
+        let q1 = u1x * gy - u1y * gx;
+        let q2 = u2x * gy - u2y * gx;
+        let fb = q2 + c_prime * t.w1_sq;
+        let fa = q1 - c_prime * t.w2_sq + fb;
+        (
+            [
+                k.j_sum_kg_m2 + 2.0 * c,
+                sa * sb * (c + k.j2_kg_m2),
+                k.j2_kg_m2,
+            ],
+            [sa * fa, sb * fb],
+        )
+    }
+
+    /// The finite part's `M̄` (lower triangle) and `f̄` with the springs and dampers, and the
+    /// angles, at `q`, `q̇` in the tree's coordinate order.
+    fn finite_part(&self, q: [f64; 2], qd: [f64; 2]) -> ([f64; 3], [f64; 2], Angles) {
+        let (qa, qb) = (q[self.a.0], q[self.b.0]);
+        let (qda, qdb) = (qd[self.a.0], qd[self.b.0]);
+        let t = self.angles([qa, qb], [qda, qdb]);
+        let (m, mut f) = self.part(&self.finite, &t);
+        let [(ka, ra, da), (kb, rb, db)] = self.springs;
+        f[0] -= (qa - ra) * ka + qda * da;
+        f[1] -= (qb - rb) * kb + qdb * db;
+        (m, f, t)
+    }
+
+    /// Both parts of `M̄` and `f̄` as the link pass assembles them (`N` must be 2).
+    pub(super) fn assemble<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Assembled<N> {
+        let (m, f, t) = self.finite_part([q[0], q[1]], [qd[0], qd[1]]);
+        let (me, fe) = if self.eps.present {
+            self.part(&self.eps, &t)
+        } else {
+            ([0.0; 3], [0.0; 2])
+        };
+        Assembled {
+            m: self.matrix(m),
+            m_eps: self.matrix(me),
+            f: self.vector(f),
+            f_eps: self.vector(fe),
+        }
+    }
+
+    /// The lower triangle `[aa, ba, bb]` as a matrix in the tree's coordinate order.
+    fn matrix<const N: usize>(&self, l: [f64; 3]) -> SMatrix<f64, N, N> {
+        let mut m = SMatrix::<f64, N, N>::zeros();
+        let (a, b) = (self.a.0, self.b.0);
+        m[(a, a)] = l[0];
+        m[(a, b)] = l[1];
+        m[(b, a)] = l[1];
+        m[(b, b)] = l[2];
+        m
+    }
+
+    /// `[a, b]` as a vector in the tree's coordinate order.
+    fn vector<const N: usize>(&self, v: [f64; 2]) -> SVector<f64, N> {
+        let mut out = SVector::<f64, N>::zeros();
+        out[self.a.0] = v[0];
+        out[self.b.0] = v[1];
+        out
+    }
+
+    /// Whether the tree has only finite bodies (the direct solve applies).
+    pub(super) fn finite_only(&self) -> bool {
+        !self.eps.present
+    }
+
+    /// `q̈` with both coordinates free, no drive and only finite bodies: `M̄ q̈ = f̄` solved by
+    /// the 2 × 2 inverse (`None`: `M̄` not positive definite, left to the Cholesky solve and
+    /// its error). `N` must be 2.
+    pub(super) fn free_accelerations<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Option<SVector<f64, N>> {
+        let ([maa, mba, mbb], [fa, fb], _) = self.finite_part([q[0], q[1]], [qd[0], qd[1]]);
+        let det = maa * mbb - mba * mba;
+        if !(maa > 0.0 && det > 0.0) {
+            return None;
+        }
+        Some(self.vector([(mbb * fa - mba * fb) / det, (maa * fb - mba * fa) / det]))
+    }
+}
