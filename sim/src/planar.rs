@@ -352,22 +352,22 @@ impl PlanarTree {
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DynamicsError> {
+        if let Some(t) = &self.two_link {
+            if N == 2 && drive.is_none() && active.len() == 2 && active[0] && active[1] {
+                // Both free: the closed form and its 2 × 2 solve. A state that is not finite
+                // gives a result that is not, and the checks below its error.
+                if let Some(qdd) = t.free_accelerations(q, qd) {
+                    if qdd[0].is_finite() && qdd[1].is_finite() {
+                        return Ok(qdd);
+                    }
+                }
+            }
+        }
         if N != self.dof || active.len() != N {
             return Err(DynamicsError::NonFinite);
         }
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
-        }
-        if let Some(t) = &self.two_link {
-            if N == 2 && drive.is_none() && t.finite_only() && active.iter().all(|&a| a) {
-                // Both free, finite bodies: the closed form and the 2 × 2 inverse.
-                if let Some(qdd) = t.free_accelerations(q, qd) {
-                    if qdd.iter().all(|v| v.is_finite()) {
-                        return Ok(qdd);
-                    }
-                    return Err(DynamicsError::NonFinite);
-                }
-            }
         }
         let (mut qs, mut qds) = (*q, *qd);
         let mut qdd = SVector::<f64, N>::zeros();

@@ -124,6 +124,25 @@ pub(super) struct TwoLink {
     gravity_m_s2: [f64; 2],
     /// Joint spring and damper per coordinate: stiffness, rest position, damping.
     springs: [(f64, f64, f64); 2],
+    /// How `q̈` is solved with both coordinates free and no drive.
+    solve: FreeSolve,
+}
+
+/// How [`TwoLink::free_accelerations`] solves `M̄ q̈ = f̄` with both coordinates free.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FreeSolve {
+    /// Finite bodies only: the 2 × 2 inverse.
+    Direct,
+    /// The vanishing-mass limit with the finite `M̄`'s null space the second coordinate by
+    /// structure (the swing leg's group has no finite mass off its joint, no finite inertia,
+    /// no spring or damper: the simplest walker). `M̄ = M + ε M_ε`, `f̄ = f + ε f_ε`,
+    /// `q̈ = x₀ + ε x₁ + …`: order 1 gives `M_aa x₀_a = f_a` (row b of `M` and `f_b` are zero),
+    /// order ε projected on the null space `e_b` gives `(M_ε x₀)_b = f_ε,b`, i.e.
+    /// `x₀_b = (f_ε,b − M_ε,ba x₀_a) / M_ε,bb` — what the general limit solve
+    /// (`singular_limit`) finds from the eigenpairs of `M`.
+    Limit,
+    /// Anything else: the planar tree's solves on the closed-form matrices.
+    Assembled,
 }
 
 impl TwoLink {
@@ -185,13 +204,26 @@ impl TwoLink {
             g.inertia_kg_m2 += body.izz_kg_m2 + m * (r[0] * r[0] + r[1] * r[1]);
         }
         let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
+        let finite = PartConstants::of(&groups[0][0], &groups[0][1], d);
+        let eps = PartConstants::of(&groups[1][0], &groups[1][1], d);
+        let springs = [spring(a.0), spring(b.0)];
+        let swing_massless = finite.j2_kg_m2 == 0.0
+            && finite.h2_kg_m == [0.0; 2]
+            && springs[1].0 == 0.0
+            && springs[1].2 == 0.0;
+        let solve = match (eps.present, swing_massless) {
+            (false, _) => FreeSolve::Direct,
+            (true, true) => FreeSolve::Limit,
+            (true, false) => FreeSolve::Assembled,
+        };
         Some(Self {
             a,
             b,
-            finite: PartConstants::of(&groups[0][0], &groups[0][1], d),
-            eps: PartConstants::of(&groups[1][0], &groups[1][1], d),
+            finite,
+            eps,
             gravity_m_s2: tree.gravity_m_s2,
-            springs: [spring(a.0), spring(b.0)],
+            springs,
+            solve,
         })
     }
 
@@ -289,24 +321,35 @@ impl TwoLink {
         out
     }
 
-    /// Whether the tree has only finite bodies (the direct solve applies).
-    pub(super) fn finite_only(&self) -> bool {
-        !self.eps.present
-    }
-
-    /// `q̈` with both coordinates free, no drive and only finite bodies: `M̄ q̈ = f̄` solved by
-    /// the 2 × 2 inverse (`None`: `M̄` not positive definite, left to the Cholesky solve and
-    /// its error). `N` must be 2.
+    /// `q̈` with both coordinates free and no drive, by the 2 × 2 inverse (finite bodies) or
+    /// the structural vanishing-mass limit ([`FreeSolve`]); `None` when neither applies or
+    /// the matrix is not positive definite there (left to the planar tree's solves and their
+    /// errors). `N` must be 2.
     pub(super) fn free_accelerations<const N: usize>(
         &self,
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> Option<SVector<f64, N>> {
-        let ([maa, mba, mbb], [fa, fb], _) = self.finite_part([q[0], q[1]], [qd[0], qd[1]]);
-        let det = maa * mbb - mba * mba;
-        if !(maa > 0.0 && det > 0.0) {
-            return None;
+        let (q, qd) = ([q[0], q[1]], [qd[0], qd[1]]);
+        match self.solve {
+            FreeSolve::Direct => {
+                let ([maa, mba, mbb], [fa, fb], _) = self.finite_part(q, qd);
+                let det = maa * mbb - mba * mba;
+                if !(maa > 0.0 && det > 0.0) {
+                    return None;
+                }
+                Some(self.vector([(mbb * fa - mba * fb) / det, (maa * fb - mba * fa) / det]))
+            }
+            FreeSolve::Limit => {
+                let ([maa, _, _], [fa, _], t) = self.finite_part(q, qd);
+                let ([_, eba, ebb], [_, feb]) = self.part(&self.eps, &t);
+                if !(maa > 0.0 && ebb > 0.0) {
+                    return None;
+                }
+                let qdd_a = fa / maa;
+                Some(self.vector([qdd_a, (feb - eba * qdd_a) / ebb]))
+            }
+            FreeSolve::Assembled => None,
         }
-        Some(self.vector([(mbb * fa - mba * fb) / det, (maa * fb - mba * fa) / det]))
     }
 }
