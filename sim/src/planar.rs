@@ -352,15 +352,9 @@ impl PlanarTree {
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DynamicsError> {
-        if let Some(t) = &self.two_link {
-            if N == 2 && drive.is_none() && active.len() == 2 && active[0] && active[1] {
-                // Both free: the closed form and its 2 × 2 solve. A state that is not finite
-                // gives a result that is not, and the checks below its error.
-                if let Some(qdd) = t.free_accelerations(q, qd) {
-                    if qdd[0].is_finite() && qdd[1].is_finite() {
-                        return Ok(qdd);
-                    }
-                }
+        if drive.is_none() && active.iter().all(|&a| a) {
+            if let Some(qdd) = self.free_closed_form(q, qd) {
+                return Ok(qdd);
             }
         }
         if N != self.dof || active.len() != N {
@@ -400,6 +394,25 @@ impl PlanarTree {
             return Err(DynamicsError::NonFinite);
         }
         Ok(qdd)
+    }
+
+    /// `q̈` by the tree's closed form with every coordinate free and no drive (the two-link
+    /// chain's, [`Self::has_closed_form`]), or `None` when it has none, `N` is not its size,
+    /// or the result is not finite (a state that is not finite gives one that is not; then
+    /// [`Self::accelerations_fixed`] reports the error): the fixed-size stride's shortcut,
+    /// equal to [`Self::accelerations_fixed`] wherever it answers.
+    #[inline]
+    pub fn free_closed_form<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Option<SVector<f64, N>> {
+        let t = self.two_link.as_ref()?;
+        if N != 2 {
+            return None;
+        }
+        let qdd = t.free_accelerations(q, qd)?;
+        (qdd[0].is_finite() && qdd[1].is_finite()).then_some(qdd)
     }
 
     /// The damping coefficient of coordinate `c`'s joint [N·m·s/rad] (zero when undamped).

@@ -126,6 +126,10 @@ pub(super) struct TwoLink {
     springs: [(f64, f64, f64); 2],
     /// How `q̈` is solved with both coordinates free and no drive.
     solve: FreeSolve,
+    /// The first joint owns coordinate 1 (the tree's order is `(b, a)`).
+    swapped: bool,
+    /// Any joint spring or damper.
+    has_springs: bool,
 }
 
 /// How [`TwoLink::free_accelerations`] solves `M̄ q̈ = f̄` with both coordinates free.
@@ -224,9 +228,12 @@ impl TwoLink {
             gravity_m_s2: tree.gravity_m_s2,
             springs,
             solve,
+            swapped: a.0 == 1,
+            has_springs: springs.iter().any(|&(k, _, d)| k != 0.0 || d != 0.0),
         })
     }
 
+    #[inline(always)]
     fn angles(&self, q: [f64; 2], qd: [f64; 2]) -> Angles {
         let (s1, c1) = (self.a.1 * q[0]).sin_cos();
         let (sp, cp) = (self.b.1 * q[1]).sin_cos();
@@ -245,6 +252,7 @@ impl TwoLink {
     }
 
     /// `M̄` (lower triangle `[aa, ba, bb]`) and `f̄` (`[a, b]`) of one part, springs excluded.
+    #[inline(always)]
     fn part(&self, k: &PartConstants, t: &Angles) -> ([f64; 3], [f64; 2]) {
         let [gx, gy] = self.gravity_m_s2;
         let (sa, sb) = (self.a.1, self.b.1);
@@ -271,15 +279,28 @@ impl TwoLink {
 
     /// The finite part's `M̄` (lower triangle) and `f̄` with the springs and dampers, and the
     /// angles, at `q`, `q̇` in the tree's coordinate order.
+    #[inline(always)]
     fn finite_part(&self, q: [f64; 2], qd: [f64; 2]) -> ([f64; 3], [f64; 2], Angles) {
-        let (qa, qb) = (q[self.a.0], q[self.b.0]);
-        let (qda, qdb) = (qd[self.a.0], qd[self.b.0]);
+        let [qa, qb] = self.ordered(q);
+        let [qda, qdb] = self.ordered(qd);
         let t = self.angles([qa, qb], [qda, qdb]);
         let (m, mut f) = self.part(&self.finite, &t);
-        let [(ka, ra, da), (kb, rb, db)] = self.springs;
-        f[0] -= (qa - ra) * ka + qda * da;
-        f[1] -= (qb - rb) * kb + qdb * db;
+        if self.has_springs {
+            let [(ka, ra, da), (kb, rb, db)] = self.springs;
+            f[0] -= (qa - ra) * ka + qda * da;
+            f[1] -= (qb - rb) * kb + qdb * db;
+        }
         (m, f, t)
+    }
+
+    /// `[v_a, v_b]` from `v` in the tree's coordinate order, or back.
+    #[inline(always)]
+    fn ordered(&self, v: [f64; 2]) -> [f64; 2] {
+        if self.swapped {
+            [v[1], v[0]]
+        } else {
+            v
+        }
     }
 
     /// Both parts of `M̄` and `f̄` as the link pass assembles them (`N` must be 2).
@@ -314,11 +335,10 @@ impl TwoLink {
     }
 
     /// `[a, b]` as a vector in the tree's coordinate order.
+    #[inline(always)]
     fn vector<const N: usize>(&self, v: [f64; 2]) -> SVector<f64, N> {
-        let mut out = SVector::<f64, N>::zeros();
-        out[self.a.0] = v[0];
-        out[self.b.0] = v[1];
-        out
+        let v = self.ordered(v);
+        SVector::<f64, N>::from_fn(|i, _| if i == 0 { v[0] } else { v[1] })
     }
 
     /// `q̈` with both coordinates free and no drive, by the 2 × 2 inverse (finite bodies) or

@@ -49,6 +49,11 @@ impl<const N: usize> FixedSystem<N> for FastPhase<'_, N> {
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DynamicsError> {
+        if self.active.iter().all(|&a| a) {
+            if let Some(qdd) = self.tree.free_closed_form(q, qd) {
+                return Ok(qdd);
+            }
+        }
         let (limit, model) = (&mut self.limit, self.model);
         self.tree.accelerations_fixed(
             || limit.get_or_insert_with(|| Dynamics::new(model)),
