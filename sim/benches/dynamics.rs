@@ -60,6 +60,25 @@ fn benches(c: &mut Criterion) {
                     .unwrap()
                 })
             });
+            if tree.has_closed_form() {
+                // The same evaluation by the planar link pass instead of the two-link closed
+                // form (the compass).
+                let link_pass = tree.clone().link_pass_only();
+                group.bench_function("accelerations_planar_link_pass", |b| {
+                    b.iter(|| {
+                        link_pass
+                            .accelerations_into(
+                                &mut dynamics,
+                                &active,
+                                None,
+                                black_box(&q),
+                                black_box(&qd),
+                                &mut out,
+                            )
+                            .unwrap()
+                    })
+                });
+            }
         }
         if !model.has_infinitesimal_bodies() {
             // Each coordinate carries a unit direction (mod 6), as the variational equations

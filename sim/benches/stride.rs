@@ -104,6 +104,18 @@ fn benches(c: &mut Criterion) {
                         walker.stride(black_box(&q), black_box(&qd), request)
                     })
                 });
+                if sim::planar::PlanarTree::of(&walker.model).is_some_and(|t| t.has_closed_form()) {
+                    // The fixed-size stride on the planar link pass instead of the two-link
+                    // closed form: what the closed form buys.
+                    let mut link_pass = settings.clone();
+                    link_pass.evaluation = EvaluationPath::LinkPass;
+                    group.bench_function(format!("{label}_link_pass"), |b| {
+                        b.iter(|| {
+                            let request = StrideRequest::new(&link_pass);
+                            walker.stride(black_box(&q), black_box(&qd), request)
+                        })
+                    });
+                }
             }
         }
         group.finish();

@@ -1,7 +1,8 @@
 //! The equations of motion of a planar two-link tree in closed form: a stance leg on the
 //! ground and a swing leg on a hip (the compass gait, the simplest walker), with point and
 //! distributed masses, welds anywhere. Built once from the planar tree's own data
-//! ([`TwoLink::of`], structurally: two coordinates, the second joint below the first link);
+//! ([`TwoLink::of`], structurally: two coordinates, the second joint below the first link;
+//! with infinitesimal bodies only on request, [`PlanarTree::with_infinitesimal_closed_form`]);
 //! the link pass of [`super::PlanarTree`] and the general engine stay the reference it is
 //! tested against (`sim/tests/fast_path.rs`).
 //!
@@ -152,9 +153,13 @@ enum FreeSolve {
 impl TwoLink {
     /// The closed form of `tree`, or `None` when it is not a two-link chain: two coordinates,
     /// the first joint's link on the ground through welds only, the second joint's link below
-    /// the first's, every body with mass on one of the two.
-    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
+    /// the first's, every body with mass on one of the two; or when it has infinitesimal bodies
+    /// and `with_infinitesimal` is false ([`PlanarTree::with_infinitesimal_closed_form`]).
+    pub(super) fn of(tree: &PlanarTree, with_infinitesimal: bool) -> Option<Self> {
         if tree.dof != 2 || tree.links.len() > MAX_LINKS {
+            return None;
+        }
+        if tree.has_infinitesimal && !with_infinitesimal {
             return None;
         }
         // The joints: each link's nearest joint above it (itself included), as a link index.
