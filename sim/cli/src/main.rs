@@ -21,9 +21,9 @@ mod output;
 mod param_range;
 mod plot;
 mod progress;
-mod sweep_figures;
 #[cfg(test)]
 mod readme_commands;
+mod sweep_figures;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};

@@ -16,7 +16,8 @@ function bytes(b64) {
 // Little-endian arrays (as the binary wrote them; every browser's typed arrays are too).
 const tr = data.track;
 const times = new Float32Array(bytes(tr.t_s));
-const stepOf = new Uint16Array(bytes(tr.step));
+// Step of each frame as people number it (from 1, computed by the binary).
+const stepNumber = new Uint16Array(bytes(tr.step_number));
 const origin = new Float32Array(bytes(tr.origin_m));
 const rel = new Int16Array(bytes(tr.rel));
 const K = tr.points;
@@ -158,7 +159,7 @@ ui.slider.max = String(duration);
 let t = 0, playing = true, last = null;
 const events = data.events;
 for (const e of events) {
-  if (!["heel_strike", "fall", "fault", "command", "bus_off", "sensor_fault"].includes(e.kind)) continue;
+  if (!["heel_strike", "fall", "stop", "fault", "command", "bus_off", "sensor_fault"].includes(e.kind)) continue;
   const m = document.createElement("div");
   m.className = "mark " + e.kind;
   m.style.left = (100 * Math.min(e.t_s / duration, 1)) + "%";
@@ -167,7 +168,7 @@ for (const e of events) {
 }
 
 function overlay(frame) {
-  ui.clock.textContent = `t = ${t.toFixed(3)} s of ${duration.toFixed(3)} s · step ${stepOf[frame] + 1}`;
+  ui.clock.textContent = `t = ${t.toFixed(3)} s of ${duration.toFixed(3)} s · step ${stepNumber[frame]}`;
   const past = [];
   const nodes = {};
   // At the last frame every event has happened (a fall is located just after the last
@@ -197,8 +198,11 @@ function overlay(frame) {
       return div;
     }));
   }
-  const fall = events.find((e) => e.kind === "fall");
-  ui.banner.textContent = fall && until >= fall.t_s ? `fell at t = ${fall.t_s.toFixed(3)} s: ${fall.value}` : "";
+  // The walk's end by failure: "fell" for a fall, "stopped" for any other failure (its kind
+  // in words, from the binary).
+  const end = events.find((e) => e.kind === "fall" || e.kind === "stop");
+  const verb = end && end.kind === "fall" ? "fell" : "stopped";
+  ui.banner.textContent = end && until >= end.t_s ? `${verb} at t = ${end.t_s.toFixed(3)} s: ${end.value}` : "";
 }
 
 function render() {

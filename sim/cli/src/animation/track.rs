@@ -30,8 +30,9 @@ pub struct Track {
     pub points: usize,
     /// Walk time of each frame [s] (float32).
     pub t_s: String,
-    /// Step of each frame, numbered from 0 (uint16; saturates at 65,535).
-    pub step: String,
+    /// Step of each frame as people number it, from 1 ([`crate::labels::step_number`];
+    /// uint16, saturates at 65,535): the page shows it as it is.
+    pub step_number: String,
     /// The moving origin of each frame, the hip in the floor frame [m] (float32, x y z).
     pub origin_m: String,
     /// Key points relative to the origin, in quanta (int16, x y z per point).
@@ -138,7 +139,8 @@ fn encode(frames: &[Frame]) -> Track {
     let mut rel = Vec::new();
     for f in frames {
         t.extend((f.t_walk_s as f32).to_le_bytes());
-        step.extend(u16::try_from(f.step).unwrap_or(u16::MAX).to_le_bytes());
+        let number = crate::labels::step_number(f.step);
+        step.extend(u16::try_from(number).unwrap_or(u16::MAX).to_le_bytes());
         for x in f.origin_m.iter() {
             origin.extend((*x as f32).to_le_bytes());
         }
@@ -154,7 +156,7 @@ fn encode(frames: &[Frame]) -> Track {
         frames: frames.len(),
         points: frames.first().map_or(0, |f| f.points_m.len()),
         t_s: super::base64::encode(&t),
-        step: super::base64::encode(&step),
+        step_number: super::base64::encode(&step),
         origin_m: super::base64::encode(&origin),
         rel: super::base64::encode(&rel),
         quantum_m,

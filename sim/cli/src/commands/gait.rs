@@ -5,8 +5,8 @@
 //! long-period gait comes back wherever its branch reaches (`walker gaits` lists them all).
 
 use super::{print_json, shown};
-use crate::export;
 use crate::animation::{self, timeline, Animation};
+use crate::export;
 use crate::figures;
 use crate::gait_text::GaitFigures;
 use crate::options::Common;
