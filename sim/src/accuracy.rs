@@ -25,7 +25,8 @@ pub struct AccuracyPoint {
     pub setting: IntegratorChoice,
     /// Step [s] (fixed-step integrators) or relative tolerance (dopri5).
     pub step_or_tolerance: f64,
-    /// CPU time of one stride from the reference fixed point [µs] (median of repeats).
+    /// CPU time of one stride from the reference fixed point [µs]: the minimum of
+    /// [`TIMING_REPEATS`] repeats, so that other work on a loaded machine inflates it less.
     pub cpu_us_per_stride: f64,
     /// Right-hand-side evaluations per stride.
     pub evaluations_per_stride: usize,
@@ -117,6 +118,10 @@ fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Repeats of the timed stride of each setting; the study keeps the fastest (other processes
+/// only ever add time).
+pub const TIMING_REPEATS: usize = 9;
+
 /// Runs the study: the reference gait with `reference`, then every setting, each gait search
 /// starting from the reference fixed point. The other stride settings (event tolerances, time
 /// budget) are the setup's.
@@ -125,6 +130,18 @@ pub fn study(
     reference: IntegratorChoice,
     settings: &[(String, f64, IntegratorChoice)],
     newton: &NewtonSettings,
+) -> Result<AccuracyStudy, NewtonError> {
+    study_with_progress(setup, reference, settings, newton, &|| {})
+}
+
+/// As [`study`], calling `on_setting` after each setting of `settings` is done (for a
+/// progress bar).
+pub fn study_with_progress(
+    setup: &Setup,
+    reference: IntegratorChoice,
+    settings: &[(String, f64, IntegratorChoice)],
+    newton: &NewtonSettings,
+    on_setting: &dyn Fn(),
 ) -> Result<AccuracyStudy, NewtonError> {
     let w = &setup.walker;
     let mut stride_settings = setup.settings.with_integrator(reference.clone());
@@ -140,20 +157,20 @@ pub fn study(
     let mut points = Vec::new();
     for (family, value, setting) in settings {
         stride_settings = setup.settings.with_integrator(setting.clone());
-        // CPU time per stride: median of a few repeats of the stride from the reference point.
-        let mut times = Vec::new();
+        // CPU time per stride: the fastest of the repeats of the stride from the reference
+        // point.
+        let mut fastest_us = f64::INFINITY;
         let mut evaluations = 0;
         let mut t_hs = None;
-        for _ in 0..5 {
+        for _ in 0..TIMING_REPEATS {
             let start = Instant::now();
             let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(&stride_settings));
-            times.push(start.elapsed().as_secs_f64() * 1e6);
+            fastest_us = fastest_us.min(start.elapsed().as_secs_f64() * 1e6);
             if let Ok(r) = r {
                 evaluations = r.evaluations;
                 t_hs = Some(r.duration_s);
             }
         }
-        times.sort_by(f64::total_cmp);
         let gait = GaitSearch::new(w, &stride_settings, &study_newton).find(&x_ref);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (
@@ -167,13 +184,14 @@ pub fn study(
             integrator: family.clone(),
             setting: setting.clone(),
             step_or_tolerance: *value,
-            cpu_us_per_stride: times[times.len() / 2],
+            cpu_us_per_stride: fastest_us,
             evaluations_per_stride: evaluations,
             fixed_point_error: fp,
             eigenvalue_error: ev,
             heel_strike_time_error_s: t_hs.map(|t| (t - t_ref).abs()),
             failure,
         });
+        on_setting();
     }
     Ok(AccuracyStudy {
         scene: w.name.clone(),
