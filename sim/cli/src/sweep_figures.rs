@@ -8,7 +8,9 @@ use crate::axis::Scale;
 use crate::figures::state_label;
 use crate::labels::{parameter_label, walker_name};
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
+use nalgebra::{Complex, DVector};
 use sim::continuation::{BifurcationKind, BranchPoint, Continuation};
+use sim::hermite::{self, Knot};
 use sim::scene::Scene;
 
 /// A point of a branch in arclength order: a grid point, or a bifurcation (with the
@@ -163,6 +165,11 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
                         if !open {
                             pts.push((w[0].value, y(&w[0])));
                         }
+                        // A period-1 branch between its points: the cubic through both with
+                        // the continuation's tangents (its orbit has one state, the tangent's).
+                        if b.period_strides == 1 {
+                            pts.extend(between(w[0].point, w[1].point, index));
+                        }
                         pts.push((w[1].value, y(&w[1])));
                     }
                     if !open {
@@ -249,7 +256,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             label: label.into(),
             points: found
                 .iter()
-                .map(|x| (x.value, x.point.max_abs_multiplier()))
+                .map(|x| (x.value, crossing_modulus(kind, &x.multipliers)))
                 .collect(),
             style: Style::markers(marker),
             color,
@@ -299,6 +306,11 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         },
         Plot {
             title: format!("{name}: stability against the {}", param_words(&param)),
+            caption: Some(
+                "bifurcations are marked at the modulus of the multiplier that crosses the unit \
+                 circle there (≈ 1), below the largest"
+                    .into(),
+            ),
             x_label: param,
             y_label: "largest |λ| of the stride map".into(),
             y_scale,
@@ -306,6 +318,71 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             ..Plot::default()
         },
     ]
+}
+
+/// Points drawn between two successive points of a period-1 branch, besides them.
+const HERMITE_POINTS: usize = 12;
+
+/// The branch between points `a` and `b` (in arclength order) as the cubic Hermite curve in
+/// the arclength through both, with the continuation's unit tangents `(dv/ds, dp/ds)` as
+/// rates, the arclength between them taken as their distance: [`HERMITE_POINTS`] points
+/// (parameter, stride-map entry `index`) strictly between them. None when the two coincide or
+/// a tangent is missing. A tangent pointing against the chord is turned round (a located
+/// bifurcation's may be oriented either way).
+pub fn between(a: &BranchPoint, b: &BranchPoint, index: usize) -> Vec<(f64, f64)> {
+    hermite_between((&a.x(), &a.tangent), (&b.x(), &b.tangent), index)
+}
+
+/// [`between`] on points `x = (v, p)` (the parameter last) with their tangents.
+fn hermite_between(
+    (xa, ta): (&DVector<f64>, &DVector<f64>),
+    (xb, tb): (&DVector<f64>, &DVector<f64>),
+    index: usize,
+) -> Vec<(f64, f64)> {
+    let n = xa.len();
+    if xb.len() != n || ta.len() != n || tb.len() != n || index + 1 >= n {
+        return Vec::new();
+    }
+    let chord = xb - xa;
+    let h = chord.norm();
+    if !(h > 0.0) || !h.is_finite() {
+        return Vec::new();
+    }
+    let along = |t: &DVector<f64>| if t.dot(&chord) < 0.0 { -t } else { t.clone() };
+    let (ta, tb) = (along(ta), along(tb));
+    let knot = |x: &DVector<f64>, t: &DVector<f64>, i: usize| Knot {
+        value: x[i],
+        rate: t[i],
+    };
+    let p = n - 1;
+    (1..=HERMITE_POINTS)
+        .map(|k| {
+            let u = k as f64 / (HERMITE_POINTS + 1) as f64;
+            let (pv, ..) = hermite::scalar(knot(xa, &ta, p), knot(xb, &tb, p), h, u);
+            let (yv, ..) = hermite::scalar(knot(xa, &ta, index), knot(xb, &tb, index), h, u);
+            (pv, yv)
+        })
+        .collect()
+}
+
+/// The modulus of the multiplier that crosses the unit circle at a bifurcation of `kind`: the
+/// one closest to +1 (fold, branch point), to −1 (period doubling), or the complex one
+/// closest to the circle (Neimark–Sacker); the largest modulus if there is none such.
+pub fn crossing_modulus(kind: BifurcationKind, multipliers: &[Complex<f64>]) -> f64 {
+    let target = |z: &Complex<f64>| match kind {
+        BifurcationKind::Fold | BifurcationKind::BranchPoint => (z - 1.0).norm(),
+        BifurcationKind::PeriodDoubling => (z + 1.0).norm(),
+        BifurcationKind::NeimarkSacker if z.im.abs() > 1e-9 => (z.norm() - 1.0).abs(),
+        BifurcationKind::NeimarkSacker => f64::INFINITY,
+    };
+    multipliers
+        .iter()
+        .filter(|z| target(z).is_finite())
+        .min_by(|a, b| target(a).total_cmp(&target(b)))
+        .map_or_else(
+            || multipliers.iter().map(|z| z.norm()).fold(0.0, f64::max),
+            |z| z.norm(),
+        )
 }
 
 /// The parameter's words without the unit ("floor slope (rad)" → "floor slope").
@@ -327,5 +404,41 @@ mod tests {
         // None: everything after the last point, or before the first.
         assert_eq!(slots(&[0.1, 0.2], &[(0.05, false)]), vec![0]);
         assert_eq!(slots(&[0.1, 0.2], &[(0.3, false)]), vec![2]);
+    }
+
+    #[test]
+    fn a_branch_is_drawn_through_its_tangents() {
+        // A branch on the unit circle (state, parameter) = (sin s, cos s), points 0.6 rad
+        // apart: the cubic stays on the circle (to 1e-3), the chord does not (4.5e-2).
+        let at = |s: f64| DVector::from_vec(vec![s.sin(), s.cos()]);
+        let tangent = |s: f64| DVector::from_vec(vec![s.cos(), -s.sin()]);
+        let (a, b) = (0.2, 0.8);
+        // The second tangent given the wrong way round: turned along the chord.
+        let pts = hermite_between((&at(a), &tangent(a)), (&at(b), &-tangent(b)), 0);
+        assert_eq!(pts.len(), HERMITE_POINTS);
+        for (p, y) in &pts {
+            assert!(
+                (p.hypot(*y) - 1.0).abs() < 1e-3,
+                "({p}, {y}) off the circle"
+            );
+        }
+        let mid = (at(a) + at(b)) / 2.0;
+        assert!(1.0 - mid.norm() > 4e-2);
+        // Coincident points: nothing between them.
+        assert!(hermite_between((&at(a), &tangent(a)), (&at(a), &tangent(a)), 0).is_empty());
+    }
+
+    #[test]
+    fn a_bifurcation_is_marked_at_its_crossing_multiplier() {
+        let z = |re: f64, im: f64| Complex::new(re, im);
+        let m = [z(1.257, 0.0), z(0.6, 0.8), z(0.6, -0.8), z(-0.3, 0.0)];
+        let ns = crossing_modulus(BifurcationKind::NeimarkSacker, &m);
+        assert!((ns - 1.0).abs() < 1e-12, "{ns}");
+        let m = [z(1.12, 0.0), z(0.999, 0.0), z(-0.4, 0.0)];
+        assert_eq!(crossing_modulus(BifurcationKind::Fold, &m), 0.999);
+        let m = [z(1.3, 0.0), z(-1.001, 0.0)];
+        assert_eq!(crossing_modulus(BifurcationKind::PeriodDoubling, &m), 1.001);
+        // No complex pair: the largest.
+        assert_eq!(crossing_modulus(BifurcationKind::NeimarkSacker, &m), 1.3);
     }
 }
