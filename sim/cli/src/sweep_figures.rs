@@ -150,7 +150,15 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             let mut by_phase: Vec<Vec<(f64, f64)>> = vec![Vec::new(); b.period_strides.max(1)];
             let mut lam: Vec<(f64, f64)> = Vec::new();
             let mut open = false;
-            for w in nodes.windows(2) {
+            // The largest |λ| along the arclength, for drawing between the points of a
+            // period-1 branch: monotone cubic slopes (it has no tangent of its own).
+            let lam_nodes: Vec<f64> = nodes.iter().map(|n| n.point.max_abs_multiplier()).collect();
+            let arc: Vec<f64> = nodes
+                .windows(2)
+                .map(|w| (w[1].point.x() - w[0].point.x()).norm())
+                .collect();
+            let lam_slopes = monotone_slopes(&arc, &lam_nodes);
+            for (i, w) in nodes.windows(2).enumerate() {
                 let seg_stable = w[0].stable_to_next && w[1].stable_from_previous;
                 if seg_stable == stable {
                     for (k, pts) in by_phase.iter_mut().enumerate() {
@@ -173,9 +181,24 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
                         pts.push((w[1].value, y(&w[1])));
                     }
                     if !open {
-                        lam.push((w[0].value, w[0].point.max_abs_multiplier()));
+                        lam.push((w[0].value, lam_nodes[i]));
                     }
-                    lam.push((w[1].value, w[1].point.max_abs_multiplier()));
+                    if b.period_strides == 1 {
+                        let ps = between(w[0].point, w[1].point, index);
+                        let a = Knot {
+                            value: lam_nodes[i],
+                            rate: lam_slopes[i],
+                        };
+                        let z = Knot {
+                            value: lam_nodes[i + 1],
+                            rate: lam_slopes[i + 1],
+                        };
+                        lam.extend(ps.iter().enumerate().map(|(k, (p, _))| {
+                            let u = (k + 1) as f64 / (HERMITE_POINTS + 1) as f64;
+                            (*p, hermite::scalar(a, z, arc[i], u).0)
+                        }));
+                    }
+                    lam.push((w[1].value, lam_nodes[i + 1]));
                     open = true;
                 } else if open {
                     for pts in by_phase.iter_mut() {
@@ -297,7 +320,9 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         Plot {
             title: format!("{name}: gaits against the {}", param_words(&param)),
             caption: Some(
-                "pseudo-arclength continuation; every state of a period-k gait is drawn".into(),
+                "pseudo-arclength continuation; every state of a period-k gait is drawn; \
+                 period-1 branches as cubics through the computed points along their tangents"
+                    .into(),
             ),
             x_label: param.clone(),
             y_label: state_label(coordinate, "at heel strike"),
@@ -307,8 +332,8 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         Plot {
             title: format!("{name}: stability against the {}", param_words(&param)),
             caption: Some(
-                "bifurcations are marked at the modulus of the multiplier that crosses the unit \
-                 circle there (≈ 1), below the largest"
+                "bifurcations marked at the modulus of their crossing multiplier (≈ 1); \
+                 period-1 curves are monotone cubics between the computed points"
                     .into(),
             ),
             x_label: param,
@@ -361,6 +386,43 @@ fn hermite_between(
             let (pv, ..) = hermite::scalar(knot(xa, &ta, p), knot(xb, &tb, p), h, u);
             let (yv, ..) = hermite::scalar(knot(xa, &ta, index), knot(xb, &tb, index), h, u);
             (pv, yv)
+        })
+        .collect()
+}
+
+/// Slopes at the knots of values `y` spaced `h` apart (`h[i]` between knots `i` and `i + 1`)
+/// that keep the cubic Hermite curve through them monotone between knots (Fritsch–Carlson:
+/// zero at a local extremum, the weighted harmonic mean of the neighbouring secants
+/// elsewhere, the one secant at the ends). A zero spacing gives a zero slope.
+pub fn monotone_slopes(h: &[f64], y: &[f64]) -> Vec<f64> {
+    let n = y.len();
+    if n < 2 || h.len() + 1 != n {
+        return vec![0.0; n];
+    }
+    let secant: Vec<f64> = (0..n - 1)
+        .map(|i| {
+            if h[i] > 0.0 {
+                (y[i + 1] - y[i]) / h[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    (0..n)
+        .map(|i| {
+            if i == 0 {
+                secant[0]
+            } else if i == n - 1 {
+                secant[n - 2]
+            } else {
+                let (d0, d1) = (secant[i - 1], secant[i]);
+                if d0 * d1 <= 0.0 {
+                    0.0
+                } else {
+                    let (w0, w1) = (2.0 * h[i] + h[i - 1], h[i] + 2.0 * h[i - 1]);
+                    (w0 + w1) / (w0 / d0 + w1 / d1)
+                }
+            }
         })
         .collect()
 }
@@ -426,6 +488,34 @@ mod tests {
         assert!(1.0 - mid.norm() > 4e-2);
         // Coincident points: nothing between them.
         assert!(hermite_between((&at(a), &tangent(a)), (&at(a), &tangent(a)), 0).is_empty());
+    }
+
+    #[test]
+    fn monotone_slopes_keep_the_curve_between_its_knots() {
+        // A rise, a peak, a fall: zero slope at the peak, the secant at the ends.
+        let h = [1.0, 1.0, 2.0];
+        let y = [0.0, 1.0, 2.0, 1.0];
+        let d = monotone_slopes(&h, &y);
+        assert_eq!(d[0], 1.0);
+        assert_eq!(d[2], 0.0);
+        assert_eq!(d[3], -0.5);
+        assert!(d[1] > 0.0 && d[1] <= 1.0 + 1e-12);
+        for i in 0..3 {
+            let (a, b) = (
+                Knot {
+                    value: y[i],
+                    rate: d[i],
+                },
+                Knot {
+                    value: y[i + 1],
+                    rate: d[i + 1],
+                },
+            );
+            for k in 1..10 {
+                let v = hermite::scalar(a, b, h[i], f64::from(k) / 10.0).0;
+                assert!(v >= y[i].min(y[i + 1]) - 1e-12 && v <= y[i].max(y[i + 1]) + 1e-12);
+            }
+        }
     }
 
     #[test]
