@@ -76,9 +76,11 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     if let Some(dir) = out {
         output::write_file("--out", &dir.join("accuracy.md"), &table)?;
         let panels: [(&str, &str, ErrorOf); 3] = [
-            ("fixed_point_error.svg", "fixed-point error", |p| {
-                p.fixed_point_error
-            }),
+            (
+                "fixed_point_error.svg",
+                "fixed-point error (∞-norm, rad and rad/s)",
+                |p| p.fixed_point_error,
+            ),
             ("eigenvalue_error.svg", "eigenvalue error", |p| {
                 p.eigenvalue_error
             }),
