@@ -370,7 +370,7 @@ fn hermite_between(
     }
     let chord = xb - xa;
     let h = chord.norm();
-    if !(h > 0.0) || !h.is_finite() {
+    if h <= 0.0 || !h.is_finite() {
         return Vec::new();
     }
     let along = |t: &DVector<f64>| if t.dot(&chord) < 0.0 { -t } else { t.clone() };
