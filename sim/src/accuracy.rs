@@ -118,8 +118,8 @@ fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Repeats of the timed stride of each setting; the study keeps the fastest (other processes
-/// only ever add time).
+/// Repeats of the timed stride of each setting, in rounds over all settings; the study keeps
+/// the fastest (other processes only ever add time).
 pub const TIMING_REPEATS: usize = 9;
 
 /// Runs the study: the reference gait with `reference`, then every setting, each gait search
@@ -154,23 +154,30 @@ pub fn study_with_progress(
     let x_ref = reference_gait.fixed_point.clone();
     let t_ref = reference_gait.stride.duration_s;
     let (q_ref, qd_ref) = w.unpack(&x_ref);
-    let mut points = Vec::new();
-    for (family, value, setting) in settings {
-        stride_settings = setup.settings.with_integrator(setting.clone());
-        // CPU time per stride: the fastest of the repeats of the stride from the reference
-        // point.
-        let mut fastest_us = f64::INFINITY;
-        let mut evaluations = 0;
-        let mut t_hs = None;
-        for _ in 0..TIMING_REPEATS {
+    // CPU time per stride: the fastest of TIMING_REPEATS strides from the reference point,
+    // taken in rounds over all settings, so that a burst of other work on the machine slows
+    // one repeat of a setting rather than all of them.
+    let all: Vec<_> = settings
+        .iter()
+        .map(|(_, _, setting)| setup.settings.with_integrator(setting.clone()))
+        .collect();
+    let mut fastest_us = vec![f64::INFINITY; all.len()];
+    let mut evaluations = vec![0; all.len()];
+    let mut t_hs = vec![None; all.len()];
+    for _ in 0..TIMING_REPEATS {
+        for (i, s) in all.iter().enumerate() {
             let start = Instant::now();
-            let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(&stride_settings));
-            fastest_us = fastest_us.min(start.elapsed().as_secs_f64() * 1e6);
+            let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(s));
+            fastest_us[i] = fastest_us[i].min(start.elapsed().as_secs_f64() * 1e6);
             if let Ok(r) = r {
-                evaluations = r.evaluations;
-                t_hs = Some(r.duration_s);
+                evaluations[i] = r.evaluations;
+                t_hs[i] = Some(r.duration_s);
             }
         }
+    }
+    let mut points = Vec::new();
+    for (i, (family, value, setting)) in settings.iter().enumerate() {
+        stride_settings = all[i].clone();
         let gait = GaitSearch::new(w, &stride_settings, &study_newton).find(&x_ref);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (
@@ -184,11 +191,11 @@ pub fn study_with_progress(
             integrator: family.clone(),
             setting: setting.clone(),
             step_or_tolerance: *value,
-            cpu_us_per_stride: fastest_us,
-            evaluations_per_stride: evaluations,
+            cpu_us_per_stride: fastest_us[i],
+            evaluations_per_stride: evaluations[i],
             fixed_point_error: fp,
             eigenvalue_error: ev,
-            heel_strike_time_error_s: t_hs.map(|t| (t - t_ref).abs()),
+            heel_strike_time_error_s: t_hs[i].map(|t| (t - t_ref).abs()),
             failure,
         });
         on_setting();
