@@ -1,7 +1,8 @@
 // The animation page's drawing code. Everything it shows comes from the data the walker
 // binary computed (the key points' floor-frame positions per frame, from the engine's forward
 // kinematics); this file only decodes and draws them. The page API for tests and scripts:
-// window.walker = { ready, error, duration_s, frames, seek(t_s), play(), pause(), time() }.
+// window.walker = { ready, error, duration_s, frames, frameTime(i), seek(t_s), play(),
+// pause(), time() }.
 import * as THREE from "three";
 
 const data = JSON.parse(document.getElementById("walker-data").textContent);
@@ -274,6 +275,7 @@ resize();
 
 api.duration_s = duration;
 api.frames = N;
+api.frameTime = (i) => times[Math.min(Math.max(Math.trunc(Number(i)), 0), N - 1)];
 api.time = () => t;
 api.seek = (s) => { t = Math.min(Math.max(Number(s), 0), duration); setPlaying(false); render(); return frameAt(t); };
 api.play = () => setPlaying(true);
