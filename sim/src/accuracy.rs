@@ -25,7 +25,8 @@ pub struct AccuracyPoint {
     pub setting: IntegratorChoice,
     /// Step [s] (fixed-step integrators) or relative tolerance (dopri5).
     pub step_or_tolerance: f64,
-    /// CPU time of one stride from the reference fixed point [µs] (median of repeats).
+    /// CPU time of one stride from the reference fixed point [µs]: the minimum of
+    /// [`TIMING_REPEATS`] repeats, so that other work on a loaded machine inflates it less.
     pub cpu_us_per_stride: f64,
     /// Right-hand-side evaluations per stride.
     pub evaluations_per_stride: usize,
@@ -117,6 +118,10 @@ fn max_eigen_error(reference: &[Complex<f64>], other: &[Complex<f64>]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Repeats of the timed stride of each setting, in rounds over all settings; the study keeps
+/// the fastest (other processes only ever add time).
+pub const TIMING_REPEATS: usize = 9;
+
 /// Runs the study: the reference gait with `reference`, then every setting, each gait search
 /// starting from the reference fixed point. The other stride settings (event tolerances, time
 /// budget) are the setup's.
@@ -125,6 +130,18 @@ pub fn study(
     reference: IntegratorChoice,
     settings: &[(String, f64, IntegratorChoice)],
     newton: &NewtonSettings,
+) -> Result<AccuracyStudy, NewtonError> {
+    study_with_progress(setup, reference, settings, newton, &|| {})
+}
+
+/// As [`study`], calling `on_setting` after each setting of `settings` is done (for a
+/// progress bar).
+pub fn study_with_progress(
+    setup: &Setup,
+    reference: IntegratorChoice,
+    settings: &[(String, f64, IntegratorChoice)],
+    newton: &NewtonSettings,
+    on_setting: &dyn Fn(),
 ) -> Result<AccuracyStudy, NewtonError> {
     let w = &setup.walker;
     let mut stride_settings = setup.settings.with_integrator(reference.clone());
@@ -137,23 +154,30 @@ pub fn study(
     let x_ref = reference_gait.fixed_point.clone();
     let t_ref = reference_gait.stride.duration_s;
     let (q_ref, qd_ref) = w.unpack(&x_ref);
-    let mut points = Vec::new();
-    for (family, value, setting) in settings {
-        stride_settings = setup.settings.with_integrator(setting.clone());
-        // CPU time per stride: median of a few repeats of the stride from the reference point.
-        let mut times = Vec::new();
-        let mut evaluations = 0;
-        let mut t_hs = None;
-        for _ in 0..5 {
+    // CPU time per stride: the fastest of TIMING_REPEATS strides from the reference point,
+    // taken in rounds over all settings, so that a burst of other work on the machine slows
+    // one repeat of a setting rather than all of them.
+    let all: Vec<_> = settings
+        .iter()
+        .map(|(_, _, setting)| setup.settings.with_integrator(setting.clone()))
+        .collect();
+    let mut fastest_us = vec![f64::INFINITY; all.len()];
+    let mut evaluations = vec![0; all.len()];
+    let mut t_hs = vec![None; all.len()];
+    for _ in 0..TIMING_REPEATS {
+        for (i, s) in all.iter().enumerate() {
             let start = Instant::now();
-            let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(&stride_settings));
-            times.push(start.elapsed().as_secs_f64() * 1e6);
+            let r = w.stride(&q_ref, &qd_ref, StrideRequest::new(s));
+            fastest_us[i] = fastest_us[i].min(start.elapsed().as_secs_f64() * 1e6);
             if let Ok(r) = r {
-                evaluations = r.evaluations;
-                t_hs = Some(r.duration_s);
+                evaluations[i] = r.evaluations;
+                t_hs[i] = Some(r.duration_s);
             }
         }
-        times.sort_by(f64::total_cmp);
+    }
+    let mut points = Vec::new();
+    for (i, (family, value, setting)) in settings.iter().enumerate() {
+        stride_settings = all[i].clone();
         let gait = GaitSearch::new(w, &stride_settings, &study_newton).find(&x_ref);
         let (fp, ev, failure) = match &gait {
             Ok(g) => (
@@ -167,13 +191,14 @@ pub fn study(
             integrator: family.clone(),
             setting: setting.clone(),
             step_or_tolerance: *value,
-            cpu_us_per_stride: times[times.len() / 2],
-            evaluations_per_stride: evaluations,
+            cpu_us_per_stride: fastest_us[i],
+            evaluations_per_stride: evaluations[i],
             fixed_point_error: fp,
             eigenvalue_error: ev,
-            heel_strike_time_error_s: t_hs.map(|t| (t - t_ref).abs()),
+            heel_strike_time_error_s: t_hs[i].map(|t| (t - t_ref).abs()),
             failure,
         });
+        on_setting();
     }
     Ok(AccuracyStudy {
         scene: w.name.clone(),

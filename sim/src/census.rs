@@ -224,11 +224,16 @@ fn multi_start(
     setup: &Setup,
     newton: &NewtonSettings,
     settings: &CensusSettings,
+    on_search: &(dyn Fn() + Sync),
 ) -> Vec<Result<Gait, NewtonError>> {
     let search = GaitSearch::new(&setup.walker, &setup.settings, newton);
     starts(setup, settings)
         .par_iter()
-        .map(|v| search.find(v))
+        .map(|v| {
+            let found = search.find(v);
+            on_search();
+            found
+        })
         .collect()
 }
 
@@ -259,8 +264,33 @@ pub fn census(
     newton: &NewtonSettings,
     settings: &CensusSettings,
 ) -> Result<Census, SceneError> {
+    census_with_progress(scene, setup_for, newton, settings, &|| {})
+}
+
+/// The progress units of a census of `scene` ([`census_with_progress`]): one per multi-start
+/// search (at the requested values, and at the defaults when they differ) and one per gait
+/// followed from the defaults (at most one per start there).
+pub fn census_units(scene: &Scene, settings: &CensusSettings) -> usize {
+    let k = 1 + settings.scales.len() + settings.rate_scales.len();
+    if is_at_defaults(scene) {
+        k
+    } else {
+        3 * k
+    }
+}
+
+/// As [`census`], calling `on_unit` after each multi-start search and each followed gait
+/// (for a progress bar of [`census_units`]; fewer when fewer gaits are found at the
+/// defaults). May be called from several threads at once.
+pub fn census_with_progress(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    settings: &CensusSettings,
+    on_unit: &(dyn Fn() + Sync),
+) -> Result<Census, SceneError> {
     let setup = setup_for(scene)?;
-    let here = multi_start(&setup, newton, settings);
+    let here = multi_start(&setup, newton, settings, on_unit);
     let mut searches = here.len();
     let guess_error = here.first().and_then(|r| r.as_ref().err().cloned());
     let mut gaits: Vec<Gait> = Vec::new();
@@ -270,7 +300,7 @@ pub fn census(
     if !is_at_defaults(scene) {
         let defaults = at_defaults(scene)?;
         let default_setup = setup_for(&defaults)?;
-        let found = multi_start(&default_setup, newton, settings);
+        let found = multi_start(&default_setup, newton, settings, on_unit);
         searches += found.len();
         let mut origins: Vec<Gait> = Vec::new();
         for g in found.into_iter().flatten() {
@@ -278,7 +308,11 @@ pub fn census(
         }
         let followed: Vec<(Result<Gait, NewtonError>, usize)> = origins
             .par_iter()
-            .map(|g| follow(&defaults, scene, setup_for, g, newton, &settings.homotopy))
+            .map(|g| {
+                let followed = follow(&defaults, scene, setup_for, g, newton, &settings.homotopy);
+                on_unit();
+                followed
+            })
             .collect();
         for (g, n) in followed {
             searches += n;

@@ -50,6 +50,18 @@ pub fn tune(
     evaluations: usize,
     settings: &NewtonSettings,
 ) -> Result<TuneResult, SceneError> {
+    tune_with_progress(scene, params, evaluations, settings, &|| {})
+}
+
+/// As [`tune`], calling `on_evaluation` after each gait search (at most `evaluations`; for a
+/// progress bar).
+pub fn tune_with_progress(
+    scene: &Scene,
+    params: &[TunedParameter],
+    evaluations: usize,
+    settings: &NewtonSettings,
+    on_evaluation: &dyn Fn(),
+) -> Result<TuneResult, SceneError> {
     let mut scene = scene.clone();
     let n = params.len();
     let start: Vec<f64> = params
@@ -94,6 +106,7 @@ pub fn tune(
             values: clamped,
             max_abs_eigenvalue: value,
         });
+        on_evaluation();
         Ok(value.unwrap_or(NO_GAIT))
     };
     // Nelder-Mead on the box, initial simplex 10% of each range.

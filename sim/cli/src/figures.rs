@@ -5,7 +5,7 @@
 
 use crate::axis::Scale;
 use crate::labels::{
-    coordinate_label, failure_label, integrator_label, parameter_label, walker_name,
+    coordinate_label, failure_label, integrator_label, parameter_label, step_label, walker_name,
 };
 use crate::plot::{Aspect, Marker, Note, Plot, Series, Style, PALETTE};
 use sim::integrators::Sample;
@@ -164,9 +164,9 @@ pub fn floor_paths(walks: &[(&Scene, &Walk)], (width, height): (f64, f64)) -> Pl
         .map(|(i, (scene, w))| Series {
             label: match &w.failure {
                 Some(f) => format!(
-                    "{} (falls in step {}: {})",
+                    "{} (falls in {}: {})",
                     walker_name(scene),
-                    f.step + 1,
+                    step_label(f.step),
                     failure_label(f.kind)
                 ),
                 None => format!("{} ({} steps)", walker_name(scene), w.steps_completed),

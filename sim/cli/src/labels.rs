@@ -96,11 +96,43 @@ pub fn integrator_label(name: &str) -> String {
     }
 }
 
-/// A failure in words (`HeelStrikeBeforeKneeLock` → "heel strike before knee lock").
+/// A failure in words (`HeelStrikeBeforeKneeLock` → "heel strike before knee lock"). The one
+/// spelling of failures for people: `walker walk`/`walker sil` text, figure legends and the
+/// animation page.
 pub fn failure_label(kind: FailureKind) -> String {
     match serde_json::to_value(kind) {
         Ok(serde_json::Value::String(s)) => s.replace('_', " "),
         _ => format!("{kind:?}"),
+    }
+}
+
+/// Whether a failure is the walker falling over (backward or forward), as opposed to a walk
+/// that stopped for another reason (an impact that could not be solved, a budget, ...).
+pub fn is_fall(kind: FailureKind) -> bool {
+    matches!(kind, FailureKind::FellBackward | FailureKind::FellForward)
+}
+
+/// The number people read for the step of 0-based index `index` (the engine's and JSON's
+/// numbering): steps are numbered from 1, the first step is "step 1".
+pub fn step_number(index: usize) -> usize {
+    index.saturating_add(1)
+}
+
+/// The step of 0-based index `index` in words: "step 1" for the first.
+pub fn step_label(index: usize) -> String {
+    format!("step {}", step_number(index))
+}
+
+/// A walk event's engine name in words (`knee_lock:swing_knee` → "knee lock (swing knee)",
+/// `heel_strike` → "heel strike").
+pub fn event_label(name: &str) -> String {
+    match name.split_once(':') {
+        Some((what, coordinate)) => format!(
+            "{} ({})",
+            what.replace('_', " "),
+            coordinate_label(coordinate)
+        ),
+        None => name.replace('_', " "),
     }
 }
 
@@ -132,5 +164,16 @@ mod tests {
             "heel strike before knee lock"
         );
         assert_eq!(failure_label(FailureKind::FellForward), "fell forward");
+        assert_eq!(
+            failure_label(FailureKind::ImpactSingular),
+            "impact singular"
+        );
+        assert!(is_fall(FailureKind::FellBackward) && !is_fall(FailureKind::ImpactSingular));
+        assert_eq!((step_number(0), step_label(2).as_str()), (1, "step 3"));
+        assert_eq!(
+            event_label("knee_lock:swing_knee"),
+            "knee lock (swing knee)"
+        );
+        assert_eq!(event_label("heel_strike"), "heel strike");
     }
 }

@@ -8,7 +8,9 @@ use crate::axis::Scale;
 use crate::figures::state_label;
 use crate::labels::{parameter_label, walker_name};
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
+use nalgebra::{Complex, DVector};
 use sim::continuation::{BifurcationKind, BranchPoint, Continuation};
+use sim::hermite::{self, Knot};
 use sim::scene::Scene;
 
 /// A point of a branch in arclength order: a grid point, or a bifurcation (with the
@@ -148,7 +150,15 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             let mut by_phase: Vec<Vec<(f64, f64)>> = vec![Vec::new(); b.period_strides.max(1)];
             let mut lam: Vec<(f64, f64)> = Vec::new();
             let mut open = false;
-            for w in nodes.windows(2) {
+            // The largest |λ| along the arclength, for drawing between the points of a
+            // period-1 branch: monotone cubic slopes (it has no tangent of its own).
+            let lam_nodes: Vec<f64> = nodes.iter().map(|n| n.point.max_abs_multiplier()).collect();
+            let arc: Vec<f64> = nodes
+                .windows(2)
+                .map(|w| (w[1].point.x() - w[0].point.x()).norm())
+                .collect();
+            let lam_slopes = monotone_slopes(&arc, &lam_nodes);
+            for (i, w) in nodes.windows(2).enumerate() {
                 let seg_stable = w[0].stable_to_next && w[1].stable_from_previous;
                 if seg_stable == stable {
                     for (k, pts) in by_phase.iter_mut().enumerate() {
@@ -163,12 +173,32 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
                         if !open {
                             pts.push((w[0].value, y(&w[0])));
                         }
+                        // A period-1 branch between its points: the cubic through both with
+                        // the continuation's tangents (its orbit has one state, the tangent's).
+                        if b.period_strides == 1 {
+                            pts.extend(between(w[0].point, w[1].point, index));
+                        }
                         pts.push((w[1].value, y(&w[1])));
                     }
                     if !open {
-                        lam.push((w[0].value, w[0].point.max_abs_multiplier()));
+                        lam.push((w[0].value, lam_nodes[i]));
                     }
-                    lam.push((w[1].value, w[1].point.max_abs_multiplier()));
+                    if b.period_strides == 1 {
+                        let ps = between(w[0].point, w[1].point, index);
+                        let a = Knot {
+                            value: lam_nodes[i],
+                            rate: lam_slopes[i],
+                        };
+                        let z = Knot {
+                            value: lam_nodes[i + 1],
+                            rate: lam_slopes[i + 1],
+                        };
+                        lam.extend(ps.iter().enumerate().map(|(k, (p, _))| {
+                            let u = (k + 1) as f64 / (HERMITE_POINTS + 1) as f64;
+                            (*p, hermite::scalar(a, z, arc[i], u).0)
+                        }));
+                    }
+                    lam.push((w[1].value, lam_nodes[i + 1]));
                     open = true;
                 } else if open {
                     for pts in by_phase.iter_mut() {
@@ -249,7 +279,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             label: label.into(),
             points: found
                 .iter()
-                .map(|x| (x.value, x.point.max_abs_multiplier()))
+                .map(|x| (x.value, crossing_modulus(kind, &x.multipliers)))
                 .collect(),
             style: Style::markers(marker),
             color,
@@ -290,7 +320,9 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         Plot {
             title: format!("{name}: gaits against the {}", param_words(&param)),
             caption: Some(
-                "pseudo-arclength continuation; every state of a period-k gait is drawn".into(),
+                "pseudo-arclength continuation; every state of a period-k gait is drawn; \
+                 period-1 branches as cubics through the computed points along their tangents"
+                    .into(),
             ),
             x_label: param.clone(),
             y_label: state_label(coordinate, "at heel strike"),
@@ -299,6 +331,11 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         },
         Plot {
             title: format!("{name}: stability against the {}", param_words(&param)),
+            caption: Some(
+                "bifurcations marked at the modulus of their crossing multiplier (≈ 1); \
+                 period-1 curves are monotone cubics between the computed points"
+                    .into(),
+            ),
             x_label: param,
             y_label: "largest |λ| of the stride map".into(),
             y_scale,
@@ -306,6 +343,108 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             ..Plot::default()
         },
     ]
+}
+
+/// Points drawn between two successive points of a period-1 branch, besides them.
+const HERMITE_POINTS: usize = 12;
+
+/// The branch between points `a` and `b` (in arclength order) as the cubic Hermite curve in
+/// the arclength through both, with the continuation's unit tangents `(dv/ds, dp/ds)` as
+/// rates, the arclength between them taken as their distance: [`HERMITE_POINTS`] points
+/// (parameter, stride-map entry `index`) strictly between them. None when the two coincide or
+/// a tangent is missing. A tangent pointing against the chord is turned round (a located
+/// bifurcation's may be oriented either way).
+pub fn between(a: &BranchPoint, b: &BranchPoint, index: usize) -> Vec<(f64, f64)> {
+    hermite_between((&a.x(), &a.tangent), (&b.x(), &b.tangent), index)
+}
+
+/// [`between`] on points `x = (v, p)` (the parameter last) with their tangents.
+fn hermite_between(
+    (xa, ta): (&DVector<f64>, &DVector<f64>),
+    (xb, tb): (&DVector<f64>, &DVector<f64>),
+    index: usize,
+) -> Vec<(f64, f64)> {
+    let n = xa.len();
+    if xb.len() != n || ta.len() != n || tb.len() != n || index + 1 >= n {
+        return Vec::new();
+    }
+    let chord = xb - xa;
+    let h = chord.norm();
+    if h <= 0.0 || !h.is_finite() {
+        return Vec::new();
+    }
+    let along = |t: &DVector<f64>| if t.dot(&chord) < 0.0 { -t } else { t.clone() };
+    let (ta, tb) = (along(ta), along(tb));
+    let knot = |x: &DVector<f64>, t: &DVector<f64>, i: usize| Knot {
+        value: x[i],
+        rate: t[i],
+    };
+    let p = n - 1;
+    (1..=HERMITE_POINTS)
+        .map(|k| {
+            let u = k as f64 / (HERMITE_POINTS + 1) as f64;
+            let (pv, ..) = hermite::scalar(knot(xa, &ta, p), knot(xb, &tb, p), h, u);
+            let (yv, ..) = hermite::scalar(knot(xa, &ta, index), knot(xb, &tb, index), h, u);
+            (pv, yv)
+        })
+        .collect()
+}
+
+/// Slopes at the knots of values `y` spaced `h` apart (`h[i]` between knots `i` and `i + 1`)
+/// that keep the cubic Hermite curve through them monotone between knots (Fritsch–Carlson:
+/// zero at a local extremum, the weighted harmonic mean of the neighbouring secants
+/// elsewhere, the one secant at the ends). A zero spacing gives a zero slope.
+pub fn monotone_slopes(h: &[f64], y: &[f64]) -> Vec<f64> {
+    let n = y.len();
+    if n < 2 || h.len() + 1 != n {
+        return vec![0.0; n];
+    }
+    let secant: Vec<f64> = (0..n - 1)
+        .map(|i| {
+            if h[i] > 0.0 {
+                (y[i + 1] - y[i]) / h[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    (0..n)
+        .map(|i| {
+            if i == 0 {
+                secant[0]
+            } else if i == n - 1 {
+                secant[n - 2]
+            } else {
+                let (d0, d1) = (secant[i - 1], secant[i]);
+                if d0 * d1 <= 0.0 {
+                    0.0
+                } else {
+                    let (w0, w1) = (2.0 * h[i] + h[i - 1], h[i] + 2.0 * h[i - 1]);
+                    (w0 + w1) / (w0 / d0 + w1 / d1)
+                }
+            }
+        })
+        .collect()
+}
+
+/// The modulus of the multiplier that crosses the unit circle at a bifurcation of `kind`: the
+/// one closest to +1 (fold, branch point), to −1 (period doubling), or the complex one
+/// closest to the circle (Neimark–Sacker); the largest modulus if there is none such.
+pub fn crossing_modulus(kind: BifurcationKind, multipliers: &[Complex<f64>]) -> f64 {
+    let target = |z: &Complex<f64>| match kind {
+        BifurcationKind::Fold | BifurcationKind::BranchPoint => (z - 1.0).norm(),
+        BifurcationKind::PeriodDoubling => (z + 1.0).norm(),
+        BifurcationKind::NeimarkSacker if z.im.abs() > 1e-9 => (z.norm() - 1.0).abs(),
+        BifurcationKind::NeimarkSacker => f64::INFINITY,
+    };
+    multipliers
+        .iter()
+        .filter(|z| target(z).is_finite())
+        .min_by(|a, b| target(a).total_cmp(&target(b)))
+        .map_or_else(
+            || multipliers.iter().map(|z| z.norm()).fold(0.0, f64::max),
+            |z| z.norm(),
+        )
 }
 
 /// The parameter's words without the unit ("floor slope (rad)" → "floor slope").
@@ -327,5 +466,69 @@ mod tests {
         // None: everything after the last point, or before the first.
         assert_eq!(slots(&[0.1, 0.2], &[(0.05, false)]), vec![0]);
         assert_eq!(slots(&[0.1, 0.2], &[(0.3, false)]), vec![2]);
+    }
+
+    #[test]
+    fn a_branch_is_drawn_through_its_tangents() {
+        // A branch on the unit circle (state, parameter) = (sin s, cos s), points 0.6 rad
+        // apart: the cubic stays on the circle (to 1e-3), the chord does not (4.5e-2).
+        let at = |s: f64| DVector::from_vec(vec![s.sin(), s.cos()]);
+        let tangent = |s: f64| DVector::from_vec(vec![s.cos(), -s.sin()]);
+        let (a, b) = (0.2, 0.8);
+        // The second tangent given the wrong way round: turned along the chord.
+        let pts = hermite_between((&at(a), &tangent(a)), (&at(b), &-tangent(b)), 0);
+        assert_eq!(pts.len(), HERMITE_POINTS);
+        for (p, y) in &pts {
+            assert!(
+                (p.hypot(*y) - 1.0).abs() < 1e-3,
+                "({p}, {y}) off the circle"
+            );
+        }
+        let mid = (at(a) + at(b)) / 2.0;
+        assert!(1.0 - mid.norm() > 4e-2);
+        // Coincident points: nothing between them.
+        assert!(hermite_between((&at(a), &tangent(a)), (&at(a), &tangent(a)), 0).is_empty());
+    }
+
+    #[test]
+    fn monotone_slopes_keep_the_curve_between_its_knots() {
+        // A rise, a peak, a fall: zero slope at the peak, the secant at the ends.
+        let h = [1.0, 1.0, 2.0];
+        let y = [0.0, 1.0, 2.0, 1.0];
+        let d = monotone_slopes(&h, &y);
+        assert_eq!(d[0], 1.0);
+        assert_eq!(d[2], 0.0);
+        assert_eq!(d[3], -0.5);
+        assert!(d[1] > 0.0 && d[1] <= 1.0 + 1e-12);
+        for i in 0..3 {
+            let (a, b) = (
+                Knot {
+                    value: y[i],
+                    rate: d[i],
+                },
+                Knot {
+                    value: y[i + 1],
+                    rate: d[i + 1],
+                },
+            );
+            for k in 1..10 {
+                let v = hermite::scalar(a, b, h[i], f64::from(k) / 10.0).0;
+                assert!(v >= y[i].min(y[i + 1]) - 1e-12 && v <= y[i].max(y[i + 1]) + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_bifurcation_is_marked_at_its_crossing_multiplier() {
+        let z = |re: f64, im: f64| Complex::new(re, im);
+        let m = [z(1.257, 0.0), z(0.6, 0.8), z(0.6, -0.8), z(-0.3, 0.0)];
+        let ns = crossing_modulus(BifurcationKind::NeimarkSacker, &m);
+        assert!((ns - 1.0).abs() < 1e-12, "{ns}");
+        let m = [z(1.12, 0.0), z(0.999, 0.0), z(-0.4, 0.0)];
+        assert_eq!(crossing_modulus(BifurcationKind::Fold, &m), 0.999);
+        let m = [z(1.3, 0.0), z(-1.001, 0.0)];
+        assert_eq!(crossing_modulus(BifurcationKind::PeriodDoubling, &m), 1.001);
+        // No complex pair: the largest.
+        assert_eq!(crossing_modulus(BifurcationKind::NeimarkSacker, &m), 1.3);
     }
 }

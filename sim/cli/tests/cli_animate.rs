@@ -50,7 +50,8 @@ fn walk_writes_a_page_and_prints_the_same_text() {
         with.stdout, without.stdout,
         "--animate changed the text output"
     );
-    assert_page(&page, "compass: 3 steps");
+    // The walker by name, as the figures call it.
+    assert_page(&page, "compass-gait walker (Goswami et al.): 3 steps");
 }
 
 #[test]
@@ -66,10 +67,53 @@ fn a_fall_is_animated_and_the_exit_code_stays_3() {
         page.to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(3));
-    assert_page(&page, "then the fall");
-    assert!(std::fs::read_to_string(&page)
-        .unwrap()
-        .contains("\"kind\":\"fall\""));
+    assert_page(
+        &page,
+        "3D walker without compensator: 1 step, then the fall",
+    );
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("\"kind\":\"fall\""));
+    // Failures and events in words, numbered as the text output numbers them.
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("failure: fell forward in step 2 at t = "),
+        "{text}"
+    );
+    assert!(html.contains("\"text\":\"step 2: fell forward: "));
+    assert!(html.contains("knee lock (swing knee)"));
+    for code in ["FellForward", "swing_knee)", "fell at"] {
+        assert!(!html.contains(code), "the page shows `{code}`");
+    }
+}
+
+#[test]
+fn a_failure_that_is_not_a_fall_is_a_stop() {
+    // The emergency stop at 4 s: the walk ends on a singular impact, not on a fall.
+    let page = tmp("stop.html");
+    let out = walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "12",
+        "--estop-at",
+        "4",
+        "--animate",
+        page.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("failure: impact singular in step 5"),
+        "{text}"
+    );
+    assert_page(
+        &page,
+        "3D walker with pelvic compensator: 4 steps, firmware in the loop, then stopped: impact singular",
+    );
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("\"kind\":\"stop\""));
+    assert!(!html.contains("\"kind\":\"fall\""));
 }
 
 #[test]
@@ -83,7 +127,8 @@ fn gait_and_sil_write_pages() {
         gait.to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(0));
-    assert_page(&gait, "strides of its gait");
+    // Steps, as the page's clock counts them.
+    assert_page(&gait, "steps of its gait");
     let sil = tmp("sil.html");
     let out = walker(&[
         "sil",

@@ -362,7 +362,7 @@ fn a_walk_that_falls_exits_3_with_its_report_unchanged() {
         "stance_leg_dot=0.6",
     ]);
     assert_eq!(text.status.code(), Some(3));
-    assert!(String::from_utf8_lossy(&text.stdout).contains("failure: FellBackward"));
+    assert!(String::from_utf8_lossy(&text.stdout).contains("failure: fell backward in step "));
     assert_eq!(
         walker(&["walk", "--scene", "compass", "--steps", "2"])
             .status

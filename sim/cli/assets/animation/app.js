@@ -1,7 +1,8 @@
 // The animation page's drawing code. Everything it shows comes from the data the walker
 // binary computed (the key points' floor-frame positions per frame, from the engine's forward
 // kinematics); this file only decodes and draws them. The page API for tests and scripts:
-// window.walker = { ready, error, duration_s, frames, seek(t_s), play(), pause(), time() }.
+// window.walker = { ready, error, duration_s, frames, frameTime(i), seek(t_s), play(),
+// pause(), time() }.
 import * as THREE from "three";
 
 const data = JSON.parse(document.getElementById("walker-data").textContent);
@@ -16,10 +17,13 @@ function bytes(b64) {
 // Little-endian arrays (as the binary wrote them; every browser's typed arrays are too).
 const tr = data.track;
 const times = new Float32Array(bytes(tr.t_s));
-const stepOf = new Uint16Array(bytes(tr.step));
+// Step of each frame as people number it (from 1, computed by the binary).
+const stepNumber = new Uint16Array(bytes(tr.step_number));
 const origin = new Float32Array(bytes(tr.origin_m));
 const rel = new Int16Array(bytes(tr.rel));
 const K = tr.points;
+// The stored point of each key point the parts name (shared rod ends are stored once).
+const pointOf = tr.point_of;
 const N = tr.frames;
 const duration = times[N - 1];
 
@@ -93,9 +97,31 @@ const parts = data.parts.map((p) => {
 });
 
 const a = new THREE.Vector3(), b = new THREE.Vector3(), d = new THREE.Vector3();
-function point(frame, k, out) {
-  const o = 3 * frame, r = 3 * (frame * K + k), q = tr.quantum_m;
-  return out.set(origin[o] + rel[r] * q, origin[o + 1] + rel[r + 1] * q, origin[o + 2] + rel[r + 2] * q);
+// The frames a time falls between and the weight of the later one (0: the earlier frame as
+// it is). Successive frames of the same step and different times are interpolated linearly
+// (so slow motion plays smoothly); frames at the same time (a heel strike's before and
+// after) or of different steps never are, so impacts stay sharp. The binary puts a frame at
+// every event's instant, so no interpolated pair straddles one.
+const pair = { i: 0, j: 0, w: 0 };
+function pairAt(t) {
+  const i = frameAt(t);
+  pair.i = i; pair.j = i; pair.w = 0;
+  if (i + 1 < N && times[i + 1] > times[i] && stepNumber[i + 1] === stepNumber[i] && t > times[i]) {
+    pair.j = i + 1;
+    pair.w = Math.min((t - times[i]) / (times[i + 1] - times[i]), 1);
+  }
+  return pair;
+}
+function stored(frame, s, c) {
+  return origin[3 * frame + c] + rel[3 * (frame * K + s) + c] * tr.quantum_m;
+}
+function point(sp, k, out) {
+  const s = pointOf[k], w = sp.w;
+  const at = (c) => (1 - w) * stored(sp.i, s, c) + w * stored(sp.j, s, c);
+  return out.set(at(0), at(1), at(2));
+}
+function originAt(sp, c) {
+  return (1 - sp.w) * origin[3 * sp.i + c] + sp.w * origin[3 * sp.j + c];
 }
 
 // Frame lookup: the last frame at or before t.
@@ -112,31 +138,31 @@ function frameAt(t) {
 
 const target = new THREE.Vector3();
 const viewHeight = 0.5 * origin[1];
-function pose(frame) {
+function pose(sp) {
   for (const { p, mesh } of parts) {
     if (p.kind === "rod") {
-      point(frame, p.a, a);
-      point(frame, p.b, b);
+      point(sp, p.a, a);
+      point(sp, p.b, b);
       d.subVectors(b, a);
       const len = d.length();
       mesh.position.addVectors(a, b).multiplyScalar(0.5);
       mesh.scale.set(1, Math.max(len, 1e-6), 1);
       if (len > 1e-9) mesh.quaternion.setFromUnitVectors(yAxis, d.normalize());
     } else if (p.kind === "ring") {
-      point(frame, p.centre, a);
-      point(frame, p.normal_tip, b);
+      point(sp, p.centre, a);
+      point(sp, p.normal_tip, b);
       mesh.position.copy(a);
       mesh.quaternion.setFromUnitVectors(zAxis, d.subVectors(b, a).normalize());
     } else {
-      point(frame, p.at, a);
+      point(sp, p.at, a);
       mesh.position.copy(a);
     }
   }
-  pathGeometry.setDrawRange(0, frame + 1);
-  grid.position.set(Math.round(origin[3 * frame]), 0, Math.round(origin[3 * frame + 2]));
+  pathGeometry.setDrawRange(0, sp.i + 1);
+  const ox = originAt(sp, 0), oz = originAt(sp, 2);
+  grid.position.set(Math.round(ox), 0, Math.round(oz));
   // The camera follows the hip (in world coordinates), keeping the user's view angle.
-  const o = 3 * frame;
-  const next = world.localToWorld(new THREE.Vector3(origin[o], viewHeight, origin[o + 2]));
+  const next = world.localToWorld(new THREE.Vector3(ox, viewHeight, oz));
   camera.position.add(d.subVectors(next, target));
   target.copy(next);
   controls.target.copy(target);
@@ -158,7 +184,7 @@ ui.slider.max = String(duration);
 let t = 0, playing = true, last = null;
 const events = data.events;
 for (const e of events) {
-  if (!["heel_strike", "fall", "fault", "command", "bus_off", "sensor_fault"].includes(e.kind)) continue;
+  if (!["heel_strike", "fall", "stop", "fault", "command", "bus_off", "sensor_fault"].includes(e.kind)) continue;
   const m = document.createElement("div");
   m.className = "mark " + e.kind;
   m.style.left = (100 * Math.min(e.t_s / duration, 1)) + "%";
@@ -167,7 +193,7 @@ for (const e of events) {
 }
 
 function overlay(frame) {
-  ui.clock.textContent = `t = ${t.toFixed(3)} s of ${duration.toFixed(3)} s · step ${stepOf[frame] + 1}`;
+  ui.clock.textContent = `t = ${t.toFixed(3)} s of ${duration.toFixed(3)} s · step ${stepNumber[frame]}`;
   const past = [];
   const nodes = {};
   // At the last frame every event has happened (a fall is located just after the last
@@ -197,14 +223,17 @@ function overlay(frame) {
       return div;
     }));
   }
-  const fall = events.find((e) => e.kind === "fall");
-  ui.banner.textContent = fall && until >= fall.t_s ? `fell at t = ${fall.t_s.toFixed(3)} s: ${fall.value}` : "";
+  // The walk's end by failure: "fell" for a fall, "stopped" for any other failure (its kind
+  // in words, from the binary).
+  const end = events.find((e) => e.kind === "fall" || e.kind === "stop");
+  const verb = end && end.kind === "fall" ? "fell" : "stopped";
+  ui.banner.textContent = end && until >= end.t_s ? `${verb} at t = ${end.t_s.toFixed(3)} s: ${end.value}` : "";
 }
 
 function render() {
-  const frame = frameAt(t);
-  pose(frame);
-  overlay(frame);
+  const sp = pairAt(t);
+  pose(sp);
+  overlay(sp.i);
   ui.slider.value = String(t);
   renderer.render(scene, camera);
 }
@@ -246,6 +275,7 @@ resize();
 
 api.duration_s = duration;
 api.frames = N;
+api.frameTime = (i) => times[Math.min(Math.max(Math.trunc(Number(i)), 0), N - 1)];
 api.time = () => t;
 api.seek = (s) => { t = Math.min(Math.max(Number(s), 0), duration); setPlaying(false); render(); return frameAt(t); };
 api.play = () => setPlaying(true);

@@ -195,7 +195,7 @@ impl Figure {
                 let (a, b) = (self.point(link, pa), self.point(link, pb));
                 self.parts.push(Part::Rod {
                     name: name.clone(),
-                    role: role(link_name),
+                    role: shape_role(name, link_name),
                     a,
                     b,
                     radius_m,
@@ -218,7 +218,7 @@ impl Figure {
                 let (centre, normal_tip) = (self.point(link, c), self.point(link, c + n));
                 self.parts.push(Part::Ring {
                     name: name.clone(),
-                    role: role(link_name),
+                    role: shape_role(name, link_name),
                     centre,
                     normal_tip,
                     radius_m,
@@ -226,6 +226,18 @@ impl Figure {
             }
         }
         Ok(())
+    }
+}
+
+/// A shape's colour: a shape named after the hip or the pelvis (the hip axle, the pelvic
+/// ring) is the body's, as the page's legend says ("hip, pelvis"), whichever link carries it
+/// (wisse3d's hip axle rides on the stance thigh); any other shape is its link's.
+fn shape_role(shape_name: &str, link_name: &str) -> Role {
+    let name = shape_name.to_lowercase();
+    if name.starts_with("hip") || name.starts_with("pelvi") {
+        Role::Body
+    } else {
+        role(link_name)
     }
 }
 
@@ -265,6 +277,20 @@ mod tests {
         assert!(names(&with).contains(&"pelvic ring"));
         assert!(!names(&without).contains(&"pelvic ring"));
         assert!(names(&without).contains(&"hip axle"));
+        // Hip axle and pelvic ring in the body's colour (the legend's "hip, pelvis"), the
+        // legs in theirs.
+        let role_of = |name: &str| {
+            with.parts.iter().find_map(|p| match p {
+                Part::Rod { name: n, role, .. } | Part::Ring { name: n, role, .. } if n == name => {
+                    Some(*role)
+                }
+                _ => None,
+            })
+        };
+        assert_eq!(role_of("hip axle"), Some(Role::Body));
+        assert_eq!(role_of("pelvic ring"), Some(Role::Body));
+        assert_eq!(role_of("stance shank"), Some(Role::Stance));
+        assert_eq!(role_of("swing shank"), Some(Role::Swing));
         // Welded freedoms keep their bodies (and shapes).
         let planar = figure(&Scene::load("wisse2d").unwrap()).unwrap();
         assert_eq!(names(&planar), names(&with));

@@ -9,6 +9,7 @@ mod page;
 pub mod timeline;
 pub mod track;
 
+use crate::labels;
 use crate::output::PathError;
 use serde::Serialize;
 use sim::scene::{Scene, SceneError};
@@ -95,18 +96,23 @@ struct PageData<'a> {
 }
 
 impl Animation<'_> {
-    /// The title.
+    /// The title: the walker by name (as the figures name it), what it did, and how the walk
+    /// ended: "then the fall" for a fall, "then stopped: <reason in words>" for any other
+    /// failure. A gait's page counts steps, as its clock does.
     pub fn title(&self) -> String {
         let n = self.walk.steps_completed;
         let steps = format!("{n} step{}", if n == 1 { "" } else { "s" });
-        let what = match (self.command, &self.walk.failure) {
-            ("gait", _) => format!("{n} strides of its gait"),
-            ("sil", None) => format!("{steps}, firmware in the loop"),
-            ("sil", Some(_)) => format!("{steps}, firmware in the loop, then the fall"),
-            (_, None) => steps,
-            (_, Some(_)) => format!("{steps}, then the fall"),
+        let what = match (self.command, self.firmware) {
+            ("gait", _) => format!("{steps} of its gait"),
+            (_, true) => format!("{steps}, firmware in the loop"),
+            (_, false) => steps,
         };
-        format!("{}: {what}", self.scene.name())
+        let end = match &self.walk.failure {
+            None => String::new(),
+            Some(f) if labels::is_fall(f.kind) => ", then the fall".into(),
+            Some(f) => format!(", then stopped: {}", labels::failure_label(f.kind)),
+        };
+        format!("{}: {what}{end}", labels::walker_name(self.scene))
     }
 
     /// The page.

@@ -3,6 +3,7 @@
 //! changes, faults, landings, bus-off, host commands such as the emergency stop, injected
 //! encoder faults). Steps are numbered from 1 in the text.
 
+use crate::labels::{event_label, failure_label, is_fall, step_label};
 use serde::Serialize;
 use sim::walk::Walk;
 
@@ -11,12 +12,14 @@ use sim::walk::Walk;
 pub struct Event {
     /// Walk time [s].
     pub t_s: f64,
-    /// `knee_lock`, `heel_strike`, `fall`, `state`, `phase`, `fault`, `landing`, `bus_off`,
-    /// `command`, `sensor_fault`.
+    /// `knee_lock`, `heel_strike`, `fall` (the walker fell over), `stop` (the walk ended
+    /// on another failure, e.g. an impact that could not be solved), `state`, `phase`,
+    /// `fault`, `landing`, `bus_off`, `command`, `sensor_fault`.
     pub kind: &'static str,
     /// The ankle node (`Left`, `Right`), for the firmware's events.
     pub side: Option<String>,
-    /// The new state or phase (for `state` and `phase`), else empty.
+    /// The new state or phase (for `state` and `phase`), the failure in words (for `fall`
+    /// and `stop`), else empty.
     pub value: String,
     /// What happened, for people.
     pub text: String,
@@ -26,15 +29,14 @@ pub struct Event {
 pub fn walk_events(walk: &Walk) -> Vec<Event> {
     let mut out = Vec::new();
     for s in &walk.steps {
-        let n = s.step + 1;
+        let step = step_label(s.step);
         for e in &s.events {
-            let (kind, text) = match e.name.strip_prefix("knee_lock:") {
-                Some(c) => ("knee_lock", format!("step {n}: knee lock ({c})")),
-                None if e.name == "heel_strike" => {
-                    ("heel_strike", format!("step {n}: heel strike"))
-                }
-                None => ("event", format!("step {n}: {}", e.name.replace('_', " "))),
+            let kind = match e.name.as_str() {
+                n if n.starts_with("knee_lock:") => "knee_lock",
+                "heel_strike" => "heel_strike",
+                _ => "event",
             };
+            let text = format!("{step}: {}", event_label(&e.name));
             out.push(Event {
                 t_s: s.start_t_walk_s + e.t_stride_s,
                 kind,
@@ -47,13 +49,13 @@ pub fn walk_events(walk: &Walk) -> Vec<Event> {
     if let Some(f) = &walk.failure {
         out.push(Event {
             t_s: f.t_walk_s,
-            kind: "fall",
+            kind: if is_fall(f.kind) { "fall" } else { "stop" },
             side: None,
-            value: words(&format!("{:?}", f.kind)),
+            value: failure_label(f.kind),
             text: format!(
-                "step {}: {}: {}",
-                f.step + 1,
-                words(&format!("{:?}", f.kind)),
+                "{}: {}: {}",
+                step_label(f.step),
+                failure_label(f.kind),
                 f.detail
             ),
         });
@@ -151,18 +153,6 @@ fn command_words(debug: &str) -> String {
     }
 }
 
-/// A type name in words: `FellForward` → `fell forward`.
-fn words(camel: &str) -> String {
-    let mut out = String::new();
-    for c in camel.chars() {
-        if c.is_uppercase() && !out.is_empty() {
-            out.push(' ');
-        }
-        out.extend(c.to_lowercase());
-    }
-    out
-}
-
 fn sorted(mut events: Vec<Event>) -> Vec<Event> {
     events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
     events
@@ -174,7 +164,6 @@ mod tests {
 
     #[test]
     fn names_read_as_words() {
-        assert_eq!(words("FellForward"), "fell forward");
         assert_eq!(
             command_words("Command(Command { target: Broadcast, kind: EmergencyStop })"),
             "EmergencyStop to Broadcast"

@@ -1,7 +1,11 @@
 //! The frames of an animation: the walk's recorded samples resampled at a fixed rate of walk
 //! time, plus each step's first and last sample (heel strike, the fall), each turned into the
 //! floor-frame positions of the figure's key points by the engine's forward kinematics.
-//! Stored compactly: positions relative to a moving origin (the hip), quantised to 16 bits.
+//! Stored compactly: each distinct point once (key points that coincide in every frame, such
+//! as the ends of two rods meeting at a joint, share one), positions relative to a moving
+//! origin (the hip), quantised to 16 bits. Every event has a frame at its instant and a heel
+//! strike is two frames at the same time (before and after), so the page may interpolate
+//! between two successive frames of different times and one step without blurring an impact.
 
 use super::geometry::Figure;
 use nalgebra::{DVector, Vector3};
@@ -26,12 +30,16 @@ struct Frame {
 pub struct Track {
     /// Frames.
     pub frames: usize,
-    /// Key points per frame.
+    /// Stored points per frame (distinct key points).
     pub points: usize,
+    /// For each key point of the figure ([`Figure::points`], as the parts index them), the
+    /// stored point it is.
+    pub point_of: Vec<usize>,
     /// Walk time of each frame [s] (float32).
     pub t_s: String,
-    /// Step of each frame, numbered from 0 (uint16; saturates at 65,535).
-    pub step: String,
+    /// Step of each frame as people number it, from 1 ([`crate::labels::step_number`];
+    /// uint16, saturates at 65,535): the page shows it as it is.
+    pub step_number: String,
     /// The moving origin of each frame, the hip in the floor frame [m] (float32, x y z).
     pub origin_m: String,
     /// Key points relative to the origin, in quanta (int16, x y z per point).
@@ -126,7 +134,35 @@ fn frames(
     frames
 }
 
+/// Largest distance between two key points that are one stored point [m].
+const SAME_POINT_M: f64 = 1e-9;
+
+/// For each key point the index of its stored point, and for each stored point the key point
+/// it is stored as: key points within [`SAME_POINT_M`] of an earlier one in every frame are
+/// that one.
+fn distinct_points(frames: &[Frame]) -> (Vec<usize>, Vec<usize>) {
+    let count = frames.first().map_or(0, |f| f.points_m.len());
+    let mut point_of = Vec::with_capacity(count);
+    let mut stored: Vec<usize> = Vec::new();
+    for k in 0..count {
+        let same = stored.iter().position(|&j| {
+            frames
+                .iter()
+                .all(|f| (f.points_m[j] - f.points_m[k]).amax() <= SAME_POINT_M)
+        });
+        match same {
+            Some(i) => point_of.push(i),
+            None => {
+                point_of.push(stored.len());
+                stored.push(k);
+            }
+        }
+    }
+    (point_of, stored)
+}
+
 fn encode(frames: &[Frame]) -> Track {
+    let (point_of, stored) = distinct_points(frames);
     let largest_m = frames
         .iter()
         .flat_map(|f| f.points_m.iter().map(move |p| (p - f.origin_m).amax()))
@@ -138,11 +174,12 @@ fn encode(frames: &[Frame]) -> Track {
     let mut rel = Vec::new();
     for f in frames {
         t.extend((f.t_walk_s as f32).to_le_bytes());
-        step.extend(u16::try_from(f.step).unwrap_or(u16::MAX).to_le_bytes());
+        let number = crate::labels::step_number(f.step);
+        step.extend(u16::try_from(number).unwrap_or(u16::MAX).to_le_bytes());
         for x in f.origin_m.iter() {
             origin.extend((*x as f32).to_le_bytes());
         }
-        for p in &f.points_m {
+        for p in stored.iter().map(|&k| &f.points_m[k]) {
             for x in (p - f.origin_m).iter() {
                 // Within ±i16::MAX by the choice of the quantum.
                 let n = (x / quantum_m).round() as i16;
@@ -152,9 +189,10 @@ fn encode(frames: &[Frame]) -> Track {
     }
     Track {
         frames: frames.len(),
-        points: frames.first().map_or(0, |f| f.points_m.len()),
+        points: stored.len(),
+        point_of,
         t_s: super::base64::encode(&t),
-        step: super::base64::encode(&step),
+        step_number: super::base64::encode(&step),
         origin_m: super::base64::encode(&origin),
         rel: super::base64::encode(&rel),
         quantum_m,
@@ -271,7 +309,16 @@ mod tests {
             (fr.points_m[a] - fr.points_m[b]).norm()
         };
         let track = encode(&f);
+        // Shared rod ends (knees, hip, ankles) stored once.
+        assert_eq!(track.point_of.len(), figure.points.len());
+        assert!(
+            track.points < figure.points.len(),
+            "{} stored of {}",
+            track.points,
+            figure.points.len()
+        );
         let rel = decode_i16(&track.rel);
+        assert_eq!(rel.len(), 3 * f.len() * track.points);
         for (i, fr) in f.iter().enumerate() {
             assert!((length("hip axle", fr) - v("hip_width_m")).abs() < 1e-9);
             assert!((length("swing shank", fr) - v("shank_length_m")).abs() < 1e-9);
@@ -279,7 +326,8 @@ mod tests {
             // Decoded positions within half a quantum (and float32 rounding of the origin).
             for (k, p) in fr.points_m.iter().enumerate() {
                 for c in 0..3 {
-                    let got = f64::from(rel[3 * (i * track.points + k) + c]) * track.quantum_m
+                    let j = track.point_of[k];
+                    let got = f64::from(rel[3 * (i * track.points + j) + c]) * track.quantum_m
                         + fr.origin_m[c];
                     assert!((got - p[c]).abs() <= 0.5 * track.quantum_m + 1e-6);
                 }

@@ -5,6 +5,7 @@ use crate::export;
 use crate::figures;
 use crate::options::Common;
 use crate::output;
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::accuracy;
@@ -48,7 +49,18 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
         }
     };
     let settings = accuracy::default_settings(period);
-    let study = match accuracy::study(&setup, reference, &settings, &common.newton()) {
+    let progress = Progress::after(
+        super::walk::PROGRESS_DELAY,
+        settings.len(),
+        "accuracy (integrator settings)",
+        !common.json,
+    );
+    let studied =
+        accuracy::study_with_progress(&setup, reference, &settings, &common.newton(), &|| {
+            progress.tick()
+        });
+    progress.finish();
+    let study = match studied {
         Ok(s) => s,
         Err(e) => {
             output::note(format_args!("error: no reference gait: {e}"));
@@ -64,9 +76,11 @@ pub fn run(args: AccuracyArgs) -> Result<ExitCode> {
     if let Some(dir) = out {
         output::write_file("--out", &dir.join("accuracy.md"), &table)?;
         let panels: [(&str, &str, ErrorOf); 3] = [
-            ("fixed_point_error.svg", "fixed-point error", |p| {
-                p.fixed_point_error
-            }),
+            (
+                "fixed_point_error.svg",
+                "fixed-point error (∞-norm, rad and rad/s)",
+                |p| p.fixed_point_error,
+            ),
             ("eigenvalue_error.svg", "eigenvalue error", |p| {
                 p.eigenvalue_error
             }),

@@ -5,9 +5,10 @@ use super::gait::report;
 use super::{print_json, shown};
 use crate::options::Common;
 use crate::output;
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::census::{census, CensusSettings};
+use sim::census::{census_units, census_with_progress, CensusSettings};
 use sim::report::{GaitOutcome, GaitsReport};
 use std::io::Write;
 use std::process::ExitCode;
@@ -24,12 +25,21 @@ pub fn run(args: GaitsArgs) -> Result<ExitCode> {
     let GaitsArgs { common } = args;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
-    let found = census(
+    let settings = CensusSettings::default();
+    let progress = Progress::after(
+        super::walk::PROGRESS_DELAY,
+        census_units(&scene, &settings),
+        "gaits (Newton searches)",
+        !common.json,
+    );
+    let found = census_with_progress(
         &scene,
         &common.setup_for(),
         &common.newton(),
-        &CensusSettings::default(),
+        &settings,
+        &|| progress.tick(),
     )?;
+    progress.finish();
     let gaits = found
         .gaits
         .into_iter()

@@ -5,9 +5,10 @@ use crate::input_error::InputError;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
+use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::tune::{tune, TuneResult, TunedParameter};
+use sim::tune::{tune_with_progress, TuneResult, TunedParameter};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -61,7 +62,16 @@ pub fn run(args: TuneArgs) -> Result<ExitCode> {
             .into());
         }
     }
-    let result = tune(&scene, &params, evaluations, &common.newton())?;
+    let progress = Progress::after(
+        super::walk::PROGRESS_DELAY,
+        evaluations,
+        "tune (gait searches)",
+        !common.json,
+    );
+    let result = tune_with_progress(&scene, &params, evaluations, &common.newton(), &|| {
+        progress.tick()
+    })?;
+    progress.finish();
     if common.json {
         print_json(&result)?;
     } else {

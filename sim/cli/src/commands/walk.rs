@@ -8,6 +8,7 @@ use crate::export;
 use crate::figures;
 use crate::gait_text::GaitFigures;
 use crate::input_error::InputError;
+use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
@@ -227,7 +228,7 @@ fn print_text(
         writeln!(
             out,
             "{:>5} {:>10.4} {:>10.5} {:>10.5} {:>12.3e}",
-            s.step + 1,
+            labels::step_number(s.step),
             s.start_t_walk_s,
             s.duration_s,
             s.step_length_m,
@@ -248,13 +249,14 @@ fn print_text(
     }
 }
 
-/// A walk's failure for people: its kind, the step (numbered from 1), the walk time and the
-/// engine's detail. `walker sil` prints it so too.
+/// A walk's failure for people: its kind in words, the step (numbered from 1), the walk time
+/// and the engine's detail ("fell forward in step 2 at t = 1.9297 s: …"). `walker sil` prints
+/// it so too.
 pub fn failure_text(f: &sim::walk::WalkFailure) -> String {
     format!(
-        "{:?} in step {} at t = {:.4} s: {}",
-        f.kind,
-        f.step + 1,
+        "{} in {} at t = {:.4} s: {}",
+        labels::failure_label(f.kind),
+        labels::step_label(f.step),
         f.t_walk_s,
         f.detail
     )

@@ -78,9 +78,25 @@ def test_page_loads_and_shows_the_walker_moving(browser, path):
     assert len(a) > 300 and len(b) > 300, f"walker pixels {len(a)}, {len(b)}: blank?"
     moved = len(a ^ b) / len(a | b)
     assert moved > 0.3, f"the two times look alike ({moved:.2f} of the walker pixels differ)"
-    # A walk that ends in a fall says so at its end.
-    if page.evaluate("JSON.parse(document.getElementById('walker-data').textContent).events.some(e => e.kind === 'fall')"):
+    # A walk that ends in a fall says so at its end; one that ends on another failure says
+    # it stopped, and why.
+    kinds = page.evaluate("JSON.parse(document.getElementById('walker-data').textContent).events.map(e => e.kind)")
+    if "fall" in kinds:
         page.evaluate("walker.seek(walker.duration_s)")
-        assert "fell" in page.inner_text("#banner")
+        assert "fell at" in page.inner_text("#banner")
+    if "stop" in kinds:
+        page.evaluate("walker.seek(walker.duration_s)")
+        banner = page.inner_text("#banner")
+        assert banner.startswith("stopped at") and "fell" not in banner, banner
+    # Between two frames of different times the pose is interpolated: halfway it is drawn
+    # as neither frame (without interpolation it would be the earlier one, pixel for pixel).
+    i = page.evaluate("walker.seek(0.5 * walker.duration_s)")
+    t0, t1 = page.evaluate(f"[walker.frameTime({i}), walker.frameTime({i + 1})]")
+    if t1 > t0:
+        shots = []
+        for t in (t0, 0.5 * (t0 + t1)):
+            page.evaluate(f"walker.seek({t})")
+            shots.append(walker_mask(page.locator("#view").screenshot()))
+        assert shots[0] != shots[1], "the pose between two frames is the earlier frame's"
     assert not problems, problems
     page.close()
