@@ -89,7 +89,7 @@ fn a_servo_weaker_than_the_push_stalls_and_the_walk_ends_safe() {
     // −0.055 rad, 0.2 s reading): a catch-up finally moves the ankle faster than the
     // plausibility limit, a node raises `EncoderRate` and goes `Safe`, the other follows
     // (`PeerSafe`), and without pushes the robot falls (measured: right `Safe` at 10.194 s,
-    // `FellBackward` in step 14).
+    // `FellBackward` in JSON step 14, "step 15" counted from 1).
     let rate = Side::BOTH
         .iter()
         .filter_map(|s| rw.first_raise(*s, "EncoderRate"))

@@ -320,8 +320,8 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         Plot {
             title: format!("{name}: gaits against the {}", param_words(&param)),
             caption: Some(
-                "pseudo-arclength continuation; every state of a period-k gait is drawn; \
-                 period-1 branches as cubics through the computed points along their tangents"
+                "continuation: every state of a period-k gait; period-1 branches as cubics \
+                 along the tangents"
                     .into(),
             ),
             x_label: param.clone(),
@@ -332,8 +332,8 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
         Plot {
             title: format!("{name}: stability against the {}", param_words(&param)),
             caption: Some(
-                "bifurcations marked at the modulus of their crossing multiplier (≈ 1); \
-                 period-1 curves are monotone cubics between the computed points"
+                "bifurcations at their crossing multiplier's modulus (≈ 1); \
+                 monotone cubics between computed points"
                     .into(),
             ),
             x_label: param,

@@ -17,7 +17,6 @@ use super::settings::StrideSettings;
 use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
 use crate::control::{ActuatorSegment, AnkleSensing};
 use crate::events::locate;
-use crate::hermite::{self, Knot};
 use crate::integrators::{Integrator, Sample};
 use crate::walker::Walker;
 use nalgebra::DVector;
@@ -387,26 +386,17 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             _ => self.wit.eval(cur),
         };
         let mut w_next = self.wit.eval(&next);
-        if w_cur.foot_height_m > 0.0 && w_next.foot_height_m > 0.0 {
-            let n = self.settings.event_tolerance.grazing_samples;
-            let h = next.t_s - cur.t_s;
-            let knot = |w: &WitnessValues| Knot {
-                value: w.foot_height_m,
-                rate: w.foot_height_rate_m_s,
-            };
-            let height_at = |x: f64| hermite::scalar(knot(&w_cur), knot(&w_next), h, x).0;
-            if let Some(k) = (1..=n).find(|&k| height_at(k as f64 / (n + 1) as f64) <= 0.0) {
-                let t = cur.t_s + h * k as f64 / (n + 1) as f64;
-                let mut s = self
-                    .integrator
-                    .step_exact(&mut self.phase, cur, t - cur.t_s)
-                    .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
-                self.phase.snap(&mut s);
-                let ws = self.wit.eval(&s);
-                if ws.foot_height_m <= 0.0 {
-                    next = s;
-                    w_next = ws;
-                }
+        let samples = self.settings.event_tolerance.grazing_samples;
+        if let Some(t) = w_cur.grazing_sample_time(&w_next, samples) {
+            let mut s = self
+                .integrator
+                .step_exact(&mut self.phase, cur, t - cur.t_s)
+                .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
+            self.phase.snap(&mut s);
+            let ws = self.wit.eval(&s);
+            if ws.foot_height_m <= 0.0 {
+                next = s;
+                w_next = ws;
             }
         }
         self.w_cached = Some(w_next);

@@ -9,6 +9,7 @@
 use super::phase::Phase;
 use crate::control::ActuatorSegment;
 use crate::events::Direction;
+use crate::hermite::{self, Knot};
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
 use crate::walker::Walker;
@@ -64,6 +65,29 @@ pub(super) struct WitnessValues {
     pub(super) hip_height_margin_m: f64,
     pub(super) hip_ahead_m: f64,
     pub(super) hip_forward_velocity_m_s: f64,
+}
+
+impl WitnessValues {
+    /// A swing foot that dips below the floor and back inside one step (both ends above
+    /// it): the stride time of the first of `samples` evenly spaced points of the step
+    /// `self` → `next` at which the cubic Hermite of the foot's height (values and rates at
+    /// both ends) is at or below zero, or `None` when the ends are not both above the floor
+    /// or no point is below it. Shared by the general and the fixed-size stride loops.
+    pub(super) fn grazing_sample_time(&self, next: &WitnessValues, samples: usize) -> Option<f64> {
+        if self.foot_height_m <= 0.0 || next.foot_height_m <= 0.0 {
+            return None;
+        }
+        let h = next.t_s - self.t_s;
+        let knot = |w: &WitnessValues| Knot {
+            value: w.foot_height_m,
+            rate: w.foot_height_rate_m_s,
+        };
+        let fraction = |k: usize| k as f64 / (samples + 1) as f64;
+        let height_at = |x: f64| hermite::scalar(knot(self), knot(next), h, x).0;
+        (1..=samples)
+            .find(|&k| height_at(fraction(k)) <= 0.0)
+            .map(|k| self.t_s + h * k as f64 / (samples + 1) as f64)
+    }
 }
 
 /// Witness values at a sample: what the stride loop watches.

@@ -123,12 +123,21 @@ fn print_text(
 ) -> std::io::Result<()> {
     writeln!(
         out,
-        "{:>14} {:>10} {:>7} {:>8}  {coordinate} at heel strike (or how it fell)",
-        r.param, "attractor", "period", "strides"
+        "{:>14} {:>10} {:>7} {:>8}  {} at heel strike (or how it fell)",
+        r.param,
+        "attractor",
+        "period",
+        "strides",
+        crate::labels::coordinate_label(coordinate)
     )?;
     for p in &r.points {
         let detail = match &p.failure {
-            Some(f) => format!("{:?} in stride {}", f.kind, f.stride),
+            // `f.stride` counts from 1 already (the report's numbering).
+            Some(f) => format!(
+                "{} in {}",
+                crate::labels::failure_label(f.kind),
+                crate::labels::step_label(f.stride.saturating_sub(1))
+            ),
             None => {
                 let ys = p.samples.get(coordinate).map_or(&[][..], Vec::as_slice);
                 let (lo, hi) = ys

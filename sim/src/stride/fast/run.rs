@@ -9,7 +9,6 @@ use super::witness::PlanarWitnesses;
 use super::Outcome;
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::events::{refine, root_on_dense, Direction};
-use crate::hermite::{self, Knot};
 use crate::integrators::{IntegratorChoice, Sample};
 use crate::model::Model;
 use crate::planar::{EvaluationPath, PlanarTree};
@@ -265,25 +264,16 @@ impl<const N: usize> Run<'_, N> {
             _ => self.wit.eval(self.tree, &cur),
         };
         let mut w_next = self.wit.eval(self.tree, &next);
-        if w_cur.foot_height_m > 0.0 && w_next.foot_height_m > 0.0 {
-            let n = self.settings.event_tolerance.grazing_samples;
-            let h = next.t_s - cur.t_s;
-            let knot = |w: &WitnessValues| Knot {
-                value: w.foot_height_m,
-                rate: w.foot_height_rate_m_s,
-            };
-            let height_at = |x: f64| hermite::scalar(knot(&w_cur), knot(&w_next), h, x).0;
-            if let Some(k) = (1..=n).find(|&k| height_at(k as f64 / (n + 1) as f64) <= 0.0) {
-                let t = cur.t_s + h * k as f64 / (n + 1) as f64;
-                let s = self
-                    .integrator
-                    .step_exact(&mut self.sys, &cur, t - cur.t_s)
-                    .ok()?;
-                let ws = self.wit.eval(self.tree, &s);
-                if ws.foot_height_m <= 0.0 {
-                    next = s;
-                    w_next = ws;
-                }
+        let samples = self.settings.event_tolerance.grazing_samples;
+        if let Some(t) = w_cur.grazing_sample_time(&w_next, samples) {
+            let s = self
+                .integrator
+                .step_exact(&mut self.sys, &cur, t - cur.t_s)
+                .ok()?;
+            let ws = self.wit.eval(self.tree, &s);
+            if ws.foot_height_m <= 0.0 {
+                next = s;
+                w_next = ws;
             }
         }
         self.w_cached = Some(w_next);
