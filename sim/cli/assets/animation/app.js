@@ -223,9 +223,9 @@ function overlay(frame) {
       return div;
     }));
   }
-  // The emergency stop once sent, then the walk's end by failure: "fell at t = …: fell
-  // forward" for a fall, "simulation ended at t = …: <reason>" for any other failure (the
-  // words from the binary).
+  // The emergency stop once sent, then the walk's end by failure: "fell" and the fall in
+  // words for a fall, "simulation ended" and the reason for any other failure, each with its
+  // time (the words from the binary).
   const end = events.find((e) => e.kind === "fall" || e.kind === "stop");
   const parts = [];
   if (data.emergency_stop_sent_s !== null && until >= data.emergency_stop_sent_s) parts.push(data.emergency_stop_text);
