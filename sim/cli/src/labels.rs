@@ -112,6 +112,46 @@ pub fn is_fall(kind: FailureKind) -> bool {
     matches!(kind, FailureKind::FellBackward | FailureKind::FellForward)
 }
 
+/// What a failure that is not a fall means, as a clause ("the impact equations were
+/// singular"); a fall reads as its label ("fell forward").
+fn failure_clause(kind: FailureKind) -> String {
+    match kind {
+        FailureKind::FellBackward | FailureKind::FellForward => failure_label(kind),
+        FailureKind::Scuffed => "the swing foot hit the floor mid-swing".into(),
+        FailureKind::HeelStrikeBeforeKneeLock => {
+            "heel strike came before the swing knee locked".into()
+        }
+        FailureKind::StanceFootDidNotLift => "the old stance foot did not lift".into(),
+        FailureKind::NoImpactWithinTime => "no heel strike within the stride's time".into(),
+        FailureKind::NonFiniteState => "the state became non-finite".into(),
+        FailureKind::StepTooLarge => "a fixed step exceeded the stability limit".into(),
+        FailureKind::StepUnderflow => "an adaptive step fell below its floor".into(),
+        FailureKind::HeelDidNotLift => "the heel would not lift at string engagement".into(),
+        FailureKind::HeelReturnedToFloor => "the heel came back down during push-off".into(),
+        FailureKind::EventNotLocated => "an event could not be located".into(),
+        FailureKind::ImpactSingular => "the impact equations were singular".into(),
+        FailureKind::RelabelFailed => "the relabelled state did not match the model".into(),
+        FailureKind::StepBudgetExceeded => "the stride used its integrator-step budget".into(),
+        FailureKind::EvaluationBudgetExceeded => "the stride used its evaluation budget".into(),
+    }
+}
+
+/// How a walk ended, the one wording of the `walker sil`/`walker walk` text and the animation
+/// page: a fall as its label ("fell forward"), any other failure as what it is
+/// ("simulation ended: the impact equations were singular").
+pub fn walk_end_label(kind: FailureKind) -> String {
+    if is_fall(kind) {
+        failure_label(kind)
+    } else {
+        format!("simulation ended: {}", failure_clause(kind))
+    }
+}
+
+/// The host's emergency stop, sent at walk time `t_s` [s], in words.
+pub fn emergency_stop_label(t_s: f64) -> String {
+    format!("emergency stop sent at {t_s:.3} s")
+}
+
 /// The number people read for the step of 0-based index `index` (the engine's and JSON's
 /// numbering): steps are numbered from 1, the first step is "step 1".
 pub fn step_number(index: usize) -> usize {
@@ -169,6 +209,11 @@ mod tests {
             "impact singular"
         );
         assert!(is_fall(FailureKind::FellBackward) && !is_fall(FailureKind::ImpactSingular));
+        assert_eq!(
+            walk_end_label(FailureKind::ImpactSingular),
+            "simulation ended: the impact equations were singular"
+        );
+        assert_eq!(walk_end_label(FailureKind::FellForward), "fell forward");
         assert_eq!((step_number(0), step_label(2).as_str()), (1, "step 3"));
         assert_eq!(
             event_label("knee_lock:swing_knee"),

@@ -104,12 +104,16 @@ fn a_failure_that_is_not_a_fall_is_a_stop() {
     assert_eq!(out.status.code(), Some(3));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("failure: impact singular in step 5"),
+        text.contains("failure: simulation ended: the impact equations were singular in step 5"),
         "{text}"
+    );
+    assert!(
+        text.contains("emergency stop sent at 4.000 s"),
+        "the text names the emergency stop: {text}"
     );
     assert_page(
         &page,
-        "3D walker with pelvic compensator: 4 steps, firmware in the loop, then stopped: impact singular",
+        "3D walker with pelvic compensator: 4 steps, firmware in the loop, emergency stop sent at 4.000 s, then simulation ended: the impact equations were singular",
     );
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(html.contains("\"kind\":\"stop\""));
@@ -208,4 +212,62 @@ fn zero_steps_or_too_many_are_refused() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("1 to 2000 steps"));
+}
+
+#[test]
+fn the_firmware_gait_averages_only_steps_before_the_emergency_stop() {
+    // At 3.5 s the fifth step (begun at 3.2 s) is under way: it, and any step after the
+    // stop, is not the firmware's gait.
+    let out = walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "12",
+        "--estop-at",
+        "3.5",
+        "--json",
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let t_stop = r["emergency_stop_sent_s"].as_f64().unwrap();
+    assert!((3.5..3.502).contains(&t_stop), "{t_stop}");
+    let before = r["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| {
+            s["start_time_s"].as_f64().unwrap() + s["duration_s"].as_f64().unwrap() <= t_stop
+        })
+        .count();
+    let completed = r["steps_completed"].as_u64().unwrap() as usize;
+    assert!(
+        before >= 1 && before < completed,
+        "{before} of {completed} steps ended before the stop"
+    );
+    assert_eq!(
+        r["steps_before_emergency_stop"].as_u64().unwrap() as usize,
+        before
+    );
+    assert_eq!(
+        r["gait"]["steps_averaged"].as_u64().unwrap() as usize,
+        before.min(10)
+    );
+    let out = walker(&[
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "12",
+        "--estop-at",
+        "3.5",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!(
+            "firmware's gait, mean over the last {} steps before the emergency stop:",
+            before.min(10)
+        )),
+        "{text}"
+    );
+    assert!(text.contains("emergency stop sent at 3.500 s"), "{text}");
 }

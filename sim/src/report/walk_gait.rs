@@ -43,11 +43,17 @@ impl WalkGaitRecord {
     /// The figures over the last `last` completed steps of `walk` by `walker`; `None` if no
     /// step completed.
     pub fn of(walker: &Walker, walk: &Walk, last: usize) -> Option<Self> {
-        let n = walk.steps.len().min(last);
+        Self::of_steps(walker, &walk.steps, last)
+    }
+
+    /// The figures over the last `last` of `steps` (consecutive completed steps of one walk
+    /// by `walker`, e.g. those before some walk time); `None` if there are none.
+    pub fn of_steps(walker: &Walker, steps: &[StepSummary], last: usize) -> Option<Self> {
+        let n = steps.len().min(last);
         if n == 0 {
             return None;
         }
-        let steps = &walk.steps[walk.steps.len() - n..];
+        let steps = &steps[steps.len() - n..];
         let mean = |f: &dyn Fn(&StepSummary) -> f64| steps.iter().map(f).sum::<f64>() / n as f64;
         let period = mean(&|s| s.duration_s);
         let length = mean(&|s| s.step_length_m);

@@ -223,11 +223,17 @@ function overlay(frame) {
       return div;
     }));
   }
-  // The walk's end by failure: "fell" for a fall, "stopped" for any other failure (its kind
-  // in words, from the binary).
+  // The emergency stop once sent, then the walk's end by failure: "fell" and the fall in
+  // words for a fall, "simulation ended" and the reason for any other failure, each with its
+  // time (the words from the binary).
   const end = events.find((e) => e.kind === "fall" || e.kind === "stop");
-  const verb = end && end.kind === "fall" ? "fell" : "stopped";
-  ui.banner.textContent = end && until >= end.t_s ? `${verb} at t = ${end.t_s.toFixed(3)} s: ${end.value}` : "";
+  const parts = [];
+  if (data.emergency_stop_sent_s !== null && until >= data.emergency_stop_sent_s) parts.push(data.emergency_stop_text);
+  if (end && until >= end.t_s) {
+    const [head, reason] = end.kind === "fall" ? ["fell", end.value] : end.value.split(": ", 2);
+    parts.push(`${head} at t = ${end.t_s.toFixed(3)} s: ${reason || end.value}`);
+  }
+  ui.banner.textContent = parts.join("; ");
 }
 
 function render() {

@@ -74,6 +74,8 @@ pub struct Animation<'a> {
     pub events: Vec<timeline::Event>,
     /// The firmware was in the loop (the page shows the ankle nodes).
     pub firmware: bool,
+    /// Walk time the host sent the emergency stop [s] (`None`: none sent).
+    pub emergency_stop_sent_s: Option<f64>,
 }
 
 /// The page's data.
@@ -84,6 +86,10 @@ struct PageData<'a> {
     scene: &'a str,
     command: &'a str,
     firmware: bool,
+    /// Walk time the host sent the emergency stop [s] (`null`: none sent).
+    emergency_stop_sent_s: Option<f64>,
+    /// The emergency stop in words (empty: none sent), for the banner.
+    emergency_stop_text: String,
     /// Turn of the floor frame about its z axis that makes gravity point down [rad].
     world_rotation_z_rad: f64,
     /// Floor grid spacing [m].
@@ -97,8 +103,9 @@ struct PageData<'a> {
 
 impl Animation<'_> {
     /// The title: the walker by name (as the figures name it), what it did, and how the walk
-    /// ended: "then the fall" for a fall, "then stopped: <reason in words>" for any other
-    /// failure. A gait's page counts steps, as its clock does.
+    /// ended: "then the fall" for a fall, "then simulation ended: <reason in words>" for any
+    /// other failure; an emergency stop is named with its time. A gait's page counts steps,
+    /// as its clock does.
     pub fn title(&self) -> String {
         let n = self.walk.steps_completed;
         let steps = format!("{n} step{}", if n == 1 { "" } else { "s" });
@@ -107,12 +114,15 @@ impl Animation<'_> {
             (_, true) => format!("{steps}, firmware in the loop"),
             (_, false) => steps,
         };
+        let stop = self.emergency_stop_sent_s.map_or_else(String::new, |t| {
+            format!(", {}", labels::emergency_stop_label(t))
+        });
         let end = match &self.walk.failure {
             None => String::new(),
             Some(f) if labels::is_fall(f.kind) => ", then the fall".into(),
-            Some(f) => format!(", then stopped: {}", labels::failure_label(f.kind)),
+            Some(f) => format!(", then {}", labels::walk_end_label(f.kind)),
         };
-        format!("{}: {what}{end}", labels::walker_name(self.scene))
+        format!("{}: {what}{stop}{end}", labels::walker_name(self.scene))
     }
 
     /// The page.
@@ -136,6 +146,10 @@ impl Animation<'_> {
             scene: self.scene.name(),
             command: self.command,
             firmware: self.firmware,
+            emergency_stop_sent_s: self.emergency_stop_sent_s,
+            emergency_stop_text: self
+                .emergency_stop_sent_s
+                .map_or_else(String::new, labels::emergency_stop_label),
             // Rz(θ) g points along −y: θ = −atan2(g_x, −g_y) (−slope for a slope's gravity).
             world_rotation_z_rad: -g.x.atan2(-g.y),
             grid_m: 0.25,

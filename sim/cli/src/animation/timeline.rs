@@ -3,7 +3,7 @@
 //! changes, faults, landings, bus-off, host commands such as the emergency stop, injected
 //! encoder faults). Steps are numbered from 1 in the text.
 
-use crate::labels::{event_label, failure_label, is_fall, step_label};
+use crate::labels::{event_label, failure_label, is_fall, step_label, walk_end_label};
 use serde::Serialize;
 use sim::walk::Walk;
 
@@ -18,8 +18,8 @@ pub struct Event {
     pub kind: &'static str,
     /// The ankle node (`Left`, `Right`), for the firmware's events.
     pub side: Option<String>,
-    /// The new state or phase (for `state` and `phase`), the failure in words (for `fall`
-    /// and `stop`), else empty.
+    /// The new state or phase (for `state` and `phase`), how the walk ended in words (for
+    /// `fall` and `stop`: `labels::walk_end_label`), else empty.
     pub value: String,
     /// What happened, for people.
     pub text: String,
@@ -51,7 +51,7 @@ pub fn walk_events(walk: &Walk) -> Vec<Event> {
             t_s: f.t_walk_s,
             kind: if is_fall(f.kind) { "fall" } else { "stop" },
             side: None,
-            value: failure_label(f.kind),
+            value: walk_end_label(f.kind),
             text: format!(
                 "{}: {}: {}",
                 step_label(f.step),
@@ -136,6 +136,16 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
         });
     }
     sorted(out)
+}
+
+/// The walk time the host sent its first emergency stop [s], from the run's report (`None`
+/// if it sent none).
+pub fn emergency_stop_sent_s(r: &sil::SilReport) -> Option<f64> {
+    r.host
+        .commands_sent
+        .iter()
+        .find(|(_, command)| command.contains("EmergencyStop"))
+        .map(|(t_s, _)| *t_s)
 }
 
 /// A host command as the run's report writes it (`Command(Command { target: Broadcast, kind:

@@ -87,6 +87,7 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
                 command: "gait",
                 events: timeline::walk_events(&walk),
                 firmware: false,
+                emergency_stop_sent_s: None,
             })?;
         }
         (Some(file), Err(_)) => file.discard(),

@@ -6,6 +6,7 @@ use super::{print_json, shown, walk_exit_code};
 use crate::animation::{self, timeline, Animation};
 use crate::gait_text::GaitFigures;
 use crate::input_error::InputError;
+use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
@@ -100,8 +101,13 @@ struct SilWalkReport<'a, Bus: Serialize> {
     steps_completed: usize,
     /// The first failure (`null` if none).
     failure: Option<&'a WalkFailure>,
-    /// The firmware's gait over the last 10 steps (`null` if no step completed).
+    /// The firmware's gait over the last 10 steps that ended by the emergency stop (all
+    /// steps without one; `null` if there is no such step).
     gait: Option<WalkGaitRecord>,
+    /// Walk time the host sent the emergency stop (`--estop-at`) [s]; `null` if none was sent.
+    emergency_stop_sent_s: Option<f64>,
+    /// Steps completed that ended by the emergency stop (all of them without one).
+    steps_before_emergency_stop: usize,
     /// The ideal-actuator gait.
     ideal_gait: IdealGaitRecord,
     /// Faults the nodes raised or cleared.
@@ -309,6 +315,18 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         InputError::Other(m) => anyhow::anyhow!(m),
         other => anyhow::Error::from(other),
     })?;
+    let emergency_stop_sent_s = timeline::emergency_stop_sent_s(&firmware);
+    // The firmware's gait: the steps that ended by the emergency stop (one under way at the
+    // stop, or begun after it, is not walked with the ankles actuating throughout).
+    let actuated_steps = match emergency_stop_sent_s {
+        Some(t_stop) => {
+            let before = walk
+                .steps
+                .partition_point(|s| s.start_t_walk_s + s.duration_s <= t_stop);
+            &walk.steps[..before]
+        }
+        None => &walk.steps[..],
+    };
     if let Some(file) = animation {
         let mut events = timeline::walk_events(&walk);
         events.extend(timeline::firmware_events(&firmware));
@@ -320,6 +338,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             command: "sil",
             events,
             firmware: true,
+            emergency_stop_sent_s,
         })?;
     }
     let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
@@ -331,7 +350,9 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         integrator: &stride_settings.integrator,
         steps_completed: walk.steps_completed,
         failure: walk.failure.as_ref(),
-        gait: WalkGaitRecord::of(&walker, &walk, 10),
+        gait: WalkGaitRecord::of_steps(&walker, actuated_steps, 10),
+        emergency_stop_sent_s,
+        steps_before_emergency_stop: actuated_steps.len(),
         ideal_gait: IdealGaitRecord::of(ideal_walker, &ideal),
         node_faults: &firmware.faults,
         nodes: &firmware.nodes,
@@ -368,24 +389,39 @@ fn print_text<Bus: Serialize>(
     r: &SilWalkReport<'_, Bus>,
     steps: usize,
 ) -> std::io::Result<()> {
-    writeln!(
-        out,
-        "scene {}: {} of {steps} steps with the firmware actuating",
-        r.scene, r.steps_completed
-    )?;
+    match r.emergency_stop_sent_s {
+        None => writeln!(
+            out,
+            "scene {}: {} of {steps} steps with the firmware actuating",
+            r.scene, r.steps_completed
+        )?,
+        Some(t) => {
+            writeln!(
+                out,
+                "scene {}: {} of {steps} steps, {} of them with the firmware actuating before the emergency stop",
+                r.scene, r.steps_completed, r.steps_before_emergency_stop
+            )?;
+            writeln!(out, "{}", labels::emergency_stop_label(t))?;
+        }
+    }
     if let Some(f) = r.failure {
         writeln!(out, "failure: {}", failure_text(f))?;
     }
+    let before_stop = if r.emergency_stop_sent_s.is_some() {
+        " before the emergency stop"
+    } else {
+        ""
+    };
     match &r.gait {
         Some(g) => {
             writeln!(
                 out,
-                "firmware's gait, mean over the last {} steps:",
+                "firmware's gait, mean over the last {} steps{before_stop}:",
                 g.steps_averaged
             )?;
             GaitFigures::of_walk(g, true).write(out, "    ")?;
         }
-        None => writeln!(out, "firmware's gait: no step completed")?,
+        None => writeln!(out, "firmware's gait: no step completed{before_stop}")?,
     }
     writeln!(
         out,

@@ -180,6 +180,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             command: "walk",
             events: timeline::walk_events(&walk),
             firmware: false,
+            emergency_stop_sent_s: None,
         })?;
     }
     let report = WalkReport::new(&scene, &walk);
@@ -255,7 +256,7 @@ fn print_text(
 pub fn failure_text(f: &sim::walk::WalkFailure) -> String {
     format!(
         "{} in {} at t = {:.4} s: {}",
-        labels::failure_label(f.kind),
+        labels::walk_end_label(f.kind),
         labels::step_label(f.step),
         f.t_walk_s,
         f.detail
