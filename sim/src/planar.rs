@@ -21,7 +21,10 @@ use crate::singular_limit::{
 };
 use nalgebra::{DVector, SMatrix, SVector};
 
+mod trig;
 mod two_link;
+
+pub use trig::sin_cos;
 
 /// Most coordinates a tree may have to take the fast path.
 pub const MAX_COORDINATES: usize = 6;
@@ -157,7 +160,8 @@ pub struct PlanarTree {
     gravity_m_s2: [f64; 2],
     dof: usize,
     has_infinitesimal: bool,
-    /// The closed form of a two-link chain (the compass), when the tree is one.
+    /// The closed form of a two-link chain (the compass, the simplest walker), when the tree
+    /// is one.
     two_link: Option<two_link::TwoLink>,
 }
 
@@ -245,7 +249,7 @@ impl PlanarTree {
             has_infinitesimal: model.has_infinitesimal_bodies(),
             two_link: None,
         };
-        tree.two_link = two_link::TwoLink::of(&tree, false);
+        tree.two_link = two_link::TwoLink::of(&tree);
         Some(tree)
     }
 
@@ -266,23 +270,9 @@ impl PlanarTree {
         self
     }
 
-    /// The same tree with the two-link closed form also when it has infinitesimal bodies (the
-    /// simplest walker: its vanishing-mass limit in closed form, the finite `M̄`'s null space
-    /// being the swing leg's coordinate by structure). Not taken by [`Self::of`]: it equals the
-    /// link pass to 3e-15 over random states and halves the simplest walker's stride
-    /// (docs/performance.md, fourth round), but the rounding it changes moves the simplest
-    /// walker's period doubling located with frozen-step central differences by 2.2e-9, past
-    /// `tests/continuation.rs`'s 1e-9 between Jacobian methods (whose Jacobians differ by
-    /// 1.2e-8 there); until that tolerance is revisited, an opt-in.
-    pub fn with_infinitesimal_closed_form(mut self) -> Self {
-        if let Some(t) = two_link::TwoLink::of(&self, true) {
-            self.two_link = Some(t);
-        }
-        self
-    }
-
-    /// Whether the tree evaluates by a closed form (a two-link chain: the compass; the
-    /// simplest walker on request) rather than by its link pass.
+    /// Whether the tree evaluates by a closed form (a two-link chain: the compass, and the
+    /// simplest walker with its vanishing-mass limit in closed form) rather than by its link
+    /// pass.
     pub fn has_closed_form(&self) -> bool {
         self.two_link.is_some()
     }

@@ -298,10 +298,27 @@ fn the_tuned_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages(
     assert!(beyond.as_ref() != Ok(&before), "{beyond:?}");
 }
 
+/// How far the simplest walker's period doubling may move between the plain and the
+/// frozen-step central-difference Jacobians (`sim/examples/pd_sensitivity.rs` computes each
+/// term). The location is the zero of `det(M + I)` on the branch, so a Jacobian difference `δJ`
+/// moves it by `δλ / (dλ/dμ)`, `λ` the multiplier through −1: there `dλ/dμ = −218.7` per rad of
+/// slope (gaits at ±1e-6 on the branch), and the two Jacobians, which differ by 1.1e-8 (largest
+/// entry), give multipliers that differ by 7e-9 to 4.7e-7 at located points 2e-9 apart (the
+/// frozen steps' Jacobian changes by more than its smooth part wherever the step schedule
+/// does): up to 2.1e-9 of slope. Each located value is itself only known to its arclength
+/// bracket, [`LOCATION_TOLERANCE`] (the parameter moves at most as much). Both together:
+/// 2.1e-9 + 2 × 1e-9. Measured: rounding changes at the ulp level alone (glibc's or musl's
+/// `sincos`, the link pass or the closed form of the equations of motion) move the frozen-step
+/// location between 0.0150884360 and 0.0150884403 (4.3e-9), the plain one by 5e-12; the
+/// earlier 1e-9 was tighter than the methods' own difference.
+const SIMPLEST_PERIOD_DOUBLING_TOL: f64 = 2.2e-9 + 2.0 * LOCATION_TOLERANCE;
+
 /// The stride Jacobian's error at located points (docs/bifurcations.md, "The stride map and its
 /// Jacobian"): the simplest walker's has no variational Jacobian (infinitesimal feet) and is
 /// compared with central differences on frozen step sizes; the tuned wisse2d one with the
-/// variational Jacobian. The located values must not move by more than 1e-9 between methods.
+/// variational Jacobian. The located values may move between methods by what the methods'
+/// own difference allows: 1e-9 for wisse2d's fold; [`SIMPLEST_PERIOD_DOUBLING_TOL`] for the
+/// simplest walker's period doubling.
 #[test]
 fn the_stride_jacobian_error_at_the_located_points_is_small() {
     use sim::limit_cycle::JacobianMethod;
@@ -312,6 +329,7 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
             (0.009, 0.017, 5),
             BifurcationKind::PeriodDoubling,
             true,
+            SIMPLEST_PERIOD_DOUBLING_TOL,
         ),
         (
             "wisse2d-tuned",
@@ -319,9 +337,10 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
             (-0.055, -0.06, 3),
             BifurcationKind::Fold,
             false,
+            1e-9,
         ),
     ];
-    for (name, param, range, kind, frozen) in cases {
+    for (name, param, range, kind, frozen, tol) in cases {
         let scene = Scene::load(name).unwrap();
         let settings = ContinuationSettings {
             max_period: 1,
@@ -351,7 +370,11 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
             "{name}: {kind:?} at {:.12} (central, h = 1e-6) and {:.12} (reference)",
             ours.value, reference.value
         );
-        assert!((ours.value - reference.value).abs() < 1e-9);
+        let moved = (ours.value - reference.value).abs();
+        assert!(
+            moved < tol,
+            "{name}: moved by {moved:e} between methods, tolerance {tol:e}"
+        );
         let mut s = scene.clone();
         s.set(param, ours.value).unwrap();
         let setup = s.setup().unwrap();

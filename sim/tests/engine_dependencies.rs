@@ -3,9 +3,10 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 /// Every dependency the engine may have: the numerics, serialisation, errors, rayon for
-/// parallel stride evaluations (independent Jacobian columns, parameter sides), and the
-/// dependency-free extension profile it shares with the firmware.
-const ALLOWED: [&str; 8] = [
+/// parallel stride evaluations (independent Jacobian columns, parameter sides), the
+/// dependency-free extension profile it shares with the firmware, and `libm` (musl's math,
+/// also the firmware's) for the planar fast path's `sincos`.
+const ALLOWED: [&str; 9] = [
     "ankle-profile",
     "nalgebra",
     "num-dual",
@@ -14,6 +15,7 @@ const ALLOWED: [&str; 8] = [
     "toml",
     "thiserror",
     "rayon",
+    "libm",
 ];
 
 const FORBIDDEN: [&str; 12] = [

@@ -272,11 +272,11 @@ fn compare_with_general(
 
 #[test]
 fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
-    // Which trees have it: the two-link chains, found from the model (the simplest walker's,
-    // with infinitesimal feet, on request).
+    // Which trees have it: the two-link chains, found from the model (the simplest walker's
+    // with its infinitesimal feet: the vanishing-mass limit in closed form).
     for (name, closed) in [
         ("compass", true),
-        ("simplest", false),
+        ("simplest", true),
         ("kneed2d", false),
         ("wisse2d", false),
     ] {
@@ -286,13 +286,6 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
         assert!(!tree.link_pass_only().has_closed_form());
         let path = PlanarTree::for_path(&s.walker.model, EvaluationPath::LinkPass).unwrap();
         assert!(!path.has_closed_form());
-        let opt_in = PlanarTree::of(&s.walker.model)
-            .unwrap()
-            .with_infinitesimal_closed_form();
-        assert_eq!(
-            opt_in.has_closed_form(),
-            name != "kneed2d" && name != "wisse2d"
-        );
     }
     // The scenes as they are, then variants the scene files cannot express: distributed
     // masses (I_zz), centres of mass off the legs' axes, an axis along −z, a spring and a
@@ -334,9 +327,7 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
                     model.links[swing].joint_force.damping = 0.4;
                 }
             }
-            let closed = PlanarTree::of(&model)
-                .unwrap()
-                .with_infinitesimal_closed_form();
+            let closed = PlanarTree::of(&model).unwrap();
             assert!(closed.has_closed_form(), "{name} {variant}");
             let link_pass = closed.clone().link_pass_only();
             let center = (&s.guess.q, &s.guess.qd);

@@ -2,7 +2,7 @@
 //! ground and a swing leg on a hip (the compass gait, the simplest walker), with point and
 //! distributed masses, welds anywhere. Built once from the planar tree's own data
 //! ([`TwoLink::of`], structurally: two coordinates, the second joint below the first link;
-//! with infinitesimal bodies only on request, [`PlanarTree::with_infinitesimal_closed_form`]);
+//! infinitesimal bodies in their own `ε` part, the simplest walker's limit in closed form);
 //! the link pass of [`super::PlanarTree`] and the general engine stay the reference it is
 //! tested against (`sim/tests/fast_path.rs`).
 //!
@@ -43,7 +43,7 @@
 //! less the joint springs and dampers (`k (q − q_rest) + d q̇`), as in the link pass. Finite
 //! and infinitesimal bodies lump separately (the `ε` parts of `M̄`, `f̄`).
 
-use super::{Assembled, LinkFrame, PlanarTree, MAX_LINKS};
+use super::{sin_cos, Assembled, LinkFrame, PlanarTree, MAX_LINKS};
 use nalgebra::{SMatrix, SVector};
 
 /// One group's lumped mass properties about its joint, in its link's frame.
@@ -67,28 +67,38 @@ struct PartConstants {
     /// `A = d · h₂` and `B = d_y h₂ₓ − dₓ h₂_y` [kg·m²].
     a_kg_m2: f64,
     b_kg_m2: f64,
-    /// `H₁ = h₁ + m₂ d` (link A's frame) [kg·m].
-    h1_kg_m: [f64; 2],
     /// `h₂` (link B's frame) [kg·m].
     h2_kg_m: [f64; 2],
+    /// The moments of gravity as `Q₁ = cos θ₁ G₁ − sin θ₁ G₁′` and `Q₂ = cos θ₂ G₂ − sin θ₂ G₂′`:
+    /// `G = h × g = h_x g_y − h_y g_x`, `G′ = h · g` (of `H₁` and `h₂`) [N·m].
+    gravity_moments_n_m: [f64; 4],
+    /// `s₁ s₂`, the sign of `M̄_ab`.
+    sign_ab: f64,
     /// The part has any mass or inertia.
     present: bool,
 }
 
 impl PartConstants {
-    fn of(g1: &Lumped, g2: &Lumped, d: [f64; 2]) -> Self {
+    fn of(g1: &Lumped, g2: &Lumped, d: [f64; 2], [gx, gy]: [f64; 2], sign_ab: f64) -> Self {
         let j1p = g1.inertia_kg_m2 + g2.mass_kg * (d[0] * d[0] + d[1] * d[1]);
         let h2 = g2.moment_kg_m;
+        let h1 = [
+            g1.moment_kg_m[0] + g2.mass_kg * d[0],
+            g1.moment_kg_m[1] + g2.mass_kg * d[1],
+        ];
         Self {
             j_sum_kg_m2: j1p + g2.inertia_kg_m2,
             j2_kg_m2: g2.inertia_kg_m2,
             a_kg_m2: d[0] * h2[0] + d[1] * h2[1],
             b_kg_m2: d[1] * h2[0] - d[0] * h2[1],
-            h1_kg_m: [
-                g1.moment_kg_m[0] + g2.mass_kg * d[0],
-                g1.moment_kg_m[1] + g2.mass_kg * d[1],
-            ],
             h2_kg_m: h2,
+            gravity_moments_n_m: [
+                h1[0] * gy - h1[1] * gx,
+                h1[0] * gx + h1[1] * gy,
+                h2[0] * gy - h2[1] * gx,
+                h2[0] * gx + h2[1] * gy,
+            ],
+            sign_ab,
             present: *g1 != Lumped::default() || *g2 != Lumped::default(),
         }
     }
@@ -121,8 +131,6 @@ pub(super) struct TwoLink {
     finite: PartConstants,
     /// Infinitesimal bodies' constants.
     eps: PartConstants,
-    /// Gravity in the floor's x-y plane [m/s²].
-    gravity_m_s2: [f64; 2],
     /// Joint spring and damper per coordinate: stiffness, rest position, damping.
     springs: [(f64, f64, f64); 2],
     /// How `q̈` is solved with both coordinates free and no drive.
@@ -153,13 +161,9 @@ enum FreeSolve {
 impl TwoLink {
     /// The closed form of `tree`, or `None` when it is not a two-link chain: two coordinates,
     /// the first joint's link on the ground through welds only, the second joint's link below
-    /// the first's, every body with mass on one of the two; or when it has infinitesimal bodies
-    /// and `with_infinitesimal` is false ([`PlanarTree::with_infinitesimal_closed_form`]).
-    pub(super) fn of(tree: &PlanarTree, with_infinitesimal: bool) -> Option<Self> {
+    /// the first's, every body with mass on one of the two.
+    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
         if tree.dof != 2 || tree.links.len() > MAX_LINKS {
-            return None;
-        }
-        if tree.has_infinitesimal && !with_infinitesimal {
             return None;
         }
         // The joints: each link's nearest joint above it (itself included), as a link index.
@@ -213,8 +217,9 @@ impl TwoLink {
             g.inertia_kg_m2 += body.izz_kg_m2 + m * (r[0] * r[0] + r[1] * r[1]);
         }
         let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
-        let finite = PartConstants::of(&groups[0][0], &groups[0][1], d);
-        let eps = PartConstants::of(&groups[1][0], &groups[1][1], d);
+        let (g, sign_ab) = (tree.gravity_m_s2, a.1 * b.1);
+        let finite = PartConstants::of(&groups[0][0], &groups[0][1], d, g, sign_ab);
+        let eps = PartConstants::of(&groups[1][0], &groups[1][1], d, g, sign_ab);
         let springs = [spring(a.0), spring(b.0)];
         let swing_massless = finite.j2_kg_m2 == 0.0
             && finite.h2_kg_m == [0.0; 2]
@@ -230,7 +235,6 @@ impl TwoLink {
             b,
             finite,
             eps,
-            gravity_m_s2: tree.gravity_m_s2,
             springs,
             solve,
             swapped: a.0 == 1,
@@ -240,8 +244,8 @@ impl TwoLink {
 
     #[inline(always)]
     fn angles(&self, q: [f64; 2], qd: [f64; 2]) -> Angles {
-        let (s1, c1) = (self.a.1 * q[0]).sin_cos();
-        let (sp, cp) = (self.b.1 * q[1]).sin_cos();
+        let (s1, c1) = sin_cos(self.a.1 * q[0]);
+        let (sp, cp) = sin_cos(self.b.1 * q[1]);
         let w1 = self.a.1 * qd[0];
         let w2 = w1 + self.b.1 * qd[1];
         Angles {
@@ -259,23 +263,19 @@ impl TwoLink {
     /// `M̄` (lower triangle `[aa, ba, bb]`) and `f̄` (`[a, b]`) of one part, springs excluded.
     #[inline(always)]
     fn part(&self, k: &PartConstants, t: &Angles) -> ([f64; 3], [f64; 2]) {
-        let [gx, gy] = self.gravity_m_s2;
         let (sa, sb) = (self.a.1, self.b.1);
         let c = k.a_kg_m2 * t.cp + k.b_kg_m2 * t.sp;
         let c_prime = k.b_kg_m2 * t.cp - k.a_kg_m2 * t.sp;
-        // R₁ H₁ and R₂ h₂ in the floor frame, and their moments of gravity.
-        let [h1x, h1y] = k.h1_kg_m;
-        let [h2x, h2y] = k.h2_kg_m;
-        let (u1x, u1y) = (t.c1 * h1x - t.s1 * h1y, t.s1 * h1x + t.c1 * h1y);
-        let (u2x, u2y) = (t.c2 * h2x - t.s2 * h2y, t.s2 * h2x + t.c2 * h2y);
-        let q1 = u1x * gy - u1y * gx;
-        let q2 = u2x * gy - u2y * gx;
+        // The moments of gravity of R₁ H₁ and R₂ h₂ (`(R u) × g` expanded, constants folded).
+        let [g1, g1p, g2, g2p] = k.gravity_moments_n_m;
+        let q1 = t.c1 * g1 - t.s1 * g1p;
+        let q2 = t.c2 * g2 - t.s2 * g2p;
         let fb = q2 + c_prime * t.w1_sq;
         let fa = q1 - c_prime * t.w2_sq + fb;
         (
             [
                 k.j_sum_kg_m2 + 2.0 * c,
-                sa * sb * (c + k.j2_kg_m2),
+                k.sign_ab * (c + k.j2_kg_m2),
                 k.j2_kg_m2,
             ],
             [sa * fa, sb * fb],
@@ -286,8 +286,11 @@ impl TwoLink {
     /// angles, at `q`, `q̇` in the tree's coordinate order.
     #[inline(always)]
     fn finite_part(&self, q: [f64; 2], qd: [f64; 2]) -> ([f64; 3], [f64; 2], Angles) {
-        let [qa, qb] = self.ordered(q);
-        let [qda, qdb] = self.ordered(qd);
+        let [qa, qb, qda, qdb] = if self.swapped {
+            [q[1], q[0], qd[1], qd[0]]
+        } else {
+            [q[0], q[1], qd[0], qd[1]]
+        };
         let t = self.angles([qa, qb], [qda, qdb]);
         let (m, mut f) = self.part(&self.finite, &t);
         if self.has_springs {

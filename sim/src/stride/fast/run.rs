@@ -131,6 +131,9 @@ pub(super) fn stride<const N: usize>(
             None => return Outcome::Fallback,
         }
     }
+    let Some(wit) = PlanarWitnesses::new::<N>(walker, tree) else {
+        return Outcome::Fallback;
+    };
     if options.record {
         trajectory.push(sample(&cur));
     }
@@ -151,7 +154,7 @@ pub(super) fn stride<const N: usize>(
         steps: 0,
         damping: SVector::from_fn(|c, _| tree.damping(c)),
         dissipation_j: 0.0,
-        wit: PlanarWitnesses::new(walker),
+        wit,
         w_cached: None,
         cur,
         events: Vec::new(),
@@ -261,16 +264,16 @@ impl<const N: usize> Run<'_, N> {
         let cur = self.cur;
         let w_cur = match self.w_cached {
             Some(w) if w.t_s == cur.t_s => w,
-            _ => self.wit.eval(self.tree, &cur),
+            _ => self.wit.eval(&cur),
         };
-        let mut w_next = self.wit.eval(self.tree, &next);
+        let mut w_next = self.wit.eval(&next);
         let samples = self.settings.event_tolerance.grazing_samples;
         if let Some(t) = w_cur.grazing_sample_time(&w_next, samples) {
             let s = self
                 .integrator
                 .step_exact(&mut self.sys, &cur, t - cur.t_s)
                 .ok()?;
-            let ws = self.wit.eval(self.tree, &s);
+            let ws = self.wit.eval(&s);
             if ws.foot_height_m <= 0.0 {
                 next = s;
                 w_next = ws;
@@ -327,7 +330,7 @@ impl<const N: usize> Run<'_, N> {
     /// loop then estimates on the Hermite interpolant) or the location fails.
     fn locate(&mut self, watch: Watch, next: &State<N>) -> Option<State<N>> {
         let cur = self.cur;
-        let (tree, wit) = (self.tree, self.wit);
+        let wit = self.wit;
         let knee = match watch {
             Watch::Knee(k) => self
                 .walker
@@ -338,9 +341,9 @@ impl<const N: usize> Run<'_, N> {
         };
         let g = |s: &State<N>| match (watch, knee) {
             (Watch::Knee(_), Some((c, stop))) => s.q.get(c).map_or(f64::NAN, |q| q - stop),
-            (Watch::HipLow, _) => wit.eval(tree, s).hip_height_margin_m,
-            (Watch::HipBack, _) => wit.eval(tree, s).hip_forward_velocity_m_s,
-            _ => wit.eval(tree, s).foot_height_m,
+            (Watch::HipLow, _) => wit.eval(s).hip_height_margin_m,
+            (Watch::HipBack, _) => wit.eval(s).hip_forward_velocity_m_s,
+            _ => wit.eval(s).foot_height_m,
         };
         let (ga, gb) = (g(&cur), g(next));
         let dense = self
@@ -445,7 +448,7 @@ impl<const N: usize> Run<'_, N> {
     /// failure.
     fn heel_strike(&mut self, at: &State<N>) -> Option<HeelOutcome> {
         let w = self.walker;
-        let ahead = self.wit.eval(self.tree, at).foot_ahead_m;
+        let ahead = self.wit.eval(at).foot_ahead_m;
         if ahead < w.heel_strike.min_ahead_m {
             return w
                 .heel_strike

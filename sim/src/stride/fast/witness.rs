@@ -1,59 +1,172 @@
 //! The stride's witnesses on the planar kinematics: the same [`WitnessValues`] as the general
 //! loop's `Witnesses::eval` (swing-foot height, its rate and how far ahead, the hip's height
-//! margin, how far ahead and its forward velocity), from one pass over the planar tree's link
-//! frames instead of the general 3D kinematics.
+//! margin, how far ahead and its forward velocity), from the planar tree's joints alone.
+//!
+//! Each followed point is written once, from the tree's frames at `q = 0` (every rotation the
+//! identity there), as a fixed base plus one constant arm per joint of its chain, each turned
+//! by its joint's link: `p = o₁ + R(θ₁) (o₂ − o₁) + … + R(θₖ) (p₀ − oₖ)`, `oⱼ` the joints'
+//! origins and `p₀` the point at `q = 0`, welds between joints lumped into the arms; its
+//! velocity `Σ ωⱼ ẑ × R(θⱼ) armⱼ`. An evaluation then takes one `sin_cos` per joint and a few
+//! products per arm, instead of every link's frame.
 
 use super::dop853::State;
-use crate::planar::PlanarTree;
+use crate::planar::{sin_cos, PlanarTree, MAX_COORDINATES, MAX_LINKS};
 use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
+use nalgebra::SVector;
 
-/// A point fixed in a link: the link's frame slot and the point in the link frame (x, y) [m].
+/// One joint of the tree, parents first: its coordinate, axis sign along z, and the nearest
+/// joint above it (an index into the joints).
+#[derive(Clone, Copy, Debug, Default)]
+struct Joint {
+    coordinate: usize,
+    sign: f64,
+    parent: Option<usize>,
+}
+
+/// A point fixed in a link: a base fixed in the floor frame and an arm per joint of its chain,
+/// turned by that joint's link (x, y) [m]; and the joint whose link carries the point (its
+/// link's angle; `None`: a link welded to the ground).
 #[derive(Clone, Copy, Debug)]
-struct LinkPoint {
-    slot: usize,
-    p_link_m: [f64; 2],
+struct Arms {
+    base_m: [f64; 2],
+    arms: [(usize, [f64; 2]); MAX_COORDINATES],
+    len: usize,
+    link_joint: Option<usize>,
+}
+
+/// The angle's cos and sin and the angular rate of each joint's link.
+type JointFrames = [(f64, f64, f64); MAX_COORDINATES];
+
+impl Arms {
+    /// Position and velocity (floor frame, x and y) at the joints' frames.
+    fn point(&self, jf: &JointFrames) -> ([f64; 2], [f64; 2]) {
+        let (mut p, mut v) = (self.base_m, [0.0; 2]);
+        for &(j, [x, y]) in &self.arms[..self.len] {
+            let (c, s, w) = jf[j];
+            let (rx, ry) = (c * x - s * y, s * x + c * y);
+            p[0] += rx;
+            p[1] += ry;
+            v[0] -= w * ry;
+            v[1] += w * rx;
+        }
+        (p, v)
+    }
 }
 
 /// The points the witnesses follow, with the walker's fall rule.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PlanarWitnesses {
-    foot: LinkPoint,
-    hip: LinkPoint,
-    contact: LinkPoint,
+    joints: [Joint; MAX_COORDINATES],
+    joint_count: usize,
+    foot: Arms,
+    hip: Arms,
+    contact: Arms,
     min_hip_height_m: f64,
 }
 
 impl PlanarWitnesses {
-    /// The swing foot, hip and stance contact of `walker`.
-    pub(super) fn new(walker: &Walker) -> Self {
-        let m = &walker.model;
-        let point = |i: usize| {
-            let p = &m.points[i];
-            LinkPoint {
-                slot: p.link.0 + 1,
-                p_link_m: [p.p_link_m.x, p.p_link_m.y],
-            }
-        };
-        Self {
-            foot: point(walker.heel_strike.swing_foot.0),
-            hip: point(walker.fall.hip.0),
-            contact: point(walker.heel_strike.stance_contact.0),
-            min_hip_height_m: walker.fall.min_hip_height_m,
+    /// The swing foot, hip and stance contact of `walker` on `tree` (`N` its coordinates);
+    /// `None` when a point's link is not in the tree or the tree has more joints than
+    /// coordinates.
+    pub(super) fn new<const N: usize>(walker: &Walker, tree: &PlanarTree) -> Option<Self> {
+        let fr = tree.frames(&SVector::<f64, N>::zeros(), &SVector::zeros());
+        let mut joints = [Joint::default(); MAX_COORDINATES];
+        let mut joint_count = 0;
+        // Each link's nearest joint (itself included), as an index into `joints`.
+        let mut nearest = [None::<usize>; MAX_LINKS];
+        let mut origin = [[0.0; 2]; MAX_COORDINATES];
+        for i in 0..tree.link_count() {
+            let (parent_slot, coordinate) = tree.link_joint(i)?;
+            let above = match parent_slot {
+                0 => None,
+                s => *nearest.get(s - 1)?,
+            };
+            *nearest.get_mut(i)? = match coordinate {
+                Some((c, sign)) => {
+                    *joints.get_mut(joint_count)? = Joint {
+                        coordinate: c,
+                        sign,
+                        parent: above,
+                    };
+                    origin[joint_count] = fr.get(i + 1)?.origin_m;
+                    joint_count += 1;
+                    Some(joint_count - 1)
+                }
+                None => above,
+            };
         }
+        let m = &walker.model;
+        let point = |i: usize| -> Option<Arms> {
+            let p = m.points.get(i)?;
+            let link = p.link.0;
+            let o = fr.get(link + 1)?.origin_m;
+            let mut at = [o[0] + p.p_link_m.x, o[1] + p.p_link_m.y];
+            let link_joint = *nearest.get(link)?;
+            let mut arms = Arms {
+                base_m: at,
+                arms: [(0, [0.0; 2]); MAX_COORDINATES],
+                len: 0,
+                link_joint,
+            };
+            // From the point up its chain of joints: arms nearest first, then reversed.
+            let mut cur = link_joint;
+            while let Some(j) = cur {
+                let oj = origin[j];
+                *arms.arms.get_mut(arms.len)? = (j, [at[0] - oj[0], at[1] - oj[1]]);
+                arms.len += 1;
+                at = oj;
+                cur = joints[j].parent;
+            }
+            arms.base_m = at;
+            arms.arms[..arms.len].reverse();
+            Some(arms)
+        };
+        Some(Self {
+            joints,
+            joint_count,
+            foot: point(walker.heel_strike.swing_foot.0)?,
+            hip: point(walker.fall.hip.0)?,
+            contact: point(walker.heel_strike.stance_contact.0)?,
+            min_hip_height_m: walker.fall.min_hip_height_m,
+        })
+    }
+
+    /// Every joint's link angle (cos, sin) and rate at `q`, `q̇`, parents first.
+    fn joint_frames<const N: usize>(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> JointFrames {
+        let mut jf = [(1.0, 0.0, 0.0); MAX_COORDINATES];
+        for j in 0..self.joint_count {
+            let Joint {
+                coordinate: c,
+                sign,
+                parent,
+            } = self.joints[j];
+            let (s, co) = sin_cos(sign * q[c]);
+            let rate = sign * qd[c];
+            jf[j] = match parent {
+                Some(p) => {
+                    let (pc, ps, pw) = jf[p];
+                    (pc * co - ps * s, ps * co + pc * s, pw + rate)
+                }
+                None => (co, s, rate),
+            };
+        }
+        jf
     }
 
     /// Every witness at `s`.
-    pub(super) fn eval<const N: usize>(&self, tree: &PlanarTree, s: &State<N>) -> WitnessValues {
-        let fr = tree.frames(&s.q, &s.qd);
-        let at = |p: &LinkPoint| fr.get(p.slot).map(|f| f.point(p.p_link_m));
-        let nan = ([f64::NAN; 2], [f64::NAN; 2]);
-        let (p_foot, v_foot) = at(&self.foot).unwrap_or(nan);
-        let (p_hip, v_hip) = at(&self.hip).unwrap_or(nan);
-        let (p_contact, _) = at(&self.contact).unwrap_or(nan);
+    pub(super) fn eval<const N: usize>(&self, s: &State<N>) -> WitnessValues {
+        let jf = self.joint_frames(&s.q, &s.qd);
+        let (p_foot, v_foot) = self.foot.point(&jf);
+        let (p_hip, v_hip) = self.hip.point(&jf);
+        let (p_contact, _) = self.contact.point(&jf);
         // The walking direction: the stance contact link's x axis, level with the floor (as
         // the general `Witnesses::heading`): along ±x, or x when the link stands vertical.
-        let c = fr.get(self.contact.slot).map_or(1.0, |f| f.cos);
+        let c = self.contact.link_joint.map_or(1.0, |j| jf[j].0);
         let heading_x = if c.abs() > 1e-9 { c / c.abs() } else { 1.0 };
         WitnessValues {
             t_s: s.t_s,
