@@ -58,8 +58,8 @@ fn main() {
         };
         let (jp, jf) = (jac(&plain), jac(&frozen));
         let (lp, lf) = (
-            near_minus_one(&jp.complex_eigenvalues().as_slice()),
-            near_minus_one(&jf.complex_eigenvalues().as_slice()),
+            near_minus_one(jp.complex_eigenvalues().as_slice()),
+            near_minus_one(jf.complex_eigenvalues().as_slice()),
         );
         println!(
             "  at it: |Jp - Jf|max = {:e}, lambda plain {:.13} frozen {:.13}, diff {:e}",

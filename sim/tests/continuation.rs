@@ -303,14 +303,15 @@ fn the_tuned_wisse2d_branch_ends_where_the_knee_locks_before_the_string_engages(
 /// term). The location is the zero of `det(M + I)` on the branch, so a Jacobian difference `δJ`
 /// moves it by `δλ / (dλ/dμ)`, `λ` the multiplier through −1: there `dλ/dμ = −218.7` per rad of
 /// slope (gaits at ±1e-6 on the branch), and the two Jacobians, which differ by 1.1e-8 (largest
-/// entry), give multipliers that differ by 7e-9 to 4.7e-7 at located points 2e-9 apart (the
-/// frozen steps' Jacobian changes by more than its smooth part wherever the step schedule
-/// does): up to 2.1e-9 of slope. Each located value is itself only known to its arclength
+/// entry), give multipliers that differ by 4e-8 at the plain location and 4.7e-7 at the
+/// frozen-step one, 1.9e-9 of slope away (the frozen steps' Jacobian changes by more than its
+/// smooth part wherever the step schedule does): 2.2e-9 of slope, the shift measured between
+/// the two locations (1.9e-9). Each located value is itself only known to its arclength
 /// bracket, [`LOCATION_TOLERANCE`] (the parameter moves at most as much). Both together:
-/// 2.1e-9 + 2 × 1e-9. Measured: rounding changes at the ulp level alone (glibc's or musl's
-/// `sincos`, the link pass or the closed form of the equations of motion) move the frozen-step
-/// location between 0.0150884360 and 0.0150884403 (4.3e-9), the plain one by 5e-12; the
-/// earlier 1e-9 was tighter than the methods' own difference.
+/// 2.2e-9 + 2 × 1e-9. Rounding changes at the ulp level alone (glibc's or musl's `sincos`, the
+/// link pass or the closed form of the equations of motion) move the frozen-step location
+/// between 0.0150884360 and 0.0150884403 (4.3e-9), the plain one by 3e-11: the earlier 1e-9
+/// was tighter than the methods' own difference.
 const SIMPLEST_PERIOD_DOUBLING_TOL: f64 = 2.2e-9 + 2.0 * LOCATION_TOLERANCE;
 
 /// The stride Jacobian's error at located points (docs/bifurcations.md, "The stride map and its
