@@ -452,14 +452,14 @@ impl PlanarTree {
     }
 
     /// The whole tree's mass [kg] and the Jacobian of its linear momentum `Σ m Jv` (x and y
-    /// rows) at `q`: the coupling of a translation of the root with the coordinates; over the
-    /// finite bodies, or the infinitesimal ones (`infinitesimal`, their `ε` parts).
+    /// rows) at the frames `fr` ([`Self::frames`] at `q`; only their positions enter): the
+    /// coupling of a translation of the root with the coordinates; over the finite bodies, or
+    /// the infinitesimal ones (`infinitesimal`, their `ε` parts).
     pub fn momentum_jacobian<const N: usize>(
         &self,
-        q: &SVector<f64, N>,
+        fr: &[LinkFrame; MAX_LINKS + 1],
         infinitesimal: bool,
     ) -> (f64, SMatrix<f64, 2, N>) {
-        let fr = self.frames(q, &SVector::zeros());
         let mut total = 0.0;
         let mut jac = SMatrix::<f64, 2, N>::zeros();
         for body in self

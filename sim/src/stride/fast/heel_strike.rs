@@ -95,7 +95,7 @@ pub(super) fn heel_strike<const N: usize>(
     let n = N + 2;
     let (m_q, m_q_eps) = tree.mass_matrices(&at.q);
     let impact_matrix = |m_q: &nalgebra::SMatrix<f64, N, N>, infinitesimal: bool| {
-        let (mass, b) = tree.momentum_jacobian(&at.q, infinitesimal);
+        let (mass, b) = tree.momentum_jacobian::<N>(&fr, infinitesimal);
         DMatrix::from_fn(n, n, |i, j| match (i < 2, j < 2) {
             (true, true) => {
                 if i == j {
@@ -110,7 +110,6 @@ pub(super) fn heel_strike<const N: usize>(
         })
     };
     let m_imp = impact_matrix(&m_q, false);
-    let m_imp_eps = impact_matrix(&m_q_eps, true);
     let jf = tree.point_jacobian::<N>(&fr, foot_link, foot_p);
     // Constraint rows of the contact: x and y (z and yaw rows vanish on a planar tree, and the
     // general rows drop them).
@@ -148,6 +147,7 @@ pub(super) fn heel_strike<const N: usize>(
     let x = if tree.has_infinitesimal() {
         let no_rows = DMatrix::zeros(g.nrows(), n);
         let no_target = DVector::zeros(target.len());
+        let m_imp_eps = impact_matrix(&m_q_eps, true);
         let (a1, b1) = kkt_system(&m_imp_eps, &free, &u_minus, &no_rows, &no_target);
         solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?
     } else {
@@ -155,7 +155,8 @@ pub(super) fn heel_strike<const N: usize>(
         // strike back to the general impact, which reports it: whether it comes out exactly
         // zero depends on the rounding of `M̄`.
         let lu = a0.lu();
-        let pivots = lu.u().diagonal().abs();
+        // U's diagonal, read off the factorisation without unpacking U.
+        let pivots = lu.lu_internal().diagonal().abs();
         if pivots.iter().any(|&p| p <= 1e-12 * pivots.max()) {
             return None;
         }
