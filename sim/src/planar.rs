@@ -21,6 +21,7 @@ use crate::singular_limit::{
 };
 use nalgebra::{DVector, SMatrix, SVector};
 
+mod three_link;
 mod trig;
 mod two_link;
 
@@ -163,6 +164,9 @@ pub struct PlanarTree {
     /// The closed form of a two-link chain (the compass, the simplest walker), when the tree
     /// is one.
     two_link: Option<two_link::TwoLink>,
+    /// The closed form of a three-link serial chain of finite bodies (kneed2d), when the tree
+    /// is one.
+    three_link: Option<three_link::ThreeLink>,
 }
 
 /// `M̄` and `f̄` of one evaluation, finite and infinitesimal parts.
@@ -248,8 +252,10 @@ impl PlanarTree {
             dof,
             has_infinitesimal: model.has_infinitesimal_bodies(),
             two_link: None,
+            three_link: None,
         };
         tree.two_link = two_link::TwoLink::of(&tree);
+        tree.three_link = three_link::ThreeLink::of(&tree);
         Some(tree)
     }
 
@@ -267,14 +273,15 @@ impl PlanarTree {
     /// The same tree without its closed form: every evaluation by the link pass.
     pub fn link_pass_only(mut self) -> Self {
         self.two_link = None;
+        self.three_link = None;
         self
     }
 
     /// Whether the tree evaluates by a closed form (a two-link chain: the compass, and the
-    /// simplest walker with its vanishing-mass limit in closed form) rather than by its link
-    /// pass.
+    /// simplest walker with its vanishing-mass limit in closed form; a three-link serial chain
+    /// of finite bodies: kneed2d) rather than by its link pass.
     pub fn has_closed_form(&self) -> bool {
-        self.two_link.is_some()
+        self.two_link.is_some() || self.three_link.is_some()
     }
 
     /// Number of coordinates.
@@ -412,12 +419,19 @@ impl PlanarTree {
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> Option<SVector<f64, N>> {
-        let t = self.two_link.as_ref()?;
-        if N != 2 {
-            return None;
-        }
-        let qdd = t.free_accelerations(q, qd)?;
-        (qdd[0].is_finite() && qdd[1].is_finite()).then_some(qdd)
+        let qdd = match (&self.two_link, &self.three_link) {
+            (Some(t), _) if N == 2 => t.free_accelerations(q, qd)?,
+            (_, Some(t)) if N == 3 => {
+                let a = t.assemble(q, qd);
+                let (mut m, mut f) = (a.m, a.f);
+                if !cholesky_solve(&mut m, &mut f) {
+                    return None;
+                }
+                f
+            }
+            _ => return None,
+        };
+        qdd.iter().all(|v| v.is_finite()).then_some(qdd)
     }
 
     /// The damping coefficient of coordinate `c`'s joint [N·m·s/rad] (zero when undamped).
@@ -544,8 +558,9 @@ impl PlanarTree {
     /// `M̄ = Σ m Jvᵀ Jv + I_zz Jwᵀ Jw` and `f̄ = Σ Jvᵀ m (g − a_bias)` minus the joint springs and
     /// dampers, body by body, over the planar kinematics.
     fn assemble<const N: usize>(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Assembled<N> {
-        match &self.two_link {
-            Some(t) if N == 2 => t.assemble(q, qd),
+        match (&self.two_link, &self.three_link) {
+            (Some(t), _) if N == 2 => t.assemble(q, qd),
+            (_, Some(t)) if N == 3 => t.assemble(q, qd),
             _ => self.assemble_link_pass(q, qd),
         }
     }

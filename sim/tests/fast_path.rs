@@ -271,13 +271,14 @@ fn compare_with_general(
 }
 
 #[test]
-fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
-    // Which trees have it: the two-link chains, found from the model (the simplest walker's
-    // with its infinitesimal feet: the vanishing-mass limit in closed form).
+fn the_closed_forms_agree_with_the_link_pass_and_the_general_engine() {
+    // Which trees have one: the two-link chains, found from the model (the simplest walker's
+    // with its infinitesimal feet: the vanishing-mass limit in closed form), and the
+    // three-link serial chain of finite bodies (kneed2d; wisse2d's tree is not one).
     for (name, closed) in [
         ("compass", true),
         ("simplest", true),
-        ("kneed2d", false),
+        ("kneed2d", true),
         ("wisse2d", false),
     ] {
         let s = setup(name);
@@ -291,7 +292,7 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
     // masses (I_zz), centres of mass off the legs' axes, an axis along −z, a spring and a
     // damper at the hip, other masses and lengths.
     let mut seed = 23u64;
-    for name in ["compass", "simplest"] {
+    for name in ["compass", "simplest", "kneed2d"] {
         for variant in 0..4 {
             let mut s = Scene::load(name).unwrap();
             if variant >= 2 && name == "compass" {
@@ -301,6 +302,11 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
             if variant >= 2 && name == "simplest" {
                 s.set("leg_length_m", 1.7).unwrap();
                 s.set("hip_mass_kg", 3.0).unwrap();
+            }
+            if variant >= 2 && name == "kneed2d" {
+                s.set("shank_mass_kg", 0.4).unwrap();
+                s.set("thigh_length_m", 0.6).unwrap();
+                s.set("shank_com_from_knee_m", 0.3).unwrap();
             }
             let s = s.setup().unwrap();
             let mut model = s.walker.model.clone();
@@ -320,7 +326,7 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
                 {
                     axis_parent.z = -1.0;
                 }
-                if name == "compass" {
+                if name != "simplest" {
                     // (A spring on the simplest walker's massless swing leg has no limit.)
                     model.links[swing].joint_force.stiffness = 3.0;
                     model.links[swing].joint_force.rest_position = 0.1;
@@ -340,11 +346,13 @@ fn the_two_link_closed_form_agrees_with_the_link_pass_and_the_general_engine() {
                 sim::dynamics::Dynamics::new(&model),
                 sim::dynamics::Dynamics::new(&model),
             );
+            let n = model.dof();
+            let free = vec![true; n];
             for _ in 0..200 {
-                let q = DVector::from_fn(2, |i, _| s.guess.q[i] + 0.8 * noise(&mut sd));
-                let qd = DVector::from_fn(2, |i, _| s.guess.qd[i] + 3.0 * noise(&mut sd));
-                let a = closed.accelerations(&mut dyn_a, &[true, true], None, &q, &qd);
-                let b = link_pass.accelerations(&mut dyn_b, &[true, true], None, &q, &qd);
+                let q = DVector::from_fn(n, |i, _| s.guess.q[i] + 0.8 * noise(&mut sd));
+                let qd = DVector::from_fn(n, |i, _| s.guess.qd[i] + 3.0 * noise(&mut sd));
+                let a = closed.accelerations(&mut dyn_a, &free, None, &q, &qd);
+                let b = link_pass.accelerations(&mut dyn_b, &free, None, &q, &qd);
                 let (a, b) = (a.unwrap(), b.unwrap());
                 to_pass = to_pass.max((&a - &b).amax() / (1.0 + b.amax()));
             }
