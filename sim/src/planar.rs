@@ -47,7 +47,8 @@ pub enum EvaluationPath {
     General,
     /// As [`Self::Auto`] (the fixed-size stride where it covers the stride), but the planar
     /// evaluation always by its link pass, without the closed forms of particular trees (the
-    /// two-link chain's, `planar/two_link.rs`): what those are measured and tested against.
+    /// two-link chain's, `planar/two_link.rs`, and the three-link chain's, `planar/three_link.rs`):
+    /// what those are measured and tested against.
     LinkPass,
 }
 

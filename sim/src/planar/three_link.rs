@@ -86,7 +86,11 @@ impl ThreeLink {
             tree.frames(&SVector::<f64, 3>::zeros(), &SVector::zeros());
         let origin = |k: usize| fr[links[k] + 1].origin_m;
         let sub = |a: [f64; 2], b: [f64; 2]| [a[0] - b[0], a[1] - b[1]];
-        let d = [sub(origin(1), origin(0)), sub(origin(2), origin(1)), [0.0; 2]];
+        let d = [
+            sub(origin(1), origin(0)),
+            sub(origin(2), origin(1)),
+            [0.0; 2],
+        ];
         // Lumped groups: mass, first moment and inertia about the joint.
         let mut mass = [0.0; 3];
         let mut h = [[0.0; 2]; 3];
@@ -105,8 +109,9 @@ impl ThreeLink {
         let below = [mass[1] + mass[2], mass[2], 0.0];
         let big_h: [[f64; 2]; 3] =
             std::array::from_fn(|k| [h[k][0] + below[k] * d[k][0], h[k][1] + below[k] * d[k][1]]);
-        let diagonal_kg_m2 =
-            std::array::from_fn(|k| inertia[k] + below[k] * (d[k][0] * d[k][0] + d[k][1] * d[k][1]));
+        let diagonal_kg_m2 = std::array::from_fn(|k| {
+            inertia[k] + below[k] * (d[k][0] * d[k][0] + d[k][1] * d[k][1])
+        });
         let pair = |k: usize, l: usize| {
             let (dk, hl) = (d[k], big_h[l]);
             (dk[0] * hl[0] + dk[1] * hl[1], dk[1] * hl[0] - dk[0] * hl[1])
@@ -117,7 +122,11 @@ impl ThreeLink {
             (hk[0] * gy - hk[1] * gx, hk[0] * gx + hk[1] * gy)
         });
         let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
-        let springs = [spring(joints[0].0), spring(joints[1].0), spring(joints[2].0)];
+        let springs = [
+            spring(joints[0].0),
+            spring(joints[1].0),
+            spring(joints[2].0),
+        ];
         Some(Self {
             joints,
             diagonal_kg_m2,

@@ -6,7 +6,8 @@
 //! of the exact values, and they differ from each other by at most one ulp on the angles the
 //! walkers meet (`sim/tests/planar_sin_cos.rs` checks it over `[-4π, 4π]`).
 //!
-//! Used by the two-link closed form (`two_link.rs`) and the fixed-size stride's witnesses. The
+//! Used by the two- and three-link closed forms (`two_link.rs`, `three_link.rs`) and the
+//! fixed-size stride's witnesses. The
 //! link pass and [`super::PlanarTree::frames`] keep the standard library's: the link pass is
 //! checked against the general engine (which uses it) to 1e-13 relative, and wisse2d's
 //! ill-conditioned `q̈` turns a one-ulp difference in an angle into 2.6e-13 of it.
