@@ -69,6 +69,22 @@ impl ActuatorSegment {
         }
     }
 
+    /// The limit does not move over the tick: released, or held at one angle.
+    pub fn is_held(&self) -> bool {
+        self.released || (self.p0_rad == self.p1_rad && self.v0_rad_s == 0.0 && self.v1_rad_s == 0.0)
+    }
+
+    /// `next` gives the plant the same input as `self` (as functions of time, whatever their
+    /// ticks): both released, or both held at the same angle. A controlled stride's step may
+    /// then run across the tick between them ([`TickStepping::HeldAcrossTicks`]).
+    pub fn same_held_input(&self, next: &ActuatorSegment) -> bool {
+        match (self.released, next.released) {
+            (true, true) => true,
+            (false, false) => self.is_held() && next.is_held() && self.p1_rad == next.p0_rad,
+            _ => false,
+        }
+    }
+
     /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (the clock of
     /// [`Self::t0_s`]; clamped to the tick).
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
@@ -85,6 +101,22 @@ impl ActuatorSegment {
             x,
         )
     }
+}
+
+/// How a controlled stride's integration steps meet the control ticks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TickStepping {
+    /// The default: while the controller's output holds the plant's input (a released string,
+    /// a limit held at one angle) a step runs across ticks; the controller still runs at every
+    /// tick, on the state the integrator's interpolant gives there, and the step ends at the
+    /// first tick whose output changes the plant's input (the state there is the
+    /// interpolant's, the one the controller saw, so nothing is rolled back). A moving limit,
+    /// or an integrator without an interpolant (RK4, Meijaard), ends every step at a tick.
+    #[default]
+    HeldAcrossTicks,
+    /// Every step ends at the next tick (the reference the default is tested against).
+    EndAtEveryTick,
 }
 
 /// Why a controller could not run a tick.
