@@ -71,7 +71,8 @@ impl ActuatorSegment {
 
     /// The limit does not move over the tick: released, or held at one angle.
     pub fn is_held(&self) -> bool {
-        self.released || (self.p0_rad == self.p1_rad && self.v0_rad_s == 0.0 && self.v1_rad_s == 0.0)
+        self.released
+            || (self.p0_rad == self.p1_rad && self.v0_rad_s == 0.0 && self.v1_rad_s == 0.0)
     }
 
     /// `next` gives the plant the same input as `self` (as functions of time, whatever their

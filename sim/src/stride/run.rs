@@ -240,14 +240,16 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 self.wit
                     .triggered(&self.phase, limit, (&self.cur, &w_cur), (&next, &w_next));
             if triggered.is_empty() {
-                let next = self.held_ticks(dense.as_ref(), next.t_s)?.unwrap_or(next);
+                let next = self
+                    .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
+                    .unwrap_or(next);
                 self.accept(next, drive_end_s)?;
                 continue;
             }
             let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
                 continue;
             };
-            if let Some(at_tick) = self.held_ticks(dense.as_ref(), at.t_s)? {
+            if let Some(at_tick) = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s)? {
                 // A tick before the event changed the plant's input: the step ends there.
                 self.accept(at_tick, drive_end_s)?;
                 continue;
@@ -257,7 +259,9 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             match self.apply(watch, &at)? {
                 Applied::Done(result) => return Ok(*result),
                 Applied::Ignored => {
-                    let next = self.held_ticks(dense.as_ref(), next.t_s)?.unwrap_or(next);
+                    let next = self
+                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
+                        .unwrap_or(next);
                     self.accept_ignored(&at, next);
                 }
                 Applied::Skipped => {}

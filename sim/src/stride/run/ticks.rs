@@ -13,10 +13,11 @@
 
 use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
+use crate::hermite::{self, Knot};
 use crate::integrators::{DenseOutput, Sample};
 use crate::stride::phase::{Drive, Phase};
 use crate::stride::result::{FailureKind, StrideEvent, StrideFailure};
-use crate::stride::witnesses::Witnesses;
+use crate::stride::witnesses::{WitnessValues, Witnesses};
 use crate::walker::Walker;
 
 /// A tick's time is reached when a sample is within this of it [s].
@@ -27,16 +28,43 @@ fn tick_failure(t_s: f64, detail: String) -> StrideFailure {
     StrideFailure::new(FailureKind::NonFiniteState, t_s, detail)
 }
 
+/// The swing foot is on the floor at this height [m] or below.
+const ON_FLOOR_M: f64 = 1e-9;
+
+/// Inside a step, the cubic Hermite of the swing foot's height (values and rates at the step's
+/// ends) decides "off the floor" without a kinematics update when it is above this [m]: its
+/// error over a step of 10 ms is of the order of 1e-8 m (`h⁴/384 · |y⁗|`, the swing foot's
+/// `|y⁗|` a few hundred m/s⁴), so the answer is the exact one's.
+const CLEAR_OF_FLOOR_M: f64 = 1e-4;
+
+/// The swing foot is clearly off the floor at `t_s` inside the step `from` → `to` (the cubic
+/// Hermite of its height above [`CLEAR_OF_FLOOR_M`]).
+fn clear_of_floor(from: &WitnessValues, to: &WitnessValues, t_s: f64) -> bool {
+    let h = to.t_s - from.t_s;
+    if h <= 0.0 {
+        return false;
+    }
+    let knot = |w: &WitnessValues| Knot {
+        value: w.foot_height_m,
+        rate: w.foot_height_rate_m_s,
+    };
+    let (height_m, _, _) = hermite::scalar(knot(from), knot(to), h, (t_s - from.t_s) / h);
+    height_m > CLEAR_OF_FLOOR_M
+}
+
 /// What the stance ankle's sensors see at `s` (stride time; `t_walk_start_s` the walk time
-/// at the start of the stride).
+/// at the start of the stride). `swing_foot_on_floor`: when already known (the witnesses of
+/// this sample, or a foot clear of the floor), else from the kinematics.
 fn sense(
     walker: &Walker,
     wit: &mut Witnesses<'_>,
     phase: &mut Phase<'_>,
     t_walk_start_s: f64,
     s: &Sample,
+    swing_foot_on_floor: Option<bool>,
 ) -> Result<AnkleSensing, StrideFailure> {
-    let w = wit.eval(s);
+    let swing_foot_on_floor =
+        swing_foot_on_floor.unwrap_or_else(|| wit.eval(s).foot_height_m <= ON_FLOOR_M);
     let (a, engaged) = match &walker.ankle {
         Some(r) => (r.ankle.0, phase.prescribed.is_some()),
         None => (0, false),
@@ -46,7 +74,7 @@ fn sense(
         stance_ankle_rad: s.q[a],
         stance_ankle_rate_rad_s: s.qd[a],
         stance_foot_on_floor: true,
-        swing_foot_on_floor: w.foot_height_m <= 1e-9,
+        swing_foot_on_floor,
         string_engaged: engaged,
         string_torque_n_m: if engaged {
             phase
@@ -68,15 +96,16 @@ impl Run<'_, '_, '_> {
         interpolates: bool,
         controlled: bool,
     ) -> bool {
-        tick_stepping == TickStepping::HeldAcrossTicks && free_schedule && interpolates && controlled
+        tick_stepping == TickStepping::HeldAcrossTicks
+            && free_schedule
+            && interpolates
+            && controlled
     }
 
     /// The next step may run across the next tick: held stepping, no tick output waiting to
     /// take effect, and a limit in force that does not move.
     pub(super) fn held_ahead(&self) -> bool {
-        self.held_stepping
-            && self.pending.is_none()
-            && self.segment.is_some_and(|s| s.is_held())
+        self.held_stepping && self.pending.is_none() && self.segment.is_some_and(|s| s.is_held())
     }
 
     /// The end of the next step as the ticks allow [s]: the next tick, or ∞ across ticks.
@@ -102,7 +131,14 @@ impl Run<'_, '_, '_> {
         let seg = match self.pending.take() {
             Some(seg) => seg,
             None => {
-                let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &self.cur)?;
+                // The witnesses of the step that ended here, when at this sample's time (an
+                // impact since changes the velocities, not the foot's height).
+                let on_floor = self
+                    .w_cached
+                    .filter(|w| w.t_s == self.cur.t_s)
+                    .map(|w| w.foot_height_m <= ON_FLOOR_M);
+                let (wit, phase) = (&mut self.wit, &mut self.phase);
+                let sensing = sense(self.walker, wit, phase, t0, &self.cur, on_floor)?;
                 self.tick_controller(&sensing)?
             }
         };
@@ -111,7 +147,10 @@ impl Run<'_, '_, '_> {
     }
 
     /// The controller's tick: its segment, shifted to stride time.
-    fn tick_controller(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, StrideFailure> {
+    fn tick_controller(
+        &mut self,
+        sensing: &AnkleSensing,
+    ) -> Result<ActuatorSegment, StrideFailure> {
         let Some(control) = self.control.as_mut() else {
             return Err(tick_failure(
                 sensing.t_walk_s,
@@ -183,6 +222,7 @@ impl Run<'_, '_, '_> {
     pub(super) fn held_ticks(
         &mut self,
         dense: Option<&DenseOutput>,
+        ends: (&WitnessValues, &WitnessValues),
         end_s: f64,
     ) -> Result<Option<Sample>, StrideFailure> {
         let (Some(dense), Some(control)) = (dense, self.control.as_ref()) else {
@@ -192,7 +232,8 @@ impl Run<'_, '_, '_> {
         while self.next_tick_s < end_s - TICK_SLACK_S {
             let mut s = dense.eval(self.next_tick_s);
             self.phase.snap(&mut s);
-            let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &s)?;
+            let clear = clear_of_floor(ends.0, ends.1, s.t_s).then_some(false);
+            let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &s, clear)?;
             let seg = self.tick_controller(&sensing)?;
             match self.segment {
                 Some(held) if held.same_held_input(&seg) => self.next_tick_s += self.period_s,
