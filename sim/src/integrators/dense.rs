@@ -60,7 +60,11 @@ impl DenseOutput {
         let last = self.f.len().saturating_sub(1);
         for (i, (fq, fv)) in self.f.iter().rev().enumerate() {
             // `F_k` is multiplied by θ for even k, by 1 − θ for odd k.
-            let w = if (last - i) % 2 == 0 { x } else { 1.0 - x };
+            let w = if (last - i).is_multiple_of(2) {
+                x
+            } else {
+                1.0 - x
+            };
             for k in 0..n {
                 q[k] = (q[k] + fq[k]) * w;
                 qd[k] = (qd[k] + fv[k]) * w;
