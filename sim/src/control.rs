@@ -1,6 +1,8 @@
 //! Closing the loop on the stance ankle: a controller (the firmware's ankle nodes, or any other)
 //! is sampled at fixed control ticks, sample-and-hold, and moves the string's limit on the
-//! stance ankle angle. Ticks are breakpoints of the integration, not approximated.
+//! stance ankle angle. Every tick runs, at its exact time; a tick whose output changes the
+//! plant's input is a breakpoint of the integration, a tick that holds it may fall inside a
+//! step and see the integrator's interpolant there ([`TickStepping`]).
 //!
 //! The string is a unilateral constraint: the stance ankle angle cannot fall below the limit.
 //! While the angle is above it the ankle is free and the foot flat; reaching it is the string
@@ -287,6 +289,39 @@ mod tests {
             assert!(paced.tick(&sensing).is_ok(), "{factor}");
             assert_eq!(inner.0, 1, "{factor}");
         }
+    }
+
+    #[test]
+    fn only_a_released_string_or_one_held_angle_holds_the_plant_s_input() {
+        let hold = |t0: f64, p: f64| ActuatorSegment::hold(t0, t0 + 1e-3, p);
+        let released = ActuatorSegment {
+            released: true,
+            ..hold(0.0, 0.3)
+        };
+        let moving = ActuatorSegment {
+            p1_rad: -0.079,
+            v1_rad_s: 1.0,
+            ..hold(0.0, -0.08)
+        };
+        assert!(hold(0.0, -0.08).is_held() && released.is_held() && !moving.is_held());
+        // Released to released (whatever the angles), the same angle at the next tick.
+        let next_released = ActuatorSegment {
+            released: true,
+            ..hold(1e-3, -0.2)
+        };
+        assert!(released.same_held_input(&next_released));
+        assert!(hold(0.0, -0.08).same_held_input(&hold(1e-3, -0.08)));
+        // Another angle, taut after slack, slack after taut, a limit that starts moving.
+        assert!(!hold(0.0, -0.08).same_held_input(&hold(1e-3, -0.0801)));
+        assert!(!released.same_held_input(&hold(1e-3, 0.3)));
+        assert!(!hold(0.0, 0.3).same_held_input(&next_released));
+        let starts_moving = ActuatorSegment {
+            t0_s: 1e-3,
+            t1_s: 2e-3,
+            ..moving
+        };
+        assert!(!hold(0.0, -0.08).same_held_input(&starts_moving));
+        assert!(!moving.same_held_input(&hold(1e-3, -0.079)));
     }
 
     #[test]
