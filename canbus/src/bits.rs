@@ -26,34 +26,59 @@ pub fn crc15(bits: &[bool]) -> u16 {
     crc
 }
 
-fn push_bits(out: &mut Vec<bool>, value: u32, n: u32) {
-    for i in (0..n).rev() {
-        out.push((value >> i) & 1 == 1);
+/// The most bits exposed to stuffing: a frame of 8 data bytes.
+const MAX_STUFFED_BITS: usize = STUFFED_HEADER_BITS as usize + 64;
+
+/// A frame's unstuffed bits in a fixed buffer (no allocation: the bus counts the stuff bits
+/// of every frame it sends).
+struct UnstuffedBits {
+    bits: [bool; MAX_STUFFED_BITS],
+    len: usize,
+}
+
+impl UnstuffedBits {
+    fn push(&mut self, value: u32, n: u32) {
+        for i in (0..n).rev() {
+            self.bits[self.len] = (value >> i) & 1 == 1;
+            self.len += 1;
+        }
+    }
+
+    /// From start of frame to the end of the CRC field.
+    fn of(frame: &Frame) -> Self {
+        let mut b = UnstuffedBits {
+            bits: [false; MAX_STUFFED_BITS],
+            len: 0,
+        };
+        b.push(0, 1); // SOF
+        b.push(u32::from(frame.id()), 11);
+        b.push(0, 3); // RTR (data frame), IDE (standard), r0
+        b.push(u32::from(frame.dlc()), 4);
+        for &byte in frame.data() {
+            b.push(u32::from(byte), 8);
+        }
+        let crc = crc15(b.as_slice());
+        b.push(u32::from(crc), 15);
+        b
+    }
+
+    fn as_slice(&self) -> &[bool] {
+        &self.bits[..self.len]
     }
 }
 
 /// The unstuffed bits from start of frame to the end of the CRC field (`true` = recessive).
 pub fn unstuffed_bits(frame: &Frame) -> Vec<bool> {
-    let mut bits = Vec::with_capacity(STUFFED_HEADER_BITS as usize + 64);
-    bits.push(false); // SOF
-    push_bits(&mut bits, u32::from(frame.id()), 11);
-    bits.extend([false, false, false]); // RTR (data frame), IDE (standard), r0
-    push_bits(&mut bits, u32::from(frame.dlc()), 4);
-    for &byte in frame.data() {
-        push_bits(&mut bits, u32::from(byte), 8);
-    }
-    let crc = crc15(&bits);
-    push_bits(&mut bits, u32::from(crc), 15);
-    bits
+    UnstuffedBits::of(frame).as_slice().to_vec()
 }
 
-/// Insert stuff bits as a transmitter does.
-pub fn stuff(bits: &[bool]) -> Vec<bool> {
-    let mut out = Vec::with_capacity(bits.len() + bits.len() / 4 + 1);
+/// Walks `bits` as a transmitter sends them: `emit(bit, is_stuff)` for each bit on the wire,
+/// a stuff bit of the opposite level after five equal bits (which counts towards the next run).
+fn transmit(bits: &[bool], mut emit: impl FnMut(bool, bool)) {
     let mut run = 0u32;
     let mut last = None;
     for &b in bits {
-        out.push(b);
+        emit(b, false);
         if Some(b) == last {
             run += 1;
         } else {
@@ -61,18 +86,27 @@ pub fn stuff(bits: &[bool]) -> Vec<bool> {
             last = Some(b);
         }
         if run == 5 {
-            out.push(!b);
+            emit(!b, true);
             last = Some(!b);
             run = 1;
         }
     }
+}
+
+/// Insert stuff bits as a transmitter does.
+pub fn stuff(bits: &[bool]) -> Vec<bool> {
+    let mut out = Vec::with_capacity(bits.len() + bits.len() / 4 + 1);
+    transmit(bits, |b, _| out.push(b));
     out
 }
 
 /// Number of stuff bits the frame carries on the wire.
 pub fn stuff_bit_count(frame: &Frame) -> u32 {
-    let raw = unstuffed_bits(frame);
-    (stuff(&raw).len() - raw.len()) as u32
+    let mut count = 0;
+    transmit(UnstuffedBits::of(frame).as_slice(), |_, is_stuff| {
+        count += u32::from(is_stuff)
+    });
+    count
 }
 
 /// Length of the frame on the wire [bits], with its actual stuff bits and the 3-bit
@@ -135,6 +169,14 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn the_stuff_bit_count_is_the_stuffed_stream_s_extra_length(id in 0u32..0x800, data in proptest::collection::vec(any::<u8>(), 0..=8)) {
+            let f = Frame::new(id, &data).unwrap();
+            let raw = unstuffed_bits(&f);
+            prop_assert_eq!(raw.len(), 34 + 8 * data.len());
+            prop_assert_eq!(stuff_bit_count(&f) as usize, stuff(&raw).len() - raw.len());
+        }
+
         #[test]
         fn stuffing_is_bounded_and_reversible(id in 0u32..0x800, data in proptest::collection::vec(any::<u8>(), 0..=8)) {
             let f = Frame::new(id, &data).unwrap();

@@ -1,6 +1,8 @@
 //! Closing the loop on the stance ankle: a controller (the firmware's ankle nodes, or any other)
 //! is sampled at fixed control ticks, sample-and-hold, and moves the string's limit on the
-//! stance ankle angle. Ticks are breakpoints of the integration, not approximated.
+//! stance ankle angle. Every tick runs, at its exact time; a tick whose output changes the
+//! plant's input is a breakpoint of the integration, a tick that holds it may fall inside a
+//! step and see the integrator's interpolant there ([`TickStepping`]).
 //!
 //! The string is a unilateral constraint: the stance ankle angle cannot fall below the limit.
 //! While the angle is above it the ankle is free and the foot flat; reaching it is the string
@@ -69,6 +71,23 @@ impl ActuatorSegment {
         }
     }
 
+    /// The limit does not move over the tick: released, or held at one angle.
+    pub fn is_held(&self) -> bool {
+        self.released
+            || (self.p0_rad == self.p1_rad && self.v0_rad_s == 0.0 && self.v1_rad_s == 0.0)
+    }
+
+    /// `next` gives the plant the same input as `self` (as functions of time, whatever their
+    /// ticks): both released, or both held at the same angle. A controlled stride's step may
+    /// then run across the tick between them ([`TickStepping::HeldAcrossTicks`]).
+    pub fn same_held_input(&self, next: &ActuatorSegment) -> bool {
+        match (self.released, next.released) {
+            (true, true) => true,
+            (false, false) => self.is_held() && next.is_held() && self.p1_rad == next.p0_rad,
+            _ => false,
+        }
+    }
+
     /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (the clock of
     /// [`Self::t0_s`]; clamped to the tick).
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
@@ -85,6 +104,22 @@ impl ActuatorSegment {
             x,
         )
     }
+}
+
+/// How a controlled stride's integration steps meet the control ticks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TickStepping {
+    /// The default: while the controller's output holds the plant's input (a released string,
+    /// a limit held at one angle) a step runs across ticks; the controller still runs at every
+    /// tick, on the state the integrator's interpolant gives there, and the step ends at the
+    /// first tick whose output changes the plant's input (the state there is the
+    /// interpolant's, the one the controller saw, so nothing is rolled back). A moving limit,
+    /// or an integrator without an interpolant (RK4, Meijaard), ends every step at a tick.
+    #[default]
+    HeldAcrossTicks,
+    /// Every step ends at the next tick (the reference the default is tested against).
+    EndAtEveryTick,
 }
 
 /// Why a controller could not run a tick.
@@ -254,6 +289,39 @@ mod tests {
             assert!(paced.tick(&sensing).is_ok(), "{factor}");
             assert_eq!(inner.0, 1, "{factor}");
         }
+    }
+
+    #[test]
+    fn only_a_released_string_or_one_held_angle_holds_the_plant_s_input() {
+        let hold = |t0: f64, p: f64| ActuatorSegment::hold(t0, t0 + 1e-3, p);
+        let released = ActuatorSegment {
+            released: true,
+            ..hold(0.0, 0.3)
+        };
+        let moving = ActuatorSegment {
+            p1_rad: -0.079,
+            v1_rad_s: 1.0,
+            ..hold(0.0, -0.08)
+        };
+        assert!(hold(0.0, -0.08).is_held() && released.is_held() && !moving.is_held());
+        // Released to released (whatever the angles), the same angle at the next tick.
+        let next_released = ActuatorSegment {
+            released: true,
+            ..hold(1e-3, -0.2)
+        };
+        assert!(released.same_held_input(&next_released));
+        assert!(hold(0.0, -0.08).same_held_input(&hold(1e-3, -0.08)));
+        // Another angle, taut after slack, slack after taut, a limit that starts moving.
+        assert!(!hold(0.0, -0.08).same_held_input(&hold(1e-3, -0.0801)));
+        assert!(!released.same_held_input(&hold(1e-3, 0.3)));
+        assert!(!hold(0.0, 0.3).same_held_input(&next_released));
+        let starts_moving = ActuatorSegment {
+            t0_s: 1e-3,
+            t1_s: 2e-3,
+            ..moving
+        };
+        assert!(!hold(0.0, -0.08).same_held_input(&starts_moving));
+        assert!(!moving.same_held_input(&hold(1e-3, -0.079)));
     }
 
     #[test]

@@ -1,11 +1,14 @@
 //! Walks the 3D walker with both ankle nodes' firmware and the simulated bus in the loop, for
 //! profilers: real-time factor and right-hand-side evaluations per control tick
-//! (`cargo run --release -p sil --example profile_sil -- 50 [dopri5|rk4] [tolerance|step_s]`;
-//! without an integrator, `walker sil`'s own, `sil::SIL_INTEGRATOR`).
+//! (`cargo run --release -p sil --example profile_sil -- 50 [dopri5|rk4|every_tick]
+//! [tolerance|step_s] [h_max_s]`; without an integrator, `walker sil`'s own,
+//! `sil::SIL_INTEGRATOR`; `every_tick`: `SIL_INTEGRATOR` with every step ending at a control
+//! tick, `TickStepping::EndAtEveryTick`, the scheme before steps ran across held ticks).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use sil::config::SilConfig;
 use sil::FirmwareInTheLoop;
+use sim::control::TickStepping;
 use sim::integrators::IntegratorChoice;
 use sim::walk::WalkRequest;
 
@@ -14,6 +17,7 @@ fn main() {
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(30);
     let kind = args.next().unwrap_or_else(|| "sil".into());
     let x: Option<f64> = args.next().and_then(|s| s.parse().ok());
+    let h_max_s: f64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(0.01);
     let scene = sim::scene::Scene::load("wisse3d").expect("scene");
     let setup = scene.setup().expect("build");
     let g = setup.find_gait(&Default::default()).expect("gait");
@@ -26,11 +30,18 @@ fn main() {
         "dopri5" => IntegratorChoice::Dopri5 {
             rtol: x.unwrap_or(1e-6),
             atol: x.unwrap_or(1e-6),
-            h_max_s: 0.01,
+            h_max_s,
         },
         _ => sil::SIL_INTEGRATOR,
     };
-    let settings = setup.settings.with_integrator(integrator);
+    let stepping = match kind.as_str() {
+        "every_tick" => TickStepping::EndAtEveryTick,
+        _ => TickStepping::HeldAcrossTicks,
+    };
+    let settings = setup
+        .settings
+        .with_integrator(integrator)
+        .with_tick_stepping(stepping);
     let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
     let mut evals = 0usize;
     let start = std::time::Instant::now();

@@ -19,6 +19,10 @@ use crate::history::BoundedLog;
 use crate::report::SocketcandReport;
 use crate::side::Side;
 
+/// Longest wait for the socketcand server to write out its clients' queues at the end of a
+/// walk.
+pub(crate) const SERVER_FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+
 /// The bus, its host node, its outputs and its records.
 pub(crate) struct BusSide {
     bus: Bus,
@@ -213,7 +217,9 @@ impl BusSide {
         })
     }
 
-    /// Flush the candump log and stop the server.
+    /// Flush the candump log, let the server write out what its clients are still owed (at
+    /// most [`SERVER_FLUSH_TIMEOUT`]; a client that stops reading is given up within 100 ms)
+    /// and stop it.
     ///
     /// # Errors
     /// [`SilError::Candump`] when the log cannot be flushed.
@@ -222,6 +228,9 @@ impl BusSide {
             w.finish()?.flush()?;
         }
         if let Some(mut s) = self.server.take() {
+            // A walk can end within a few milliseconds of its first frames, before the
+            // client threads' next poll: without this their last frames were lost.
+            s.flush(SERVER_FLUSH_TIMEOUT);
             s.shutdown();
         }
         Ok(())

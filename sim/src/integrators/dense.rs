@@ -57,8 +57,14 @@ impl DenseOutput {
         let n = self.q0.len();
         let mut q = DVector::zeros(n);
         let mut qd = DVector::zeros(n);
+        let last = self.f.len().saturating_sub(1);
         for (i, (fq, fv)) in self.f.iter().rev().enumerate() {
-            let w = if i % 2 == 0 { x } else { 1.0 - x };
+            // `F_k` is multiplied by θ for even k, by 1 − θ for odd k.
+            let w = if (last - i).is_multiple_of(2) {
+                x
+            } else {
+                1.0 - x
+            };
             for k in 0..n {
                 q[k] = (q[k] + fq[k]) * w;
                 qd[k] = (qd[k] + fv[k]) * w;

@@ -136,8 +136,12 @@ pub trait EmbeddedPair: Clone + Debug {
     /// First same as last: the last stage is the derivative at the step's end (kept from an
     /// accepted step for the next one). Otherwise the first stage is kept once evaluated.
     const FSAL: bool;
-    /// The pair's continuous extension, if it has one.
+    /// The pair's continuous extension, if it has one (the event locator's dense output).
     const DENSE: Option<DenseCoefficients> = None;
+    /// The continuous extension [`Integrator::interpolant`] samples with: [`Self::DENSE`]
+    /// unless the pair gives one for sampling only (DOPRI5, whose events keep their exact-step
+    /// refinement).
+    const INTERPOLANT: Option<DenseCoefficients> = Self::DENSE;
 
     /// The scaled error norm of a step of size `h` [s] from `s` to `(q_new, v_new)` with
     /// stage derivatives `kq` (of the positions) and `kv` (of the velocities).
@@ -195,7 +199,8 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
     /// Number of stage buffers: the step's stages, and with a continuous extension the end
     /// derivative and its extra stages.
     fn stage_count() -> usize {
-        P::C.len() + P::DENSE.map_or(0, |d| 1 + d.extra_c.len())
+        let extension = |d: Option<DenseCoefficients>| d.map_or(0, |d| 1 + d.extra_c.len());
+        P::C.len() + extension(P::DENSE).max(extension(P::INTERPOLANT))
     }
 
     /// The derivative at the step's start into stage 0, from the kept one when it is at `s`.
@@ -229,10 +234,18 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
         let (t0, h) = (last.t0_s, last.h_s);
         let s = P::C.len();
         let st = &mut self.stages;
-        st.q.copy_from(&last.q1);
-        st.v.copy_from(&last.v1);
-        self.evaluations += 1;
-        st.evaluate(sys, s, t0 + h)?;
+        if P::FSAL {
+            // The last stage was evaluated at the step's end: it is the end derivative.
+            let (steps, extension) = st.kq.split_at_mut(s);
+            extension[0].copy_from(&steps[s - 1]);
+            let (steps, extension) = st.kv.split_at_mut(s);
+            extension[0].copy_from(&steps[s - 1]);
+        } else {
+            st.q.copy_from(&last.q1);
+            st.v.copy_from(&last.v1);
+            self.evaluations += 1;
+            st.evaluate(sys, s, t0 + h)?;
+        }
         for (k, (c, row)) in coefficients
             .extra_c
             .iter()
@@ -264,6 +277,16 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             f.push((fq, fv));
         }
         Ok(DenseOutput::new(t0, h, last.q0.clone(), last.v0.clone(), f))
+    }
+
+    /// The last trial step went from `from` to `to` (its stages are still in the buffers).
+    fn last_step_is(&self, from: &Sample, to: &Sample) -> bool {
+        let last = &self.last_step;
+        last.valid
+            && last.t0_s == from.t_s
+            && last.t0_s + last.h_s == to.t_s
+            && last.q0 == from.q
+            && last.v0 == from.qd
     }
 
     /// Keeps an accepted step's end derivative for the next step (FSAL pairs).
@@ -308,7 +331,7 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
         // FSAL: the last stage was evaluated at the propagated solution at t + h, kept for
         // the next step if this one is accepted.
         self.last_stage = P::FSAL;
-        if P::DENSE.is_some() {
+        if P::DENSE.is_some() || P::INTERPOLANT.is_some() {
             let l = &mut self.last_step;
             l.valid = true;
             l.t0_s = s.t_s;
@@ -350,13 +373,21 @@ impl<P: EmbeddedPair> Integrator for EmbeddedRk<P> {
         to: &Sample,
     ) -> Option<Result<DenseOutput, IntegrationError>> {
         let coefficients = P::DENSE?;
-        let last = &self.last_step;
-        let same = last.valid
-            && last.t0_s == from.t_s
-            && last.t0_s + last.h_s == to.t_s
-            && last.q0 == from.q
-            && last.v0 == from.qd;
-        same.then(|| self.build_dense(sys, &coefficients))
+        self.last_step_is(from, to)
+            .then(|| self.build_dense(sys, &coefficients))
+    }
+    fn interpolates(&self) -> bool {
+        P::INTERPOLANT.is_some()
+    }
+    fn interpolant(
+        &mut self,
+        sys: &mut dyn SecondOrderSystem,
+        from: &Sample,
+        to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        let coefficients = P::INTERPOLANT?;
+        self.last_step_is(from, to)
+            .then(|| self.build_dense(sys, &coefficients))
     }
     fn proposed_step_s(&self) -> f64 {
         if self.h_next_s > 0.0 {

@@ -420,4 +420,21 @@ pub trait Integrator {
     ) -> Option<Result<DenseOutput, IntegrationError>> {
         None
     }
+    /// Whether [`Self::interpolant`] can give the solution inside a step (a continuous
+    /// extension for sampling, which events need not use).
+    fn interpolates(&self) -> bool {
+        false
+    }
+    /// An interpolant of the last step taken when it went from `from` to `to`: the solution
+    /// anywhere inside it, for sampling (a controller's ticks inside a step). DOP853's dense
+    /// output, DOPRI5's continuous extension (which its event location does not use); `None`
+    /// otherwise. Its extra stages, if any, count as evaluations.
+    fn interpolant(
+        &mut self,
+        _sys: &mut dyn SecondOrderSystem,
+        _from: &Sample,
+        _to: &Sample,
+    ) -> Option<Result<DenseOutput, IntegrationError>> {
+        None
+    }
 }

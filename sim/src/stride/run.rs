@@ -15,11 +15,13 @@ use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
-use crate::control::{ActuatorSegment, AnkleSensing};
+use crate::control::ActuatorSegment;
 use crate::events::locate;
 use crate::integrators::{Integrator, Sample};
 use crate::walker::Walker;
 use nalgebra::DVector;
+
+mod ticks;
 
 impl Walker {
     /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
@@ -136,6 +138,12 @@ struct Run<'w, 'r, 't> {
     next_tick_s: f64,
     /// The stance string's limit over the current tick (stride time), from the controller.
     segment: Option<ActuatorSegment>,
+    /// Steps may run across ticks ([`crate::control::TickStepping::HeldAcrossTicks`], possible
+    /// for this stride).
+    held_stepping: bool,
+    /// The output of the tick at `next_tick_s`, run on a step's interpolant, to take effect
+    /// when the stride reaches that tick.
+    pending: Option<ActuatorSegment>,
 }
 
 impl<'w, 'r, 't> Run<'w, 'r, 't> {
@@ -168,6 +176,12 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             Some(c) => (c.controller.period_s(), c.t_walk_start_s),
             None => (f64::INFINITY, 0.0),
         };
+        let held_stepping = Self::held_stepping(
+            settings.tick_stepping,
+            matches!(schedule, super::Schedule::Free),
+            integrator.interpolates(),
+            control.is_some(),
+        );
         let next_tick_s = if period_s.is_finite() {
             (t_walk0 / period_s - 1e-9).ceil() * period_s - t_walk0
         } else {
@@ -195,6 +209,8 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             period_s,
             next_tick_s,
             segment: None,
+            held_stepping,
+            pending: None,
         })
     }
 
@@ -216,22 +232,38 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             let drive_end_s = self.drive_end_s();
             let next = self.step(drive_end_s)?;
             let (next, w_cur, w_next) = self.grazing_check(next)?;
+            // Ticks the step ran across: sampled on its interpolant (before event location
+            // takes other steps), run before the step's events apply.
+            let dense = self.held_interpolant(&next)?;
             let limit = self.string_limit();
             let triggered =
                 self.wit
                     .triggered(&self.phase, limit, (&self.cur, &w_cur), (&next, &w_next));
             if triggered.is_empty() {
+                let next = self
+                    .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
+                    .unwrap_or(next);
                 self.accept(next, drive_end_s)?;
                 continue;
             }
             let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
                 continue;
             };
+            if let Some(at_tick) = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s)? {
+                // A tick before the event changed the plant's input: the step ends there.
+                self.accept(at_tick, drive_end_s)?;
+                continue;
+            }
             self.phase.snap(&mut at);
             self.power.accumulate(&self.cur, &at);
             match self.apply(watch, &at)? {
                 Applied::Done(result) => return Ok(*result),
-                Applied::Ignored => self.accept_ignored(&at, next),
+                Applied::Ignored => {
+                    let next = self
+                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
+                        .unwrap_or(next);
+                    self.accept_ignored(&at, next);
+                }
                 Applied::Skipped => {}
                 Applied::Impact(name) => self.after_impact(name, at),
             }
@@ -266,75 +298,6 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         Ok(())
     }
 
-    /// A control tick, when one is due: the controller sees the stance ankle and sets the
-    /// string's limit until the next tick.
-    fn control_tick(&mut self) -> Result<(), StrideFailure> {
-        let Some(control) = self.control.as_mut() else {
-            return Ok(());
-        };
-        if self.cur.t_s < self.next_tick_s - 1e-12 {
-            return Ok(());
-        }
-        let (cur, phase) = (&mut self.cur, &mut self.phase);
-        let fail = |t: f64| move |e: String| StrideFailure::new(FailureKind::NonFiniteState, t, e);
-        let t0 = control.t_walk_start_s;
-        let w = self.wit.eval(cur);
-        let (a, engaged) = match &self.walker.ankle {
-            Some(r) => (r.ankle.0, phase.prescribed.is_some()),
-            None => (0, false),
-        };
-        let sensing = AnkleSensing {
-            t_walk_s: t0 + cur.t_s,
-            stance_ankle_rad: cur.q[a],
-            stance_ankle_rate_rad_s: cur.qd[a],
-            stance_foot_on_floor: true,
-            swing_foot_on_floor: w.foot_height_m <= 1e-9,
-            string_engaged: engaged,
-            string_torque_n_m: if engaged {
-                phase
-                    .actuator_torque(cur)
-                    .map_err(|e| fail(cur.t_s)(e.to_string()))?
-                    .0
-            } else {
-                0.0
-            },
-        };
-        let mut seg = control
-            .controller
-            .tick(&sensing)
-            .map_err(|e| fail(cur.t_s)(e.to_string()))?;
-        seg.t0_s -= t0;
-        seg.t1_s -= t0;
-        if let Some((coord, Drive::Segment(_))) = phase.prescribed {
-            if seg.released {
-                // The string goes slack during the push (an emergency stop, a fault): no
-                // impulse, the ankle is free again, and the foot keeps pivoting about its toe
-                // until the heel comes back down or the stride ends.
-                self.power.close(&self.walker.model, cur);
-                phase.prescribed = None;
-                phase.active[coord.0] = true;
-                self.integrator.system_changed();
-                self.events.push(StrideEvent {
-                    name: "string_released".into(),
-                    t_stride_s: cur.t_s,
-                });
-                self.event_states.push((cur.clone(), cur.clone()));
-            } else {
-                phase.prescribed = Some((coord, Drive::Segment(seg)));
-                phase.snap(cur);
-            }
-        }
-        // Only an engaged string's new segment changes the vector field; while the ankle is
-        // free the tick only moves the engagement witness, and the integrator keeps its last
-        // stage (first same as last).
-        if phase.prescribed.is_some() {
-            self.integrator.system_changed();
-        }
-        self.segment = Some(seg);
-        self.next_tick_s += self.period_s;
-        Ok(())
-    }
-
     /// The ideal drive's profile ends with a jump in its jerk: a breakpoint, so that no step
     /// straddles it (the step sizes stay smooth functions of the initial state, and replayed
     /// schedules stay accurate when the end moves). ∞ when there is none ahead.
@@ -352,7 +315,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     fn step(&mut self, drive_end_s: f64) -> Result<Sample, StrideFailure> {
         self.steps += 1;
         let cur = &self.cur;
-        let h_limit = (self.next_tick_s.min(drive_end_s) - cur.t_s).max(1e-12);
+        let h_limit = (self.tick_limit_s().min(drive_end_s) - cur.t_s).max(1e-12);
         let mut next = match self.schedule.replayed() {
             Some(h) => self
                 .integrator

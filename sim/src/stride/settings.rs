@@ -2,6 +2,7 @@
 //! and how long it may last. Apart from the walker (the physics), so that the same walker can be
 //! run with other settings without being changed.
 
+use crate::control::TickStepping;
 use crate::events::EventTolerance;
 use crate::integrators::{IntegratorChoice, IntegratorError};
 use crate::planar::EvaluationPath;
@@ -32,6 +33,9 @@ pub struct StrideSettings {
     /// [`EvaluationPath::Auto`] (the planar fast path when the walker qualifies); `General`
     /// forces the general engine, the reference.
     pub evaluation: EvaluationPath,
+    /// How a controlled stride's steps meet the control ticks. Default:
+    /// [`TickStepping::HeldAcrossTicks`]; `EndAtEveryTick` is the reference.
+    pub tick_stepping: TickStepping,
 }
 
 impl Default for StrideSettings {
@@ -47,6 +51,7 @@ impl Default for StrideSettings {
             max_steps: Self::DEFAULT_MAX_STEPS,
             max_evaluations: Self::DEFAULT_MAX_EVALUATIONS,
             evaluation: EvaluationPath::Auto,
+            tick_stepping: TickStepping::default(),
         }
     }
 }
@@ -76,6 +81,14 @@ impl StrideSettings {
     pub fn with_integrator(&self, integrator: IntegratorChoice) -> Self {
         Self {
             integrator,
+            ..self.clone()
+        }
+    }
+
+    /// The same settings with another way of stepping across control ticks.
+    pub fn with_tick_stepping(&self, tick_stepping: TickStepping) -> Self {
+        Self {
+            tick_stepping,
             ..self.clone()
         }
     }

@@ -1,0 +1,248 @@
+//! The control ticks of a controlled stride: at each tick the controller sees the stance ankle
+//! and sets the string's limit until the next tick (sample and hold).
+//!
+//! With [`TickStepping::EndAtEveryTick`] every step ends at the next tick and the controller
+//! runs at the step's end. With [`TickStepping::HeldAcrossTicks`] (the default) a step runs
+//! across ticks while the limit in force does not move (released, or held at one angle): the
+//! ticks inside the step run on the integrator's interpolant there, in order, before any event
+//! of the step is applied; the first tick whose output changes the plant's input
+//! ([`ActuatorSegment::same_held_input`]) ends the step at that tick, at the interpolated state
+//! the controller saw (so the controller is never rolled back), and its output takes effect
+//! there. Without an interpolant (RK4, Meijaard), with a step schedule recorded or replayed, or
+//! while the limit moves, every step ends at a tick.
+
+use super::Run;
+use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
+use crate::hermite::{self, Knot};
+use crate::integrators::{DenseOutput, Sample};
+use crate::stride::phase::{Drive, Phase};
+use crate::stride::result::{FailureKind, StrideEvent, StrideFailure};
+use crate::stride::witnesses::{WitnessValues, Witnesses};
+use crate::walker::Walker;
+
+/// A tick's time is reached when a sample is within this of it [s].
+const TICK_SLACK_S: f64 = 1e-12;
+
+/// A failure of the controller or of the sensing at stride time `t_s`.
+fn tick_failure(t_s: f64, detail: String) -> StrideFailure {
+    StrideFailure::new(FailureKind::NonFiniteState, t_s, detail)
+}
+
+/// The swing foot is on the floor at this height [m] or below.
+const ON_FLOOR_M: f64 = 1e-9;
+
+/// Inside a step, the cubic Hermite of the swing foot's height (values and rates at the step's
+/// ends) decides "off the floor" without a kinematics update when it is above this [m]: its
+/// error over a step of 10 ms is of the order of 1e-8 m (`h⁴/384 · |y⁗|`, the swing foot's
+/// `|y⁗|` a few hundred m/s⁴), so the answer is the exact one's.
+const CLEAR_OF_FLOOR_M: f64 = 1e-4;
+
+/// The swing foot is clearly off the floor at `t_s` inside the step `from` → `to` (the cubic
+/// Hermite of its height above [`CLEAR_OF_FLOOR_M`]).
+fn clear_of_floor(from: &WitnessValues, to: &WitnessValues, t_s: f64) -> bool {
+    let h = to.t_s - from.t_s;
+    if h <= 0.0 {
+        return false;
+    }
+    let knot = |w: &WitnessValues| Knot {
+        value: w.foot_height_m,
+        rate: w.foot_height_rate_m_s,
+    };
+    let (height_m, _, _) = hermite::scalar(knot(from), knot(to), h, (t_s - from.t_s) / h);
+    height_m > CLEAR_OF_FLOOR_M
+}
+
+/// What the stance ankle's sensors see at `s` (stride time; `t_walk_start_s` the walk time
+/// at the start of the stride). `swing_foot_on_floor`: when already known (the witnesses of
+/// this sample, or a foot clear of the floor), else from the kinematics.
+fn sense(
+    walker: &Walker,
+    wit: &mut Witnesses<'_>,
+    phase: &mut Phase<'_>,
+    t_walk_start_s: f64,
+    s: &Sample,
+    swing_foot_on_floor: Option<bool>,
+) -> Result<AnkleSensing, StrideFailure> {
+    let swing_foot_on_floor =
+        swing_foot_on_floor.unwrap_or_else(|| wit.eval(s).foot_height_m <= ON_FLOOR_M);
+    let (a, engaged) = match &walker.ankle {
+        Some(r) => (r.ankle.0, phase.prescribed.is_some()),
+        None => (0, false),
+    };
+    Ok(AnkleSensing {
+        t_walk_s: t_walk_start_s + s.t_s,
+        stance_ankle_rad: s.q[a],
+        stance_ankle_rate_rad_s: s.qd[a],
+        stance_foot_on_floor: true,
+        swing_foot_on_floor,
+        string_engaged: engaged,
+        string_torque_n_m: if engaged {
+            phase
+                .actuator_torque(s)
+                .map_err(|e| tick_failure(s.t_s, e.to_string()))?
+                .0
+        } else {
+            0.0
+        },
+    })
+}
+
+impl Run<'_, '_, '_> {
+    /// Whether this stride steps across ticks at all: a controller, `HeldAcrossTicks`, the
+    /// integrator's own steps (no schedule) and an integrator with an interpolant.
+    pub(super) fn held_stepping(
+        tick_stepping: TickStepping,
+        free_schedule: bool,
+        interpolates: bool,
+        controlled: bool,
+    ) -> bool {
+        tick_stepping == TickStepping::HeldAcrossTicks
+            && free_schedule
+            && interpolates
+            && controlled
+    }
+
+    /// The next step may run across the next tick: held stepping, no tick output waiting to
+    /// take effect, and a limit in force that does not move.
+    pub(super) fn held_ahead(&self) -> bool {
+        self.held_stepping && self.pending.is_none() && self.segment.is_some_and(|s| s.is_held())
+    }
+
+    /// The end of the next step as the ticks allow [s]: the next tick, or ∞ across ticks.
+    pub(super) fn tick_limit_s(&self) -> f64 {
+        if self.held_ahead() {
+            f64::INFINITY
+        } else {
+            self.next_tick_s
+        }
+    }
+
+    /// A control tick, when one is due at `cur`: the controller sees the stance ankle (or its
+    /// output at this tick is already known, from the interpolant) and sets the string's
+    /// limit until the next tick.
+    pub(super) fn control_tick(&mut self) -> Result<(), StrideFailure> {
+        let Some(control) = self.control.as_ref() else {
+            return Ok(());
+        };
+        if self.cur.t_s < self.next_tick_s - TICK_SLACK_S {
+            return Ok(());
+        }
+        let t0 = control.t_walk_start_s;
+        let seg = match self.pending.take() {
+            Some(seg) => seg,
+            None => {
+                // The witnesses of the step that ended here, when at this sample's time (an
+                // impact since changes the velocities, not the foot's height).
+                let on_floor = self
+                    .w_cached
+                    .filter(|w| w.t_s == self.cur.t_s)
+                    .map(|w| w.foot_height_m <= ON_FLOOR_M);
+                let (wit, phase) = (&mut self.wit, &mut self.phase);
+                let sensing = sense(self.walker, wit, phase, t0, &self.cur, on_floor)?;
+                self.tick_controller(&sensing)?
+            }
+        };
+        self.apply_segment(seg);
+        Ok(())
+    }
+
+    /// The controller's tick: its segment, shifted to stride time.
+    fn tick_controller(
+        &mut self,
+        sensing: &AnkleSensing,
+    ) -> Result<ActuatorSegment, StrideFailure> {
+        let Some(control) = self.control.as_mut() else {
+            return Err(tick_failure(
+                sensing.t_walk_s,
+                "a control tick without a controller".into(),
+            ));
+        };
+        let t0 = control.t_walk_start_s;
+        let mut seg = control
+            .controller
+            .tick(sensing)
+            .map_err(|e| tick_failure(sensing.t_walk_s - t0, e.to_string()))?;
+        seg.t0_s -= t0;
+        seg.t1_s -= t0;
+        Ok(seg)
+    }
+
+    /// The tick's segment takes effect at `cur`.
+    fn apply_segment(&mut self, seg: ActuatorSegment) {
+        let (cur, phase) = (&mut self.cur, &mut self.phase);
+        if let Some((coord, Drive::Segment(_))) = phase.prescribed {
+            if seg.released {
+                // The string goes slack during the push (an emergency stop, a fault): no
+                // impulse, the ankle is free again, and the foot keeps pivoting about its toe
+                // until the heel comes back down or the stride ends.
+                self.power.close(&self.walker.model, cur);
+                phase.prescribed = None;
+                phase.active[coord.0] = true;
+                self.integrator.system_changed();
+                self.events.push(StrideEvent {
+                    name: "string_released".into(),
+                    t_stride_s: cur.t_s,
+                });
+                self.event_states.push((cur.clone(), cur.clone()));
+            } else {
+                phase.prescribed = Some((coord, Drive::Segment(seg)));
+                phase.snap(cur);
+            }
+        }
+        // Only an engaged string's new segment changes the vector field; while the ankle is
+        // free the tick only moves the engagement witness, and the integrator keeps its last
+        // stage (first same as last).
+        if phase.prescribed.is_some() {
+            self.integrator.system_changed();
+        }
+        self.segment = Some(seg);
+        self.next_tick_s += self.period_s;
+    }
+
+    /// The interpolant of the step `cur` → `next` when it ran across a tick (built before the
+    /// event location takes other steps).
+    pub(super) fn held_interpolant(
+        &mut self,
+        next: &Sample,
+    ) -> Result<Option<DenseOutput>, StrideFailure> {
+        if !self.held_ahead() || self.next_tick_s >= next.t_s - TICK_SLACK_S {
+            return Ok(None);
+        }
+        let cur = &self.cur;
+        self.integrator
+            .interpolant(&mut self.phase, cur, next)
+            .transpose()
+            .map_err(|e| StrideFailure::from_integration(e, cur.t_s))
+    }
+
+    /// Runs the ticks strictly before `end_s` on the step's interpolant, in order. While their
+    /// outputs give the plant the same input the step stands (`None`); the first that changes
+    /// it ends the step there: the interpolated state at that tick is returned, and the tick's
+    /// output takes effect when the loop reaches it.
+    pub(super) fn held_ticks(
+        &mut self,
+        dense: Option<&DenseOutput>,
+        ends: (&WitnessValues, &WitnessValues),
+        end_s: f64,
+    ) -> Result<Option<Sample>, StrideFailure> {
+        let (Some(dense), Some(control)) = (dense, self.control.as_ref()) else {
+            return Ok(None);
+        };
+        let t0 = control.t_walk_start_s;
+        while self.next_tick_s < end_s - TICK_SLACK_S {
+            let mut s = dense.eval(self.next_tick_s);
+            self.phase.snap(&mut s);
+            let clear = clear_of_floor(ends.0, ends.1, s.t_s).then_some(false);
+            let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &s, clear)?;
+            let seg = self.tick_controller(&sensing)?;
+            match self.segment {
+                Some(held) if held.same_held_input(&seg) => self.next_tick_s += self.period_s,
+                _ => {
+                    self.pending = Some(seg);
+                    return Ok(Some(s));
+                }
+            }
+        }
+        Ok(None)
+    }
+}
