@@ -49,6 +49,8 @@ pub struct DynamicsOf<T: Scalar> {
     has_infinitesimal: bool,
     /// For each link, whether its body has a nonzero inertia tensor.
     rotational: Vec<bool>,
+    /// Scratch: the coordinates whose rows and columns a partial assembly computes.
+    needed: Vec<bool>,
 }
 
 impl<T: RealField + Copy> DynamicsOf<T> {
@@ -84,6 +86,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
                 .iter()
                 .map(|l| l.body.inertia_com_kg_m2.iter().any(|v| *v != 0.0))
                 .collect(),
+            needed: vec![true; n],
         }
     }
 
@@ -94,6 +97,21 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         q: &DVector<T>,
         qd: &DVector<T>,
         tau_extra: Option<&DVector<T>>,
+    ) {
+        self.assemble_entries(model, q, qd, tau_extra, false);
+    }
+
+    /// [`Self::assemble`], with only the rows and columns of the coordinates where
+    /// `self.needed` is true when `partial` (the others' Jacobian columns skipped: their
+    /// entries stay zero, the spring and damper forces excepted). Each computed entry is the
+    /// same sum as in the full assembly.
+    fn assemble_entries(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        tau_extra: Option<&DVector<T>>,
+        partial: bool,
     ) {
         self.kin.update(model, q, qd);
         // On the contiguous storage: nalgebra's `fill` walks a strided iterator per entry.
@@ -119,6 +137,9 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             // columns are zero): linear at the c.m. and angular.
             self.cols.clear();
             for &(c, l, revolute) in &self.chains[i] {
+                if partial && !self.needed[c] {
+                    continue;
+                }
                 let a = self.kin.axis_floor[l];
                 let (jv, jw) = if revolute {
                     (a.cross(&(p_com - self.kin.p_floor_link_m[l])), a)
@@ -210,11 +231,35 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         qdd_prescribed: Option<&DVector<T>>,
         qdd: &mut DVector<T>,
     ) -> Result<(), DynamicsError> {
+        self.solve_finite_into(model, q, qd, active, qdd_prescribed, qdd, false)
+    }
+
+    /// As [`Self::accelerations_finite_into`]; when `partial`, assembling only what the
+    /// solve reads: the rows and columns of the free coordinates and of the prescribed ones
+    /// with a nonzero acceleration (a zero one contributes `M̄_ij · 0 = 0` to the right-hand
+    /// side either way), so that the free coordinates' `q̈` is the same, to the bit, as with
+    /// the full assembly.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_finite_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<T>>,
+        qdd: &mut DVector<T>,
+        partial: bool,
+    ) -> Result<(), DynamicsError> {
         if self.has_infinitesimal {
             return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
         }
-        self.assemble(model, q, qd, None);
         let n = q.len();
+        if partial {
+            for (j, needed) in self.needed.iter_mut().enumerate() {
+                *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != T::zero());
+            }
+        }
+        self.assemble_entries(model, q, qd, None, partial);
         match qdd_prescribed {
             Some(p) => qdd.copy_from(p),
             None => qdd.as_mut_slice().fill(T::zero()),
@@ -228,7 +273,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         for (r, &i) in self.work_idx.iter().enumerate() {
             let mut b = self.force[i];
             if qdd_prescribed.is_some() {
-                for j in (0..n).filter(|&j| !active[j]) {
+                for j in (0..n).filter(|&j| !active[j] && (!partial || self.needed[j])) {
                     b -= m[j * rows + i] * qdd[j];
                 }
             }
@@ -300,11 +345,47 @@ impl Dynamics {
         qdd_prescribed: Option<&DVector<f64>>,
         qdd: &mut DVector<f64>,
     ) -> Result<(), DynamicsError> {
+        self.solve_into(model, q, qd, active, qdd_prescribed, qdd, false)
+    }
+
+    /// As [`Self::accelerations_into`], assembling only the entries of `M̄` and `f̄` the solve
+    /// reads (the rows and columns of the free coordinates and of prescribed ones with a
+    /// nonzero acceleration; see `solve_finite_into`): the same `q̈`, to the bit, for less
+    /// work where coordinates are locked. The workspace's `M̄` and `f̄` are then partial: not
+    /// for energies, momenta or actuator torques. Models with infinitesimal bodies assemble
+    /// fully.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`].
+    pub fn accelerations_of_free_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.solve_into(model, q, qd, active, qdd_prescribed, qdd, true)
+    }
+
+    /// [`Self::accelerations_into`], with a partial assembly when `partial`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+        partial: bool,
+    ) -> Result<(), DynamicsError> {
         if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
             return Err(DynamicsError::NonFinite);
         }
         if !self.has_infinitesimal {
-            self.accelerations_finite_into(model, q, qd, active, qdd_prescribed, qdd)?;
+            self.solve_finite_into(model, q, qd, active, qdd_prescribed, qdd, partial)?;
             if qdd.iter().any(|v| !v.is_finite()) {
                 return Err(DynamicsError::NonFinite);
             }

@@ -167,3 +167,45 @@ fn the_general_evaluation_equals_the_reference_arithmetic_on_random_states() {
     // Not bit for bit (the coordinate-axis rotations round differently), but to rounding.
     assert!(worst < 1e-14, "{worst:e}");
 }
+
+#[test]
+fn the_partial_assembly_gives_the_full_assemblys_accelerations_to_the_bit() {
+    let mut seed = 5u64;
+    let mut compared = 0;
+    for name in ["wisse3d", "wisse2d", "kneed2d"] {
+        let (_, w) = common::walker(name);
+        let model = &w.walker.model;
+        let n = model.dof();
+        let (mut full, mut partial) = (Dynamics::new(model), Dynamics::new(model));
+        for trial in 0..60 {
+            let q = DVector::from_fn(n, |i, _| w.guess.q[i] + 0.3 * noise(&mut seed));
+            let qd = DVector::from_fn(n, |i, _| w.guess.qd[i] + noise(&mut seed));
+            // Some coordinates locked, and every third trial one of them driven.
+            let active: Vec<bool> = (0..n).map(|_| noise(&mut seed) > -0.4).collect();
+            let driven = (trial % 3 == 0)
+                .then(|| (0..n).find(|&j| !active[j]))
+                .flatten();
+            let prescribed = driven.map(|j| {
+                let mut p = DVector::zeros(n);
+                p[j] = 5.0 * noise(&mut seed);
+                p
+            });
+            let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
+            let ra = full.accelerations_into(model, &q, &qd, &active, prescribed.as_ref(), &mut a);
+            let rb = partial.accelerations_of_free_into(
+                model,
+                &q,
+                &qd,
+                &active,
+                prescribed.as_ref(),
+                &mut b,
+            );
+            assert_eq!(ra.is_ok(), rb.is_ok(), "{name}");
+            if ra.is_ok() {
+                assert_eq!(a, b, "{name}: trial {trial}");
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 100, "{compared}");
+}

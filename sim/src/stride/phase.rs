@@ -154,13 +154,19 @@ impl SecondOrderSystem for Phase<'_> {
                 p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
             }
             // The general engine's solve straight into `out` with the arithmetic of
-            // `hybrid::phase::accelerations`, without allocating.
+            // `hybrid::phase::accelerations`, without allocating, assembling only what the
+            // solve reads (the workspace's `M̄`, `f̄` are partial afterwards: whatever reads
+            // them, `actuator_torque` and `linearised_limit`, assembles again).
             None if out.len() == q.len() && self.driven.0.len() == q.len() => {
                 match self.drive_at(t) {
-                    None => {
-                        self.dynamics
-                            .accelerations_into(self.model, q, qd, &self.active, None, out)
-                    }
+                    None => self.dynamics.accelerations_of_free_into(
+                        self.model,
+                        q,
+                        qd,
+                        &self.active,
+                        None,
+                        out,
+                    ),
                     Some(d) => {
                         let (dq, dqd, qdd_p) = &mut self.driven;
                         dq.copy_from(q);
@@ -169,7 +175,7 @@ impl SecondOrderSystem for Phase<'_> {
                         dqd[d.coordinate] = d.rate_rad_s;
                         qdd_p.as_mut_slice().fill(0.0);
                         qdd_p[d.coordinate] = d.acceleration_rad_s2;
-                        self.dynamics.accelerations_into(
+                        self.dynamics.accelerations_of_free_into(
                             self.model,
                             dq,
                             dqd,
