@@ -381,12 +381,14 @@ impl Dynamics {
         qdd: &mut DVector<f64>,
         partial: bool,
     ) -> Result<(), DynamicsError> {
-        if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
+        // On the contiguous storage: nalgebra's matrix iterator is strided.
+        let finite = |x: &DVector<f64>| x.as_slice().iter().all(|v| v.is_finite());
+        if !finite(q) || !finite(qd) {
             return Err(DynamicsError::NonFinite);
         }
         if !self.has_infinitesimal {
             self.solve_finite_into(model, q, qd, active, qdd_prescribed, qdd, partial)?;
-            if qdd.iter().any(|v| !v.is_finite()) {
+            if !finite(qdd) {
                 return Err(DynamicsError::NonFinite);
             }
             return Ok(());
