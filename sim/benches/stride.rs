@@ -158,6 +158,18 @@ fn benches(c: &mut Criterion) {
                 continue;
             }
             group.bench_function(label, |b| b.iter(|| search.find(black_box(&v0))));
+            if label == "dop853_1e-8" {
+                // The stepping Jacobian by central differences (2n strides instead of n): what
+                // the forward-difference stepping buys, in the same run.
+                let central = NewtonSettings {
+                    forward_stepping: false,
+                    ..newton
+                };
+                let search = GaitSearch::new(walker, &settings, &central);
+                group.bench_function(format!("{label}_central_stepping"), |b| {
+                    b.iter(|| search.find(black_box(&v0)))
+                });
+            }
         }
         group.finish();
     }

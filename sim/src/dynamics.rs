@@ -36,8 +36,9 @@ pub struct DynamicsOf<T: Scalar> {
     pub force: DVector<T>,
     /// `f̄` per unit of infinitesimal mass.
     pub force_infinitesimal: DVector<T>,
-    /// For each link, `(coordinate, link owning it)` along its ancestry.
-    chains: Vec<Vec<(usize, usize)>>,
+    /// For each link, `(coordinate, link owning it, whether its joint is revolute)` along its
+    /// ancestry: the only nonzero columns of the link's Jacobians.
+    chains: Vec<Vec<(usize, usize, bool)>>,
     /// Scratch: one body's nonzero Jacobian columns `(coordinate, linear, angular)`.
     cols: Vec<(usize, Vector3<T>, Vector3<T>)>,
     /// Scratch for the active-set solve (row-major k × k, then k).
@@ -48,6 +49,8 @@ pub struct DynamicsOf<T: Scalar> {
     has_infinitesimal: bool,
     /// For each link, whether its body has a nonzero inertia tensor.
     rotational: Vec<bool>,
+    /// Scratch: the coordinates whose rows and columns a partial assembly computes.
+    needed: Vec<bool>,
 }
 
 impl<T: RealField + Copy> DynamicsOf<T> {
@@ -65,7 +68,11 @@ impl<T: RealField + Copy> DynamicsOf<T> {
                     model
                         .ancestry(LinkIndex(i))
                         .into_iter()
-                        .filter_map(|l| model.links[l.0].coordinate.map(|c| (c.0, l.0)))
+                        .filter_map(|l| {
+                            let link = &model.links[l.0];
+                            let revolute = matches!(link.joint, JointKind::Revolute { .. });
+                            link.coordinate.map(|c| (c.0, l.0, revolute))
+                        })
                         .collect()
                 })
                 .collect(),
@@ -79,6 +86,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
                 .iter()
                 .map(|l| l.body.inertia_com_kg_m2.iter().any(|v| *v != 0.0))
                 .collect(),
+            needed: vec![true; n],
         }
     }
 
@@ -90,6 +98,21 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         qd: &DVector<T>,
         tau_extra: Option<&DVector<T>>,
     ) {
+        self.assemble_entries(model, q, qd, tau_extra, false);
+    }
+
+    /// [`Self::assemble`], with only the rows and columns of the coordinates where
+    /// `self.needed` is true when `partial` (the others' Jacobian columns skipped: their
+    /// entries stay zero, the spring and damper forces excepted). Each computed entry is the
+    /// same sum as in the full assembly.
+    fn assemble_entries(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        tau_extra: Option<&DVector<T>>,
+        partial: bool,
+    ) {
         self.kin.update(model, q, qd);
         // On the contiguous storage: nalgebra's `fill` walks a strided iterator per entry.
         self.mass_matrix.as_mut_slice().fill(T::zero());
@@ -100,6 +123,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         self.force_infinitesimal.as_mut_slice().fill(T::zero());
         let c = |x: f64| -> T { nalgebra::convert(x) };
         let g: Vector3<T> = model.gravity_floor_m_s2.map(c);
+        let n = self.force.len();
         for (i, link) in model.links.iter().enumerate() {
             let b = &link.body;
             let has_rot = self.rotational[i];
@@ -112,23 +136,25 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             // The body's Jacobian columns, only for the coordinates of its ancestry (the other
             // columns are zero): linear at the c.m. and angular.
             self.cols.clear();
-            for &(c, l) in &self.chains[i] {
+            for &(c, l, revolute) in &self.chains[i] {
+                if partial && !self.needed[c] {
+                    continue;
+                }
                 let a = self.kin.axis_floor[l];
-                let (jv, jw) = match model.links[l].joint {
-                    JointKind::Revolute { .. } => {
-                        (a.cross(&(p_com - self.kin.p_floor_link_m[l])), a)
-                    }
-                    _ => (a, Vector3::zeros()),
+                let (jv, jw) = if revolute {
+                    (a.cross(&(p_com - self.kin.p_floor_link_m[l])), a)
+                } else {
+                    (a, Vector3::zeros())
                 };
                 self.cols.push((c, jv, jw));
             }
             let (mm, ff) = if b.infinitesimal {
                 (
-                    &mut self.mass_matrix_infinitesimal,
-                    &mut self.force_infinitesimal,
+                    self.mass_matrix_infinitesimal.as_mut_slice(),
+                    self.force_infinitesimal.as_mut_slice(),
                 )
             } else {
-                (&mut self.mass_matrix, &mut self.force)
+                (self.mass_matrix.as_mut_slice(), self.force.as_mut_slice())
             };
             // m Jvᵀ Jv + Jwᵀ I Jw and Jvᵀ m (g − a_bias) + Jwᵀ (−I α_bias − ω × I ω).
             let mass = c(b.mass_kg);
@@ -144,17 +170,20 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             } else {
                 (Matrix3::zeros(), Vector3::zeros())
             };
+            // Only the lower triangle (row ≥ column, column-major storage), mirrored once
+            // below: each pair's sum is the same in both halves.
             for (x, &(ci, jvi, jwi)) in self.cols.iter().enumerate() {
                 ff[ci] += dot3(&jvi, &f_lin) + dot3(&jwi, &torque);
                 let iw_jwi = i_w * jwi;
                 for &(cj, jvj, jwj) in &self.cols[..=x] {
                     let v = mass * dot3(&jvi, &jvj) + dot3(&jwj, &iw_jwi);
-                    mm[(ci, cj)] += v;
-                    if ci != cj {
-                        mm[(cj, ci)] += v;
-                    }
+                    mm[ci.min(cj) * n + ci.max(cj)] += v;
                 }
             }
+        }
+        mirror_lower(self.mass_matrix.as_mut_slice(), n);
+        if self.has_infinitesimal {
+            mirror_lower(self.mass_matrix_infinitesimal.as_mut_slice(), n);
         }
         for link in &model.links {
             if let Some(c) = link.coordinate {
@@ -183,15 +212,58 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         active: &[bool],
         qdd_prescribed: Option<&DVector<T>>,
     ) -> Result<DVector<T>, DynamicsError> {
+        let mut qdd = DVector::zeros(q.len());
+        self.accelerations_finite_into(model, q, qd, active, qdd_prescribed, &mut qdd)?;
+        Ok(qdd)
+    }
+
+    /// As [`Self::accelerations_finite`], writing `q̈` into `qdd` (of `q`'s length) without
+    /// allocating.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations_finite`].
+    pub fn accelerations_finite_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<T>>,
+        qdd: &mut DVector<T>,
+    ) -> Result<(), DynamicsError> {
+        self.solve_finite_into(model, q, qd, active, qdd_prescribed, qdd, false)
+    }
+
+    /// As [`Self::accelerations_finite_into`]; when `partial`, assembling only what the
+    /// solve reads: the rows and columns of the free coordinates and of the prescribed ones
+    /// with a nonzero acceleration (a zero one contributes `M̄_ij · 0 = 0` to the right-hand
+    /// side either way), so that the free coordinates' `q̈` is the same, to the bit, as with
+    /// the full assembly.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_finite_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<T>,
+        qd: &DVector<T>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<T>>,
+        qdd: &mut DVector<T>,
+        partial: bool,
+    ) -> Result<(), DynamicsError> {
         if self.has_infinitesimal {
             return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
         }
-        self.assemble(model, q, qd, None);
         let n = q.len();
-        let mut qdd = match qdd_prescribed {
-            Some(p) => p.clone(),
-            None => DVector::zeros(n),
-        };
+        if partial {
+            for (j, needed) in self.needed.iter_mut().enumerate() {
+                *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != T::zero());
+            }
+        }
+        self.assemble_entries(model, q, qd, None, partial);
+        match qdd_prescribed {
+            Some(p) => qdd.copy_from(p),
+            None => qdd.as_mut_slice().fill(T::zero()),
+        }
         // Allocation-free Cholesky solve of M̄_aa q̈_a = f̄_a − M̄_ap q̈_p on scratch buffers;
         // the active coordinates listed once, `M̄` read from its column-major storage.
         self.work_idx.clear();
@@ -201,7 +273,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         for (r, &i) in self.work_idx.iter().enumerate() {
             let mut b = self.force[i];
             if qdd_prescribed.is_some() {
-                for j in (0..n).filter(|&j| !active[j]) {
+                for j in (0..n).filter(|&j| !active[j] && (!partial || self.needed[j])) {
                     b -= m[j * rows + i] * qdd[j];
                 }
             }
@@ -217,7 +289,16 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         for (r, &i) in self.work_idx.iter().enumerate() {
             qdd[i] = self.work_b[r];
         }
-        Ok(qdd)
+        Ok(())
+    }
+}
+
+/// Copies the lower triangle of the column-major `n × n` matrix `m` onto its upper triangle.
+fn mirror_lower<T: Copy>(m: &mut [T], n: usize) {
+    for col in 0..n {
+        for row in col + 1..n {
+            m[row * n + col] = m[col * n + row];
+        }
     }
 }
 
@@ -245,18 +326,76 @@ impl Dynamics {
         active: &[bool],
         qdd_prescribed: Option<&DVector<f64>>,
     ) -> Result<DVector<f64>, DynamicsError> {
-        if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
+        let mut qdd = DVector::zeros(q.len());
+        self.accelerations_into(model, q, qd, active, qdd_prescribed, &mut qdd)?;
+        Ok(qdd)
+    }
+
+    /// As [`Self::accelerations`], writing `q̈` into `qdd` (of `q`'s length); without
+    /// allocating when the model has no infinitesimal bodies.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`].
+    pub fn accelerations_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.solve_into(model, q, qd, active, qdd_prescribed, qdd, false)
+    }
+
+    /// As [`Self::accelerations_into`], assembling only the entries of `M̄` and `f̄` the solve
+    /// reads (the rows and columns of the free coordinates and of prescribed ones with a
+    /// nonzero acceleration; see `solve_finite_into`): the same `q̈`, to the bit, for less
+    /// work where coordinates are locked. The workspace's `M̄` and `f̄` are then partial: not
+    /// for energies, momenta or actuator torques. Models with infinitesimal bodies assemble
+    /// fully.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`].
+    pub fn accelerations_of_free_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.solve_into(model, q, qd, active, qdd_prescribed, qdd, true)
+    }
+
+    /// [`Self::accelerations_into`], with a partial assembly when `partial`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_into(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+        partial: bool,
+    ) -> Result<(), DynamicsError> {
+        // On the contiguous storage: nalgebra's matrix iterator is strided.
+        let finite = |x: &DVector<f64>| x.as_slice().iter().all(|v| v.is_finite());
+        if !finite(q) || !finite(qd) {
             return Err(DynamicsError::NonFinite);
         }
         if !self.has_infinitesimal {
-            let qdd = self.accelerations_finite(model, q, qd, active, qdd_prescribed)?;
-            if qdd.iter().any(|v| !v.is_finite()) {
+            self.solve_finite_into(model, q, qd, active, qdd_prescribed, qdd, partial)?;
+            if !finite(qdd) {
                 return Err(DynamicsError::NonFinite);
             }
-            return Ok(qdd);
+            return Ok(());
         }
         self.assemble(model, q, qd, None);
-        self.solve_assembled_limit(active, qdd_prescribed)
+        *qdd = self.solve_assembled_limit(active, qdd_prescribed)?;
+        Ok(())
     }
 
     /// The vanishing-mass limit of `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p` on the matrices already

@@ -28,6 +28,45 @@ pub struct KinematicsOf<T: Scalar> {
     pub a_bias_link_m_s2: Vec<Vector3<T>>,
 }
 
+/// A revolute axis along one of the parent frame's own axes (`+x`, `+y`, `+z`): the joint's
+/// rotation mixes two columns of the parent's rotation, with one `sin_cos`, instead of a full
+/// rotation matrix and a 3 × 3 product (the same rotation, `R·e_k` exact where the general
+/// formula rounds `c + (1 − c)`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CoordinateAxis {
+    X,
+    Y,
+    Z,
+}
+
+impl CoordinateAxis {
+    /// The axis `axis` is, exactly, if any.
+    fn of(axis: &Vector3<f64>) -> Option<Self> {
+        match (axis.x, axis.y, axis.z) {
+            (1.0, 0.0, 0.0) => Some(Self::X),
+            (0.0, 1.0, 0.0) => Some(Self::Y),
+            (0.0, 0.0, 1.0) => Some(Self::Z),
+            _ => None,
+        }
+    }
+
+    /// The joint axis in the floor frame and `r_p · R_k(angle)`, for a parent rotation `r_p`.
+    fn rotate<T: RealField + Copy>(self, r_p: &Matrix3<T>, angle: T) -> (Vector3<T>, Matrix3<T>) {
+        let (s, c) = angle.sin_cos();
+        // Columns i, j of `r_p` rotate into c·i + s·j and c·j − s·i, about the third.
+        let (i, j, k) = match self {
+            Self::X => (1, 2, 0),
+            Self::Y => (2, 0, 1),
+            Self::Z => (0, 1, 2),
+        };
+        let (ci, cj) = (r_p.column(i).into_owned(), r_p.column(j).into_owned());
+        let mut r = *r_p;
+        r.set_column(i, &(ci * c + cj * s));
+        r.set_column(j, &(cj * c - ci * s));
+        (r_p.column(k).into_owned(), r)
+    }
+}
+
 /// A model vector in the scalar `T`.
 fn lift<T: RealField + Copy>(v: &Vector3<f64>) -> Vector3<T> {
     v.map(nalgebra::convert)
@@ -79,9 +118,15 @@ impl<T: RealField + Copy> KinematicsOf<T> {
             };
             match &link.joint {
                 JointKind::Revolute { axis_parent } => {
-                    let a = r_p * lift::<T>(axis_parent);
+                    let (a, r) = match CoordinateAxis::of(axis_parent) {
+                        Some(k) => k.rotate(&r_p, qi),
+                        None => (
+                            r_p * lift::<T>(axis_parent),
+                            r_p * rotation_about(axis_parent, qi),
+                        ),
+                    };
                     self.axis_floor[i] = a;
-                    self.r_floor_link[i] = r_p * rotation_about(axis_parent, qi);
+                    self.r_floor_link[i] = r;
                     self.p_floor_link_m[i] = o;
                     self.omega_floor_rad_s[i] = w_p + a * qdi;
                     self.v_floor_link_m_s[i] = v_o;

@@ -25,6 +25,12 @@ pub struct NewtonSettings {
     pub perturbation: f64,
     /// Central (true) or forward (false) differences.
     pub central: bool,
+    /// The Jacobian that only steps Newton (not the one at the converged point, whose
+    /// eigenvalues are the gait's) by forward differences that reuse the nominal stride: `n`
+    /// strides instead of `2n`. Its `O(perturbation)` error only slows the chord iteration's
+    /// linear convergence by about that factor; the fixed point is where the residual
+    /// vanishes, as with central differences. False: the stepping Jacobian as `central` says.
+    pub forward_stepping: bool,
     /// Step halvings allowed when a full Newton step lands where the stride fails or the
     /// residual grows (0: the plain iteration of eq. 26).
     pub max_halvings: usize,
@@ -56,6 +62,7 @@ impl Default for NewtonSettings {
             max_iterations: 30,
             perturbation: 1e-6,
             central: true,
+            forward_stepping: true,
             max_halvings: 8,
             frozen_steps: false,
             jacobian: JacobianMethod::CentralDifferences,
@@ -103,6 +110,9 @@ pub struct Gait {
     pub eigenvalues: Vec<Complex<f64>>,
     /// Newton iterations.
     pub iterations: usize,
+    /// Strides the search integrated: one per iterate and trial step, and those of the
+    /// Jacobians (a variational Jacobian counts one).
+    pub strides: usize,
     /// `|S(v) − v|` at the fixed point (∞-norm).
     pub residual: f64,
     /// The stride from the fixed point.
@@ -260,6 +270,38 @@ impl<'a> GaitSearch<'a> {
         Ok(j)
     }
 
+    /// The Jacobian that steps Newton at `v` (whose stride is `s_v`), as
+    /// [`Self::stride_jacobian_by`] but by forward differences when `newton.forward_stepping`;
+    /// with the method used and whether its differences were central.
+    fn stepping_jacobian(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, JacobianMethod, bool), StrideFailure> {
+        let central = self.newton.central && !self.newton.forward_stepping;
+        let newton = NewtonSettings {
+            central,
+            ..*self.newton
+        };
+        let (j, method) = GaitSearch {
+            newton: &newton,
+            ..*self
+        }
+        .stride_jacobian_by(v, s_v)?;
+        Ok((j, method, central))
+    }
+
+    /// Strides one Jacobian of an `n`-vector took by `method` (`central` differences or not).
+    fn jacobian_strides(&self, n: usize, method: JacobianMethod, central: bool) -> usize {
+        match method {
+            JacobianMethod::Variational => 1,
+            JacobianMethod::CentralDifferences => {
+                let nominal = usize::from(self.newton.frozen_steps);
+                n * if central { 2 } else { 1 } + nominal
+            }
+        }
+    }
+
     /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
     ///
     /// # Errors
@@ -276,6 +318,7 @@ impl<'a> GaitSearch<'a> {
         let mut last_residual = f64::INFINITY;
         // The accepted trial's stride, reused as the next iteration's.
         let mut carried: Option<(DVector<f64>, StrideResult)> = None;
+        let mut strides = 0;
         for it in 0..=settings.max_iterations {
             let fail = |failure| NewtonError::StrideFailed {
                 iteration: it,
@@ -283,11 +326,15 @@ impl<'a> GaitSearch<'a> {
             };
             let (s, stride) = match carried.take() {
                 Some(c) => c,
-                None => self.stride_map(&v).map_err(fail)?,
+                None => {
+                    strides += 1;
+                    self.stride_map(&v).map_err(fail)?
+                }
             };
             let r = &s - &v;
             if last_step < settings.tolerance {
                 let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
+                strides += self.jacobian_strides(n, jacobian_method, self.newton.central);
                 let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
                 return Ok(Gait {
                     jacobian_method,
@@ -295,6 +342,7 @@ impl<'a> GaitSearch<'a> {
                     jacobian: j,
                     eigenvalues,
                     iterations: it,
+                    strides,
                     residual: r.amax(),
                     stride,
                 });
@@ -305,7 +353,11 @@ impl<'a> GaitSearch<'a> {
             let r_norm_now = r.amax();
             let j = match kept.take() {
                 Some(j) if r_norm_now <= 0.25 * last_residual => j,
-                _ => self.stride_jacobian_by(&v, &s).map_err(fail)?.0,
+                _ => {
+                    let (j, method, central) = self.stepping_jacobian(&v, &s).map_err(fail)?;
+                    strides += self.jacobian_strides(n, method, central);
+                    j
+                }
             };
             last_residual = r_norm_now;
             let a = DMatrix::identity(n, n) - &j;
@@ -320,6 +372,7 @@ impl<'a> GaitSearch<'a> {
             let mut accepted = settings.max_halvings == 0;
             for _ in 0..settings.max_halvings {
                 let trial = &v + &dv * lambda;
+                strides += 1;
                 match self.stride_map(&trial) {
                     Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
                         carried = Some((st, sr));

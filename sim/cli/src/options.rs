@@ -123,6 +123,7 @@ impl Common {
             max_iterations: self.newton_max_iter,
             perturbation: self.perturbation,
             central: true,
+            forward_stepping: true,
             max_halvings: 8,
             frozen_steps: self.frozen_steps,
             jacobian: match self.jacobian.as_str() {

@@ -39,6 +39,9 @@ pub struct Phase<'a> {
     pub active: Vec<bool>,
     /// A coordinate driven along a profile (not free, not locked).
     pub prescribed: Option<(CoordIndex, Drive)>,
+    /// Scratch for a driven evaluation: `q`, `q̇` with the drive's angle and rate put in, and
+    /// the prescribed accelerations (zero but the driven coordinate's).
+    driven: (DVector<f64>, DVector<f64>, DVector<f64>),
 }
 
 impl<'a> Phase<'a> {
@@ -55,6 +58,11 @@ impl<'a> Phase<'a> {
             planar: PlanarTree::for_path(model, path),
             active: vec![true; model.dof()],
             prescribed: None,
+            driven: (
+                DVector::zeros(model.dof()),
+                DVector::zeros(model.dof()),
+                DVector::zeros(model.dof()),
+            ),
         }
     }
 
@@ -144,6 +152,39 @@ impl SecondOrderSystem for Phase<'_> {
             Some(p) if out.len() == q.len() => {
                 let drive = self.drive_at(t);
                 p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
+            }
+            // The general engine's solve straight into `out` with the arithmetic of
+            // `hybrid::phase::accelerations`, without allocating, assembling only what the
+            // solve reads (the workspace's `M̄`, `f̄` are partial afterwards: whatever reads
+            // them, `actuator_torque` and `linearised_limit`, assembles again).
+            None if out.len() == q.len() && self.driven.0.len() == q.len() => {
+                match self.drive_at(t) {
+                    None => self.dynamics.accelerations_of_free_into(
+                        self.model,
+                        q,
+                        qd,
+                        &self.active,
+                        None,
+                        out,
+                    ),
+                    Some(d) => {
+                        let (dq, dqd, qdd_p) = &mut self.driven;
+                        dq.copy_from(q);
+                        dqd.copy_from(qd);
+                        dq[d.coordinate] = d.angle_rad;
+                        dqd[d.coordinate] = d.rate_rad_s;
+                        qdd_p.as_mut_slice().fill(0.0);
+                        qdd_p[d.coordinate] = d.acceleration_rad_s2;
+                        self.dynamics.accelerations_of_free_into(
+                            self.model,
+                            dq,
+                            dqd,
+                            &self.active,
+                            Some(qdd_p),
+                            out,
+                        )
+                    }
+                }
             }
             _ => {
                 *out = self.accelerations(t, q, qd)?;
