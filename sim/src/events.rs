@@ -29,8 +29,7 @@ impl Direction {
 /// Tolerances for event location.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct EventTolerance {
-    /// Stop refining when the bracket is this narrow [s], or, at the first exact step after a
-    /// dense-output estimate, when the Newton correction with the dense slope is this small.
+    /// Stop refining when the bracket is this narrow [s].
     pub time_s: f64,
     /// Or when the witness is this close to zero (its own unit).
     pub witness: f64,
@@ -117,11 +116,7 @@ pub fn locate(
 /// The refinement of an event's estimate `guess` (with the witness's slope there when it came
 /// from a dense output): the Illinois method on exact steps (`exact(t)`: the sample at `t` and
 /// its witness value), bracketed by the step's start `(t_a, g_a)` and its end `b` (at `t_b`,
-/// witness `g_b`). Written once for [`locate`] and the fixed-size stride. Done when the
-/// witness is within its tolerance, the bracket narrower than the time tolerance, or — at the
-/// dense estimate, the first exact step — the Newton correction `g / slope` with the dense
-/// output's slope no larger than the time tolerance (the root then lies within it of the
-/// step's time: the one more exact step it would take moves the event by less than that).
+/// witness `g_b`). Written once for [`locate`] and the fixed-size stride.
 ///
 /// # Errors
 /// [`EventError`]: a failed step, or no convergence within the tolerance's budget.
@@ -145,13 +140,6 @@ pub(crate) fn refine<S: Clone>(
         best = s;
         if gt.abs() <= tol.witness || bracket.width() <= tol.time_s {
             return Ok(best);
-        }
-        // At the dense estimate: when the Newton correction with the dense output's slope is
-        // already within the time tolerance, the root is located to it without another step.
-        if let (0, Some(d)) = (it, slope) {
-            if d != 0.0 && d.is_finite() && (gt / d).abs() <= tol.time_s {
-                return Ok(best);
-            }
         }
         let t_prev = t;
         bracket.update(t, gt);
