@@ -89,10 +89,23 @@ mod tests {
         }
         // The ends of the kernel range, one ulp either side, and outside it.
         let high = |w: u32| f64::from_bits(u64::from(w) << 32);
-        let mut edges = vec![0.0, -0.0, 1e-300, 1e-9, 3.0, -100.0, f64::NAN, f64::INFINITY];
+        let mut edges = vec![
+            0.0,
+            -0.0,
+            1e-300,
+            1e-9,
+            3.0,
+            -100.0,
+            f64::NAN,
+            f64::INFINITY,
+        ];
         for w in [KERNEL_LOW, KERNEL_HIGH, KERNEL_HIGH + 1] {
             let x = high(w);
-            for y in [x, f64::from_bits(x.to_bits() - 1), f64::from_bits(x.to_bits() + 1)] {
+            for y in [
+                x,
+                f64::from_bits(x.to_bits() - 1),
+                f64::from_bits(x.to_bits() + 1),
+            ] {
                 edges.extend([y, -y, y + high(w) * 1e-9]);
             }
         }
