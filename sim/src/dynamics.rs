@@ -413,7 +413,12 @@ impl Dynamics {
         for (j, needed) in self.needed.iter_mut().enumerate() {
             *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != 0.0);
         }
-        if self.needed.iter().zip(&self.assembled).any(|(&n, &a)| n && !a) {
+        if self
+            .needed
+            .iter()
+            .zip(&self.assembled)
+            .any(|(&n, &a)| n && !a)
+        {
             return Ok(false);
         }
         self.solve_assembled_finite_into(active, qdd_prescribed, qdd, true)?;

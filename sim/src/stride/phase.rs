@@ -105,7 +105,9 @@ fn accelerations_of_free(
     qdd_prescribed: Option<&DVector<f64>>,
     out: &mut DVector<f64>,
 ) -> Result<(), DynamicsError> {
-    if key.is(q, qd, active) && dynamics.accelerations_on_assembly_into(active, qdd_prescribed, out)? {
+    if key.is(q, qd, active)
+        && dynamics.accelerations_on_assembly_into(active, qdd_prescribed, out)?
+    {
         return Ok(());
     }
     key.valid = false;
@@ -379,4 +381,89 @@ pub fn linearised_limit(
         lambda_max_rad_s: lambda,
         beta,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limit_cycle::NewtonSettings;
+    use crate::scene::Scene;
+
+    /// The torque and the accelerations solved on the workspace's assembly equal, to the bit,
+    /// those of a fresh phase (a full general evaluation, and a partial assembly there).
+    #[test]
+    fn solving_on_the_last_assembly_is_bit_for_bit_a_fresh_evaluation() {
+        let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
+        let gait = setup.find_gait(&NewtonSettings::default()).unwrap();
+        let walker = &setup.walker;
+        let ankle = walker.ankle.as_ref().unwrap().ankle;
+        let (q, qd) = walker.unpack(&gait.fixed_point);
+        let seg = |t0_s: f64, p0_rad: f64, v0_rad_s: f64, v1_rad_s: f64| ActuatorSegment {
+            t0_s,
+            t1_s: t0_s + 1e-3,
+            p0_rad,
+            v0_rad_s,
+            p1_rad: p0_rad + 1e-3 * v0_rad_s,
+            v1_rad_s,
+            released: false,
+        };
+        let (old, new) = (
+            seg(0.099, q[ankle.0], 0.5, 1.5),
+            seg(0.1, q[ankle.0], 1.5, 3.0),
+        );
+        let phase_with = |s: ActuatorSegment| {
+            let mut p = Phase::new(&walker.model);
+            p.active[ankle.0] = false;
+            p.prescribed = Some((ankle, Drive::Segment(s)));
+            p
+        };
+        let mut at = Sample {
+            t_s: 0.1,
+            q: q.clone(),
+            qd: qd.clone(),
+        };
+        let mut phase = phase_with(old);
+        phase.snap(&mut at);
+        let mut qdd = DVector::zeros(q.len());
+        phase
+            .accelerations_into(0.1, &at.q, &at.qd, &mut qdd)
+            .unwrap();
+        assert!(phase.assembled_at.is(
+            &phase.driven.0.clone(),
+            &phase.driven.1.clone(),
+            &phase.active
+        ));
+        let torque = phase.actuator_torque(&at).unwrap();
+        let fresh = phase_with(old).actuator_torque(&at).unwrap();
+        assert_eq!(torque.0.to_bits(), fresh.0.to_bits());
+        assert_eq!(torque.1.to_bits(), fresh.1.to_bits());
+        // Another drive acceleration at the same angle and rate (the new segment's rate at its
+        // start equals the old one's at its end here only in the acceleration's input): a
+        // solve on the assembly, the same bits as a fresh evaluation.
+        let (p_old, v_old, _) = old.eval(0.1);
+        let (_, _, a_new) = new.eval(0.1);
+        let other = ActuatorSegment {
+            t0_s: 0.1,
+            t1_s: 0.101,
+            p0_rad: p_old,
+            v0_rad_s: v_old,
+            p1_rad: p_old + 1e-3 * v_old + 1e-7,
+            v1_rad_s: v_old + 1e-3 * a_new,
+            released: false,
+        };
+        phase.prescribed = Some((ankle, Drive::Segment(other)));
+        let mut reused = DVector::zeros(q.len());
+        phase
+            .accelerations_into(0.1, &at.q, &at.qd, &mut reused)
+            .unwrap();
+        let mut again = DVector::zeros(q.len());
+        phase_with(other)
+            .accelerations_into(0.1, &at.q, &at.qd, &mut again)
+            .unwrap();
+        assert!(reused
+            .iter()
+            .zip(again.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert_ne!(reused, qdd);
+    }
 }
