@@ -51,6 +51,9 @@ pub struct DynamicsOf<T: Scalar> {
     rotational: Vec<bool>,
     /// Scratch: the coordinates whose rows and columns a partial assembly computes.
     needed: Vec<bool>,
+    /// The coordinates whose rows and columns the last assembly computed (all after a full
+    /// one).
+    assembled: Vec<bool>,
 }
 
 impl<T: RealField + Copy> DynamicsOf<T> {
@@ -87,6 +90,7 @@ impl<T: RealField + Copy> DynamicsOf<T> {
                 .map(|l| l.body.inertia_com_kg_m2.iter().any(|v| *v != 0.0))
                 .collect(),
             needed: vec![true; n],
+            assembled: vec![true; n],
         }
     }
 
@@ -114,6 +118,9 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         partial: bool,
     ) {
         self.kin.update(model, q, qd);
+        for (j, assembled) in self.assembled.iter_mut().enumerate() {
+            *assembled = !partial || self.needed[j];
+        }
         // On the contiguous storage: nalgebra's `fill` walks a strided iterator per entry.
         self.mass_matrix.as_mut_slice().fill(T::zero());
         self.mass_matrix_infinitesimal
@@ -253,13 +260,26 @@ impl<T: RealField + Copy> DynamicsOf<T> {
         if self.has_infinitesimal {
             return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
         }
-        let n = q.len();
         if partial {
             for (j, needed) in self.needed.iter_mut().enumerate() {
                 *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != T::zero());
             }
         }
         self.assemble_entries(model, q, qd, None, partial);
+        self.solve_assembled_finite_into(active, qdd_prescribed, qdd, partial)
+    }
+
+    /// The solve of [`Self::solve_finite_into`] on the matrices already assembled here:
+    /// `M̄_aa q̈_a = f̄_a − M̄_ap q̈_p`, reading, when `partial`, only the prescribed
+    /// coordinates marked in `self.needed`.
+    fn solve_assembled_finite_into(
+        &mut self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<T>>,
+        qdd: &mut DVector<T>,
+        partial: bool,
+    ) -> Result<(), DynamicsError> {
+        let n = qdd.len();
         match qdd_prescribed {
             Some(p) => qdd.copy_from(p),
             None => qdd.as_mut_slice().fill(T::zero()),
@@ -367,6 +387,51 @@ impl Dynamics {
         qdd: &mut DVector<f64>,
     ) -> Result<(), DynamicsError> {
         self.solve_into(model, q, qd, active, qdd_prescribed, qdd, true)
+    }
+
+    /// As [`Self::accelerations_of_free_into`] at the `q`, `q̇` of the workspace's last
+    /// assembly, on that assembly: only the solve, for another set of prescribed accelerations
+    /// (the assembly depends on `q`, `q̇` only). `Ok(false)`, and nothing written, when the last
+    /// assembly did not compute every row and column this solve reads (the free coordinates and
+    /// the prescribed ones with a nonzero acceleration) or the model has infinitesimal bodies.
+    /// The caller vouches that the workspace was last assembled (by this type's methods, its
+    /// `M̄` and `f̄` untouched since) at the `q`, `q̇` it means: the result is then, to the bit,
+    /// that of [`Self::accelerations_of_free_into`] there.
+    ///
+    /// # Errors
+    /// As [`Self::accelerations`].
+    pub fn accelerations_on_assembly_into(
+        &mut self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        let n = self.assembled.len();
+        if self.has_infinitesimal || active.len() != n || qdd.len() != n {
+            return Ok(false);
+        }
+        for (j, needed) in self.needed.iter_mut().enumerate() {
+            *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != 0.0);
+        }
+        if self
+            .needed
+            .iter()
+            .zip(&self.assembled)
+            .any(|(&n, &a)| n && !a)
+        {
+            return Ok(false);
+        }
+        self.solve_assembled_finite_into(active, qdd_prescribed, qdd, true)?;
+        if !qdd.as_slice().iter().all(|v| v.is_finite()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        Ok(true)
+    }
+
+    /// Whether the last assembly computed coordinate `c`'s row and column of `M̄` and its
+    /// entry of `f̄` (always after a full assembly).
+    pub fn assembled_row(&self, c: usize) -> bool {
+        self.assembled.get(c).copied().unwrap_or(false)
     }
 
     /// [`Self::accelerations_into`], with a partial assembly when `partial`.

@@ -42,6 +42,78 @@ pub struct Phase<'a> {
     /// Scratch for a driven evaluation: `q`, `q̇` with the drive's angle and rate put in, and
     /// the prescribed accelerations (zero but the driven coordinate's).
     driven: (DVector<f64>, DVector<f64>, DVector<f64>),
+    /// Where the general engine's workspace was last assembled by this phase's partial
+    /// evaluations (`None` after anything else used it).
+    assembled_at: AssemblyKey,
+}
+
+/// The state (`q`, `q̇` as evaluated: the drive's angle and rate put in) and free set of the
+/// workspace's last assembly. Another evaluation there (the first stage after a tick's new
+/// segment, at the state where the step before it ended; the string's torque at that tick)
+/// solves on that assembly instead of assembling again: `M̄`, `f̄` depend on `q`, `q̇`
+/// only, not on the drive's acceleration, so the result is the same to the bit. Compared
+/// bit for bit.
+#[derive(Clone, Debug)]
+struct AssemblyKey {
+    valid: bool,
+    q: DVector<f64>,
+    qd: DVector<f64>,
+    active: Vec<bool>,
+}
+
+impl AssemblyKey {
+    fn new(n: usize) -> Self {
+        Self {
+            valid: false,
+            q: DVector::zeros(n),
+            qd: DVector::zeros(n),
+            active: vec![false; n],
+        }
+    }
+
+    fn is(&self, q: &DVector<f64>, qd: &DVector<f64>, active: &[bool]) -> bool {
+        let same = |a: &DVector<f64>, b: &DVector<f64>| {
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b.iter())
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        self.valid && self.active == active && same(&self.q, q) && same(&self.qd, qd)
+    }
+
+    fn set(&mut self, q: &DVector<f64>, qd: &DVector<f64>, active: &[bool]) {
+        self.valid = self.q.len() == q.len() && self.qd.len() == qd.len();
+        if self.valid {
+            self.q.copy_from(q);
+            self.qd.copy_from(qd);
+            self.active.clear();
+            self.active.extend_from_slice(active);
+        }
+    }
+}
+
+/// `q̈` by the general engine's partial assembly at (`q`, `q̇`), or by a solve on the
+/// workspace's assembly when `key` says it was made there; `key` follows.
+#[allow(clippy::too_many_arguments)]
+fn accelerations_of_free(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    key: &mut AssemblyKey,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    active: &[bool],
+    qdd_prescribed: Option<&DVector<f64>>,
+    out: &mut DVector<f64>,
+) -> Result<(), DynamicsError> {
+    if key.is(q, qd, active)
+        && dynamics.accelerations_on_assembly_into(active, qdd_prescribed, out)?
+    {
+        return Ok(());
+    }
+    key.valid = false;
+    dynamics.accelerations_of_free_into(model, q, qd, active, qdd_prescribed, out)?;
+    key.set(q, qd, active);
+    Ok(())
 }
 
 impl<'a> Phase<'a> {
@@ -63,6 +135,7 @@ impl<'a> Phase<'a> {
                 DVector::zeros(model.dof()),
                 DVector::zeros(model.dof()),
             ),
+            assembled_at: AssemblyKey::new(model.dof()),
         }
     }
 
@@ -78,14 +151,56 @@ impl<'a> Phase<'a> {
     /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
     /// coordinate's rate: their product is the actuator power.
     pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
-        let Some((c, _)) = self.prescribed else {
+        let Some((c, drive)) = self.prescribed else {
             return Ok((0.0, 0.0));
         };
+        if let Some(tau) = self.torque_on_assembly(c.0, &drive, s)? {
+            return Ok((tau, s.qd[c.0]));
+        }
         // The general path: its workspace keeps the assembled M̄ and f̄ read below.
         let qdd = self.general_accelerations(s.t_s, &s.q, &s.qd)?;
         let m = &self.dynamics.mass_matrix;
         let tau = (m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0];
         Ok((tau, s.qd[c.0]))
+    }
+
+    /// The actuator torque at `s` from the workspace's assembly, when it was made at `s` (as
+    /// evaluated, the drive's angle and rate put in) and computed the driven coordinate's row:
+    /// the step that ended at `s` evaluated its last stage there. The same arithmetic as the
+    /// general path (its `q̈` the same to the bit; the row's entries the assembly skipped are
+    /// those of locked coordinates, whose `q̈` is zero). `None` otherwise.
+    fn torque_on_assembly(
+        &mut self,
+        c: usize,
+        drive: &Drive,
+        s: &Sample,
+    ) -> Result<Option<f64>, DynamicsError> {
+        if self.planar.is_some() || !self.dynamics.assembled_row(c) {
+            return Ok(None);
+        }
+        let (angle_rad, rate_rad_s, acceleration_rad_s2) = drive.eval(s.t_s);
+        let (dq, dqd, qdd_p) = &mut self.driven;
+        if dq.len() != s.q.len() || dqd.len() != s.qd.len() {
+            return Ok(None);
+        }
+        dq.copy_from(&s.q);
+        dqd.copy_from(&s.qd);
+        dq[c] = angle_rad;
+        dqd[c] = rate_rad_s;
+        if !self.assembled_at.is(dq, dqd, &self.active) {
+            return Ok(None);
+        }
+        qdd_p.as_mut_slice().fill(0.0);
+        qdd_p[c] = acceleration_rad_s2;
+        let mut qdd = DVector::zeros(s.q.len());
+        if !self
+            .dynamics
+            .accelerations_on_assembly_into(&self.active, Some(qdd_p), &mut qdd)?
+        {
+            return Ok(None);
+        }
+        let m = &self.dynamics.mass_matrix;
+        Ok(Some((m.row(c) * &qdd)[(0, 0)] - self.dynamics.force[c]))
     }
 
     /// Whether this phase evaluates along the planar fast path.
@@ -114,6 +229,7 @@ impl<'a> Phase<'a> {
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
         let drive = self.drive_at(t);
+        self.assembled_at.valid = false;
         crate::hybrid::phase::accelerations(
             self.model,
             &mut self.dynamics,
@@ -135,6 +251,7 @@ impl SecondOrderSystem for Phase<'_> {
         match &self.planar {
             Some(p) => {
                 let drive = self.drive_at(t);
+                self.assembled_at.valid = false;
                 p.accelerations(&mut self.dynamics, &self.active, drive.as_ref(), q, qd)
             }
             None => self.general_accelerations(t, q, qd),
@@ -151,6 +268,7 @@ impl SecondOrderSystem for Phase<'_> {
         match &self.planar {
             Some(p) if out.len() == q.len() => {
                 let drive = self.drive_at(t);
+                self.assembled_at.valid = false;
                 p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
             }
             // The general engine's solve straight into `out` with the arithmetic of
@@ -159,8 +277,10 @@ impl SecondOrderSystem for Phase<'_> {
             // them, `actuator_torque` and `linearised_limit`, assembles again).
             None if out.len() == q.len() && self.driven.0.len() == q.len() => {
                 match self.drive_at(t) {
-                    None => self.dynamics.accelerations_of_free_into(
+                    None => accelerations_of_free(
                         self.model,
+                        &mut self.dynamics,
+                        &mut self.assembled_at,
                         q,
                         qd,
                         &self.active,
@@ -175,8 +295,10 @@ impl SecondOrderSystem for Phase<'_> {
                         dqd[d.coordinate] = d.rate_rad_s;
                         qdd_p.as_mut_slice().fill(0.0);
                         qdd_p[d.coordinate] = d.acceleration_rad_s2;
-                        self.dynamics.accelerations_of_free_into(
+                        accelerations_of_free(
                             self.model,
+                            &mut self.dynamics,
+                            &mut self.assembled_at,
                             dq,
                             dqd,
                             &self.active,
@@ -199,6 +321,7 @@ impl SecondOrderSystem for Phase<'_> {
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Option<StabilityLimit> {
+        self.assembled_at.valid = false;
         linearised_limit(self.model, &mut self.dynamics, q, qd, &self.active)
     }
 }
@@ -258,4 +381,89 @@ pub fn linearised_limit(
         lambda_max_rad_s: lambda,
         beta,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limit_cycle::NewtonSettings;
+    use crate::scene::Scene;
+
+    /// The torque and the accelerations solved on the workspace's assembly equal, to the bit,
+    /// those of a fresh phase (a full general evaluation, and a partial assembly there).
+    #[test]
+    fn solving_on_the_last_assembly_is_bit_for_bit_a_fresh_evaluation() {
+        let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
+        let gait = setup.find_gait(&NewtonSettings::default()).unwrap();
+        let walker = &setup.walker;
+        let ankle = walker.ankle.as_ref().unwrap().ankle;
+        let (q, qd) = walker.unpack(&gait.fixed_point);
+        let seg = |t0_s: f64, p0_rad: f64, v0_rad_s: f64, v1_rad_s: f64| ActuatorSegment {
+            t0_s,
+            t1_s: t0_s + 1e-3,
+            p0_rad,
+            v0_rad_s,
+            p1_rad: p0_rad + 1e-3 * v0_rad_s,
+            v1_rad_s,
+            released: false,
+        };
+        let (old, new) = (
+            seg(0.099, q[ankle.0], 0.5, 1.5),
+            seg(0.1, q[ankle.0], 1.5, 3.0),
+        );
+        let phase_with = |s: ActuatorSegment| {
+            let mut p = Phase::new(&walker.model);
+            p.active[ankle.0] = false;
+            p.prescribed = Some((ankle, Drive::Segment(s)));
+            p
+        };
+        let mut at = Sample {
+            t_s: 0.1,
+            q: q.clone(),
+            qd: qd.clone(),
+        };
+        let mut phase = phase_with(old);
+        phase.snap(&mut at);
+        let mut qdd = DVector::zeros(q.len());
+        phase
+            .accelerations_into(0.1, &at.q, &at.qd, &mut qdd)
+            .unwrap();
+        assert!(phase.assembled_at.is(
+            &phase.driven.0.clone(),
+            &phase.driven.1.clone(),
+            &phase.active
+        ));
+        let torque = phase.actuator_torque(&at).unwrap();
+        let fresh = phase_with(old).actuator_torque(&at).unwrap();
+        assert_eq!(torque.0.to_bits(), fresh.0.to_bits());
+        assert_eq!(torque.1.to_bits(), fresh.1.to_bits());
+        // Another drive acceleration at the same angle and rate (the new segment's rate at its
+        // start equals the old one's at its end here only in the acceleration's input): a
+        // solve on the assembly, the same bits as a fresh evaluation.
+        let (p_old, v_old, _) = old.eval(0.1);
+        let (_, _, a_new) = new.eval(0.1);
+        let other = ActuatorSegment {
+            t0_s: 0.1,
+            t1_s: 0.101,
+            p0_rad: p_old,
+            v0_rad_s: v_old,
+            p1_rad: p_old + 1e-3 * v_old + 1e-7,
+            v1_rad_s: v_old + 1e-3 * a_new,
+            released: false,
+        };
+        phase.prescribed = Some((ankle, Drive::Segment(other)));
+        let mut reused = DVector::zeros(q.len());
+        phase
+            .accelerations_into(0.1, &at.q, &at.qd, &mut reused)
+            .unwrap();
+        let mut again = DVector::zeros(q.len());
+        phase_with(other)
+            .accelerations_into(0.1, &at.q, &at.qd, &mut again)
+            .unwrap();
+        assert!(reused
+            .iter()
+            .zip(again.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert_ne!(reused, qdd);
+    }
 }

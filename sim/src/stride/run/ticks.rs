@@ -52,6 +52,51 @@ fn clear_of_floor(from: &WitnessValues, to: &WitnessValues, t_s: f64) -> bool {
     height_m > CLEAR_OF_FLOOR_M
 }
 
+/// The largest rounding difference [rad, rad/s] between the ending segment's angle and rate
+/// at the tick (its `x = (t − t0)/h` only near 1 in stride time) and its end knot that
+/// [`continue_at_tick`] absorbs.
+const KNOT_ROUNDING: f64 = 1e-12;
+
+/// The tick's moving segment `next` taking effect at stride time `t_s` after `ended` (the
+/// segment in force until then), both engaged: when the firmware's knot is continuous (the end
+/// knot of `ended` is exactly the start knot of `next`, angle and rate, checked here per tick),
+/// `next` starts at `t_s` from `ended`'s angle and rate at `t_s` exactly (they differ from
+/// the knot by rounding only: the two segments' clocks are shifted to stride time by
+/// rounding). The plant's angle and rate are then the same bits on both sides of the tick, so
+/// the next step's first stage is evaluated on the assembly of the last stage of the step that
+/// ended there (`Phase`'s assembly key). Any other pair is returned unchanged.
+fn continue_at_tick(
+    ended: Option<&ActuatorSegment>,
+    next: ActuatorSegment,
+    t_s: f64,
+) -> ActuatorSegment {
+    let Some(ended) = ended else {
+        return next;
+    };
+    let continuous = !ended.released
+        && !next.released
+        && !next.is_held()
+        && ended.p1_rad.to_bits() == next.p0_rad.to_bits()
+        && ended.v1_rad_s.to_bits() == next.v0_rad_s.to_bits();
+    if !continuous {
+        return next;
+    }
+    let (angle_rad, rate_rad_s, _) = ended.eval(t_s);
+    if (angle_rad - next.p0_rad).abs() > KNOT_ROUNDING
+        || (rate_rad_s - next.v0_rad_s).abs() > KNOT_ROUNDING
+        || (t_s - next.t0_s).abs() > TICK_SLACK_S
+    {
+        return next;
+    }
+    ActuatorSegment {
+        t0_s: t_s,
+        t1_s: t_s + (next.t1_s - next.t0_s),
+        p0_rad: angle_rad,
+        v0_rad_s: rate_rad_s,
+        ..next
+    }
+}
+
 /// What the stance ankle's sensors see at `s` (stride time; `t_walk_start_s` the walk time
 /// at the start of the stride). `swing_foot_on_floor`: when already known (the witnesses of
 /// this sample, or a foot clear of the floor), else from the kinematics.
@@ -168,7 +213,7 @@ impl Run<'_, '_, '_> {
     }
 
     /// The tick's segment takes effect at `cur`.
-    fn apply_segment(&mut self, seg: ActuatorSegment) {
+    fn apply_segment(&mut self, mut seg: ActuatorSegment) {
         let (cur, phase) = (&mut self.cur, &mut self.phase);
         if let Some((coord, Drive::Segment(_))) = phase.prescribed {
             if seg.released {
@@ -185,6 +230,7 @@ impl Run<'_, '_, '_> {
                 });
                 self.event_states.push((cur.clone(), cur.clone()));
             } else {
+                seg = continue_at_tick(self.segment.as_ref(), seg, cur.t_s);
                 phase.prescribed = Some((coord, Drive::Segment(seg)));
                 phase.snap(cur);
             }
