@@ -21,10 +21,12 @@ use crate::singular_limit::{
 };
 use nalgebra::{DVector, SMatrix, SVector};
 
+mod chain;
 mod three_link;
 mod trig;
 mod two_link;
 
+pub(crate) use chain::Joints;
 pub use trig::sin_cos;
 
 /// Most coordinates a tree may have to take the fast path.

@@ -23,7 +23,8 @@
 //! `f̄ = Sᵀ (Q − …)`: `M̄_ij = sᵢ sⱼ Σ_{k≥i, l≥j} P_kl`, `f̄ᵢ = sᵢ Σ_{k≥i} fₖ`, less the joint
 //! springs and dampers (`k (q − q_rest) + d q̇`), as in the link pass.
 
-use super::{sin_cos, Assembled, LinkFrame, PlanarTree, MAX_LINKS};
+use super::chain::SerialChain;
+use super::{sin_cos, Assembled, PlanarTree};
 use nalgebra::{SMatrix, SVector};
 
 /// A planar three-link serial chain's equations of motion in closed form (see the module's
@@ -50,67 +51,23 @@ impl ThreeLink {
     /// each further joint's link below the previous joint's, every body with mass rigid with
     /// one of the three, none infinitesimal.
     pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
-        if tree.dof != 3 || tree.links.len() > MAX_LINKS || tree.has_infinitesimal {
+        if tree.has_infinitesimal {
             return None;
         }
-        // Each link's nearest joint above it (itself included), as a link index.
-        let mut owner = [None::<usize>; MAX_LINKS];
-        let mut found = Vec::with_capacity(3);
-        for (i, link) in tree.links.iter().enumerate() {
-            let parent_owner = match link.parent_slot {
-                0 => None,
-                s => owner[s - 1],
-            };
-            owner[i] = match link.coordinate {
-                Some(_) => {
-                    found.push((i, parent_owner));
-                    Some(i)
-                }
-                None => parent_owner,
-            };
-        }
-        let [(l1, None), (l2, Some(above2)), (l3, Some(above3))] = found[..] else {
-            return None;
-        };
-        if above2 != l1 || above3 != l2 {
-            return None;
-        }
-        let links = [l1, l2, l3];
-        let joints = [
-            tree.links[l1].coordinate?,
-            tree.links[l2].coordinate?,
-            tree.links[l3].coordinate?,
+        let chain = SerialChain::<3>::of(tree)?;
+        let (d, groups) = (chain.offsets_m, chain.groups[0]);
+        // The mass below each group (μₖ).
+        let below = [
+            groups[1].mass_kg + groups[2].mass_kg,
+            groups[2].mass_kg,
+            0.0,
         ];
-        // Frames at q = 0: every rotation the identity, so origins give the offsets.
-        let fr: [LinkFrame; MAX_LINKS + 1] =
-            tree.frames(&SVector::<f64, 3>::zeros(), &SVector::zeros());
-        let origin = |k: usize| fr[links[k] + 1].origin_m;
-        let sub = |a: [f64; 2], b: [f64; 2]| [a[0] - b[0], a[1] - b[1]];
-        let d = [
-            sub(origin(1), origin(0)),
-            sub(origin(2), origin(1)),
-            [0.0; 2],
-        ];
-        // Lumped groups: mass, first moment and inertia about the joint.
-        let mut mass = [0.0; 3];
-        let mut h = [[0.0; 2]; 3];
-        let mut inertia = [0.0; 3];
-        for body in &tree.bodies {
-            let owner_link = owner.get(body.slot - 1).copied().flatten()?;
-            let k = links.iter().position(|&l| l == owner_link)?;
-            let r = sub(fr[body.slot].origin_m, origin(k));
-            let r = [r[0] + body.com_xy_m[0], r[1] + body.com_xy_m[1]];
-            let m = body.mass_kg;
-            mass[k] += m;
-            h[k][0] += m * r[0];
-            h[k][1] += m * r[1];
-            inertia[k] += body.izz_kg_m2 + m * (r[0] * r[0] + r[1] * r[1]);
-        }
-        let below = [mass[1] + mass[2], mass[2], 0.0];
-        let big_h: [[f64; 2]; 3] =
-            std::array::from_fn(|k| [h[k][0] + below[k] * d[k][0], h[k][1] + below[k] * d[k][1]]);
+        let big_h: [[f64; 2]; 3] = std::array::from_fn(|k| {
+            let h = groups[k].moment_kg_m;
+            [h[0] + below[k] * d[k][0], h[1] + below[k] * d[k][1]]
+        });
         let diagonal_kg_m2 = std::array::from_fn(|k| {
-            inertia[k] + below[k] * (d[k][0] * d[k][0] + d[k][1] * d[k][1])
+            groups[k].inertia_kg_m2 + below[k] * (d[k][0] * d[k][0] + d[k][1] * d[k][1])
         });
         let pair = |k: usize, l: usize| {
             let (dk, hl) = (d[k], big_h[l]);
@@ -121,19 +78,13 @@ impl ThreeLink {
             let hk = big_h[k];
             (hk[0] * gy - hk[1] * gx, hk[0] * gx + hk[1] * gy)
         });
-        let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
-        let springs = [
-            spring(joints[0].0),
-            spring(joints[1].0),
-            spring(joints[2].0),
-        ];
         Some(Self {
-            joints,
+            joints: chain.joints,
             diagonal_kg_m2,
             pairs_kg_m2: [pair(0, 1), pair(1, 2), pair(0, 2)],
             gravity_moments_n_m,
-            springs,
-            has_springs: springs.iter().any(|&(k, _, d)| k != 0.0 || d != 0.0),
+            springs: chain.springs,
+            has_springs: chain.has_springs(),
         })
     }
 

@@ -43,19 +43,9 @@
 //! less the joint springs and dampers (`k (q − q_rest) + d q̇`), as in the link pass. Finite
 //! and infinitesimal bodies lump separately (the `ε` parts of `M̄`, `f̄`).
 
-use super::{sin_cos, Assembled, LinkFrame, PlanarTree, MAX_LINKS};
+use super::chain::{Lumped, SerialChain};
+use super::{sin_cos, Assembled, PlanarTree};
 use nalgebra::{SMatrix, SVector};
-
-/// One group's lumped mass properties about its joint, in its link's frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Lumped {
-    /// Mass [kg].
-    mass_kg: f64,
-    /// First moment `Σ m r` about the joint [kg·m].
-    moment_kg_m: [f64; 2],
-    /// Rotational inertia `Σ (I_zz + m |r|²)` about the joint [kg·m²].
-    inertia_kg_m2: f64,
-}
 
 /// The constants of `M̄` and `f̄` for one part (finite or infinitesimal bodies).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -163,64 +153,13 @@ impl TwoLink {
     /// the first joint's link on the ground through welds only, the second joint's link below
     /// the first's, every body with mass on one of the two.
     pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
-        if tree.dof != 2 || tree.links.len() > MAX_LINKS {
-            return None;
-        }
-        // The joints: each link's nearest joint above it (itself included), as a link index.
-        let mut owner = [None::<usize>; MAX_LINKS];
-        let mut joints = Vec::with_capacity(2);
-        for (i, link) in tree.links.iter().enumerate() {
-            let parent_owner = match link.parent_slot {
-                0 => None,
-                s => owner[s - 1],
-            };
-            owner[i] = match link.coordinate {
-                Some(_) => {
-                    joints.push((i, parent_owner));
-                    Some(i)
-                }
-                None => parent_owner,
-            };
-        }
-        let [(link_a, None), (link_b, Some(above_b))] = joints[..] else {
-            return None;
-        };
-        if above_b != link_a {
-            return None;
-        }
-        let (a, b) = (
-            tree.links[link_a].coordinate?,
-            tree.links[link_b].coordinate?,
-        );
-        // Frames at q = 0: every rotation the identity, so origins give the offsets.
-        let fr: [LinkFrame; MAX_LINKS + 1] =
-            tree.frames(&SVector::<f64, 2>::zeros(), &SVector::zeros());
-        let (o1, o2) = (fr[link_a + 1].origin_m, fr[link_b + 1].origin_m);
-        let d = [o2[0] - o1[0], o2[1] - o1[1]];
-        let mut groups = [[Lumped::default(); 2]; 2];
-        for body in &tree.bodies {
-            let (group, origin) = match owner.get(body.slot - 1).copied().flatten() {
-                Some(l) if l == link_a => (0, o1),
-                Some(l) if l == link_b => (1, o2),
-                _ => return None,
-            };
-            let o = fr[body.slot].origin_m;
-            let r = [
-                o[0] - origin[0] + body.com_xy_m[0],
-                o[1] - origin[1] + body.com_xy_m[1],
-            ];
-            let g = &mut groups[usize::from(body.infinitesimal)][group];
-            let m = body.mass_kg;
-            g.mass_kg += m;
-            g.moment_kg_m[0] += m * r[0];
-            g.moment_kg_m[1] += m * r[1];
-            g.inertia_kg_m2 += body.izz_kg_m2 + m * (r[0] * r[0] + r[1] * r[1]);
-        }
-        let spring = |c: usize| tree.springs.get(c).copied().unwrap_or((0.0, 0.0, 0.0));
-        let (g, sign_ab) = (tree.gravity_m_s2, a.1 * b.1);
-        let finite = PartConstants::of(&groups[0][0], &groups[0][1], d, g, sign_ab);
-        let eps = PartConstants::of(&groups[1][0], &groups[1][1], d, g, sign_ab);
-        let springs = [spring(a.0), spring(b.0)];
+        let chain = SerialChain::<2>::of(tree)?;
+        let [a, b] = chain.joints;
+        let [finite, eps] = chain.groups;
+        let (d, g, sign_ab) = (chain.offsets_m[0], tree.gravity_m_s2, a.1 * b.1);
+        let finite = PartConstants::of(&finite[0], &finite[1], d, g, sign_ab);
+        let eps = PartConstants::of(&eps[0], &eps[1], d, g, sign_ab);
+        let springs = chain.springs;
         let swing_massless = finite.j2_kg_m2 == 0.0
             && finite.h2_kg_m == [0.0; 2]
             && springs[1].0 == 0.0
@@ -238,7 +177,7 @@ impl TwoLink {
             springs,
             solve,
             swapped: a.0 == 1,
-            has_springs: springs.iter().any(|&(k, _, d)| k != 0.0 || d != 0.0),
+            has_springs: chain.has_springs(),
         })
     }
 

@@ -59,6 +59,9 @@ struct AssemblyKey {
     q: DVector<f64>,
     qd: DVector<f64>,
     active: Vec<bool>,
+    /// How many evaluations (accelerations or the actuator torque) solved on the assembly
+    /// instead of assembling again (what the tests read to know the cache was taken).
+    reuses: u64,
 }
 
 impl AssemblyKey {
@@ -68,6 +71,7 @@ impl AssemblyKey {
             q: DVector::zeros(n),
             qd: DVector::zeros(n),
             active: vec![false; n],
+            reuses: 0,
         }
     }
 
@@ -108,6 +112,7 @@ fn accelerations_of_free(
     if key.is(q, qd, active)
         && dynamics.accelerations_on_assembly_into(active, qdd_prescribed, out)?
     {
+        key.reuses += 1;
         return Ok(());
     }
     key.valid = false;
@@ -199,6 +204,7 @@ impl<'a> Phase<'a> {
         {
             return Ok(None);
         }
+        self.assembled_at.reuses += 1;
         let m = &self.dynamics.mass_matrix;
         Ok(Some((m.row(c) * &qdd)[(0, 0)] - self.dynamics.force[c]))
     }
@@ -389,8 +395,9 @@ mod tests {
     use crate::limit_cycle::NewtonSettings;
     use crate::scene::Scene;
 
-    /// The torque and the accelerations solved on the workspace's assembly equal, to the bit,
-    /// those of a fresh phase (a full general evaluation, and a partial assembly there).
+    /// The torque and the accelerations solved on the workspace's assembly (the cache taken
+    /// both times, counted) equal, to the bit, those of a fresh phase (a full general
+    /// evaluation, and a partial assembly there).
     #[test]
     fn solving_on_the_last_assembly_is_bit_for_bit_a_fresh_evaluation() {
         let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
@@ -433,7 +440,10 @@ mod tests {
             &phase.driven.1.clone(),
             &phase.active
         ));
+        let reuses = phase.assembled_at.reuses;
         let torque = phase.actuator_torque(&at).unwrap();
+        // The torque was solved on the assembly, not by a fresh evaluation.
+        assert_eq!(phase.assembled_at.reuses, reuses + 1);
         let fresh = phase_with(old).actuator_torque(&at).unwrap();
         assert_eq!(torque.0.to_bits(), fresh.0.to_bits());
         assert_eq!(torque.1.to_bits(), fresh.1.to_bits());
@@ -456,6 +466,8 @@ mod tests {
         phase
             .accelerations_into(0.1, &at.q, &at.qd, &mut reused)
             .unwrap();
+        // The accelerations were solved on the assembly, not by a fresh evaluation.
+        assert_eq!(phase.assembled_at.reuses, reuses + 2);
         let mut again = DVector::zeros(q.len());
         phase_with(other)
             .accelerations_into(0.1, &at.q, &at.qd, &mut again)

@@ -10,19 +10,10 @@
 //! products per arm, instead of every link's frame.
 
 use super::dop853::State;
-use crate::planar::{sin_cos, PlanarTree, MAX_COORDINATES, MAX_LINKS};
+use crate::planar::{sin_cos, Joints, PlanarTree, MAX_COORDINATES};
 use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
 use nalgebra::SVector;
-
-/// One joint of the tree, parents first: its coordinate, axis sign along z, and the nearest
-/// joint above it (an index into the joints).
-#[derive(Clone, Copy, Debug, Default)]
-struct Joint {
-    coordinate: usize,
-    sign: f64,
-    parent: Option<usize>,
-}
 
 /// A point fixed in a link: a base fixed in the floor frame and an arm per joint of its chain,
 /// turned by that joint's link (x, y) [m]; and the joint whose link carries the point (its
@@ -57,8 +48,7 @@ impl Arms {
 /// The points the witnesses follow, with the walker's fall rule.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PlanarWitnesses {
-    joints: [Joint; MAX_COORDINATES],
-    joint_count: usize,
+    joints: Joints,
     foot: Arms,
     hip: Arms,
     contact: Arms,
@@ -71,30 +61,10 @@ impl PlanarWitnesses {
     /// coordinates.
     pub(super) fn new<const N: usize>(walker: &Walker, tree: &PlanarTree) -> Option<Self> {
         let fr = tree.frames(&SVector::<f64, N>::zeros(), &SVector::zeros());
-        let mut joints = [Joint::default(); MAX_COORDINATES];
-        let mut joint_count = 0;
-        // Each link's nearest joint (itself included), as an index into `joints`.
-        let mut nearest = [None::<usize>; MAX_LINKS];
+        let joints = Joints::of(tree)?;
         let mut origin = [[0.0; 2]; MAX_COORDINATES];
-        for i in 0..tree.link_count() {
-            let (parent_slot, coordinate) = tree.link_joint(i)?;
-            let above = match parent_slot {
-                0 => None,
-                s => *nearest.get(s - 1)?,
-            };
-            *nearest.get_mut(i)? = match coordinate {
-                Some((c, sign)) => {
-                    *joints.get_mut(joint_count)? = Joint {
-                        coordinate: c,
-                        sign,
-                        parent: above,
-                    };
-                    origin[joint_count] = fr.get(i + 1)?.origin_m;
-                    joint_count += 1;
-                    Some(joint_count - 1)
-                }
-                None => above,
-            };
+        for (o, j) in origin.iter_mut().zip(joints.all()) {
+            *o = fr.get(j.link + 1)?.origin_m;
         }
         let m = &walker.model;
         let point = |i: usize| -> Option<Arms> {
@@ -102,7 +72,7 @@ impl PlanarWitnesses {
             let link = p.link.0;
             let o = fr.get(link + 1)?.origin_m;
             let mut at = [o[0] + p.p_link_m.x, o[1] + p.p_link_m.y];
-            let link_joint = *nearest.get(link)?;
+            let link_joint = joints.owner(link);
             let mut arms = Arms {
                 base_m: at,
                 arms: [(0, [0.0; 2]); MAX_COORDINATES],
@@ -116,7 +86,7 @@ impl PlanarWitnesses {
                 *arms.arms.get_mut(arms.len)? = (j, [at[0] - oj[0], at[1] - oj[1]]);
                 arms.len += 1;
                 at = oj;
-                cur = joints[j].parent;
+                cur = joints.all().get(j)?.parent;
             }
             arms.base_m = at;
             arms.arms[..arms.len].reverse();
@@ -124,7 +94,6 @@ impl PlanarWitnesses {
         };
         Some(Self {
             joints,
-            joint_count,
             foot: point(walker.heel_strike.swing_foot.0)?,
             hip: point(walker.fall.hip.0)?,
             contact: point(walker.heel_strike.stance_contact.0)?,
@@ -139,15 +108,10 @@ impl PlanarWitnesses {
         qd: &SVector<f64, N>,
     ) -> JointFrames {
         let mut jf = [(1.0, 0.0, 0.0); MAX_COORDINATES];
-        for j in 0..self.joint_count {
-            let Joint {
-                coordinate: c,
-                sign,
-                parent,
-            } = self.joints[j];
-            let (s, co) = sin_cos(sign * q[c]);
-            let rate = sign * qd[c];
-            jf[j] = match parent {
+        for (j, joint) in self.joints.all().iter().enumerate() {
+            let (s, co) = sin_cos(joint.sign * q[joint.coordinate]);
+            let rate = joint.sign * qd[joint.coordinate];
+            jf[j] = match joint.parent {
                 Some(p) => {
                     let (pc, ps, pw) = jf[p];
                     (pc * co - ps * s, ps * co + pc * s, pw + rate)
