@@ -129,7 +129,8 @@ pub struct ControlError(pub String);
 
 /// A controller of the stance ankle's string, sampled every `period_s`.
 pub trait AnkleController {
-    /// Control period [s].
+    /// Control period [s]: a finite positive time (a controlled stride refuses any other, as
+    /// `FailureKind::InvalidControlPeriod`).
     fn period_s(&self) -> f64;
     /// One tick at `sensing.t_walk_s`: returns the string's limit until the next tick.
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError>;

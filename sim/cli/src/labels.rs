@@ -133,6 +133,7 @@ fn failure_clause(kind: FailureKind) -> String {
         FailureKind::RelabelFailed => "the relabelled state did not match the model".into(),
         FailureKind::StepBudgetExceeded => "the stride used its integrator-step budget".into(),
         FailureKind::EvaluationBudgetExceeded => "the stride used its evaluation budget".into(),
+        FailureKind::InvalidControlPeriod => "the controller's period is not usable".into(),
     }
 }
 

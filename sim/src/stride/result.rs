@@ -46,6 +46,9 @@ pub enum FailureKind {
     /// The stride evaluated the equations of motion as often as its budget
     /// ([`super::StrideSettings::max_evaluations`]) allows without ending.
     EvaluationBudgetExceeded,
+    /// The controller's period ([`crate::control::AnkleController::period_s`]) is not a finite
+    /// positive time, or too short for its ticks to advance over the stride.
+    InvalidControlPeriod,
 }
 
 /// A failed stride.

@@ -144,6 +144,12 @@ struct Run<'w, 'r, 't> {
     /// The output of the tick at `next_tick_s`, run on a step's interpolant, to take effect
     /// when the stride reaches that tick.
     pending: Option<ActuatorSegment>,
+    /// The next step ends at the next tick whatever the limit in force (a step ran across a
+    /// tick without an interpolant and is taken again); cleared when that tick runs.
+    end_at_next_tick: bool,
+    /// Control ticks run so far, against the step budget (each tick is a step of the
+    /// reference `EndAtEveryTick`).
+    ticks: usize,
 }
 
 impl<'w, 'r, 't> Run<'w, 'r, 't> {
@@ -182,10 +188,9 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             integrator.interpolates(),
             control.is_some(),
         );
-        let next_tick_s = if period_s.is_finite() {
-            (t_walk0 / period_s - 1e-9).ceil() * period_s - t_walk0
-        } else {
-            f64::INFINITY
+        let next_tick_s = match &control {
+            Some(_) => ticks::first_tick_s(period_s, t_walk0, settings.max_stride_time_s)?,
+            None => f64::INFINITY,
         };
         Ok(Self {
             walker,
@@ -211,6 +216,8 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             segment: None,
             held_stepping,
             pending: None,
+            end_at_next_tick: false,
+            ticks: 0,
         })
     }
 
@@ -231,10 +238,26 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             self.check_budgets()?;
             let drive_end_s = self.drive_end_s();
             let next = self.step(drive_end_s)?;
-            let (next, w_cur, w_next) = self.grazing_check(next)?;
-            // Ticks the step ran across: sampled on its interpolant (before event location
-            // takes other steps), run before the step's events apply.
+            // Ticks the step ran across: sampled on its interpolant, built from the step just
+            // taken (before the grazing probe and event location take other steps), run
+            // before the step's events apply.
             let dense = self.held_interpolant(&next)?;
+            let stepped_to_s = next.t_s;
+            let (next, w_cur, w_next) = self.grazing_check(next)?;
+            // The probe's step was adopted: it is now the integrator's last step, and its own
+            // interpolant is the one of the step the stride takes.
+            let dense = if next.t_s == stepped_to_s {
+                dense
+            } else {
+                self.held_interpolant(&next)?
+            };
+            if self.tick_inside_without_interpolant(dense.as_ref(), next.t_s) {
+                // Not expected (a step runs across a tick only with its interpolant, kept for
+                // the step adopted above). A tick is never skipped: the step is taken again,
+                // ending at the tick.
+                self.end_at_next_tick = true;
+                continue;
+            }
             let limit = self.string_limit();
             let triggered =
                 self.wit
@@ -285,6 +308,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 ),
             ));
         }
+        self.check_tick_budget()?;
         if evaluations >= self.settings.max_evaluations {
             return Err(StrideFailure::new(
                 FailureKind::EvaluationBudgetExceeded,

@@ -10,6 +10,10 @@
 //! the controller saw (so the controller is never rolled back), and its output takes effect
 //! there. Without an interpolant (RK4, Meijaard), with a step schedule recorded or replayed, or
 //! while the limit moves, every step ends at a tick.
+//!
+//! Every tick runs once, at its time: a step that ran across a tick without an interpolant is
+//! taken again, ending at the tick; the controller's period is checked before the stride
+//! starts, and the ticks count against the stride's step budget.
 
 use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
@@ -22,6 +26,39 @@ use crate::walker::Walker;
 
 /// A tick's time is reached when a sample is within this of it [s].
 const TICK_SLACK_S: f64 = 1e-12;
+
+/// The first control tick of a stride [s, stride time]: the first point of the walk-time grid
+/// `k · period_s` at or after `t_walk_start_s` − [`TICK_SLACK_S`] (the stride before ran the
+/// ticks before its heel strike's time − [`TICK_SLACK_S`], so each tick runs in one stride).
+///
+/// # Errors
+/// [`FailureKind::InvalidControlPeriod`] when the period is not a finite positive time, or so
+/// short against the walk time that the tick grid does not advance over the stride's time
+/// budget `max_stride_time_s` (the stride's ticks would never end).
+pub(super) fn first_tick_s(
+    period_s: f64,
+    t_walk_start_s: f64,
+    max_stride_time_s: f64,
+) -> Result<f64, StrideFailure> {
+    let invalid = |why: &str| {
+        Err(StrideFailure::new(
+            FailureKind::InvalidControlPeriod,
+            0.0,
+            format!("control period {period_s} s {why}"),
+        ))
+    };
+    if !(period_s.is_finite() && period_s > 0.0) {
+        return invalid("is not a finite positive time");
+    }
+    let first_s = ((t_walk_start_s - TICK_SLACK_S) / period_s).ceil() * period_s - t_walk_start_s;
+    let last_s = first_s.max(0.0) + max_stride_time_s.max(0.0);
+    if !first_s.is_finite() || !last_s.is_finite() || last_s + period_s <= last_s {
+        return invalid(&format!(
+            "does not advance the tick grid from walk time {t_walk_start_s} s"
+        ));
+    }
+    Ok(first_s)
+}
 
 /// A failure of the controller or of the sensing at stride time `t_s`.
 fn tick_failure(t_s: f64, detail: String) -> StrideFailure {
@@ -150,7 +187,38 @@ impl Run<'_, '_, '_> {
     /// The next step may run across the next tick: held stepping, no tick output waiting to
     /// take effect, and a limit in force that does not move.
     pub(super) fn held_ahead(&self) -> bool {
-        self.held_stepping && self.pending.is_none() && self.segment.is_some_and(|s| s.is_held())
+        self.held_stepping
+            && !self.end_at_next_tick
+            && self.pending.is_none()
+            && self.segment.is_some_and(|s| s.is_held())
+    }
+
+    /// The stride's ticks have used its step budget (each tick is a step of the reference
+    /// `EndAtEveryTick`): a period far too short for the stride fails instead of running for
+    /// ever.
+    pub(super) fn check_tick_budget(&self) -> Result<(), StrideFailure> {
+        if self.ticks < self.settings.max_steps {
+            return Ok(());
+        }
+        Err(StrideFailure::new(
+            FailureKind::StepBudgetExceeded,
+            self.cur.t_s,
+            format!(
+                "no heel strike within the step budget max_steps = {} of control ticks \
+                 (period {} s)",
+                self.settings.max_steps, self.period_s
+            ),
+        ))
+    }
+
+    /// A tick lies strictly inside the step `cur` → `end_s` of a controlled stride, and the
+    /// step has no interpolant to run it on.
+    pub(super) fn tick_inside_without_interpolant(
+        &self,
+        dense: Option<&DenseOutput>,
+        end_s: f64,
+    ) -> bool {
+        self.control.is_some() && dense.is_none() && self.next_tick_s < end_s - TICK_SLACK_S
     }
 
     /// The end of the next step as the ticks allow [s]: the next tick, or ∞ across ticks.
@@ -171,6 +239,17 @@ impl Run<'_, '_, '_> {
         };
         if self.cur.t_s < self.next_tick_s - TICK_SLACK_S {
             return Ok(());
+        }
+        if self.cur.t_s > self.next_tick_s + TICK_SLACK_S {
+            // Each step ends at or before the next tick, or runs its ticks on its interpolant:
+            // a stride past a tick that did not run is a defect, not a result.
+            return Err(tick_failure(
+                self.cur.t_s,
+                format!(
+                    "the control tick at stride time {} s was passed without running",
+                    self.next_tick_s
+                ),
+            ));
         }
         let t0 = control.t_walk_start_s;
         let seg = match self.pending.take() {
@@ -202,6 +281,7 @@ impl Run<'_, '_, '_> {
                 "a control tick without a controller".into(),
             ));
         };
+        self.ticks += 1;
         let t0 = control.t_walk_start_s;
         let mut seg = control
             .controller
@@ -242,6 +322,7 @@ impl Run<'_, '_, '_> {
             self.integrator.system_changed();
         }
         self.segment = Some(seg);
+        self.end_at_next_tick = false;
         self.next_tick_s += self.period_s;
     }
 
@@ -265,24 +346,53 @@ impl Run<'_, '_, '_> {
     /// outputs give the plant the same input the step stands (`None`); the first that changes
     /// it ends the step there: the interpolated state at that tick is returned, and the tick's
     /// output takes effect when the loop reaches it.
+    ///
+    /// # Errors
+    /// A tick strictly before `end_s` without an interpolant (the stride loop takes such a step
+    /// again, ending at the tick, so this is a defect: it is not skipped), the step budget used
+    /// up by ticks, or a tick grid that does not advance; the controller's and the sensing's
+    /// failures.
     pub(super) fn held_ticks(
         &mut self,
         dense: Option<&DenseOutput>,
         ends: (&WitnessValues, &WitnessValues),
         end_s: f64,
     ) -> Result<Option<Sample>, StrideFailure> {
-        let (Some(dense), Some(control)) = (dense, self.control.as_ref()) else {
+        let Some(control) = self.control.as_ref() else {
             return Ok(None);
         };
         let t0 = control.t_walk_start_s;
+        if self.next_tick_s >= end_s - TICK_SLACK_S {
+            return Ok(None);
+        }
+        let Some(dense) = dense else {
+            return Err(tick_failure(
+                self.cur.t_s,
+                format!(
+                    "the control tick at stride time {} s lies inside a step without an \
+                     interpolant",
+                    self.next_tick_s
+                ),
+            ));
+        };
         while self.next_tick_s < end_s - TICK_SLACK_S {
+            self.check_tick_budget()?;
             let mut s = dense.eval(self.next_tick_s);
             self.phase.snap(&mut s);
             let clear = clear_of_floor(ends.0, ends.1, s.t_s).then_some(false);
             let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &s, clear)?;
             let seg = self.tick_controller(&sensing)?;
             match self.segment {
-                Some(held) if held.same_held_input(&seg) => self.next_tick_s += self.period_s,
+                Some(held) if held.same_held_input(&seg) => {
+                    let after_s = self.next_tick_s + self.period_s;
+                    if after_s <= self.next_tick_s {
+                        return Err(tick_failure(
+                            self.next_tick_s,
+                            format!("the control period {} s does not advance", self.period_s),
+                        ));
+                    }
+                    self.next_tick_s = after_s;
+                }
                 _ => {
                     self.pending = Some(seg);
                     return Ok(Some(s));
