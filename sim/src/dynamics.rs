@@ -261,12 +261,18 @@ impl<T: RealField + Copy> DynamicsOf<T> {
             return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
         }
         if partial {
-            for (j, needed) in self.needed.iter_mut().enumerate() {
-                *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != T::zero());
-            }
+            self.mark_needed(active, qdd_prescribed);
         }
         self.assemble_entries(model, q, qd, None, partial);
         self.solve_assembled_finite_into(active, qdd_prescribed, qdd, partial)
+    }
+
+    /// Marks in `self.needed` the coordinates whose rows and columns the solve reads: the free
+    /// ones and the prescribed ones with a nonzero acceleration.
+    fn mark_needed(&mut self, active: &[bool], qdd_prescribed: Option<&DVector<T>>) {
+        for (j, needed) in self.needed.iter_mut().enumerate() {
+            *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != T::zero());
+        }
     }
 
     /// The solve of [`Self::solve_finite_into`] on the matrices already assembled here:
@@ -410,9 +416,7 @@ impl Dynamics {
         if self.has_infinitesimal || active.len() != n || qdd.len() != n {
             return Ok(false);
         }
-        for (j, needed) in self.needed.iter_mut().enumerate() {
-            *needed = active[j] || qdd_prescribed.is_some_and(|p| p[j] != 0.0);
-        }
+        self.mark_needed(active, qdd_prescribed);
         if self
             .needed
             .iter()

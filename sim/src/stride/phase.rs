@@ -96,6 +96,24 @@ impl AssemblyKey {
     }
 }
 
+/// Fills `driven` (`q`, `q̇`, prescribed `q̈`, each of `q`'s length) for an evaluation under
+/// `drive`: `q`, `q̇` with the driven coordinate's angle and rate put in, and the prescribed
+/// accelerations zero but the driven coordinate's.
+fn put_drive(
+    driven: &mut (DVector<f64>, DVector<f64>, DVector<f64>),
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    drive: &DriveValues<f64>,
+) {
+    let (dq, dqd, qdd_p) = driven;
+    dq.copy_from(q);
+    dqd.copy_from(qd);
+    dq[drive.coordinate] = drive.angle_rad;
+    dqd[drive.coordinate] = drive.rate_rad_s;
+    qdd_p.as_mut_slice().fill(0.0);
+    qdd_p[drive.coordinate] = drive.acceleration_rad_s2;
+}
+
 /// `q̈` by the general engine's partial assembly at (`q`, `q̇`), or by a solve on the
 /// workspace's assembly when `key` says it was made there; `key` follows.
 #[allow(clippy::too_many_arguments)]
@@ -156,10 +174,10 @@ impl<'a> Phase<'a> {
     /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
     /// coordinate's rate: their product is the actuator power.
     pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
-        let Some((c, drive)) = self.prescribed else {
+        let Some((c, _)) = self.prescribed else {
             return Ok((0.0, 0.0));
         };
-        if let Some(tau) = self.torque_on_assembly(c.0, &drive, s)? {
+        if let Some(tau) = self.torque_on_assembly(s)? {
             return Ok((tau, s.qd[c.0]));
         }
         // The general path: its workspace keeps the assembled M̄ and f̄ read below.
@@ -174,29 +192,22 @@ impl<'a> Phase<'a> {
     /// the step that ended at `s` evaluated its last stage there. The same arithmetic as the
     /// general path (its `q̈` the same to the bit; the row's entries the assembly skipped are
     /// those of locked coordinates, whose `q̈` is zero). `None` otherwise.
-    fn torque_on_assembly(
-        &mut self,
-        c: usize,
-        drive: &Drive,
-        s: &Sample,
-    ) -> Result<Option<f64>, DynamicsError> {
+    fn torque_on_assembly(&mut self, s: &Sample) -> Result<Option<f64>, DynamicsError> {
+        let Some(drive) = self.drive_at(s.t_s) else {
+            return Ok(None);
+        };
+        let c = drive.coordinate;
         if self.planar.is_some() || !self.dynamics.assembled_row(c) {
             return Ok(None);
         }
-        let (angle_rad, rate_rad_s, acceleration_rad_s2) = drive.eval(s.t_s);
-        let (dq, dqd, qdd_p) = &mut self.driven;
-        if dq.len() != s.q.len() || dqd.len() != s.qd.len() {
+        if self.driven.0.len() != s.q.len() || self.driven.1.len() != s.qd.len() {
             return Ok(None);
         }
-        dq.copy_from(&s.q);
-        dqd.copy_from(&s.qd);
-        dq[c] = angle_rad;
-        dqd[c] = rate_rad_s;
+        put_drive(&mut self.driven, &s.q, &s.qd, &drive);
+        let (dq, dqd, qdd_p) = &self.driven;
         if !self.assembled_at.is(dq, dqd, &self.active) {
             return Ok(None);
         }
-        qdd_p.as_mut_slice().fill(0.0);
-        qdd_p[c] = acceleration_rad_s2;
         let mut qdd = DVector::zeros(s.q.len());
         if !self
             .dynamics
@@ -294,13 +305,8 @@ impl SecondOrderSystem for Phase<'_> {
                         out,
                     ),
                     Some(d) => {
-                        let (dq, dqd, qdd_p) = &mut self.driven;
-                        dq.copy_from(q);
-                        dqd.copy_from(qd);
-                        dq[d.coordinate] = d.angle_rad;
-                        dqd[d.coordinate] = d.rate_rad_s;
-                        qdd_p.as_mut_slice().fill(0.0);
-                        qdd_p[d.coordinate] = d.acceleration_rad_s2;
+                        put_drive(&mut self.driven, q, qd, &d);
+                        let (dq, dqd, qdd_p) = &self.driven;
                         accelerations_of_free(
                             self.model,
                             &mut self.dynamics,
