@@ -4,6 +4,7 @@
 
 pub mod accuracy;
 pub mod actuator;
+pub mod axis_tree;
 pub mod census;
 pub mod contact;
 pub mod continuation;

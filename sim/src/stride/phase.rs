@@ -2,6 +2,7 @@
 //! driven and how ([`Drive`]), and the stability limit of eq. (12) for fixed-step integrators.
 
 use crate::actuator::AnkleProfile;
+use crate::axis_tree::AxisTree;
 use crate::control::ActuatorSegment;
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
@@ -35,6 +36,8 @@ pub struct Phase<'a> {
     dynamics: Dynamics,
     /// The planar fast path, when the model qualifies and the settings allow it.
     planar: Option<PlanarTree>,
+    /// The 3D fast path, when the model is not planar but qualifies and the settings allow it.
+    axis_tree: Option<AxisTree>,
     /// Which coordinates are free to move.
     pub active: Vec<bool>,
     /// A coordinate driven along a profile (not free, not locked).
@@ -42,8 +45,9 @@ pub struct Phase<'a> {
     /// Scratch for a driven evaluation: `q`, `q̇` with the drive's angle and rate put in, and
     /// the prescribed accelerations (zero but the driven coordinate's).
     driven: (DVector<f64>, DVector<f64>, DVector<f64>),
-    /// Where the general engine's workspace was last assembled by this phase's partial
-    /// evaluations (`None` after anything else used it).
+    /// Where the evaluation's workspace (the 3D fast path's tree, or else the general engine's)
+    /// was last assembled by this phase's partial evaluations (not valid after anything else
+    /// used it).
     assembled_at: AssemblyKey,
 }
 
@@ -114,27 +118,100 @@ fn put_drive(
     qdd_p[drive.coordinate] = drive.acceleration_rad_s2;
 }
 
-/// `q̈` by the general engine's partial assembly at (`q`, `q̇`), or by a solve on the
-/// workspace's assembly when `key` says it was made there; `key` follows.
+/// An evaluation that keeps its last assembly, to solve on it again: the general engine's
+/// workspace or the 3D fast path's tree.
+trait Assembler {
+    /// `q̈` by a (partial) assembly at (`q`, `q̇`) and its solve; `driven`, a coordinate whose
+    /// row the assembly computes too, where the evaluation can.
+    #[allow(clippy::too_many_arguments)]
+    fn assemble_and_solve(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        driven: Option<usize>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError>;
+
+    /// `q̈` by a solve on the last assembly; `Ok(false)` when it lacks a row the solve reads.
+    fn solve_on_assembly(
+        &mut self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError>;
+}
+
+impl Assembler for Dynamics {
+    fn assemble_and_solve(
+        &mut self,
+        model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        _driven: Option<usize>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.accelerations_of_free_into(model, q, qd, active, qdd_prescribed, out)
+    }
+
+    fn solve_on_assembly(
+        &mut self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        self.accelerations_on_assembly_into(active, qdd_prescribed, out)
+    }
+}
+
+impl Assembler for AxisTree {
+    fn assemble_and_solve(
+        &mut self,
+        _model: &Model,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        driven: Option<usize>,
+        out: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.accelerations_into(q, qd, active, qdd_prescribed, driven, out)
+    }
+
+    fn solve_on_assembly(
+        &mut self,
+        active: &[bool],
+        qdd_prescribed: Option<&DVector<f64>>,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        self.accelerations_on_assembly_into(active, qdd_prescribed, out)
+    }
+}
+
+/// `q̈` by `assembler`'s partial assembly at (`q`, `q̇`), or by a solve on its last assembly
+/// when `key` says it was made there; `key` follows.
 #[allow(clippy::too_many_arguments)]
-fn accelerations_of_free(
+fn accelerations_of_free<A: Assembler>(
     model: &Model,
-    dynamics: &mut Dynamics,
+    assembler: &mut A,
     key: &mut AssemblyKey,
     q: &DVector<f64>,
     qd: &DVector<f64>,
     active: &[bool],
     qdd_prescribed: Option<&DVector<f64>>,
+    driven: Option<usize>,
     out: &mut DVector<f64>,
 ) -> Result<(), DynamicsError> {
-    if key.is(q, qd, active)
-        && dynamics.accelerations_on_assembly_into(active, qdd_prescribed, out)?
-    {
+    if key.is(q, qd, active) && assembler.solve_on_assembly(active, qdd_prescribed, out)? {
         key.reuses += 1;
         return Ok(());
     }
     key.valid = false;
-    dynamics.accelerations_of_free_into(model, q, qd, active, qdd_prescribed, out)?;
+    assembler.assemble_and_solve(model, q, qd, active, qdd_prescribed, driven, out)?;
     key.set(q, qd, active);
     Ok(())
 }
@@ -147,10 +224,16 @@ impl<'a> Phase<'a> {
 
     /// All coordinates active, evaluated along `path`.
     pub fn with_path(model: &'a Model, path: EvaluationPath) -> Self {
+        let planar = PlanarTree::for_path(model, path);
+        let axis_tree = match (&planar, path) {
+            (None, EvaluationPath::Auto | EvaluationPath::GeneralLoop) => AxisTree::of(model),
+            _ => None,
+        };
         Self {
             model,
             dynamics: Dynamics::new(model),
-            planar: PlanarTree::for_path(model, path),
+            planar,
+            axis_tree,
             active: vec![true; model.dof()],
             prescribed: None,
             driven: (
@@ -180,6 +263,18 @@ impl<'a> Phase<'a> {
         if let Some(tau) = self.torque_on_assembly(s)? {
             return Ok((tau, s.qd[c.0]));
         }
+        if self.axis_tree.is_some() {
+            // The 3D fast path's evaluation assembles the driven row too: the torque on it.
+            let mut qdd = DVector::zeros(s.q.len());
+            self.accelerations_into(s.t_s, &s.q, &s.qd, &mut qdd)?;
+            if let Some(tau) = self
+                .axis_tree
+                .as_ref()
+                .and_then(|t| t.actuator_force(c.0, &qdd))
+            {
+                return Ok((tau, s.qd[c.0]));
+            }
+        }
         // The general path: its workspace keeps the assembled M̄ and f̄ read below.
         let qdd = self.general_accelerations(s.t_s, &s.q, &s.qd)?;
         let m = &self.dynamics.mass_matrix;
@@ -197,7 +292,10 @@ impl<'a> Phase<'a> {
             return Ok(None);
         };
         let c = drive.coordinate;
-        if self.planar.is_some() || !self.dynamics.assembled_row(c) {
+        if self.planar.is_some() {
+            return Ok(None);
+        }
+        if self.axis_tree.is_none() && !self.dynamics.assembled_row(c) {
             return Ok(None);
         }
         if self.driven.0.len() != s.q.len() || self.driven.1.len() != s.qd.len() {
@@ -209,20 +307,39 @@ impl<'a> Phase<'a> {
             return Ok(None);
         }
         let mut qdd = DVector::zeros(s.q.len());
-        if !self
-            .dynamics
-            .accelerations_on_assembly_into(&self.active, Some(qdd_p), &mut qdd)?
-        {
-            return Ok(None);
+        let tau = match self.axis_tree.as_mut() {
+            Some(t) => {
+                if !t.accelerations_on_assembly_into(&self.active, Some(qdd_p), &mut qdd)? {
+                    return Ok(None);
+                }
+                t.actuator_force(c, &qdd)
+            }
+            None => {
+                if !self.dynamics.accelerations_on_assembly_into(
+                    &self.active,
+                    Some(qdd_p),
+                    &mut qdd,
+                )? {
+                    return Ok(None);
+                }
+                let m = &self.dynamics.mass_matrix;
+                Some((m.row(c) * &qdd)[(0, 0)] - self.dynamics.force[c])
+            }
+        };
+        if tau.is_some() {
+            self.assembled_at.reuses += 1;
         }
-        self.assembled_at.reuses += 1;
-        let m = &self.dynamics.mass_matrix;
-        Ok(Some((m.row(c) * &qdd)[(0, 0)] - self.dynamics.force[c]))
+        Ok(tau)
     }
 
     /// Whether this phase evaluates along the planar fast path.
     pub fn is_planar_fast_path(&self) -> bool {
         self.planar.is_some()
+    }
+
+    /// Whether this phase evaluates along the 3D fast path ([`AxisTree`]).
+    pub fn is_axis_tree_fast_path(&self) -> bool {
+        self.axis_tree.is_some()
     }
 
     /// The drive's prescribed motion at `t` [s], if a coordinate is driven.
@@ -271,6 +388,12 @@ impl SecondOrderSystem for Phase<'_> {
                 self.assembled_at.valid = false;
                 p.accelerations(&mut self.dynamics, &self.active, drive.as_ref(), q, qd)
             }
+            // (`accelerations_into` takes the fast path for these lengths, not this method.)
+            None if self.axis_tree.is_some() && self.driven.0.len() == q.len() => {
+                let mut out = DVector::zeros(q.len());
+                self.accelerations_into(t, q, qd, &mut out)?;
+                Ok(out)
+            }
             None => self.general_accelerations(t, q, qd),
         }
     }
@@ -288,36 +411,46 @@ impl SecondOrderSystem for Phase<'_> {
                 self.assembled_at.valid = false;
                 p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
             }
-            // The general engine's solve straight into `out` with the arithmetic of
-            // `hybrid::phase::accelerations`, without allocating, assembling only what the
-            // solve reads (the workspace's `M̄`, `f̄` are partial afterwards: whatever reads
-            // them, `actuator_torque` and `linearised_limit`, assembles again).
+            // The 3D fast path's or the general engine's solve straight into `out` (the latter
+            // with the arithmetic of `hybrid::phase::accelerations`), without allocating,
+            // assembling only what the solve reads (the workspace's `M̄`, `f̄` are partial
+            // afterwards: whatever reads the general engine's, `actuator_torque` and
+            // `linearised_limit`, assembles again).
             None if out.len() == q.len() && self.driven.0.len() == q.len() => {
-                match self.drive_at(t) {
-                    None => accelerations_of_free(
+                let drive = self.drive_at(t);
+                let (q, qd, qdd_p) = match &drive {
+                    None => (q, qd, None),
+                    Some(d) => {
+                        put_drive(&mut self.driven, q, qd, d);
+                        let (dq, dqd, qdd_p) = &self.driven;
+                        (dq, dqd, Some(qdd_p))
+                    }
+                };
+                let driven = drive.map(|d| d.coordinate);
+                let key = &mut self.assembled_at;
+                match self.axis_tree.as_mut() {
+                    Some(tree) => accelerations_of_free(
                         self.model,
-                        &mut self.dynamics,
-                        &mut self.assembled_at,
+                        tree,
+                        key,
                         q,
                         qd,
                         &self.active,
-                        None,
+                        qdd_p,
+                        driven,
                         out,
                     ),
-                    Some(d) => {
-                        put_drive(&mut self.driven, q, qd, &d);
-                        let (dq, dqd, qdd_p) = &self.driven;
-                        accelerations_of_free(
-                            self.model,
-                            &mut self.dynamics,
-                            &mut self.assembled_at,
-                            dq,
-                            dqd,
-                            &self.active,
-                            Some(qdd_p),
-                            out,
-                        )
-                    }
+                    None => accelerations_of_free(
+                        self.model,
+                        &mut self.dynamics,
+                        key,
+                        q,
+                        qd,
+                        &self.active,
+                        qdd_p,
+                        driven,
+                        out,
+                    ),
                 }
             }
             _ => {
