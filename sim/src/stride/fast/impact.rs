@@ -95,13 +95,15 @@ fn lu_solve(
         if pivot == 0.0 || !pivot.is_finite() {
             return None;
         }
-        for r in col + 1..size {
-            let f = a[r][col] / pivot;
+        let (upper, lower) = a.split_at_mut(col + 1);
+        let pivot_row = &upper[col];
+        for (k, row) in lower[..size - col - 1].iter_mut().enumerate() {
+            let f = row[col] / pivot;
             if f != 0.0 {
-                for c in col + 1..size {
-                    a[r][c] -= f * a[col][c];
+                for (x, p) in row[col + 1..size].iter_mut().zip(&pivot_row[col + 1..size]) {
+                    *x -= f * p;
                 }
-                b[r] -= f * b[col];
+                b[col + 1 + k] -= f * b[col];
             }
         }
     }
