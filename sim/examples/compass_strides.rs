@@ -1,12 +1,16 @@
 //! Our side of `scripts/bench-vs-drake`: the compass gait walks `--strides` strides from its
 //! fixed point plus a perturbation, in Drake's coordinates (`pydrake.examples.CompassGait`:
 //! stance and swing leg angles from the world vertical, positive with the hip downhill of the
-//! foot, and their rates), once per DOP853 tolerance, timed over `--repeats` repetitions.
-//! Prints one JSON object per tolerance: the start, the state at each heel strike (just before
+//! foot, and their rates), once per DOP853 tolerance and largest step, timed over `--repeats`
+//! repetitions. `--rtol` and `--h-max` may each be given several times: every tolerance runs
+//! with every largest step (`--h-max` absent: the scene's `h_max_s`, a setting of the scene's
+//! `[integrator]` section as of the tolerance). Prints one JSON object per run: its
+//! tolerance and largest step, the start, the state at each heel strike (just before
 //! the impact, legs not yet swapped) and its walk time, the evaluations, and the wall time per stride (minimum and median).
 //!
 //! `cargo run --release -p sim --example compass_strides -- --set slope_rad=0.0525
-//! --rtol 1e-12 --rtol 1e-14 --strides 50 --repeats 20 --perturb 0,0,0.05,0`
+//! --rtol 1e-12 --rtol 1e-14 --h-max 0.05 --h-max 0.04 --strides 50 --repeats 20
+//! --perturb 0,0,0.05,0`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nalgebra::DVector;
@@ -51,6 +55,7 @@ impl Coordinates {
 fn main() -> Result<(), Box<dyn Error>> {
     let mut sets = Vec::new();
     let mut rtols = Vec::new();
+    let mut h_maxes_s = Vec::new();
     let (mut strides, mut repeats) = (50usize, 10usize);
     let mut perturb = [0.0; 4];
     let mut args = std::env::args().skip(1);
@@ -59,6 +64,13 @@ fn main() -> Result<(), Box<dyn Error>> {
         match a.as_str() {
             "--set" => sets.push(value()?),
             "--rtol" => rtols.push(value()?.parse::<f64>()?),
+            "--h-max" => {
+                let h: f64 = value()?.parse()?;
+                if !(h.is_finite() && h > 0.0) {
+                    return Err(format!("--h-max takes a positive step in seconds, not {h}").into());
+                }
+                h_maxes_s.push(h);
+            }
             "--strides" => strides = value()?.parse()?,
             "--repeats" => repeats = value()?.parse::<usize>()?.max(1),
             "--perturb" => {
@@ -91,11 +103,20 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (q_fp, qd_fp) = walker.unpack(&gait.fixed_point);
     let fixed = coords.drake_of_ours(&q_fp, &qd_fp);
     let start: [f64; 4] = std::array::from_fn(|i| fixed[i] + perturb[i]);
-    for rtol in rtols {
+    if h_maxes_s.is_empty() {
+        match setup.settings.integrator {
+            IntegratorChoice::Dop853 { h_max_s, .. } => h_maxes_s.push(h_max_s),
+            _ => return Err("the compass scene's integrator is not DOP853: give --h-max".into()),
+        }
+    }
+    let runs = rtols
+        .iter()
+        .flat_map(|&rtol| h_maxes_s.iter().map(move |&h_max_s| (rtol, h_max_s)));
+    for (rtol, h_max_s) in runs {
         let settings = setup.settings.with_integrator(IntegratorChoice::Dop853 {
             rtol,
             atol: rtol,
-            h_max_s: 0.05,
+            h_max_s,
         });
         let mut times = Vec::with_capacity(repeats);
         let mut states = Vec::new();
@@ -124,6 +145,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         times.sort_by(f64::total_cmp);
         let out = serde_json::json!({
             "rtol": rtol,
+            "h_max_s": h_max_s,
             "fixed_point": fixed,
             "start": start,
             "heel_strike_states": states,

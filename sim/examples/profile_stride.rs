@@ -1,9 +1,10 @@
 //! Runs strides of a scene from its fixed point in a loop, for profilers
 //! (`cargo run --release -p sim --example profile_stride -- compass 200 [general|loop|linkpass]
-//! [rtol]`; `general` forces the general engine instead of the planar fast path, `loop` the
+//! [rtol] [h_max]`; `general` forces the general engine instead of the planar fast path, `loop` the
 //! planar evaluation inside the general stride loop instead of the fixed-size stride,
 //! `linkpass` the fixed-size stride with the planar link pass instead of a closed form; any
-//! other word the default; `rtol` replaces the scene's DOP853 tolerance).
+//! other word the default; `rtol` replaces the scene's DOP853 tolerance, `h_max` its largest
+//! step [s]).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 fn main() {
@@ -24,6 +25,18 @@ fn main() {
             .integrator
             .with_tolerance_or_step(Some(rtol), None);
         setup.settings = setup.settings.with_integrator(i);
+    }
+    if let Some(h) = args.next().and_then(|s| s.parse::<f64>().ok()) {
+        if let sim::integrators::IntegratorChoice::Dop853 { rtol, atol, .. } =
+            setup.settings.integrator
+        {
+            let i = sim::integrators::IntegratorChoice::Dop853 {
+                rtol,
+                atol,
+                h_max_s: h,
+            };
+            setup.settings = setup.settings.with_integrator(i);
+        }
     }
     let g = setup.find_gait(&Default::default()).expect("gait");
     let w = &setup.walker;

@@ -42,6 +42,11 @@ impl Power {
         }
     }
 
+    /// Whether no joint has a damper (the dissipation stays zero).
+    pub(super) fn undamped(&self) -> bool {
+        self.damping.is_empty()
+    }
+
     /// An engaged interval starts at `s` (after the engagement or a knee-lock impact).
     pub(super) fn open(&mut self, model: &Model, s: &Sample) {
         self.open = Some((energy(&mut self.dynamics, model, s), self.dissipation_j));

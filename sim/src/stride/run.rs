@@ -269,6 +269,14 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 self.accept(next, drive_end_s)?;
                 continue;
             }
+            if self.scuff_need_not_be_located(&triggered, &w_cur, &w_next) {
+                // Ignored wherever it is: the step is accepted as `apply` would accept it,
+                // without locating the crossing (it would only split the dampers' trapezoid,
+                // and there are none).
+                let at = self.cur.clone();
+                self.accept_ignored(&at, next);
+                continue;
+            }
             let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
                 continue;
             };
@@ -388,6 +396,25 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         }
         self.w_cached = Some(w_next);
         Ok((next, w_cur, w_next))
+    }
+
+    /// The step triggered only the swing foot's crossing, which the walker ignores as a
+    /// mid-swing scuff wherever it lies in the step
+    /// ([`WitnessValues::scuff_anywhere_in_step`]), and locating it would change nothing: no
+    /// dampers (whose trapezoid the location splits), no drive, no controller.
+    fn scuff_need_not_be_located(
+        &self,
+        triggered: &[Watch],
+        w_cur: &WitnessValues,
+        w_next: &WitnessValues,
+    ) -> bool {
+        let hs = &self.walker.heel_strike;
+        triggered == [Watch::Heel]
+            && hs.ignore_scuffing
+            && self.power.undamped()
+            && self.phase.prescribed.is_none()
+            && self.control.is_none()
+            && w_cur.scuff_anywhere_in_step(w_next, hs.min_ahead_m)
     }
 
     /// The string's limit the engagement witness compares with.

@@ -68,6 +68,17 @@ pub(super) struct WitnessValues {
 }
 
 impl WitnessValues {
+    /// Whether a crossing of the floor by the swing foot on the step `self` → `next` is a
+    /// mid-swing scuff wherever it lies in the step: the foot's distance ahead of the stance
+    /// contact is below `min_ahead_m` at both ends by more than it changes over the step (a
+    /// step is short against the swing: the distance is near linear over it). Such a
+    /// crossing need not be located to be told from heel strike. Shared by the general and
+    /// the fixed-size stride loops.
+    pub(super) fn scuff_anywhere_in_step(&self, next: &WitnessValues, min_ahead_m: f64) -> bool {
+        let (a, b) = (self.foot_ahead_m, next.foot_ahead_m);
+        a.max(b) + (b - a).abs() < min_ahead_m
+    }
+
     /// A swing foot that dips below the floor and back inside one step (both ends above
     /// it): the stride time of the first of `samples` evenly spaced points of the step
     /// `self` → `next` at which the cubic Hermite of the foot's height (values and rates at

@@ -3,19 +3,21 @@
 //! contact released in x and y and a relabelling by link pairs without mirror or cyclic
 //! coordinates. The impact is eq. (21) with the root's translation `v0` added to the
 //! coordinates (`M_imp = [[m I, Σ m Jv], [·ᵀ, M̄]]`, finite and infinitesimal parts from the
-//! planar tree), solved by the general impact's KKT system and vanishing-mass limit; the
+//! planar tree), solved by the general impact's KKT system and vanishing-mass limit (with infinitesimal
+//! bodies) or by the same KKT system on fixed-capacity arrays (`impact.rs`, finite bodies); the
 //! relabelling is closed-form (each new link takes its old twin's angle and
 //! angular velocity, the joint coordinates are the differences along the tree) and then
 //! checked against every pair as the general Gauss-Newton is. Anything else, or a check that
 //! does not hold, is left to the general `finish_stride` (`None`).
 
 use super::dop853::State;
-use crate::hybrid::impact::{kkt_system, scatter};
+use super::impact::{FiniteImpact, MAX_ROWS, MAX_VELOCITIES};
+use crate::hybrid::impact::kkt_system;
 use crate::model::{JointKind, Model, PointIndex};
 use crate::planar::{LinkFrame, PlanarTree, MAX_LINKS};
 use crate::singular_limit::solve_limit;
 use crate::walker::{ContactConstraint, Walker};
-use nalgebra::{DMatrix, DVector, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3};
 
 /// What heel strike hands to the stride's result.
 pub(super) struct Relabelled {
@@ -74,6 +76,27 @@ fn link_angles<const N: usize>(tree: &PlanarTree, q: &SVector<f64, N>) -> [f64; 
     a
 }
 
+/// The impact model's mass matrix `M_imp = [[m I, Σ m Jv], [·ᵀ, M̄]]` (velocities: the root's
+/// translation in x and y, then the coordinates) from the tree's mass and momentum Jacobian
+/// ([`PlanarTree::momentum_jacobian`]) and `M̄`, as entries `(i, j)`.
+fn impact_mass<const N: usize>(
+    (mass_kg, jac): (f64, SMatrix<f64, 2, N>),
+    m_q: SMatrix<f64, N, N>,
+) -> impl Fn(usize, usize) -> f64 {
+    move |i, j| match (i < 2, j < 2) {
+        (true, true) => {
+            if i == j {
+                mass_kg
+            } else {
+                0.0
+            }
+        }
+        (true, false) => jac[(i, j - 2)],
+        (false, true) => jac[(j, i - 2)],
+        (false, false) => m_q[(i - 2, j - 2)],
+    }
+}
+
 /// Heel strike at `at` with the free coordinates `active`: the impact, the lift check and the
 /// relabelling, or `None` when the general `finish_stride` is to do it.
 pub(super) fn heel_strike<const N: usize>(
@@ -93,36 +116,26 @@ pub(super) fn heel_strike<const N: usize>(
     let (p_foot, _) = fr.get(foot_link + 1)?.point(foot_p);
     // The impact model's velocities u = (v0, q̇): the root's translation first, at rest.
     let n = N + 2;
+    if n > MAX_VELOCITIES {
+        return None;
+    }
     let (m_q, m_q_eps) = tree.mass_matrices(&at.q);
-    let impact_matrix = |m_q: &nalgebra::SMatrix<f64, N, N>, infinitesimal: bool| {
-        let (mass, b) = tree.momentum_jacobian::<N>(&fr, infinitesimal);
-        DMatrix::from_fn(n, n, |i, j| match (i < 2, j < 2) {
-            (true, true) => {
-                if i == j {
-                    mass
-                } else {
-                    0.0
-                }
-            }
-            (true, false) => b[(i, j - 2)],
-            (false, true) => b[(j, i - 2)],
-            (false, false) => m_q[(i - 2, j - 2)],
-        })
-    };
-    let m_imp = impact_matrix(&m_q, false);
+    let m_imp = impact_mass(tree.momentum_jacobian::<N>(&fr, false), m_q);
     let jf = tree.point_jacobian::<N>(&fr, foot_link, foot_p);
     // Constraint rows of the contact: x and y (z and yaw rows vanish on a planar tree, and the
     // general rows drop them).
-    let rows: Vec<usize> = hs
-        .constraints
-        .iter()
-        .filter_map(|c| match c {
-            ContactConstraint::X => Some(0),
-            ContactConstraint::Y => Some(1),
-            _ => None,
-        })
-        .collect();
-    let g = DMatrix::from_fn(rows.len(), n, |r, j| {
+    let mut rows = [0usize; MAX_ROWS];
+    let mut k = 0;
+    for c in &hs.constraints {
+        let d = match c {
+            ContactConstraint::X => 0,
+            ContactConstraint::Y => 1,
+            _ => continue,
+        };
+        *rows.get_mut(k)? = d;
+        k += 1;
+    }
+    let g = |r: usize, j: usize| {
         let d = rows[r];
         if j < 2 {
             if j == d {
@@ -133,43 +146,65 @@ pub(super) fn heel_strike<const N: usize>(
         } else {
             jf[(d, j - 2)]
         }
-    });
-    let mut u_minus = DVector::zeros(n);
-    u_minus.rows_mut(2, N).copy_from(&at.qd);
-    let target = &g * &u_minus * (-hs.restitution);
-    let free: Vec<usize> = (0..n).filter(|&i| i < 2 || active[i - 2]).collect();
-    // The general impact's equations and solve (`impact::resolve_to`): the KKT system of the
-    // finite part and of the infinitesimal one, and their vanishing-mass limit.
-    // Without infinitesimal bodies the limit is the finite system itself, solved directly (an
-    // LU factorisation instead of the limit solver's eigendecomposition: 25,000 instructions
-    // less a stride).
-    let (a0, b0) = kkt_system(&m_imp, &free, &u_minus, &g, &target);
-    let x = if tree.has_infinitesimal() {
-        let no_rows = DMatrix::zeros(g.nrows(), n);
-        let no_target = DVector::zeros(target.len());
-        let m_imp_eps = impact_matrix(&m_q_eps, true);
-        let (a1, b1) = kkt_system(&m_imp_eps, &free, &u_minus, &no_rows, &no_target);
-        solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?
-    } else {
-        // A pivot that is zero up to rounding (redundant contact constraints) hands the heel
-        // strike back to the general impact, which reports it: whether it comes out exactly
-        // zero depends on the rounding of `M̄`.
-        let lu = a0.lu();
-        // U's diagonal, read off the factorisation without unpacking U.
-        let pivots = lu.lu_internal().diagonal().abs();
-        if pivots.iter().any(|&p| p <= 1e-12 * pivots.max()) {
-            return None;
-        }
-        lu.solve(&b0)?
     };
-    let u_plus = scatter(&u_minus, &free, &x).qd_plus;
-    if u_plus.iter().any(|v| !v.is_finite()) {
+    let mut u_minus = [0.0; MAX_VELOCITIES];
+    u_minus[2..n].copy_from_slice(at.qd.as_slice());
+    // G u⁻ · (−e), as the general `&g * &u_minus * (−e)`.
+    let mut target = [0.0; MAX_ROWS];
+    for (r, t) in target.iter_mut().enumerate().take(k) {
+        *t = (0..n).fold(0.0, |acc, j| acc + g(r, j) * u_minus[j]) * (-hs.restitution);
+    }
+    let mut free = [true; MAX_VELOCITIES];
+    free[2..n].copy_from_slice(active);
+    let u_plus = if tree.has_infinitesimal() {
+        // The general impact's equations and solve (`impact::resolve_to`): the KKT system of
+        // the finite part and of the infinitesimal one, and their vanishing-mass limit.
+        let free: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+        let g_rows = DMatrix::from_fn(k, n, &g);
+        let u = DVector::from_column_slice(&u_minus[..n]);
+        let t = DVector::from_column_slice(&target[..k]);
+        let (a0, b0) = kkt_system(&DMatrix::from_fn(n, n, &m_imp), &free, &u, &g_rows, &t);
+        let m_imp_eps = DMatrix::from_fn(
+            n,
+            n,
+            impact_mass(tree.momentum_jacobian::<N>(&fr, true), m_q_eps),
+        );
+        let no_rows = DMatrix::zeros(k, n);
+        let no_target = DVector::zeros(k);
+        let (a1, b1) = kkt_system(&m_imp_eps, &free, &u, &no_rows, &no_target);
+        let x = solve_limit(&a0, &a1, &b0, &b1, 1e-12).ok()?;
+        let mut u_plus = u_minus;
+        for (j, &i) in free.iter().enumerate() {
+            u_plus[i] = *x.get(j)?;
+        }
+        u_plus
+    } else {
+        // Without infinitesimal bodies the limit is the finite system itself, solved directly
+        // on fixed-capacity arrays (`impact.rs`). A pivot that is zero up to rounding
+        // (redundant contact constraints) hands the heel strike back to the general impact,
+        // which reports it.
+        FiniteImpact {
+            n,
+            mass: &m_imp,
+            k,
+            rows: &g,
+            target,
+            free: &free[..n],
+            u_minus: &u_minus,
+        }
+        .solve()?
+    };
+    if u_plus[..n].iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let energy = |u: &DVector<f64>| 0.5 * u.dot(&(&m_imp * u));
+    // Kinetic energy ½ uᵀ M_imp u (finite bodies).
+    let energy = |u: &[f64; MAX_VELOCITIES]| {
+        let mu = |i: usize| (0..n).fold(0.0, |acc, j| acc + m_imp(i, j) * u[j]);
+        0.5 * (0..n).fold(0.0, |acc, i| acc + u[i] * mu(i))
+    };
     let energy_loss_j = energy(&u_minus) - energy(&u_plus);
     let v0 = [u_plus[0], u_plus[1]];
-    let qd_plus = SVector::<f64, N>::from_iterator(u_plus.rows(2, N).iter().copied());
+    let qd_plus = SVector::<f64, N>::from_column_slice(&u_plus[2..n]);
     // The old stance contact must lift.
     let fr_plus = tree.frames(&at.q, &qd_plus);
     let (_, v_sc) = fr_plus.get(sc_link + 1)?.point(sc_p);

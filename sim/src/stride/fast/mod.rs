@@ -16,6 +16,7 @@
 
 mod dop853;
 mod heel_strike;
+mod impact;
 mod run;
 mod witness;
 

@@ -212,6 +212,11 @@ impl<const N: usize> Run<'_, N> {
                     continue;
                 }
                 Triggered::Several => return Outcome::Fallback,
+                Triggered::One(Watch::Heel) if self.scuff_need_not_be_located(&w_cur, &w_next) => {
+                    let at = self.cur;
+                    self.accept_ignored(&at, next);
+                    continue;
+                }
                 Triggered::One(watch) => watch,
             };
             let Some(at) = self.locate(watch, &next) else {
@@ -281,6 +286,16 @@ impl<const N: usize> Run<'_, N> {
         }
         self.w_cached = Some(w_next);
         Some((next, w_cur, w_next))
+    }
+
+    /// The swing foot's crossing on the step is a mid-swing scuff the walker ignores wherever
+    /// it lies in the step, and without dampers its location would change nothing (the
+    /// general loop's `scuff_need_not_be_located`).
+    fn scuff_need_not_be_located(&self, w_cur: &WitnessValues, w_next: &WitnessValues) -> bool {
+        let hs = &self.walker.heel_strike;
+        hs.ignore_scuffing
+            && self.damping.iter().all(|&d| d == 0.0)
+            && w_cur.scuff_anywhere_in_step(w_next, hs.min_ahead_m)
     }
 
     /// The events the step `cur` → `next` triggered (`Witnesses::triggered`, no string).
