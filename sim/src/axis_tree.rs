@@ -123,6 +123,11 @@ fn coordinate_axis(axis: &Vector3<f64>) -> Option<usize> {
     }
 }
 
+/// Whether every entry is finite.
+fn finite(x: &[f64]) -> bool {
+    x.iter().all(|v| v.is_finite())
+}
+
 /// `a · b` written out.
 #[inline(always)]
 fn dot3(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
@@ -193,7 +198,10 @@ impl AxisTree {
         for (i, link) in model.links.iter().enumerate() {
             let b = &link.body;
             let rotational = b.inertia_com_kg_m2.iter().any(|v| *v != 0.0);
-            if b.mass_kg == 0.0 && !rotational {
+            // An infinitesimal body (here of zero mass: the model has none with mass) goes to
+            // the general engine's infinitesimal part, which a model without infinitesimal
+            // mass never reads: it has no effect there, and none here.
+            if b.infinitesimal || (b.mass_kg == 0.0 && !rotational) {
                 continue;
             }
             let Some(f) = frame_of[i] else { continue };
@@ -397,8 +405,9 @@ impl AxisTree {
     /// `accelerations_of_free_into`.
     ///
     /// # Errors
-    /// [`DynamicsError::Singular`] when the free block of `M̄` is not positive definite (NaN
-    /// states included), as the general engine.
+    /// As the general engine: [`DynamicsError::NonFinite`] for a non-finite `q`, `q̇` or
+    /// result, [`DynamicsError::Singular`] when the free block of `M̄` is not positive
+    /// definite (or a vector has the wrong length).
     #[allow(clippy::too_many_arguments)]
     pub fn accelerations_into(
         &mut self,
@@ -413,10 +422,20 @@ impl AxisTree {
         if q.len() != n || qd.len() != n || active.len() != n || qdd.len() != n {
             return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
         }
+        if qdd_prescribed.is_some_and(|p| p.len() != n) {
+            return Err(LimitSolveError::Degenerate { nullity: 0 }.into());
+        }
+        if !finite(q.as_slice()) || !finite(qd.as_slice()) {
+            return Err(DynamicsError::NonFinite);
+        }
         let prescribed = qdd_prescribed.map(|p| p.as_slice());
         self.mark_needed(active, prescribed, driven);
         self.assemble(q.as_slice(), qd.as_slice());
-        self.solve(active, prescribed, qdd.as_mut_slice())
+        self.solve(active, prescribed, qdd.as_mut_slice())?;
+        if !finite(qdd.as_slice()) {
+            return Err(DynamicsError::NonFinite);
+        }
+        Ok(())
     }
 
     /// The solve of [`Self::accelerations_into`] on the last assembly, for other prescribed
@@ -432,7 +451,7 @@ impl AxisTree {
         qdd: &mut DVector<f64>,
     ) -> Result<bool, DynamicsError> {
         let n = self.dof;
-        if active.len() != n || qdd.len() != n {
+        if active.len() != n || qdd.len() != n || qdd_prescribed.is_some_and(|p| p.len() != n) {
             return Ok(false);
         }
         let prescribed = qdd_prescribed.map(|p| p.as_slice());
@@ -441,6 +460,9 @@ impl AxisTree {
             return Ok(false);
         }
         self.solve(active, prescribed, qdd.as_mut_slice())?;
+        if !finite(qdd.as_slice()) {
+            return Err(DynamicsError::NonFinite);
+        }
         Ok(true)
     }
 

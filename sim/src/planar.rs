@@ -38,14 +38,15 @@ pub const MAX_LINKS: usize = 12;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EvaluationPath {
-    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the general one;
-    /// and the fixed-size stride loop where it covers the stride (`crate::stride`'s `fast`).
+    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the 3D fast
+    /// path when it qualifies ([`crate::axis_tree::AxisTree::of`]), else the general one; and
+    /// the fixed-size stride loop where it covers the stride (`crate::stride`'s `fast`).
     #[default]
     Auto,
-    /// The planar fast path when the model qualifies, inside the general stride loop (no
-    /// fixed-size stride): the reference the fixed-size stride is measured against.
+    /// The planar (or 3D) fast path when the model qualifies, inside the general stride loop
+    /// (no fixed-size stride): the reference the fixed-size stride is measured against.
     GeneralLoop,
-    /// Always the general 3D engine (the reference the fast path is tested against).
+    /// Always the general 3D engine (the reference the fast paths are tested against).
     General,
     /// As [`Self::Auto`] (the fixed-size stride where it covers the stride), but the planar
     /// evaluation always by its link pass, without the closed forms of particular trees (the

@@ -74,6 +74,16 @@ fn compare(model: &Model, states: usize, seed: u64) -> (f64, f64) {
             let mut qdd_p = DVector::zeros(n);
             qdd_p[c] = 3.0 * noise(&mut k);
             phases.push((active, Some(qdd_p), Some(c)));
+            // The walker's own kind of phase: one coordinate locked, the next one driven.
+            if n > 2 {
+                let d = (c + 1) % n;
+                let mut active = vec![true; n];
+                active[c] = false;
+                active[d] = false;
+                let mut qdd_p = DVector::zeros(n);
+                qdd_p[d] = 3.0 * noise(&mut k);
+                phases.push((active, Some(qdd_p), Some(d)));
+            }
         }
         for (active, qdd_p, driven) in &phases {
             let reference = general.accelerations(model, &q, &qd, active, qdd_p.as_ref());
@@ -331,4 +341,54 @@ fn the_3d_walkers_gait_is_the_same_on_both_paths() {
         assert!(dx <= 1e-9, "fixed points {dx:e} apart");
         assert!(dl <= 1e-7, "eigenvalue moduli {dl:e} apart");
     }
+}
+
+#[test]
+fn non_finite_states_are_errors_as_on_the_general_engine() {
+    let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
+    let model = &setup.walker.model;
+    let n = model.dof();
+    let mut tree = AxisTree::of(model).unwrap();
+    let mut general = Dynamics::new(model);
+    let active = vec![true; n];
+    let mut qdd = DVector::zeros(n);
+    for bad in [f64::NAN, f64::INFINITY] {
+        for in_q in [true, false] {
+            let (mut q, mut qd) = (DVector::zeros(n), DVector::zeros(n));
+            if in_q {
+                q[3] = bad;
+            } else {
+                qd[3] = bad;
+            }
+            let fast = tree.accelerations_into(&q, &qd, &active, None, None, &mut qdd);
+            let reference = general.accelerations(model, &q, &qd, &active, None);
+            assert!(
+                matches!(fast, Err(sim::dynamics::DynamicsError::NonFinite)),
+                "{fast:?}"
+            );
+            assert!(reference.is_err());
+        }
+    }
+    // Every coordinate locked with a non-finite prescribed acceleration: an error too.
+    let mut qdd_p = DVector::zeros(n);
+    qdd_p[0] = f64::NAN;
+    let zeros = DVector::zeros(n);
+    assert!(tree
+        .accelerations_into(
+            &zeros,
+            &zeros,
+            &vec![false; n],
+            Some(&qdd_p),
+            None,
+            &mut qdd
+        )
+        .is_err());
+    // Wrong lengths: an error, no panic.
+    let short = DVector::zeros(n - 1);
+    assert!(tree
+        .accelerations_into(&short, &zeros, &active, None, None, &mut qdd)
+        .is_err());
+    assert!(tree
+        .accelerations_into(&zeros, &zeros, &active, Some(&short), None, &mut qdd)
+        .is_err());
 }

@@ -12,8 +12,8 @@
 //! it over the range and at its ends), in about 40 instructions instead of 69. Every other
 //! argument goes to `libm::sincos`.
 //!
-//! Used by the two- and three-link closed forms (`two_link.rs`, `three_link.rs`) and the
-//! fixed-size stride's witnesses. The
+//! Used by the two- and three-link closed forms (`two_link.rs`, `three_link.rs`), the
+//! fixed-size stride's witnesses and the 3D fast path (`crate::axis_tree`). The
 //! link pass and [`super::PlanarTree::frames`] keep the standard library's: the link pass is
 //! checked against the general engine (which uses it) to 1e-13 relative, and wisse2d's
 //! ill-conditioned `q̈` turns a one-ulp difference in an angle into 2.6e-13 of it.

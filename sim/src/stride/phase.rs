@@ -226,7 +226,10 @@ impl<'a> Phase<'a> {
     pub fn with_path(model: &'a Model, path: EvaluationPath) -> Self {
         let planar = PlanarTree::for_path(model, path);
         let axis_tree = match (&planar, path) {
-            (None, EvaluationPath::Auto | EvaluationPath::GeneralLoop) => AxisTree::of(model),
+            (
+                None,
+                EvaluationPath::Auto | EvaluationPath::GeneralLoop | EvaluationPath::LinkPass,
+            ) => AxisTree::of(model),
             _ => None,
         };
         Self {
@@ -535,8 +538,8 @@ mod tests {
     use crate::scene::Scene;
 
     /// The torque and the accelerations solved on the workspace's assembly (the cache taken
-    /// both times, counted) equal, to the bit, those of a fresh phase (a full general
-    /// evaluation, and a partial assembly there).
+    /// both times, counted) equal, to the bit, those of a fresh phase (a fresh evaluation
+    /// there: the 3D fast path's for wisse3d).
     #[test]
     fn solving_on_the_last_assembly_is_bit_for_bit_a_fresh_evaluation() {
         let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
