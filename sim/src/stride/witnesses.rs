@@ -62,6 +62,8 @@ pub(super) struct WitnessValues {
     pub(super) foot_height_m: f64,
     pub(super) foot_height_rate_m_s: f64,
     pub(super) foot_ahead_m: f64,
+    /// The rate of `foot_ahead_m` [m/s].
+    pub(super) foot_ahead_rate_m_s: f64,
     pub(super) hip_height_margin_m: f64,
     pub(super) hip_ahead_m: f64,
     pub(super) hip_forward_velocity_m_s: f64,
@@ -70,13 +72,23 @@ pub(super) struct WitnessValues {
 impl WitnessValues {
     /// Whether a crossing of the floor by the swing foot on the step `self` → `next` is a
     /// mid-swing scuff wherever it lies in the step: the foot's distance ahead of the stance
-    /// contact is below `min_ahead_m` at both ends by more than it changes over the step (a
-    /// step is short against the swing: the distance is near linear over it). Such a
-    /// crossing need not be located to be told from heel strike. Shared by the general and
-    /// the fixed-size stride loops.
+    /// contact, as the cubic Hermite of its values and rates at both ends (which follows a
+    /// turning point inside the step), stays below `min_ahead_m` over the step by more than
+    /// the distance changes between the ends. Such a crossing need not be located to be told
+    /// from heel strike. Shared by the general and the fixed-size stride loops.
     pub(super) fn scuff_anywhere_in_step(&self, next: &WitnessValues, min_ahead_m: f64) -> bool {
         let (a, b) = (self.foot_ahead_m, next.foot_ahead_m);
-        a.max(b) + (b - a).abs() < min_ahead_m
+        let h = next.t_s - self.t_s;
+        let knot = |w: &WitnessValues| Knot {
+            value: w.foot_ahead_m,
+            rate: w.foot_ahead_rate_m_s,
+        };
+        const SAMPLES: usize = 16;
+        let highest = (1..SAMPLES).fold(a.max(b), |m, k| {
+            let x = k as f64 / SAMPLES as f64;
+            m.max(hermite::scalar(knot(self), knot(next), h, x).0)
+        });
+        h.is_finite() && h > 0.0 && highest + (b - a).abs() < min_ahead_m
     }
 
     /// A swing foot that dips below the floor and back inside one step (both ends above
@@ -129,12 +141,16 @@ impl<'a> Witnesses<'a> {
         let p_contact = self
             .kin
             .point_position(m, self.walker.heel_strike.stance_contact);
+        let contact_link = m.points[self.walker.heel_strike.stance_contact.0].link;
         let heading = self.heading();
         WitnessValues {
             t_s: s.t_s,
             foot_height_m: p_foot.y,
             foot_height_rate_m_s: self.kin.velocity_of(foot.link, &p_foot).y,
             foot_ahead_m: (p_foot - p_contact).dot(&heading),
+            foot_ahead_rate_m_s: (self.kin.velocity_of(foot.link, &p_foot)
+                - self.kin.velocity_of(contact_link, &p_contact))
+            .dot(&heading),
             hip_height_margin_m: p_hip.y - self.walker.fall.min_hip_height_m,
             hip_ahead_m: (p_hip - p_contact).dot(&heading),
             hip_forward_velocity_m_s: self.kin.velocity_of(hip.link, &p_hip).dot(&heading),
@@ -219,5 +235,38 @@ impl<'a> Witnesses<'a> {
             }
         }
         triggered
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WitnessValues;
+
+    fn at(t_s: f64, ahead_m: f64, rate_m_s: f64) -> WitnessValues {
+        WitnessValues {
+            t_s,
+            foot_height_m: 0.0,
+            foot_height_rate_m_s: 0.0,
+            foot_ahead_m: ahead_m,
+            foot_ahead_rate_m_s: rate_m_s,
+            hip_height_margin_m: 1.0,
+            hip_ahead_m: 0.0,
+            hip_forward_velocity_m_s: 0.0,
+        }
+    }
+
+    /// A foot far behind and moving forward (the compass's mid-swing scuff) is a scuff
+    /// anywhere in the step; a foot whose distance ahead peaks above `min_ahead` inside the
+    /// step (both ends below it, rates of opposite signs) is not, nor is one ending ahead.
+    #[test]
+    fn a_scuff_anywhere_in_the_step_follows_a_turning_point() {
+        let min_ahead = 1e-3;
+        assert!(at(0.0, -0.25, 1.5).scuff_anywhere_in_step(&at(0.05, -0.175, 1.5), min_ahead));
+        // Ends at 0.5 mm, peak of the Hermite 0.5 mm + h·r/4 = 2.4 mm at mid-step.
+        let (a, b) = (at(0.0, 0.5e-3, 0.15), at(0.05, 0.5e-3, -0.15));
+        assert!(!a.scuff_anywhere_in_step(&b, min_ahead));
+        assert!(!at(0.0, -0.01, 0.5).scuff_anywhere_in_step(&at(0.05, 0.015, 0.5), min_ahead));
+        // A zero-length or non-finite step: never.
+        assert!(!at(0.1, -0.2, 1.0).scuff_anywhere_in_step(&at(0.1, -0.2, 1.0), min_ahead));
     }
 }

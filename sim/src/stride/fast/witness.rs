@@ -127,7 +127,7 @@ impl PlanarWitnesses {
         let jf = self.joint_frames(&s.q, &s.qd);
         let (p_foot, v_foot) = self.foot.point(&jf);
         let (p_hip, v_hip) = self.hip.point(&jf);
-        let (p_contact, _) = self.contact.point(&jf);
+        let (p_contact, v_contact) = self.contact.point(&jf);
         // The walking direction: the stance contact link's x axis, level with the floor (as
         // the general `Witnesses::heading`): along ±x, or x when the link stands vertical.
         let c = self.contact.link_joint.map_or(1.0, |j| jf[j].0);
@@ -137,6 +137,7 @@ impl PlanarWitnesses {
             foot_height_m: p_foot[1],
             foot_height_rate_m_s: v_foot[1],
             foot_ahead_m: (p_foot[0] - p_contact[0]) * heading_x,
+            foot_ahead_rate_m_s: (v_foot[0] - v_contact[0]) * heading_x,
             hip_height_margin_m: p_hip[1] - self.min_hip_height_m,
             hip_ahead_m: (p_hip[0] - p_contact[0]) * heading_x,
             hip_forward_velocity_m_s: v_hip[0] * heading_x,
