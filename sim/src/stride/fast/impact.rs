@@ -124,15 +124,28 @@ mod tests {
     use super::*;
     use nalgebra::DMatrix;
 
-    /// A system with a row swap needed, against nalgebra's LU.
+    /// Against nalgebra's LU: a diagonally dominant mass matrix (no row swap), and one whose
+    /// first mass entry is small against the constraint row's (the elimination swaps rows).
     #[test]
     fn the_solve_agrees_with_nalgebra_lu() {
-        let m = [
+        let dominant = [
             [3.0, 1.0, 0.5, 0.2],
             [1.0, 4.0, 0.3, 0.1],
             [0.5, 0.3, 2.0, 0.7],
             [0.2, 0.1, 0.7, 1.5],
         ];
+        let small_first = [
+            [0.01, 0.002, 0.001, 0.0],
+            [0.002, 4.0, 0.3, 0.1],
+            [0.001, 0.3, 2.0, 0.7],
+            [0.0, 0.1, 0.7, 1.5],
+        ];
+        for m in [dominant, small_first] {
+            agrees_with_nalgebra_lu(m);
+        }
+    }
+
+    fn agrees_with_nalgebra_lu(m: [[f64; 4]; 4]) {
         let g = [[1.0, 0.0, 0.4, -0.9], [0.0, 1.0, -1.1, 0.3]];
         let mut u_minus = [0.0; MAX_VELOCITIES];
         u_minus[..4].copy_from_slice(&[0.0, 0.0, -1.2, 0.8]);
@@ -177,6 +190,24 @@ mod tests {
                 assert_eq!(u_plus[i], u_minus[i]);
             }
         }
+    }
+
+    /// Two constraint rows equal but for 1e-14: refused as the general impact's LU would be
+    /// (a pivot at or below 1e-12 of the largest).
+    #[test]
+    fn nearly_redundant_rows_are_refused() {
+        let u_minus = [1.0; MAX_VELOCITIES];
+        let g = [[1.0, 2.0], [1.0, 2.0 + 1e-14]];
+        let impact = FiniteImpact {
+            n: 2,
+            mass: |i: usize, j: usize| if i == j { 1.0 } else { 0.0 },
+            k: 2,
+            rows: |r: usize, j: usize| g[r][j],
+            target: [0.0, 0.0],
+            free: &[true, true],
+            u_minus: &u_minus,
+        };
+        assert!(impact.solve().is_none());
     }
 
     #[test]
