@@ -6,6 +6,7 @@
 //! final angle, then holds it. The actuator releases at the other foot's heel strike, when this
 //! leg becomes the swing leg (whose massless foot is not modelled).
 
+pub use crate::hybrid::profile::AnkleProfile;
 use crate::model::{CoordIndex, PointIndex};
 use serde::Serialize;
 
@@ -39,27 +40,6 @@ impl AnkleReflex {
             from_rad: self.engage_rad,
             to_rad: self.final_rad,
         }
-    }
-}
-
-/// A prescribed ankle angle: a quintic smooth step (zero rate and acceleration at both ends)
-/// from `from_rad` at `start_s` to `to_rad` at `start_s + duration_s`, held after.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AnkleProfile {
-    /// Start time [s].
-    pub start_s: f64,
-    /// Duration [s].
-    pub duration_s: f64,
-    /// Start angle [rad].
-    pub from_rad: f64,
-    /// Final angle [rad].
-    pub to_rad: f64,
-}
-
-impl AnkleProfile {
-    /// Angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s`.
-    pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
-        crate::hybrid::profile::extension(self, t_s, self.start_s)
     }
 }
 

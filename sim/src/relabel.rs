@@ -7,31 +7,11 @@
 //! joint coordinates (positions) and a least-squares solve (velocities). The residuals are
 //! checked, so an inconsistent correspondence is an error, not a silent wrong state.
 
-pub use crate::hybrid::relabel::LinkStatesOf;
+pub use crate::hybrid::relabel::{LinkStatesOf, Relabel};
 use crate::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
 use crate::kinematics::Kinematics;
-use crate::model::{CoordIndex, LinkIndex, Model, PointIndex};
+use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
-
-/// Which new link takes the pose of which old link, and the symmetry used.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Relabel {
-    /// `(new, old)` link pairs whose orientations must agree.
-    pub pairs: Vec<(LinkIndex, LinkIndex)>,
-    /// `(new, old)` marker-point pairs whose positions must agree (link frames of swapped
-    /// links have different origins, so positions are matched at points).
-    pub point_pairs: Vec<(PointIndex, PointIndex)>,
-    /// Reflect about the sagittal plane (3D walkers).
-    pub mirror: bool,
-    /// Root coordinates that are cyclic (heading): reported and then set to zero.
-    pub cyclic: Vec<CoordIndex>,
-    /// Coordinates held at zero (locked at the start of a stride), not solved for.
-    pub fixed: Vec<CoordIndex>,
-    /// Gauss-Newton tolerance on the pose residual [m or rad].
-    pub tolerance: f64,
-    /// Gauss-Newton iteration budget.
-    pub max_iterations: usize,
-}
 
 /// Why the new coordinates could not be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,45 +1,11 @@
-//! A hybrid walker: a model plus its contact, impact, event and relabelling rules.
+//! A hybrid walker: a model plus its contact, impact, event and relabelling rules (the rules
+//! themselves, over the model only, are in [`crate::hybrid`]).
 
 use crate::events::Direction;
-use crate::model::{CoordIndex, JointKind, LinkIndex, Model, PointIndex};
+pub use crate::hybrid::heel_strike::{ContactConstraint, HeelStrikeRule};
+use crate::model::{CoordIndex, Model, PointIndex};
 use crate::relabel::Relabel;
 use nalgebra::DVector;
-
-/// A direction of the swing-foot contact constrained at heel strike.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ContactConstraint {
-    /// Translation along floor x.
-    X,
-    /// Translation along the floor normal y.
-    Y,
-    /// Translation along floor z.
-    Z,
-    /// Rotation of the foot link about the floor normal (no spin).
-    Yaw,
-}
-
-/// What counts as heel strike, and what is ignored.
-#[derive(Clone, Debug, PartialEq)]
-pub struct HeelStrikeRule {
-    /// The swing-foot point whose height above the floor is the witness (falling through 0).
-    pub swing_foot: PointIndex,
-    /// The link carrying the swing foot (for the yaw constraint).
-    pub swing_foot_link: LinkIndex,
-    /// A crossing counts only when the swing foot is at least this far ahead of the stance
-    /// contact along x [m]; crossings behind it are mid-swing scuffs.
-    pub min_ahead_m: f64,
-    /// Mid-swing scuffs are ignored (the foot passes through the floor, as in Garcia et al.'s
-    /// and McGeer's analyses) rather than ending the stride as a failure.
-    pub ignore_scuffing: bool,
-    /// Constrained directions at the new contact.
-    pub constraints: Vec<ContactConstraint>,
-    /// Coefficient of restitution `e` of eq. (20).
-    pub restitution: f64,
-    /// Joints that become free at the old stance contact during the impact (its release).
-    pub release: Vec<JointKind>,
-    /// The old stance contact point, which must move upward after the impact.
-    pub stance_contact: PointIndex,
-}
 
 /// A knee with a hyperextension stop that locks after its inelastic impact.
 #[derive(Clone, Debug, PartialEq)]

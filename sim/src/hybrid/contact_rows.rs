@@ -5,7 +5,7 @@
 use super::konst;
 use crate::kinematics::KinematicsOf;
 use crate::model::{LinkIndex, Model};
-use crate::walker::{ContactConstraint, HeelStrikeRule};
+use super::heel_strike::{ContactConstraint, HeelStrikeRule};
 use nalgebra::{DMatrix, DVector, RealField, Vector3};
 
 /// A row whose entries are all below this (in magnitude) is identically zero: a constraint on

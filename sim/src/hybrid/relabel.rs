@@ -2,15 +2,35 @@
 //! contact, their reflection about the sagittal plane, the poses and velocities the new
 //! labelling must match ([`RelabelTargets`]), and the matched rows' residual and Jacobian.
 //!
+//! [`Relabel`] is the rule a scene states (which new link takes the pose of which old one).
 //! The `f64` relabelling ([`crate::relabel::Relabel::solve`]) iterates Gauss-Newton on these
 //! rows; the variational Jacobian differentiates the converged solution through them.
 
 use super::konst;
 use crate::kinematics::{Kinematics, KinematicsOf};
 use crate::math::{orientation_error, sagittal_reflection};
-use crate::model::Model;
-use crate::relabel::Relabel;
+use crate::model::{CoordIndex, LinkIndex, Model, PointIndex};
 use nalgebra::{DMatrix, DVector, Matrix3, RealField, Scalar, Vector3};
+
+/// Which new link takes the pose of which old link, and the symmetry used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relabel {
+    /// `(new, old)` link pairs whose orientations must agree.
+    pub pairs: Vec<(LinkIndex, LinkIndex)>,
+    /// `(new, old)` marker-point pairs whose positions must agree (link frames of swapped
+    /// links have different origins, so positions are matched at points).
+    pub point_pairs: Vec<(PointIndex, PointIndex)>,
+    /// Reflect about the sagittal plane (3D walkers).
+    pub mirror: bool,
+    /// Root coordinates that are cyclic (heading): reported and then set to zero.
+    pub cyclic: Vec<CoordIndex>,
+    /// Coordinates held at zero (locked at the start of a stride), not solved for.
+    pub fixed: Vec<CoordIndex>,
+    /// Gauss-Newton tolerance on the pose residual [m or rad].
+    pub tolerance: f64,
+    /// Gauss-Newton iteration budget.
+    pub max_iterations: usize,
+}
 
 /// Poses and velocities of every link of a model, in the floor frame.
 #[derive(Clone, Debug)]
