@@ -11,25 +11,17 @@ use std::time::Duration;
 
 fn benches(c: &mut Criterion) {
     let scene = Scene::load("simplest").unwrap();
-    let newton = NewtonSettings::default();
-    let settings = ContinuationSettings {
-        max_period: 1,
-        ..ContinuationSettings::default()
-    };
+    let settings = ContinuationSettings::builder()
+        .newton(NewtonSettings::default())
+        .max_period(1)
+        .build()
+        .unwrap();
     let mut group = c.benchmark_group("continuation");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(5));
     group.bench_function("simplest/slope_0.009_0.016_8_points", |b| {
         b.iter(|| {
-            let r = continuation(
-                &scene,
-                "slope",
-                (0.009, 0.016, 8),
-                &newton,
-                &settings,
-                &|_| {},
-            )
-            .unwrap();
+            let r = continuation(&scene, "slope", (0.009, 0.016, 8), &settings, &|_| {}).unwrap();
             black_box(r.branches.len())
         })
     });

@@ -5,7 +5,7 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim::census::HomotopySettings;
+use sim::homotopy::HomotopySettings;
 use sim::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::scene::{Scene, Setup};
 use sim::stability_map::{stability_map, Axis};

@@ -18,10 +18,6 @@ fn near_minus_one(ev: &[nalgebra::Complex<f64>]) -> f64 {
 
 fn main() {
     let scene = Scene::load("simplest").unwrap();
-    let settings = ContinuationSettings {
-        max_period: 1,
-        ..ContinuationSettings::default()
-    };
     let frozen = NewtonSettings {
         frozen_steps: true,
         jacobian: JacobianMethod::CentralDifferences,
@@ -29,15 +25,12 @@ fn main() {
     };
     let plain = NewtonSettings::default();
     for (label, newton) in [("plain", &plain), ("frozen", &frozen)] {
-        let c = continuation(
-            &scene,
-            "slope",
-            (0.009, 0.017, 5),
-            newton,
-            &settings,
-            &|_| {},
-        )
-        .unwrap();
+        let settings = ContinuationSettings::builder()
+            .newton(*newton)
+            .max_period(1)
+            .build()
+            .unwrap();
+        let c = continuation(&scene, "slope", (0.009, 0.017, 5), &settings, &|_| {}).unwrap();
         let b = c.branches[0]
             .bifurcations
             .iter()

@@ -12,6 +12,7 @@ pub mod control;
 pub mod dynamics;
 pub mod events;
 pub mod hermite;
+pub mod homotopy;
 pub mod hybrid;
 pub mod impact;
 pub mod integrators;

@@ -23,7 +23,7 @@
 //! computed in parallel (rayon); inside a chunk each value starts from the previous one's
 //! attractor as above. The first value of a chunk (and a value after a fall) starts instead
 //! from a **seed**: the period-1 gait at that value
-//! ([`crate::census::long_period_gait`]), nudged by [`OrbitSettings::seed_nudge`] when it is
+//! ([`crate::homotopy::long_period_gait`]), nudged by [`OrbitSettings::seed_nudge`] when it is
 //! unstable so that the iteration leaves it along its unstable direction, or the scene's
 //! guess where there is no gait. Why this is faithful: the attractors a
 //! period-doubling cascade reaches are born from that period-1 gait; an unstable fixed point
@@ -33,7 +33,7 @@
 //! large as the number of values gives the purely sequential diagram. The chunking does not
 //! depend on the number of threads, so neither do the results.
 
-use crate::census::{long_period_gait, HomotopySettings, SetupFor};
+use crate::homotopy::{long_period_gait, HomotopySettings, SetupFor};
 use crate::limit_cycle::{GaitSearch, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use crate::stride::StrideFailure;

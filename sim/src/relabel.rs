@@ -7,8 +7,8 @@
 //! joint coordinates (positions) and a least-squares solve (velocities). The residuals are
 //! checked, so an inconsistent correspondence is an error, not a silent wrong state.
 
-pub use crate::hybrid::relabel::{LinkStatesOf, Relabel};
 use crate::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
+pub use crate::hybrid::relabel::{LinkStatesOf, Relabel};
 use crate::kinematics::Kinematics;
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};

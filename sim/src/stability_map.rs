@@ -7,7 +7,7 @@
 //! the corrector moved it by more than [`HomotopySettings::max_correction`] or its step period
 //! differs from the last gait's by more than [`HomotopySettings::max_period_change`] (a jump
 //! to another branch). The first cell of a row, a cell after one without a gait, and a cell
-//! whose continuation failed or jumped are **seeded** by [`crate::census::long_period_gait`]
+//! whose continuation failed or jumped are **seeded** by [`crate::homotopy::long_period_gait`]
 //! (Newton from the scene's guess and the defaults' gait followed to the cell), so a row
 //! re-enters the long-period branch where it reappears. A cell has no gait when both fail.
 //!
@@ -17,8 +17,8 @@
 //! searches with the caller's Newton budget and at most [`HomotopySettings::max_solves`]
 //! corrector searches along the path from the defaults.
 
-use crate::census::{HomotopySettings, SetupFor};
 use crate::continuation::along;
+use crate::homotopy::{HomotopySettings, SetupFor};
 use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;

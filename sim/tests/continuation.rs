@@ -21,19 +21,12 @@ const GUESS_LONG: State = State {
 
 fn run(scene: &str, param: &str, range: (f64, f64, usize), max_period: usize) -> Continuation {
     let scene = Scene::load(scene).unwrap();
-    let settings = ContinuationSettings {
-        max_period,
-        ..ContinuationSettings::default()
-    };
-    continuation(
-        &scene,
-        param,
-        range,
-        &NewtonSettings::default(),
-        &settings,
-        &|_| {},
-    )
-    .unwrap()
+    let settings = ContinuationSettings::builder()
+        .newton(NewtonSettings::default())
+        .max_period(max_period)
+        .build()
+        .unwrap();
+    continuation(&scene, param, range, &settings, &|_| {}).unwrap()
 }
 
 /// The simplest walker's state `v` in Garcia's variables (θ = stance_leg, θ̇ = stance_leg_dot).
@@ -169,11 +162,11 @@ fn a_sweep_from_slope_0_015_starts_on_the_long_period_gait_as_walker_gait_does()
     let mut at = scene.clone();
     at.set("slope", 0.015).unwrap();
     let setup_for = |s: &Scene| s.setup();
-    let gait = sim::census::long_period_gait(
+    let gait = sim::homotopy::long_period_gait(
         &at,
         &setup_for,
         &NewtonSettings::default(),
-        &sim::census::HomotopySettings::default(),
+        &sim::homotopy::HomotopySettings::default(),
     )
     .unwrap()
     .unwrap();
@@ -343,9 +336,12 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
     ];
     for (name, param, range, kind, frozen, tol) in cases {
         let scene = Scene::load(name).unwrap();
-        let settings = ContinuationSettings {
-            max_period: 1,
-            ..ContinuationSettings::default()
+        let settings = |newton: &NewtonSettings| {
+            ContinuationSettings::builder()
+                .newton(*newton)
+                .max_period(1)
+                .build()
+                .unwrap()
         };
         let reference_newton = NewtonSettings {
             frozen_steps: frozen,
@@ -357,7 +353,7 @@ fn the_stride_jacobian_error_at_the_located_points_is_small() {
             ..NewtonSettings::default()
         };
         let located = |newton: &NewtonSettings| {
-            let c = continuation(&scene, param, range, newton, &settings, &|_| {}).unwrap();
+            let c = continuation(&scene, param, range, &settings(newton), &|_| {}).unwrap();
             c.branches[0]
                 .bifurcations
                 .iter()
@@ -450,21 +446,14 @@ fn a_step_refused_at_the_smallest_step_ends_the_branch_instead_of_being_taken() 
     // smallest, is refused; the branch must end at its start (`not_converged`, saying why)
     // rather than take the step anyway.
     let scene = Scene::load("simplest").unwrap();
-    let settings = ContinuationSettings {
-        max_period: 1,
-        max_turn_deg: 1e-9,
-        min_step_fraction: 0.1,
-        ..ContinuationSettings::default()
-    };
-    let c = continuation(
-        &scene,
-        "slope",
-        (0.009, 0.017, 3),
-        &NewtonSettings::default(),
-        &settings,
-        &|_| {},
-    )
-    .unwrap();
+    let settings = ContinuationSettings::builder()
+        .newton(NewtonSettings::default())
+        .max_period(1)
+        .max_turn_deg(1e-9)
+        .min_step_fraction(0.1)
+        .build()
+        .unwrap();
+    let c = continuation(&scene, "slope", (0.009, 0.017, 3), &settings, &|_| {}).unwrap();
     let main = &c.branches[0];
     let end = main.end.as_ref().unwrap();
     assert_eq!(end.kind, BranchEndKind::NotConverged, "{end:?}");
@@ -489,20 +478,13 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
     // A budget of one branch: the period doubling on branch 0 gets no period-2 branch, and
     // the report says so with the reason.
     let scene = Scene::load("simplest").unwrap();
-    let settings = ContinuationSettings {
-        max_period: 2,
-        max_branches: 1,
-        ..ContinuationSettings::default()
-    };
-    let mut c = continuation(
-        &scene,
-        "slope",
-        (0.009, 0.017, 5),
-        &NewtonSettings::default(),
-        &settings,
-        &|_| {},
-    )
-    .unwrap();
+    let settings = ContinuationSettings::builder()
+        .newton(NewtonSettings::default())
+        .max_period(2)
+        .max_branches(1)
+        .build()
+        .unwrap();
+    let mut c = continuation(&scene, "slope", (0.009, 0.017, 5), &settings, &|_| {}).unwrap();
     assert_eq!(c.branches.len(), 1);
     assert_eq!(c.switch_failures.len(), 1, "{:?}", c.switch_failures);
     let pd = &c.branches[0].bifurcations[0];

@@ -4,7 +4,8 @@
 //! `sim/cli/tests/gait_families.rs`.)
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use sim::census::{at_defaults, census, is_at_defaults, CensusSettings, SetupFor};
+use sim::census::{census, CensusSettings};
+use sim::homotopy::{at_defaults, is_at_defaults, SetupFor};
 use sim::limit_cycle::NewtonSettings;
 use sim::orbit_diagram::{linspace, orbit_diagram, Attractor, OrbitError, OrbitSettings};
 use sim::scene::{Scene, SceneError, Setup};
@@ -190,16 +191,16 @@ fn the_secant_step_refuses_a_jump_to_another_branch() {
     scene.set("slope", 0.015).unwrap();
     let setup = scene.setup().unwrap();
     let newton = NewtonSettings::default();
-    let guard = sim::census::HomotopySettings::default();
+    let guard = sim::homotopy::HomotopySettings::default();
     let short = setup.find_gait(&newton).unwrap();
-    let mut path = sim::continuation::Secant::default();
+    let mut path = sim::homotopy::Secant::default();
     assert!(path.step(0.015, &setup, &newton, &guard).is_none());
     path.push(0.015, &short);
     let again = path.step(0.015, &setup, &newton, &guard).unwrap().unwrap();
     assert!((&again.fixed_point - &short.fixed_point).amax() < 1e-9);
     let mut disguised = short.clone();
     disguised.stride.duration_s *= 1.25;
-    let mut path = sim::continuation::Secant::default();
+    let mut path = sim::homotopy::Secant::default();
     path.push(0.015, &disguised);
     assert!(path.step(0.015, &setup, &newton, &guard).unwrap().is_err());
 }

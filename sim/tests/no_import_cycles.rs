@@ -581,7 +581,7 @@ impl Crate {
             l.binds.is_none()
                 && l.path.first().is_some_and(|s| {
                     matches!(s.as_str(), "crate" | "self" | "super")
-                        || self.is_module(&[module, &[s.clone()]].concat())
+                        || self.is_module(&[module, std::slice::from_ref(s)].concat())
                 })
         }) {
             let mut p = leaf.path.clone();

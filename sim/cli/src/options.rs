@@ -66,7 +66,7 @@ impl Common {
     }
 
     /// [`Self::setup`] as the engine's studies build a scene at other parameter values
-    /// ([`sim::census::SetupFor`]); an option error (already refused by [`Self::setup`] before
+    /// ([`sim::homotopy::SetupFor`]); an option error (already refused by [`Self::setup`] before
     /// any study starts) comes back as [`SceneError::Invalid`].
     pub fn setup_for(&self) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
         move |scene: &Scene| {

@@ -15,6 +15,7 @@
 //! [`StepControl::max_dp`] (the grid spacing).
 
 use super::family::{EvalError, EventSignature, Family};
+use super::settings::Detection;
 use crate::limit_cycle::JacobianMethod;
 use crate::scene::Setup;
 use crate::stride::StrideResult;
@@ -167,6 +168,7 @@ pub struct Constraint {
 }
 
 /// Period-`k` continuation on a family.
+#[derive(Clone, Copy)]
 pub struct Continuer<'a> {
     /// The family.
     pub family: &'a Family,
@@ -174,6 +176,8 @@ pub struct Continuer<'a> {
     pub period: usize,
     /// Step control.
     pub steps: StepControl,
+    /// Which bifurcations are located.
+    pub detect: Detection,
 }
 
 impl<'a> Continuer<'a> {

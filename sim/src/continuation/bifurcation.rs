@@ -17,6 +17,7 @@
 //! as much as the arclength, so the parameter is located at least as well).
 
 use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
+use super::settings::Detection;
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -42,6 +43,15 @@ pub enum BifurcationKind {
 }
 
 impl BifurcationKind {
+    /// Whether `detect` locates bifurcations of this kind.
+    pub fn detected_by(self, detect: &Detection) -> bool {
+        match self {
+            Self::Fold | Self::BranchPoint => detect.folds,
+            Self::PeriodDoubling => detect.period_doublings,
+            Self::NeimarkSacker => detect.neimark_sacker,
+        }
+    }
+
     /// The JSON name.
     pub fn name(self) -> &'static str {
         match self {
@@ -340,6 +350,18 @@ pub fn locate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn detection_names_each_kind() {
+        let d = Detection {
+            folds: false,
+            ..Detection::default()
+        };
+        assert!(!BifurcationKind::Fold.detected_by(&d));
+        assert!(!BifurcationKind::BranchPoint.detected_by(&d));
+        assert!(BifurcationKind::PeriodDoubling.detected_by(&d));
+        assert!(BifurcationKind::NeimarkSacker.detected_by(&d));
+    }
 
     fn polar(r: f64, angle: f64) -> [Complex<f64>; 2] {
         [

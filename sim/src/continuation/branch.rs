@@ -2,10 +2,11 @@
 //! control, bifurcations located between steps, the points at the grid values hit exactly,
 //! and the branch's end.
 
-use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation};
+use super::arclength::{BranchPoint, Continuer, CorrectorError, Linearisation, StepControl};
 use super::bifurcation::{self, Bifurcation, BifurcationKind};
 use super::branch_end::{self, BranchEnd, BranchEndKind};
 use super::family::EvalError;
+use super::settings::Detection;
 use nalgebra::DVector;
 
 /// The parameter range of a sweep and its grid.
@@ -100,6 +101,10 @@ pub struct Branch {
     pub end: Option<BranchEnd>,
     /// Continuation points computed (steps accepted).
     pub steps: usize,
+    /// The step control it was followed with.
+    pub step_control: StepControl,
+    /// The bifurcations it located.
+    pub detect: Detection,
 }
 
 impl Branch {
@@ -174,7 +179,9 @@ fn refused(a: &BranchPoint, b: &BranchPoint, h: f64, max_turn_deg: f64) -> Optio
 }
 
 /// Follows the branch from `start` across `grid` with at most `budget` steps, calling
-/// `progress` with the fraction of the range covered.
+/// `progress` with the fraction of the range covered: trial steps along the tangent, halved
+/// while refused ([`refused`]) or failed, the accepted ones recorded ([`record_step`]), until
+/// the branch leaves the range, closes, ends or the budget runs out.
 pub fn follow(
     cont: &Continuer,
     id: usize,
@@ -184,141 +191,64 @@ pub fn follow(
     budget: usize,
     progress: &dyn Fn(f64),
 ) -> Branch {
-    let mut branch = Branch {
-        id,
-        period_strides: cont.period,
-        parent,
-        grid: Vec::new(),
-        bifurcations: Vec::new(),
-        unlocated: Vec::new(),
-        missed: Vec::new(),
-        end_before: None,
-        end: None,
-        steps: 0,
-    };
-    let slack = 1e-12 * (1.0 + grid.from.abs().max(grid.to.abs()));
-    if let Some(&g) = grid
-        .values
-        .iter()
-        .find(|&&g| (g - start.0.value).abs() <= slack)
-    {
-        branch.grid.push(GridPoint {
-            value: g,
-            point: start.0.clone(),
-        });
-    }
+    let mut branch = started(cont, id, parent, &start.0, grid);
     let origin = Origin::of(&start.0);
+    let min = cont.steps.min;
     let mut cur = start;
     let mut h = cont.steps.initial;
     let mut furthest = grid.fraction(cur.0.value);
     let mut steps = 0;
     while steps < budget {
         h = cont.steps.capped(h, &cur.0.tangent);
-        let trial = cont.at_arclength(&cur.0, &cur.1, h, true);
-        match trial {
+        let halved = (h * 0.5).max(min);
+        match cont.at_arclength(&cur.0, &cur.1, h, true) {
             // A refused trial is retried with a shorter step; at the smallest step it ends the
             // branch only when its event sequence is the branch's own (a trial with another
             // sequence is never taken as a step: the arm for it locates the event change).
             Ok((p, _))
                 if refused(&cur.0, &p, h, cont.steps.max_turn_deg).is_some()
-                    && (h > cont.steps.min || p.signature == cur.0.signature) =>
+                    && (h > min || p.signature == cur.0.signature) =>
             {
-                if h > cont.steps.min {
-                    h = (h * 0.5).max(cont.steps.min);
+                if h > min {
+                    h = halved;
                     continue;
                 }
                 // Even the smallest step fails the test: taking it could jump to another
                 // branch without a word, so the branch ends here.
                 steps += 1;
                 let why = refused(&cur.0, &p, h, cont.steps.max_turn_deg).unwrap_or_default();
-                branch.end = Some(BranchEnd {
-                    kind: BranchEndKind::NotConverged,
-                    value: cur.0.value,
-                    event: None,
-                    detail: format!(
+                branch.end = Some(end(
+                    BranchEndKind::NotConverged,
+                    cur.0.value,
+                    format!(
                         "the smallest step ({h:.3e}) is refused: {why}; a jump to another \
                          branch is not taken"
                     ),
-                    bracket: h,
-                    grazing: false,
-                    budget_exhausted: false,
-                });
+                    h,
+                ));
                 break;
             }
             // Two complex pairs through the unit circle in one step cannot be located one by
             // one (their test function may keep its sign): the step is halved until they
             // come one per step, or the smallest step takes them together.
             Ok((p, _))
-                if h > cont.steps.min
+                if h > min
+                    && cont.detect.neimark_sacker
                     && p.signature == cur.0.signature
                     && bifurcation::neimark_sacker_crossings(
                         &cur.0.multipliers,
                         &p.multipliers,
                     ) > 1 =>
             {
-                h = (h * 0.5).max(cont.steps.min);
-                continue;
+                h = halved;
             }
             Ok((p, l)) if p.signature == cur.0.signature => {
                 steps += 1;
-                for kind in bifurcation::crossings(&cur.0, &p) {
-                    match bifurcation::locate(cont, kind, (&cur.0, &cur.1), &p) {
-                        Ok(b) => branch.bifurcations.push(b),
-                        Err(e) => branch.unlocated.push(Unlocated {
-                            kind,
-                            bracket: (cur.0.value, p.value),
-                            reason: e.to_string(),
-                        }),
-                    }
-                }
-                let mut crossed: Vec<f64> = grid
-                    .values
-                    .iter()
-                    .copied()
-                    .filter(|&g| between(cur.0.value, p.value, g))
-                    .collect();
-                if p.value < cur.0.value {
-                    crossed.reverse();
-                }
-                for g in crossed {
-                    match cont.at_value(&cur.0, &p, &l, g) {
-                        Ok((gp, _)) => branch.grid.push(GridPoint {
-                            value: g,
-                            point: gp,
-                        }),
-                        Err(e) => branch.missed.push((g, e.to_string())),
-                    }
-                }
+                record_step(cont, &mut branch, grid, &cur, (&p, &l));
                 furthest = furthest.max(grid.fraction(p.value));
                 progress(furthest);
                 if !grid.contains(p.value) {
-                    let towards_to = (p.value - grid.from) * (grid.to - grid.from) > 0.0;
-                    if !towards_to {
-                        let fold = branch
-                            .bifurcations
-                            .iter()
-                            .rev()
-                            .find(|b| b.kind == BifurcationKind::Fold);
-                        let (value, detail) = match fold {
-                            Some(f) => (
-                                f.value,
-                                format!(
-                                    "the branch turns back at a fold at {} and returns to {}",
-                                    f.value, grid.from
-                                ),
-                            ),
-                            None => (p.value, format!("the branch returns to {}", grid.from)),
-                        };
-                        branch.end = Some(BranchEnd {
-                            kind: BranchEndKind::Fold,
-                            value,
-                            event: None,
-                            detail,
-                            bracket: 0.0,
-                            grazing: false,
-                            budget_exhausted: false,
-                        });
-                    }
+                    branch.end = turned_back(&branch, grid, &p);
                     break;
                 }
                 if let Some(end) = origin.closed_by(&cur.0, &p, &branch.bifurcations) {
@@ -332,45 +262,160 @@ pub fn follow(
                 let stride_failed =
                     matches!(other, Err(CorrectorError::Eval(EvalError::Stride(_))));
                 let changed = branch_end::is_event_change(&cur.0, &other);
-                if (stride_failed || !changed) && h > cont.steps.min {
-                    h = (h * 0.5).max(cont.steps.min);
+                if (stride_failed || !changed) && h > min {
+                    h = halved;
                     continue;
                 }
                 steps += 1;
-                branch.end = Some(if changed {
-                    branch_end::locate(cont, (&cur.0, &cur.1), h, other)
-                } else {
-                    BranchEnd {
-                        kind: BranchEndKind::NotConverged,
-                        value: cur.0.value,
-                        event: None,
-                        detail: match other {
-                            Err(e) => format!("no point beyond: {e}"),
-                            Ok(_) => "no point beyond".into(),
-                        },
-                        bracket: h,
-                        grazing: false,
-                        budget_exhausted: false,
-                    }
-                });
+                branch.end = Some(failed_step_end(cont, &cur, h, other, changed));
                 break;
             }
         }
     }
     if steps >= budget && branch.end.is_none() {
-        branch.end = Some(BranchEnd {
-            kind: BranchEndKind::Budget,
-            value: cur.0.value,
-            event: None,
-            detail: format!("the point budget of {budget} steps ran out"),
-            bracket: 0.0,
-            grazing: false,
-            budget_exhausted: false,
-        });
+        let detail = format!("the point budget of {budget} steps ran out");
+        branch.end = Some(end(BranchEndKind::Budget, cur.0.value, detail, 0.0));
     }
     branch.steps = steps;
     progress(1.0);
     branch
+}
+
+/// A branch end without an event (no grazing, no location budget).
+fn end(kind: BranchEndKind, value: f64, detail: String, bracket: f64) -> BranchEnd {
+    BranchEnd {
+        kind,
+        value,
+        event: None,
+        detail,
+        bracket,
+        grazing: false,
+        budget_exhausted: false,
+    }
+}
+
+/// The branch before its first step: `start` as its point at a grid value when it lies on
+/// one.
+fn started(
+    cont: &Continuer,
+    id: usize,
+    parent: Option<(usize, f64)>,
+    start: &BranchPoint,
+    grid: &Grid,
+) -> Branch {
+    let mut branch = Branch {
+        id,
+        period_strides: cont.period,
+        parent,
+        grid: Vec::new(),
+        bifurcations: Vec::new(),
+        unlocated: Vec::new(),
+        missed: Vec::new(),
+        end_before: None,
+        end: None,
+        steps: 0,
+        step_control: cont.steps,
+        detect: cont.detect,
+    };
+    let slack = 1e-12 * (1.0 + grid.from.abs().max(grid.to.abs()));
+    if let Some(&g) = grid
+        .values
+        .iter()
+        .find(|&&g| (g - start.value).abs() <= slack)
+    {
+        branch.grid.push(GridPoint {
+            value: g,
+            point: start.clone(),
+        });
+    }
+    branch
+}
+
+/// Records the accepted step from `cur` to `next`: the bifurcations detected between them,
+/// located (or why not), and the branch's points at the grid values crossed (or why the
+/// corrector there failed).
+fn record_step(
+    cont: &Continuer,
+    branch: &mut Branch,
+    grid: &Grid,
+    cur: &(BranchPoint, Linearisation),
+    (p, l): (&BranchPoint, &Linearisation),
+) {
+    let detected = bifurcation::crossings(&cur.0, p)
+        .into_iter()
+        .filter(|k| k.detected_by(&cont.detect));
+    for kind in detected {
+        match bifurcation::locate(cont, kind, (&cur.0, &cur.1), p) {
+            Ok(b) => branch.bifurcations.push(b),
+            Err(e) => branch.unlocated.push(Unlocated {
+                kind,
+                bracket: (cur.0.value, p.value),
+                reason: e.to_string(),
+            }),
+        }
+    }
+    let mut crossed: Vec<f64> = grid
+        .values
+        .iter()
+        .copied()
+        .filter(|&g| between(cur.0.value, p.value, g))
+        .collect();
+    if p.value < cur.0.value {
+        crossed.reverse();
+    }
+    for g in crossed {
+        match cont.at_value(&cur.0, p, l, g) {
+            Ok((gp, _)) => branch.grid.push(GridPoint {
+                value: g,
+                point: gp,
+            }),
+            Err(e) => branch.missed.push((g, e.to_string())),
+        }
+    }
+}
+
+/// The end of a branch whose step reached `p`, outside the range: `None` past `to` (it left
+/// the range); past `from`, it turned back (at its last fold, if one was located).
+fn turned_back(branch: &Branch, grid: &Grid, p: &BranchPoint) -> Option<BranchEnd> {
+    let towards_to = (p.value - grid.from) * (grid.to - grid.from) > 0.0;
+    if towards_to {
+        return None;
+    }
+    let fold = branch
+        .bifurcations
+        .iter()
+        .rev()
+        .find(|b| b.kind == BifurcationKind::Fold);
+    let (value, detail) = match fold {
+        Some(f) => (
+            f.value,
+            format!(
+                "the branch turns back at a fold at {} and returns to {}",
+                f.value, grid.from
+            ),
+        ),
+        None => (p.value, format!("the branch returns to {}", grid.from)),
+    };
+    Some(end(BranchEndKind::Fold, value, detail, 0.0))
+}
+
+/// The end of a branch whose trial step `h` from `cur` failed for good (`other`): the event
+/// change located when the event sequence `changed`, else no point beyond.
+fn failed_step_end(
+    cont: &Continuer,
+    cur: &(BranchPoint, Linearisation),
+    h: f64,
+    other: Result<(BranchPoint, Linearisation), CorrectorError>,
+    changed: bool,
+) -> BranchEnd {
+    if changed {
+        return branch_end::locate(cont, (&cur.0, &cur.1), h, other);
+    }
+    let detail = match other {
+        Err(e) => format!("no point beyond: {e}"),
+        Ok(_) => "no point beyond".into(),
+    };
+    end(BranchEndKind::NotConverged, cur.0.value, detail, h)
 }
 
 /// Where a branch started: to recognise a closed branch (an isola) coming back to it.
@@ -406,18 +451,11 @@ impl Origin {
         }
         let lo = folds.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = folds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        Some(BranchEnd {
-            kind: BranchEndKind::ClosedLoop,
-            value: next.value,
-            event: None,
-            detail: format!(
-                "the branch is a closed loop: it came back to where it was started, between \
-                 folds at {lo} and {hi}; no gait of it lies outside that interval"
-            ),
-            bracket: 0.0,
-            grazing: false,
-            budget_exhausted: false,
-        })
+        let detail = format!(
+            "the branch is a closed loop: it came back to where it was started, between folds \
+             at {lo} and {hi}; no gait of it lies outside that interval"
+        );
+        Some(end(BranchEndKind::ClosedLoop, next.value, detail, 0.0))
     }
 
     /// Whether the step from `a` to `b` (tangent `tb` at `b`) passed through the start again,

@@ -3,17 +3,18 @@
 //! (docs/bifurcations.md).
 //!
 //! By concept:
-//! - `natural`: natural-parameter continuation: [`Secant`] (secant predictor, Newton, guard
-//!   against jumping branches: the census's homotopy and the stability map's rows use it),
-//!   [`along`] (a gait along given values, seeded by the long-period gait; the stability map's
-//!   rows) and [`sweep`];
+//! - `natural`: natural-parameter continuation by the guarded secant step of
+//!   [`crate::homotopy`]: [`along`] (a gait along given values, seeded by the long-period gait;
+//!   the stability map's rows) and [`sweep`];
 //! - `family`: [`Family`], the stride maps `Sᵏ(v; p)` of a scene in one parameter: the walker
 //!   rebuilt at `p`, orbits, monodromy matrices, `∂Sᵏ/∂p`, event sequences;
 //! - `arclength`: pseudo-arclength predictor and corrector, [`BranchPoint`], [`StepControl`];
 //! - `bifurcation`: test functions, [`Bifurcation`] and its location;
 //! - `branch_end`: [`BranchEnd`], non-smooth ends located by bisection;
 //! - `branch`: [`Branch`], following one branch across a [`Grid`];
-//! - `period2`: switching to the period-doubled branch at a period doubling.
+//! - `period2`: switching to the period-doubled branch at a period doubling;
+//! - `settings`: [`ContinuationSettings`], every setting of a continuation (the Newton ones
+//!   inside) in one validated value.
 //!
 //! [`continuation`] puts them together: the branch through the gait at `from`, followed to
 //! `to`, and the period-2, 4, … branches born on it.
@@ -25,6 +26,7 @@ mod branch_end;
 mod family;
 mod natural;
 mod period2;
+mod settings;
 
 pub use arclength::{
     BranchPoint, Constraint, Continuer, CorrectorError, Linearisation, StepControl,
@@ -37,57 +39,14 @@ pub use bifurcation::{
 pub use branch::{Branch, Grid, GridPoint, Unlocated};
 pub use branch_end::{BranchEnd, BranchEndKind};
 pub use family::{EvalError, EventSignature, Family, Orbit};
-pub use natural::{along, sweep, AlongPoint, Secant, StabilityBoundary, SweepError, SweepPoint};
+pub use natural::{along, sweep, AlongPoint, StabilityBoundary, SweepError, SweepPoint};
 pub use period2::{flip_vector, SwitchError};
+pub use settings::{ContinuationSettings, ContinuationSettingsBuilder, Detection, SettingsError};
 
-use crate::census::{long_period_gait, HomotopySettings};
-use crate::limit_cycle::NewtonSettings;
+use crate::homotopy::long_period_gait;
 use crate::scene::Scene;
 use nalgebra::DVector;
 use std::collections::VecDeque;
-
-/// Settings of a continuation beyond the Newton ones.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ContinuationSettings {
-    /// Largest period followed (1, 2, 4, …): branches of period up to this are followed,
-    /// and the period doublings on them located.
-    pub max_period: usize,
-    /// Steps allowed per branch.
-    pub steps_per_branch: usize,
-    /// Branches allowed in all.
-    pub max_branches: usize,
-    /// Largest arclength step in grid spacings (the parameter moves at most one spacing per
-    /// step in any case; the state may move more).
-    pub max_arclength_steps: f64,
-    /// Smallest step as a fraction of the grid spacing.
-    pub min_step_fraction: f64,
-    /// Corrector iteration budget.
-    pub corrector_iterations: usize,
-    /// Stride settings for every parameter value instead of the scene's (`None`: the
-    /// scene's own at each value).
-    pub stride_settings: Option<crate::stride::StrideSettings>,
-    /// Largest turn of the tangent in one accepted step [degrees]; a step that turns more is
-    /// halved, and at the smallest step the branch ends (`not_converged`) rather than jump.
-    pub max_turn_deg: f64,
-    /// Grid values tried (from `from` on) for a first gait ([`long_period_gait`]).
-    pub start_attempts: usize,
-}
-
-impl Default for ContinuationSettings {
-    fn default() -> Self {
-        Self {
-            max_period: 8,
-            steps_per_branch: 400,
-            max_branches: 8,
-            max_arclength_steps: 10.0,
-            min_step_fraction: 1e-4,
-            corrector_iterations: 12,
-            stride_settings: None,
-            max_turn_deg: 60.0,
-            start_attempts: 32,
-        }
-    }
-}
 
 /// The branches of a continuation over a grid.
 #[derive(Clone, Debug)]
@@ -103,6 +62,8 @@ pub struct Continuation {
     pub no_start: Vec<(f64, String)>,
     /// Period doublings whose doubled branch could not be started.
     pub switch_failures: Vec<SwitchFailure>,
+    /// The settings that produced it.
+    pub settings: ContinuationSettings,
 }
 
 /// A period doubling whose doubled branch was not followed.
@@ -176,7 +137,7 @@ impl Continuation {
 /// nominal gait; if none, the next grid value's), followed with the
 /// grid spacing `|to − from|/(points − 1)` as the largest step; its points at the grid values,
 /// bifurcations and end; then the period-doubled branches. `progress` is called with the
-/// fraction done.
+/// fraction done. The result carries `settings`.
 ///
 /// # Errors
 /// [`SweepError`]: a bad parameter name or value, fewer than two points.
@@ -184,71 +145,100 @@ pub fn continuation(
     scene: &Scene,
     param: &str,
     (from, to, points): (f64, f64, usize),
-    newton: &NewtonSettings,
     settings: &ContinuationSettings,
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<Continuation, SweepError> {
     if points < 2 {
         return Err(SweepError::TooFewPoints(points));
     }
-    let mut family = Family::new(scene, param, newton)?;
-    family.stride_settings = settings.stride_settings.clone();
+    let mut family = Family::new(scene, param, settings.newton())?;
+    family.stride_settings = settings.stride_settings().cloned();
     family.scene_at(from)?;
     family.scene_at(to)?;
     let grid = Grid::new(from, to, points);
-    let spacing = grid.spacing().max(1e-12);
-    let steps = StepControl {
-        initial: 0.5 * spacing,
-        max: settings.max_arclength_steps * spacing,
-        max_dp: spacing,
-        min: spacing * settings.min_step_fraction,
-        max_iterations: settings.corrector_iterations,
-        max_turn_deg: settings.max_turn_deg,
-    };
     let mut out = Continuation {
         family: family.clone(),
         grid: grid.clone(),
         branches: Vec::new(),
         no_start: Vec::new(),
         switch_failures: Vec::new(),
+        settings: settings.clone(),
     };
     let cont = Continuer {
         family: &family,
         period: 1,
-        steps,
+        steps: step_control(&grid, settings),
+        detect: settings.detect(),
     };
-    // The first gait, at the first grid value that has one (of at most `start_attempts`).
-    let mut start = None;
-    for &g in grid.values.iter().take(settings.start_attempts.max(1)) {
-        let setup_for = |s: &Scene| family.setup_of(s);
-        let homotopy = HomotopySettings::default();
-        match long_period_gait(&family.scene_at(g)?, &setup_for, newton, &homotopy)? {
+    let Some(start) = first_point(&cont, &grid, settings, &mut out.no_start)? else {
+        return Ok(out);
+    };
+    let share = 1.0 / (1.0 + settings.max_period().ilog2() as f64);
+    let main = first_branch(&cont, start, &grid, out.no_start.len(), settings, &|f| {
+        progress(f * share)
+    });
+    period_doubled_branches(&cont, main, &mut out, share, progress);
+    progress(1.0);
+    Ok(out)
+}
+
+/// The step control of a continuation over `grid`: the grid spacing is the largest change of
+/// the parameter in one step, half of it the first step.
+fn step_control(grid: &Grid, settings: &ContinuationSettings) -> StepControl {
+    let spacing = grid.spacing().max(1e-12);
+    StepControl {
+        initial: 0.5 * spacing,
+        max: settings.max_arclength_steps() * spacing,
+        max_dp: spacing,
+        min: spacing * settings.min_step_fraction(),
+        max_iterations: settings.corrector_iterations(),
+        max_turn_deg: settings.max_turn_deg(),
+    }
+}
+
+/// The first point of branch 0: the corrected gait ([`long_period_gait`]) at the first grid
+/// value that has one (of at most [`ContinuationSettings::start_attempts`]); the values
+/// before it are added to `no_start` with the reason.
+fn first_point(
+    cont: &Continuer,
+    grid: &Grid,
+    settings: &ContinuationSettings,
+    no_start: &mut Vec<(f64, String)>,
+) -> Result<Option<(BranchPoint, Linearisation)>, SweepError> {
+    let family = cont.family;
+    let setup_for = |s: &Scene| family.setup_of(s);
+    for &g in grid.values.iter().take(settings.start_attempts()) {
+        let scene = family.scene_at(g)?;
+        match long_period_gait(&scene, &setup_for, settings.newton(), settings.homotopy())? {
             Ok(gait) => {
                 let n = gait.fixed_point.len();
                 let x = DVector::from_fn(n + 1, |i, _| if i < n { gait.fixed_point[i] } else { g });
                 let mut c = DVector::zeros(n + 1);
                 c[n] = 1.0;
-                let along = &c * (to - from).signum();
+                let along = &c * (grid.to - grid.from).signum();
                 let constraint = arclength::Constraint { c, b: g };
                 match cont.correct(&x, &constraint, None, &along, true) {
-                    Ok(s) => {
-                        start = Some(s);
-                        break;
-                    }
-                    Err(e) => out
-                        .no_start
-                        .push((g, format!("the corrector at the gait failed: {e}"))),
+                    Ok(s) => return Ok(Some(s)),
+                    Err(e) => no_start.push((g, format!("the corrector at the gait failed: {e}"))),
                 }
             }
-            Err(e) => out.no_start.push((g, e.to_string())),
+            Err(e) => no_start.push((g, e.to_string())),
         }
     }
-    let Some(start) = start else {
-        return Ok(out);
-    };
-    let share = 1.0 / (1.0 + settings.max_period.max(1).ilog2() as f64);
-    // A start after `from`: the branch is also followed backward from it, toward `from`.
-    let i0 = out.no_start.len();
+    Ok(None)
+}
+
+/// Branch 0 from `start` (at grid index `i0`) to the end of the grid, and, for a start after
+/// `from`, backward from it toward `from` too (joined in front).
+fn first_branch(
+    cont: &Continuer,
+    start: (BranchPoint, Linearisation),
+    grid: &Grid,
+    i0: usize,
+    settings: &ContinuationSettings,
+    progress: &dyn Fn(f64),
+) -> Branch {
+    let budget = settings.steps_per_branch();
     let back = (i0 > 0).then(|| {
         let back_grid = Grid {
             from: grid.values[i0],
@@ -257,34 +247,33 @@ pub fn continuation(
         };
         let mut reversed = start.clone();
         reversed.0.tangent = -&reversed.0.tangent;
-        branch::follow(
-            &cont,
-            0,
-            None,
-            reversed,
-            &back_grid,
-            settings.steps_per_branch,
-            &|_| {},
-        )
+        branch::follow(cont, 0, None, reversed, &back_grid, budget, &|_| {})
     });
-    let mut main = branch::follow(
-        &cont,
-        0,
-        None,
-        start,
-        &grid,
-        settings.steps_per_branch,
-        &|f| progress(f * share),
-    );
+    let mut main = branch::follow(cont, 0, None, start, grid, budget, progress);
     if let Some(back) = back {
         branch::prepend(&mut main, back);
     }
+    main
+}
+
+/// Follows the period-doubled branches born on `main` and on them in turn (breadth first, up
+/// to [`ContinuationSettings::max_period`] and [`ContinuationSettings::max_branches`]),
+/// pushing `main` and them onto `out.branches` and the switches that failed onto
+/// `out.switch_failures`.
+fn period_doubled_branches(
+    cont: &Continuer,
+    main: Branch,
+    out: &mut Continuation,
+    share: f64,
+    progress: &(dyn Fn(f64) + Sync),
+) {
+    let settings = out.settings.clone();
     // Period doublings to switch at: (parent id, the bifurcation, parent period).
     let mut queue: VecDeque<(usize, Bifurcation, usize)> = VecDeque::new();
     let enqueue = |b: &Branch, queue: &mut VecDeque<(usize, Bifurcation, usize)>| {
         for bif in &b.bifurcations {
             if bif.kind == BifurcationKind::PeriodDoubling
-                && 2 * b.period_strides <= settings.max_period
+                && 2 * b.period_strides <= settings.max_period()
             {
                 queue.push_back((b.id, bif.clone(), b.period_strides));
             }
@@ -293,24 +282,24 @@ pub fn continuation(
     enqueue(&main, &mut queue);
     out.branches.push(main);
     while let Some((parent, pd, k)) = queue.pop_front() {
-        if out.branches.len() >= settings.max_branches {
-            out.switch_failures.push(SwitchFailure {
-                parent,
-                period_strides: k,
-                value: pd.value,
-                reason: format!(
-                    "the branch budget of {} branches was reached",
-                    settings.max_branches
-                ),
-            });
+        let failure = |reason: String| SwitchFailure {
+            parent,
+            period_strides: k,
+            value: pd.value,
+            reason,
+        };
+        if out.branches.len() >= settings.max_branches() {
+            out.switch_failures.push(failure(format!(
+                "the branch budget of {} branches was reached",
+                settings.max_branches()
+            )));
             continue;
         }
         let doubled = Continuer {
-            family: &family,
             period: 2 * k,
-            steps,
+            ..*cont
         };
-        match period2::switch(&doubled, &pd, steps.initial) {
+        match period2::switch(&doubled, &pd, cont.steps.initial) {
             Ok(first) => {
                 let id = out.branches.len();
                 let done = share * (1.0 + (2 * k).ilog2() as f64 - 1.0);
@@ -319,21 +308,17 @@ pub fn continuation(
                     id,
                     Some((parent, pd.value)),
                     first,
-                    &grid,
-                    settings.steps_per_branch,
+                    &out.grid,
+                    settings.steps_per_branch(),
                     &|f| progress((done + f * share).min(1.0)),
                 );
                 enqueue(&b, &mut queue);
                 out.branches.push(b);
             }
-            Err(e) => out.switch_failures.push(SwitchFailure {
-                parent,
-                period_strides: k,
-                value: pd.value,
-                reason: format!("the period-{} branch could not be started: {e}", 2 * k),
-            }),
+            Err(e) => out.switch_failures.push(failure(format!(
+                "the period-{} branch could not be started: {e}",
+                2 * k
+            ))),
         }
     }
-    progress(1.0);
-    Ok(out)
 }

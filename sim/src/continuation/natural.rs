@@ -1,14 +1,13 @@
-//! Natural-parameter continuation: a gait followed over given values of one parameter (or a
-//! path fraction), one Newton solve per value from a secant predictor, with a guard against
-//! jumping to another branch — the one implementation of that step ([`Secant`]) used by the
-//! census's homotopy ([`crate::census::follow`]), the stability map's rows ([`along`]) and
-//! the natural-parameter [`sweep`] (kept for tests and callers that want the gait at given
-//! values without the pseudo-arclength machinery of [`super::continuation`]).
+//! Natural-parameter continuation: a gait followed over given values of one parameter, one
+//! Newton solve per value from a secant predictor, with a guard against jumping to another
+//! branch ([`crate::homotopy::Secant`], the step the census's homotopy also takes): the
+//! stability map's rows ([`along`]) and the natural-parameter [`sweep`] (kept for tests and
+//! callers that want the gait at given values without the pseudo-arclength machinery of
+//! [`super::continuation`]).
 
-use crate::census::{long_period_gait, HomotopySettings, SetupFor};
-use crate::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
-use crate::scene::{Scene, SceneError, Setup};
-use nalgebra::DVector;
+use crate::homotopy::{long_period_gait, HomotopySettings, Secant, SetupFor};
+use crate::limit_cycle::{Gait, NewtonError, NewtonSettings};
+use crate::scene::{Scene, SceneError};
 
 /// One point of a sweep.
 #[derive(Clone, Debug)]
@@ -41,70 +40,6 @@ pub enum SweepError {
     /// Fewer than two points.
     #[error("a sweep needs at least 2 points, got {0}")]
     TooFewPoints(usize),
-}
-
-/// The last (at most two) gaits of a path, at path coordinates `s`: a secant predictor, and
-/// one guarded Newton step from it.
-#[derive(Clone, Debug, Default)]
-pub struct Secant {
-    /// `(s, fixed point, step period [s])`, oldest first.
-    history: Vec<(f64, DVector<f64>, f64)>,
-}
-
-impl Secant {
-    /// Appends the gait `g` at `s` (keeps the last two).
-    pub fn push(&mut self, s: f64, g: &Gait) {
-        self.history
-            .push((s, g.fixed_point.clone(), g.stride.duration_s));
-        if self.history.len() > 2 {
-            self.history.remove(0);
-        }
-    }
-
-    /// Forgets the path (the next step has no predictor).
-    pub fn clear(&mut self) {
-        self.history.clear();
-    }
-
-    /// The predictor at `s` (linear through the last two gaits, the last one alone after
-    /// the first) and the last gait's step period; `None` before the first gait.
-    pub fn predict(&self, s: f64) -> Option<(DVector<f64>, f64)> {
-        match self.history.as_slice() {
-            [.., (s0, v0, _), (s1, v1, t1)] => Some((v1 + (v1 - v0) * ((s - s1) / (s1 - s0)), *t1)),
-            [.., (_, v, t)] => Some((v.clone(), *t)),
-            [] => None,
-        }
-    }
-
-    /// Newton (budget cut to [`HomotopySettings::max_corrector_iterations`]) at `setup` from
-    /// the predictor at `s`; the gait is refused as a jump to another branch when the
-    /// corrector moved it by more than [`HomotopySettings::max_correction`] (relative) or its
-    /// step period changed by more than [`HomotopySettings::max_period_change`]. `None`
-    /// before the first gait.
-    pub fn step(
-        &self,
-        s: f64,
-        setup: &Setup,
-        newton: &NewtonSettings,
-        guard: &HomotopySettings,
-    ) -> Option<Result<Gait, NewtonError>> {
-        let (predictor, period) = self.predict(s)?;
-        let corrector = guard.corrector(newton);
-        let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).find(&predictor);
-        Some(g.and_then(|g| {
-            let moved = (&g.fixed_point - &predictor).amax();
-            let jumped = moved > guard.max_correction * (1.0 + predictor.amax())
-                || (g.stride.duration_s - period).abs() > guard.max_period_change * period;
-            if jumped {
-                Err(NewtonError::NotConverged {
-                    iterations: g.iterations,
-                    last_step: moved,
-                })
-            } else {
-                Ok(g)
-            }
-        }))
-    }
 }
 
 /// One value of [`along`]: the gait and whether it was seeded, or why there is none.

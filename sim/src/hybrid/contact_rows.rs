@@ -2,10 +2,10 @@
 //! (whose released root joints come first, at rest), and the rows `G` of the constrained
 //! directions of the swing foot's contact, in any scalar.
 
+use super::heel_strike::{ContactConstraint, HeelStrikeRule};
 use super::konst;
 use crate::kinematics::KinematicsOf;
 use crate::model::{LinkIndex, Model};
-use super::heel_strike::{ContactConstraint, HeelStrikeRule};
 use nalgebra::{DMatrix, DVector, RealField, Vector3};
 
 /// A row whose entries are all below this (in magnitude) is identically zero: a constraint on

@@ -26,7 +26,7 @@ pub struct GaitReport {
     /// `continued_from_defaults` (the scene's gait continued from its defaults); absent in
     /// `walker gaits`, which lists every gait found.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub gait_source: Option<crate::census::GaitSource>,
+    pub gait_source: Option<crate::homotopy::GaitSource>,
     /// The gait, or why none was found.
     #[serde(flatten)]
     pub outcome: GaitOutcome,

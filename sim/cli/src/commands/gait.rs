@@ -13,7 +13,7 @@ use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use clap::Args;
-use sim::census::{nominal_gait, GaitSource, HomotopySettings};
+use sim::homotopy::{nominal_gait, GaitSource, HomotopySettings};
 use sim::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};

@@ -12,7 +12,7 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::census::HomotopySettings;
+use sim::homotopy::HomotopySettings;
 use sim::orbit_diagram::linspace;
 use sim::report::StabilityMapReport;
 use sim::scene::Scene;

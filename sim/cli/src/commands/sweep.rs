@@ -79,24 +79,20 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     // The command line's integrator choices apply at every parameter value.
     let overridden =
         common.integrator.is_some() || common.rtol.is_some() || common.step_s.is_some();
-    let settings = ContinuationSettings {
-        max_period,
-        stride_settings: overridden.then_some(base.settings),
-        ..ContinuationSettings::default()
-    };
+    let settings = ContinuationSettings::builder()
+        .newton(newton)
+        .max_period(max_period)
+        .stride_settings(overridden.then_some(base.settings))
+        .build()
+        .map_err(|e| InputError::Other(e.to_string()))?;
     let scene_error = |e: SweepError| match e {
         SweepError::Scene(s) => InputError::Scene(s),
         other => InputError::Other(other.to_string()),
     };
     let progress = Progress::new(PROGRESS_STEPS, "sweep", !common.json);
-    let result = continuation(
-        &scene,
-        &param,
-        (from, to, points),
-        &newton,
-        &settings,
-        &|fraction| progress.set_fraction(fraction),
-    )
+    let result = continuation(&scene, &param, (from, to, points), &settings, &|fraction| {
+        progress.set_fraction(fraction)
+    })
     .map_err(scene_error)?;
     progress.finish();
     if let Some(dir) = &plot {
