@@ -213,33 +213,19 @@ pub fn follow(
                     h = halved;
                     continue;
                 }
-                // Even the smallest step fails the test: taking it could jump to another
-                // branch without a word, so the branch ends here.
                 steps += 1;
-                let why = refused(&cur.0, &p, h, cont.steps.max_turn_deg).unwrap_or_default();
-                branch.end = Some(end(
-                    BranchEndKind::NotConverged,
-                    cur.0.value,
-                    format!(
-                        "the smallest step ({h:.3e}) is refused: {why}; a jump to another \
-                         branch is not taken"
-                    ),
+                branch.end = Some(smallest_step_refused(
+                    &cur.0,
+                    &p,
                     h,
+                    cont.steps.max_turn_deg,
                 ));
                 break;
             }
             // Two complex pairs through the unit circle in one step cannot be located one by
             // one (their test function may keep its sign): the step is halved until they
             // come one per step, or the smallest step takes them together.
-            Ok((p, _))
-                if h > min
-                    && cont.detect.neimark_sacker
-                    && p.signature == cur.0.signature
-                    && bifurcation::neimark_sacker_crossings(
-                        &cur.0.multipliers,
-                        &p.multipliers,
-                    ) > 1 =>
-            {
+            Ok((p, _)) if h > min && two_pairs_at_once(cont, &cur.0, &p) => {
                 h = halved;
             }
             Ok((p, l)) if p.signature == cur.0.signature => {
@@ -247,12 +233,8 @@ pub fn follow(
                 record_step(cont, &mut branch, grid, &cur, (&p, &l));
                 furthest = furthest.max(grid.fraction(p.value));
                 progress(furthest);
-                if !grid.contains(p.value) {
-                    branch.end = turned_back(&branch, grid, &p);
-                    break;
-                }
-                if let Some(end) = origin.closed_by(&cur.0, &p, &branch.bifurcations) {
-                    branch.end = Some(end);
+                if let Some(end) = end_after(&branch, grid, &origin, &cur.0, &p) {
+                    branch.end = end;
                     break;
                 }
                 h = cont.steps.adapt(h, p.iterations);
@@ -279,6 +261,16 @@ pub fn follow(
     branch.steps = steps;
     progress(1.0);
     branch
+}
+
+/// The end of a branch where even the smallest step `h` from `a` to `b` is refused: taking it
+/// could jump to another branch without a word, so the branch ends here.
+fn smallest_step_refused(a: &BranchPoint, b: &BranchPoint, h: f64, max_turn_deg: f64) -> BranchEnd {
+    let why = refused(a, b, h, max_turn_deg).unwrap_or_default();
+    let detail = format!(
+        "the smallest step ({h:.3e}) is refused: {why}; a jump to another branch is not taken"
+    );
+    end(BranchEndKind::NotConverged, a.value, detail, h)
 }
 
 /// A branch end without an event (no grazing, no location budget).
@@ -372,6 +364,29 @@ fn record_step(
             Err(e) => branch.missed.push((g, e.to_string())),
         }
     }
+}
+
+/// Whether the step from `a` to `b` (same event sequence) takes two complex pairs through the
+/// unit circle at once, when Neimark-Sacker bifurcations are located.
+fn two_pairs_at_once(cont: &Continuer, a: &BranchPoint, b: &BranchPoint) -> bool {
+    cont.detect.neimark_sacker
+        && b.signature == a.signature
+        && bifurcation::neimark_sacker_crossings(&a.multipliers, &b.multipliers) > 1
+}
+
+/// Whether the branch stops after the accepted step from `prev` to `p`, and its end then
+/// (`Some(None)`: it left the range past `to`): out of the range, or closed.
+fn end_after(
+    branch: &Branch,
+    grid: &Grid,
+    origin: &Origin,
+    prev: &BranchPoint,
+    p: &BranchPoint,
+) -> Option<Option<BranchEnd>> {
+    if !grid.contains(p.value) {
+        return Some(turned_back(branch, grid, p));
+    }
+    origin.closed_by(prev, p, &branch.bifurcations).map(Some)
 }
 
 /// The end of a branch whose step reached `p`, outside the range: `None` past `to` (it left
