@@ -3,26 +3,6 @@
 
 use super::{IntegrationError, Integrator, Sample, SecondOrderSystem};
 
-/// The estimate behind eq. (12).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StabilityLimit {
-    /// Largest undamped eigenfrequency of the linearised system [rad/s].
-    pub lambda_max_rad_s: f64,
-    /// Relative damping of that mode (0 = undamped).
-    pub beta: f64,
-}
-
-impl StabilityLimit {
-    /// `h_max = (1 − β) 2 / λ_max` [s].
-    pub fn h_max_s(&self) -> f64 {
-        if self.lambda_max_rad_s <= 0.0 {
-            f64::INFINITY
-        } else {
-            (1.0 - self.beta).max(0.0) * 2.0 / self.lambda_max_rad_s
-        }
-    }
-}
-
 /// Meijaard's scheme: `k = f(q̇ₙ, qₙ + h/2 q̇ₙ, tₙ + h/2)`, `qₙ₊₁ = qₙ + h q̇ₙ + h²/2 k`,
 /// `q̇ₙ₊₁ = q̇ₙ + h k`. One evaluation of the equations of motion per step.
 #[derive(Clone, Debug)]
