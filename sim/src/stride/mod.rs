@@ -28,6 +28,8 @@
 
 mod contact_figures;
 mod energy;
+mod engine;
+mod evaluation_path;
 mod fast;
 mod impacts;
 mod phase;
@@ -39,6 +41,7 @@ mod settings;
 mod witnesses;
 
 pub use contact_figures::ContactSummary;
+pub use evaluation_path::EvaluationPath;
 pub use impacts::HeelStrikeImpact;
 pub use phase::{linearised_limit, Drive, Phase};
 pub use request::{StrideControl, StrideOptions, StrideRequest};

@@ -8,7 +8,8 @@ use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::integrators::{Sample, SecondOrderSystem, StabilityLimit};
 use crate::model::{CoordIndex, Model};
-use crate::planar::{EvaluationPath, PlanarTree};
+use crate::planar::PlanarTree;
+use crate::stride::EvaluationPath;
 use nalgebra::{DMatrix, DVector};
 
 /// How a driven coordinate moves (times are from the start of the stride).

@@ -5,7 +5,7 @@
 use crate::control::TickStepping;
 use crate::events::EventTolerance;
 use crate::integrators::{IntegratorChoice, IntegratorError};
-use crate::planar::EvaluationPath;
+use super::EvaluationPath;
 use serde::Serialize;
 
 /// Solver settings of a stride (after rapier's `IntegrationParameters`: each field with its unit
