@@ -119,11 +119,11 @@ pub(super) trait Engine {
     fn step_exact(&mut self, cur: &Self::State, h_s: f64)
         -> Result<Self::State, IntegrationError>;
     /// Locates the zero of `g` on the step `cur` → `next` (the last one taken).
-    fn locate(
+    fn locate<G: FnMut(&Self::State) -> f64>(
         &mut self,
         cur: &Self::State,
         next: &Self::State,
-        g: &mut dyn FnMut(&Self::State) -> f64,
+        g: G,
         tol: &EventTolerance,
     ) -> Result<Self::State, EventError>;
     /// Whether the integrator has an interpolant inside its steps.
@@ -161,12 +161,12 @@ pub(super) trait Engine {
         wit: &mut Self::Witness,
         s: &Self::State,
     ) -> Result<(), DynamicsError>;
-    /// Heel strike at `at`: the impact, the lift check and the relabelling (the run's own
-    /// figures are left for the loop).
+    /// Heel strike at `at` (`at_sample` the same state as a sample): the impact, the lift
+    /// check and the relabelling (the run's own figures are left for the loop).
     fn finish(
         &mut self,
         walker: &Walker,
-        at: &Self::State,
+        (at, at_sample): (&Self::State, Sample),
         events: Vec<StrideEvent>,
         energy_loss_j: f64,
     ) -> Result<StrideResult, StrideFailure>;
@@ -193,14 +193,14 @@ impl<'w> Engine for DynamicEngine<'w> {
         self.integrator.step_exact(&mut self.phase, cur, h_s)
     }
 
-    fn locate(
+    fn locate<G: FnMut(&Sample) -> f64>(
         &mut self,
         cur: &Sample,
         next: &Sample,
-        g: &mut dyn FnMut(&Sample) -> f64,
+        mut g: G,
         tol: &EventTolerance,
     ) -> Result<Sample, EventError> {
-        locate(self.integrator.as_mut(), &mut self.phase, cur, next, g, tol)
+        locate(self.integrator.as_mut(), &mut self.phase, cur, next, &mut g, tol)
     }
 
     fn interpolates(&self) -> bool {
@@ -264,10 +264,10 @@ impl<'w> Engine for DynamicEngine<'w> {
     fn finish(
         &mut self,
         walker: &Walker,
-        at: &Sample,
+        (_, at): (&Sample, Sample),
         events: Vec<StrideEvent>,
         energy_loss_j: f64,
     ) -> Result<StrideResult, StrideFailure> {
-        walker.finish_stride(at.clone(), &self.phase.active, events, energy_loss_j)
+        walker.finish_stride(at, &self.phase.active, events, energy_loss_j)
     }
 }

@@ -129,6 +129,16 @@ enum Applied {
     Done(Box<StrideResult>),
 }
 
+/// What a step's triggered events come to.
+enum Located<S> {
+    /// No event: the step is accepted.
+    None,
+    /// Only a mid-swing scuff the walker ignores wherever it lies in the step.
+    IgnoredScuff,
+    /// The earliest event and where it lies (`None`: none applies).
+    Earliest(Option<(Watch, S)>),
+}
+
 /// One stride in progress, on the engine `E` (its state storage and evaluation).
 pub(super) struct Run<'w, 'r, 't, E: Engine> {
     walker: &'w Walker,
@@ -145,6 +155,8 @@ pub(super) struct Run<'w, 'r, 't, E: Engine> {
     wit: E::Witness,
     /// Witness values at `cur`, carried over from the previous step.
     w_cached: Option<WitnessValues>,
+    /// The watches the last step triggered (kept to reuse its storage).
+    triggered: Vec<Watch>,
     /// The last accepted state.
     cur: E::State,
     events: Vec<StrideEvent>,
@@ -224,6 +236,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             contact: ContactSummary::default(),
             wit,
             w_cached: None,
+            triggered: Vec::new(),
             cur,
             events: Vec::new(),
             event_states: Vec::new(),
@@ -278,29 +291,35 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 continue;
             }
             let limit = self.string_limit();
-            let triggered = witnesses::triggered(
+            let mut triggered = std::mem::take(&mut self.triggered);
+            witnesses::triggered(
+                &mut triggered,
                 self.walker,
                 (self.engine.active(), self.engine.prescribed().is_some()),
                 limit,
                 (&self.cur, &w_cur),
                 (&next, &w_next),
             );
-            if triggered.is_empty() {
-                let next = self
-                    .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?
-                    .unwrap_or(next);
-                self.accept(next, drive_end_s)?;
-                continue;
-            }
-            if self.scuff_need_not_be_located(&triggered, &w_cur, &w_next) {
-                // Ignored wherever it is: the step is accepted as `apply` would accept it,
-                // without locating the crossing (it would only split the dampers' trapezoid,
-                // and there are none).
-                let at = self.cur.clone();
-                self.accept_ignored(&at, next);
-                continue;
-            }
-            let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
+            let located = self.located(&triggered, &w_cur, &w_next, &next);
+            self.triggered = triggered;
+            let Some((watch, mut at)) = (match located? {
+                Located::None => {
+                    let next = self
+                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?
+                        .unwrap_or(next);
+                    self.accept(next, drive_end_s)?;
+                    continue;
+                }
+                Located::IgnoredScuff => {
+                    // Ignored wherever it is: the step is accepted as `apply` would accept
+                    // it, without locating the crossing (it would only split the dampers'
+                    // trapezoid, and there are none).
+                    let at = self.cur.clone();
+                    self.accept_ignored(&at, next);
+                    continue;
+                }
+                Located::Earliest(e) => e,
+            }) else {
                 continue;
             };
             if let Some(at_tick) =
@@ -394,6 +413,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     /// rates at both ends) is checked at interior points; if the exact flow confirms a dip, the
     /// step is shortened to end inside it. Returns the step's end and the witness values at
     /// both ends.
+    #[inline]
     fn grazing_check(
         &mut self,
         mut next: E::State,
@@ -419,6 +439,24 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         }
         self.w_cached = Some(w_next);
         Ok((next, w_cur, w_next))
+    }
+
+    /// The events the step `cur` → `next` triggered (`triggered`), told apart: none, a scuff
+    /// that need not be located, or the earliest located event (if any applies).
+    fn located(
+        &mut self,
+        triggered: &[Watch],
+        w_cur: &WitnessValues,
+        w_next: &WitnessValues,
+        next: &E::State,
+    ) -> Result<Located<E::State>, StrideFailure> {
+        if triggered.is_empty() {
+            return Ok(Located::None);
+        }
+        if self.scuff_need_not_be_located(triggered, w_cur, w_next) {
+            return Ok(Located::IgnoredScuff);
+        }
+        Ok(Located::Earliest(self.earliest(triggered, next)?))
     }
 
     /// The step triggered only the swing foot's crossing, which the walker ignores as a
@@ -502,19 +540,24 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             ));
         }
         let limit = self.string_limit();
+        let locate = |run: &mut Self, watch: Watch| {
+            let (walker, wit) = (run.walker, &mut run.wit);
+            run.engine
+                .locate(
+                    &run.cur,
+                    next,
+                    |s: &E::State| witnesses::value(walker, wit, watch, limit, s),
+                    &run.settings.event_tolerance,
+                )
+                .map_err(|e| StrideFailure::from_event(e, run.cur.t_s()))
+        };
+        if let [watch] = triggered {
+            // One event: located, nothing to compare it with.
+            return Ok(Some((*watch, locate(self, *watch)?)));
+        }
         let mut located: Vec<(Watch, E::State)> = Vec::new();
         for &watch in triggered {
-            let (walker, wit) = (self.walker, &mut self.wit);
-            let s = self
-                .engine
-                .locate(
-                    &self.cur,
-                    next,
-                    &mut |s: &E::State| witnesses::value(walker, wit, watch, limit, s),
-                    &self.settings.event_tolerance,
-                )
-                .map_err(|e| StrideFailure::from_event(e, self.cur.t_s()))?;
-            located.push((watch, s));
+            located.push((watch, locate(self, watch)?));
         }
         located.sort_by(|a, b| a.1.t_s().total_cmp(&b.1.t_s()));
         let hs = &self.walker.heel_strike;
@@ -668,11 +711,13 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         let at_s = at.to_sample();
         self.event_states.push((at_s.clone(), at_s.clone()));
         if self.options.record {
-            self.trajectory.push(at_s);
+            self.trajectory.push(at_s.clone());
         }
         self.evaluations += self.engine.evaluations();
         let events = std::mem::take(&mut self.events);
-        let mut r = self.engine.finish(w, at, events, self.energy_loss_j)?;
+        let mut r = self
+            .engine
+            .finish(w, (at, at_s), events, self.energy_loss_j)?;
         r.actuator_work_j = self.power.work_j;
         r.event_states = std::mem::take(&mut self.event_states);
         r.evaluations = self.evaluations;

@@ -196,17 +196,18 @@ pub(super) fn value<S: StrideState>(
 }
 
 /// The watches whose witnesses changed sign in their direction over the step `cur` → `next`
-/// (witness values `w_cur`, `w_next`), in tie-breaking order; `active` the free
+/// (witness values `w_cur`, `w_next`), into `triggered`, in tie-breaking order; `active` the free
 /// coordinates, `driven` whether a coordinate is driven.
 pub(super) fn triggered<S: StrideState>(
+    triggered: &mut Vec<Watch>,
     walker: &Walker,
     (active, driven): (&[bool], bool),
     limit: StringLimit,
     (cur, w_cur): (&S, &WitnessValues),
     (next, w_next): (&S, &WitnessValues),
-) -> Vec<Watch> {
+) {
     let w = walker;
-    let mut triggered: Vec<Watch> = Vec::new();
+    triggered.clear();
     if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
         triggered.push(Watch::Heel);
     }
@@ -243,7 +244,6 @@ pub(super) fn triggered<S: StrideState>(
             triggered.push(Watch::HeelDrop);
         }
     }
-    triggered
 }
 
 #[cfg(test)]

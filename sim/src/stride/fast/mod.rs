@@ -110,11 +110,7 @@ fn stride_n<const N: usize>(
     else {
         return None;
     };
-    let cur = State::<N>::from_sample(Sample {
-        t_s: 0.0,
-        q: q0.clone(),
-        qd: qd0.clone(),
-    })?;
+    let cur = state::<N>(0.0, q0, qd0)?;
     let mut active = [true; N];
     for c in &walker.initially_locked {
         *active.get_mut(c.0)? = false;
@@ -160,13 +156,18 @@ impl<const N: usize> StrideState for State<N> {
     }
     /// `None`: another length, or not finite.
     fn from_sample(s: Sample) -> Option<Self> {
-        let finite = s.q.iter().chain(s.qd.iter()).all(|v| v.is_finite());
-        (s.q.len() == N && s.qd.len() == N && finite).then(|| State {
-            t_s: s.t_s,
-            q: SVector::from_iterator(s.q.iter().copied()),
-            qd: SVector::from_iterator(s.qd.iter().copied()),
-        })
+        state(s.t_s, &s.q, &s.qd)
     }
+}
+
+/// `q`, `q̇` at `t_s` as a fixed-size state (`None`: another length, or not finite).
+fn state<const N: usize>(t_s: f64, q: &DVector<f64>, qd: &DVector<f64>) -> Option<State<N>> {
+    let finite = q.iter().chain(qd.iter()).all(|v| v.is_finite());
+    (q.len() == N && qd.len() == N && finite).then(|| State {
+        t_s,
+        q: SVector::from_iterator(q.iter().copied()),
+        qd: SVector::from_iterator(qd.iter().copied()),
+    })
 }
 
 /// The smooth dynamics of a phase on the planar fast path: free coordinates, no drive.
@@ -229,11 +230,12 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
 
     /// [`crate::events::locate`] on the dense output (which this engine always has after a
     /// step).
-    fn locate(
+    #[inline]
+    fn locate<G: FnMut(&State<N>) -> f64>(
         &mut self,
         cur: &State<N>,
         next: &State<N>,
-        g: &mut dyn FnMut(&State<N>) -> f64,
+        mut g: G,
         tol: &EventTolerance,
     ) -> Result<State<N>, EventError> {
         let (ga, gb) = (g(cur), g(next));
@@ -329,7 +331,7 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
     fn finish(
         &mut self,
         walker: &Walker,
-        at: &State<N>,
+        (at, at_sample): (&State<N>, Sample),
         events: Vec<StrideEvent>,
         energy_loss_j: f64,
     ) -> Result<StrideResult, StrideFailure> {
@@ -342,7 +344,7 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
                 step_m: h.step_m,
                 heading_change_rad: 0.0,
                 events,
-                pre_impact: at.to_sample(),
+                pre_impact: at_sample,
                 lift_velocity_m_s: h.lift_velocity_m_s,
                 impact_energy_loss_j: energy_loss_j + h.energy_loss_j,
                 evaluations: 0,
@@ -354,7 +356,7 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
             }),
             None => self
                 .walker
-                .finish_stride(at.to_sample(), &active, events, energy_loss_j),
+                .finish_stride(at_sample, &active, events, energy_loss_j),
         }
     }
 }

@@ -32,6 +32,7 @@ type JointFrames = [(f64, f64, f64); MAX_PLANAR_COORDINATES];
 
 impl Arms {
     /// Position and velocity (floor frame, x and y) at the joints' frames.
+    #[inline]
     fn point(&self, jf: &JointFrames) -> ([f64; 2], [f64; 2]) {
         let (mut p, mut v) = (self.base_m, [0.0; 2]);
         for &(j, [x, y]) in &self.arms[..self.len] {
@@ -103,6 +104,7 @@ impl PlanarWitnesses {
     }
 
     /// Every joint's link angle (cos, sin) and rate at `q`, `q̇`, parents first.
+    #[inline]
     fn joint_frames<const N: usize>(
         &self,
         q: &SVector<f64, N>,
