@@ -166,7 +166,7 @@ pub(super) trait Engine {
     fn finish(
         &mut self,
         walker: &Walker,
-        (at, at_sample): (&Self::State, Sample),
+        at: (&Self::State, Sample),
         events: Vec<StrideEvent>,
         energy_loss_j: f64,
     ) -> Result<StrideResult, StrideFailure>;
