@@ -267,7 +267,8 @@ impl AxisTree {
             work_m: [[0.0; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
             work_b: [0.0; MAX_AXIS_TREE_COORDINATES],
             work_idx: [0; MAX_AXIS_TREE_COORDINATES],
-            cols: [(0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros()); MAX_AXIS_TREE_COORDINATES],
+            cols: [(0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+                MAX_AXIS_TREE_COORDINATES],
         })
     }
 

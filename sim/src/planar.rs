@@ -26,8 +26,8 @@ mod three_link;
 mod trig;
 mod two_link;
 
-pub(crate) use chain::Joints;
 pub use crate::stride::EvaluationPath;
+pub(crate) use chain::Joints;
 pub use trig::sin_cos;
 
 /// Most coordinates a planar tree may have to take the planar fast path (and the fixed-size

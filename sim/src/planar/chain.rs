@@ -5,7 +5,7 @@
 //! (`two_link.rs`, `three_link.rs`) and the fixed-size stride's witnesses
 //! (`stride/fast/witness.rs`) read them.
 
-use super::{LinkFrame, PlanarTree, MAX_PLANAR_COORDINATES, MAX_LINKS};
+use super::{LinkFrame, PlanarTree, MAX_LINKS, MAX_PLANAR_COORDINATES};
 use nalgebra::SVector;
 
 /// One joint of a planar tree.

@@ -116,8 +116,7 @@ pub(super) trait Engine {
         h_limit_s: f64,
     ) -> Result<Self::State, IntegrationError>;
     /// One step of exactly `h_s` from `cur`.
-    fn step_exact(&mut self, cur: &Self::State, h_s: f64)
-        -> Result<Self::State, IntegrationError>;
+    fn step_exact(&mut self, cur: &Self::State, h_s: f64) -> Result<Self::State, IntegrationError>;
     /// Locates the zero of `g` on the step `cur` → `next` (the last one taken).
     fn locate<G: FnMut(&Self::State) -> f64>(
         &mut self,
@@ -200,7 +199,14 @@ impl<'w> Engine for DynamicEngine<'w> {
         mut g: G,
         tol: &EventTolerance,
     ) -> Result<Sample, EventError> {
-        locate(self.integrator.as_mut(), &mut self.phase, cur, next, &mut g, tol)
+        locate(
+            self.integrator.as_mut(),
+            &mut self.phase,
+            cur,
+            next,
+            &mut g,
+            tol,
+        )
     }
 
     fn interpolates(&self) -> bool {

@@ -17,9 +17,9 @@ use crate::hybrid::impact::{locked_state, unit_row};
 use crate::impact::{resolve, resolve_to, ImpactError};
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
+use crate::model::CoordIndex;
 use crate::relabel::LinkStates;
 use crate::walker::Walker;
-use crate::model::CoordIndex;
 use nalgebra::{DVector, Vector3};
 
 /// The heel-strike impact on the impact model (coordinates: released root first).
@@ -75,16 +75,8 @@ impl Walker {
         let g = unit_row(self.model.dof(), c);
         let mut dynamics = Dynamics::new(&self.model);
         let before = energy(&mut dynamics, &self.model, at);
-        let imp = resolve(
-            &mut dynamics,
-            &self.model,
-            &at.q,
-            &at.qd,
-            active,
-            &g,
-            0.0,
-        )
-        .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+        let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, active, &g, 0.0)
+            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
         // A drive holding the ankle through the impact takes an impulse and does work on it
         // (impulse × its rate, which the impact does not change): the actuator's work, not part
         // of the impact's loss.

@@ -39,6 +39,7 @@ mod run;
 mod schedule;
 mod settings;
 mod witnesses;
+mod workspace;
 
 pub use contact_figures::ContactSummary;
 pub use evaluation_path::EvaluationPath;
@@ -48,3 +49,4 @@ pub use request::{StrideControl, StrideOptions, StrideRequest};
 pub use result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 pub use schedule::{Schedule, StepSchedule};
 pub use settings::StrideSettings;
+pub use workspace::StrideWorkspace;

@@ -249,6 +249,14 @@ impl<'a> Phase<'a> {
         }
     }
 
+    /// Back to the start of a stride: every coordinate free, none driven, no assembly to
+    /// solve on again.
+    pub(crate) fn restart(&mut self) {
+        self.active.iter_mut().for_each(|a| *a = true);
+        self.prescribed = None;
+        self.assembled_at.valid = false;
+    }
+
     /// Puts the prescribed coordinate of `s` exactly on its profile.
     pub fn snap(&self, s: &mut Sample) {
         if let Some((c, p)) = &self.prescribed {

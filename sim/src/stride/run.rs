@@ -8,13 +8,14 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
-use super::engine::{DynamicEngine, Engine, StrideState, WitnessEvaluator};
-use super::phase::{Drive, Phase};
+use super::engine::{Engine, StrideState, WitnessEvaluator};
+use super::phase::Drive;
 use super::request::{StrideControl, StrideOptions, StrideRequest};
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::witnesses::{self, StringLimit, Watch, WitnessValues, Witnesses};
+use super::workspace::StrideWorkspace;
 use crate::control::ActuatorSegment;
 use crate::integrators::Sample;
 use crate::walker::Walker;
@@ -24,7 +25,9 @@ mod ticks;
 
 impl Walker {
     /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
-    /// `request` asks: its settings, what it records, its step schedule, its controller.
+    /// `request` asks: its settings, what it records, its step schedule, its controller. (A
+    /// [`StrideWorkspace`] of its own: repeated strides reuse one with
+    /// [`StrideWorkspace::stride`].)
     ///
     /// # Errors
     /// A [`StrideFailure`] saying how and when (stride time) the stride failed; samples
@@ -35,6 +38,24 @@ impl Walker {
         qd0: &DVector<f64>,
         request: StrideRequest<'_>,
     ) -> Result<StrideResult, StrideFailure> {
+        StrideWorkspace::new(self).stride(q0, qd0, request)
+    }
+}
+
+impl StrideWorkspace<'_> {
+    /// [`Walker::stride`] of this workspace's walker, on this workspace: what the model gives
+    /// the stride's evaluation path is compiled at the first stride (again only when a
+    /// request asks for another path or integrator), the evaluators' storage reused.
+    ///
+    /// # Errors
+    /// As [`Walker::stride`].
+    pub fn stride(
+        &mut self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        request: StrideRequest<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let walker = self.walker();
         let StrideRequest {
             settings,
             options,
@@ -42,7 +63,7 @@ impl Walker {
             control,
             sink,
         } = request;
-        if control.is_some() && self.ankle.is_none() {
+        if control.is_some() && walker.ankle.is_none() {
             return Err(StrideFailure::new(
                 FailureKind::NonFiniteState,
                 0.0,
@@ -55,28 +76,36 @@ impl Walker {
             Some(s) => s,
             None => &mut own,
         };
-        if let Some(tree) = super::fast::covers(self, settings, options, control.is_some()) {
-            let recorded = trajectory.len();
-            let fast_schedule = match &mut schedule {
-                Schedule::Free => Schedule::Free,
-                Schedule::Record(s) => Schedule::Record(s),
-                Schedule::Replay(s) => Schedule::Replay(s),
-            };
-            let start = Start {
-                walker: self,
-                settings,
-                options,
-                schedule: fast_schedule,
-                trajectory,
-            };
-            match super::fast::stride(start, &tree, q0, qd0) {
-                Some(mut r) => {
-                    if keep_in_result {
-                        r.trajectory = own;
+        if super::fast::covers(walker, settings, options, control.is_some()) {
+            let mut triggered = std::mem::take(&mut self.triggered);
+            if let Some(fixed) = self.fixed(settings.evaluation) {
+                let recorded = trajectory.len();
+                let fast_schedule = match &mut schedule {
+                    Schedule::Free => Schedule::Free,
+                    Schedule::Record(s) => Schedule::Record(s),
+                    Schedule::Replay(s) => Schedule::Replay(s),
+                };
+                let start = Start {
+                    walker,
+                    settings,
+                    options,
+                    schedule: fast_schedule,
+                    trajectory,
+                    triggered: &mut triggered,
+                };
+                let done = super::fast::stride(start, fixed, q0, qd0);
+                self.triggered = triggered;
+                match done {
+                    Some(mut r) => {
+                        if keep_in_result {
+                            r.trajectory = own;
+                        }
+                        return Ok(r);
                     }
-                    return Ok(r);
+                    None => trajectory.truncate(recorded),
                 }
-                None => trajectory.truncate(recorded),
+            } else {
+                self.triggered = triggered;
             }
         }
         let cur = Sample {
@@ -84,22 +113,31 @@ impl Walker {
             q: q0.clone(),
             qd: qd0.clone(),
         };
-        let mut integrator = settings.integrator.build();
-        integrator.reset();
-        let mut phase = Phase::with_path(&self.model, settings.evaluation);
-        for c in &self.initially_locked {
-            phase.active[c.0] = false;
+        let mut engine = self.reference_engine(settings);
+        engine.integrator.reset();
+        for c in &walker.initially_locked {
+            engine.phase.active[c.0] = false;
         }
-        let engine = DynamicEngine { integrator, phase };
+        let wit = self
+            .witnesses
+            .take()
+            .unwrap_or_else(|| Witnesses::new(walker));
         let start = Start {
-            walker: self,
+            walker,
             settings,
             options,
             schedule,
             trajectory,
+            triggered: &mut self.triggered,
         };
-        let run = Run::new(start, engine, Witnesses::new(self), control, cur);
-        let mut r = run?.run()?;
+        let (r, parts) = match Run::new(start, engine, wit, control, cur) {
+            Ok(run) => run.run(),
+            Err(e) => return Err(e),
+        };
+        let (engine, wit) = parts;
+        self.witnesses = Some(wit);
+        self.keep_reference(settings, engine);
+        let mut r = r?;
         if keep_in_result {
             r.trajectory = own;
         }
@@ -115,6 +153,8 @@ pub(super) struct Start<'w, 'r, 't> {
     pub(super) options: StrideOptions,
     pub(super) schedule: Schedule<'r>,
     pub(super) trajectory: &'t mut Vec<Sample>,
+    /// Storage for the watches a step triggers (the workspace's).
+    pub(super) triggered: &'t mut Vec<Watch>,
 }
 
 /// What a located event did to the stride.
@@ -155,8 +195,8 @@ pub(super) struct Run<'w, 'r, 't, E: Engine> {
     wit: E::Witness,
     /// Witness values at `cur`, carried over from the previous step.
     w_cached: Option<WitnessValues>,
-    /// The watches the last step triggered (kept to reuse its storage).
-    triggered: Vec<Watch>,
+    /// The watches the last step triggered (the workspace's storage).
+    triggered: &'t mut Vec<Watch>,
     /// The last accepted state.
     cur: E::State,
     events: Vec<StrideEvent>,
@@ -199,6 +239,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             options,
             schedule,
             trajectory,
+            triggered,
         } = start;
         if !cur.is_finite() {
             return Err(StrideFailure::new(
@@ -236,7 +277,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             contact: ContactSummary::default(),
             wit,
             w_cached: None,
-            triggered: Vec::new(),
+            triggered,
             cur,
             events: Vec::new(),
             event_states: Vec::new(),
@@ -253,8 +294,15 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         })
     }
 
+    /// The loop, run to its end: the stride's result, and the engine and the witnesses'
+    /// evaluator (for the next stride to reuse).
+    pub(super) fn run(mut self) -> (Result<StrideResult, StrideFailure>, (E, E::Witness)) {
+        let r = self.steps_to_the_end();
+        (r, (self.engine, self.wit))
+    }
+
     /// The loop: step, check, locate, apply, until heel strike or a failure.
-    pub(super) fn run(mut self) -> Result<StrideResult, StrideFailure> {
+    fn steps_to_the_end(&mut self) -> Result<StrideResult, StrideFailure> {
         loop {
             self.control_tick()?;
             if self.cur.t_s() > self.settings.max_stride_time_s {
@@ -291,7 +339,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 continue;
             }
             let limit = self.string_limit();
-            let mut triggered = std::mem::take(&mut self.triggered);
+            let mut triggered = std::mem::take(self.triggered);
             witnesses::triggered(
                 &mut triggered,
                 self.walker,
@@ -301,7 +349,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 (&next, &w_next),
             );
             let located = self.located(&triggered, &w_cur, &w_next, &next);
-            self.triggered = triggered;
+            *self.triggered = triggered;
             let Some((watch, mut at)) = (match located? {
                 Located::None => {
                     let next = self
@@ -322,9 +370,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             }) else {
                 continue;
             };
-            if let Some(at_tick) =
-                self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s())?
-            {
+            if let Some(at_tick) = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s())? {
                 // A tick before the event changed the plant's input: the step ends there.
                 self.accept(at_tick, drive_end_s)?;
                 continue;
@@ -733,7 +779,8 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             name,
             t_stride_s: at.t_s(),
         });
-        self.event_states.push((at.to_sample(), self.cur.to_sample()));
+        self.event_states
+            .push((at.to_sample(), self.cur.to_sample()));
         // The integrator restarts after an impact; its evaluations so far are kept.
         self.evaluations += self.engine.evaluations();
         self.engine.reset();

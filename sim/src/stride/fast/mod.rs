@@ -37,25 +37,48 @@ use nalgebra::{DVector, SVector};
 use planar_witnesses::PlanarWitnesses;
 
 /// Whether the fixed-size engine covers a stride of `walker` with these settings and options
-/// (and no controller): the planar tree when it does.
+/// (and no controller), as far as they go: the walker's model must also qualify
+/// ([`Compiled::of`]).
 pub(super) fn covers(
     walker: &Walker,
     settings: &StrideSettings,
     options: StrideOptions,
     controlled: bool,
-) -> Option<PlanarTree> {
-    let eligible = matches!(
+) -> bool {
+    matches!(
         settings.evaluation,
         EvaluationPath::Auto | EvaluationPath::LinkPass
     ) && matches!(settings.integrator, IntegratorChoice::Dop853 { .. })
         && settings.event_tolerance.dense_output
         && !controlled
         && walker.ankle.is_none()
-        && !options.contact;
-    if !eligible {
-        return None;
+        && !options.contact
+}
+
+/// What the fixed-size engine derives from a walker's model, once per workspace: the planar
+/// tree and the points the witnesses follow.
+pub(super) struct Compiled {
+    tree: PlanarTree,
+    witnesses: PlanarWitnesses,
+}
+
+impl Compiled {
+    /// The structures of `walker` on `path`: `None` when its model is not a planar tree of 1
+    /// to [`MAX_PLANAR_COORDINATES`] coordinates on that path, or its witnesses' points are
+    /// not on the tree.
+    pub(super) fn of(walker: &Walker, path: EvaluationPath) -> Option<Self> {
+        let tree = PlanarTree::for_path(&walker.model, path)?;
+        let witnesses = match tree.dof() {
+            1 => PlanarWitnesses::new::<1>(walker, &tree),
+            2 => PlanarWitnesses::new::<2>(walker, &tree),
+            3 => PlanarWitnesses::new::<3>(walker, &tree),
+            4 => PlanarWitnesses::new::<4>(walker, &tree),
+            5 => PlanarWitnesses::new::<5>(walker, &tree),
+            6 => PlanarWitnesses::new::<6>(walker, &tree),
+            _ => None,
+        }?;
+        Some(Self { tree, witnesses })
     }
-    PlanarTree::for_path(&walker.model, settings.evaluation)
 }
 
 impl Walker {
@@ -69,27 +92,28 @@ impl Walker {
         options: StrideOptions,
     ) -> bool {
         covers(self, settings, options, false)
-            .is_some_and(|t| (1..=MAX_PLANAR_COORDINATES).contains(&t.dof()))
+            && PlanarTree::for_path(&self.model, settings.evaluation)
+                .is_some_and(|t| (1..=MAX_PLANAR_COORDINATES).contains(&t.dof()))
     }
 }
 
-/// Runs the stride from `q0`, `qd0` on fixed-size states, if `tree` has a size it is built for
-/// (1 to [`MAX_PLANAR_COORDINATES`] coordinates): the stride's result, or `None` when the
-/// stride is handed back to the reference engine (samples it recorded are then dropped by the
-/// caller).
+/// Runs the stride from `q0`, `qd0` on fixed-size states, with the walker's `compiled`
+/// structures: the stride's result, or `None` when the stride is handed back to the reference
+/// engine (samples it recorded are then dropped by the caller).
 pub(super) fn stride(
     start: Start<'_, '_, '_>,
-    tree: &PlanarTree,
+    compiled: &Compiled,
     q0: &DVector<f64>,
     qd0: &DVector<f64>,
 ) -> Option<StrideResult> {
+    let (tree, wit) = (&compiled.tree, compiled.witnesses);
     match tree.dof() {
-        1 => stride_n::<1>(start, tree, q0, qd0),
-        2 => stride_n::<2>(start, tree, q0, qd0),
-        3 => stride_n::<3>(start, tree, q0, qd0),
-        4 => stride_n::<4>(start, tree, q0, qd0),
-        5 => stride_n::<5>(start, tree, q0, qd0),
-        6 => stride_n::<6>(start, tree, q0, qd0),
+        1 => stride_n::<1>(start, tree, wit, q0, qd0),
+        2 => stride_n::<2>(start, tree, wit, q0, qd0),
+        3 => stride_n::<3>(start, tree, wit, q0, qd0),
+        4 => stride_n::<4>(start, tree, wit, q0, qd0),
+        5 => stride_n::<5>(start, tree, wit, q0, qd0),
+        6 => stride_n::<6>(start, tree, wit, q0, qd0),
         _ => None,
     }
 }
@@ -98,6 +122,7 @@ pub(super) fn stride(
 fn stride_n<const N: usize>(
     start: Start<'_, '_, '_>,
     tree: &PlanarTree,
+    wit: PlanarWitnesses,
     q0: &DVector<f64>,
     qd0: &DVector<f64>,
 ) -> Option<StrideResult> {
@@ -115,7 +140,6 @@ fn stride_n<const N: usize>(
     for c in &walker.initially_locked {
         *active.get_mut(c.0)? = false;
     }
-    let wit = PlanarWitnesses::new::<N>(walker, tree)?;
     let engine = FixedEngine {
         walker,
         tree,
@@ -127,7 +151,7 @@ fn stride_n<const N: usize>(
             limit: None,
         },
     };
-    Run::new(start, engine, wit, None, cur).ok()?.run().ok()
+    Run::new(start, engine, wit, None, cur).ok()?.run().0.ok()
 }
 
 impl<const N: usize> StrideState for State<N> {

@@ -10,8 +10,8 @@
 //! products per arm, instead of every link's frame.
 
 use super::dop853::State;
-use crate::stride::engine::WitnessEvaluator;
 use crate::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::stride::engine::WitnessEvaluator;
 use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
 use nalgebra::SVector;
