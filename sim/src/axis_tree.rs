@@ -30,7 +30,7 @@ use crate::singular_limit::LimitSolveError;
 use nalgebra::{DVector, Matrix3, Vector3};
 
 /// Most coordinates a tree may have to take the 3D fast path.
-pub const MAX_COORDINATES: usize = 12;
+pub const MAX_AXIS_TREE_COORDINATES: usize = 12;
 
 /// One frame: the link of a revolute joint about a coordinate axis, with what its kinematics
 /// needs. Frames are stored parents first.
@@ -78,12 +78,12 @@ struct JointSpring {
 /// Each frame's kinematics at one evaluation (floor axes), one array per quantity.
 #[derive(Clone, Copy, Debug)]
 struct FrameStates {
-    r_floor_frame: [Matrix3<f64>; MAX_COORDINATES],
-    p_floor_m: [Vector3<f64>; MAX_COORDINATES],
-    axis_floor: [Vector3<f64>; MAX_COORDINATES],
-    omega_rad_s: [Vector3<f64>; MAX_COORDINATES],
-    alpha_bias_rad_s2: [Vector3<f64>; MAX_COORDINATES],
-    a_bias_m_s2: [Vector3<f64>; MAX_COORDINATES],
+    r_floor_frame: [Matrix3<f64>; MAX_AXIS_TREE_COORDINATES],
+    p_floor_m: [Vector3<f64>; MAX_AXIS_TREE_COORDINATES],
+    axis_floor: [Vector3<f64>; MAX_AXIS_TREE_COORDINATES],
+    omega_rad_s: [Vector3<f64>; MAX_AXIS_TREE_COORDINATES],
+    alpha_bias_rad_s2: [Vector3<f64>; MAX_AXIS_TREE_COORDINATES],
+    a_bias_m_s2: [Vector3<f64>; MAX_AXIS_TREE_COORDINATES],
 }
 
 /// A tree of coordinate-axis revolutes and welds, with its evaluation's workspace.
@@ -98,19 +98,19 @@ pub struct AxisTree {
     gravity_floor_m_s2: Vector3<f64>,
     states: FrameStates,
     /// `M̄` (its leading `dof × dof` block; the lower triangle assembled, then mirrored).
-    mass_matrix: [[f64; MAX_COORDINATES]; MAX_COORDINATES],
+    mass_matrix: [[f64; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
     /// `f̄`.
-    force: [f64; MAX_COORDINATES],
+    force: [f64; MAX_AXIS_TREE_COORDINATES],
     /// The coordinates whose rows and columns the last assembly computed.
-    assembled: [bool; MAX_COORDINATES],
+    assembled: [bool; MAX_AXIS_TREE_COORDINATES],
     /// Scratch: the coordinates the next assembly computes.
-    needed: [bool; MAX_COORDINATES],
+    needed: [bool; MAX_AXIS_TREE_COORDINATES],
     /// Scratch for the active-set solve.
-    work_m: [[f64; MAX_COORDINATES]; MAX_COORDINATES],
-    work_b: [f64; MAX_COORDINATES],
-    work_idx: [usize; MAX_COORDINATES],
+    work_m: [[f64; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
+    work_b: [f64; MAX_AXIS_TREE_COORDINATES],
+    work_idx: [usize; MAX_AXIS_TREE_COORDINATES],
     /// Scratch: one body's needed Jacobian columns `(coordinate, linear, angular, I ω-column)`.
-    cols: [JacobianColumn; MAX_COORDINATES],
+    cols: [JacobianColumn; MAX_AXIS_TREE_COORDINATES],
 }
 
 /// The coordinate axis `axis` is, if it is one (0 x, 1 y, 2 z).
@@ -135,12 +135,12 @@ fn dot3(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 }
 
 impl AxisTree {
-    /// The tree of `model`, if it qualifies: 1 to [`MAX_COORDINATES`] coordinates, every joint
+    /// The tree of `model`, if it qualifies: 1 to [`MAX_AXIS_TREE_COORDINATES`] coordinates, every joint
     /// a revolute about a coordinate axis of its parent frame (owning a coordinate) or a weld,
     /// no infinitesimal bodies.
     pub fn of(model: &Model) -> Option<Self> {
         let dof = model.dof();
-        if dof == 0 || dof > MAX_COORDINATES || model.has_infinitesimal_bodies() {
+        if dof == 0 || dof > MAX_AXIS_TREE_COORDINATES || model.has_infinitesimal_bodies() {
             return None;
         }
         // For each link: the frame it moves with and its origin in that frame's axes, from the
@@ -253,21 +253,22 @@ impl AxisTree {
             springs,
             gravity_floor_m_s2: model.gravity_floor_m_s2,
             states: FrameStates {
-                r_floor_frame: [Matrix3::identity(); MAX_COORDINATES],
-                p_floor_m: [Vector3::zeros(); MAX_COORDINATES],
-                axis_floor: [Vector3::zeros(); MAX_COORDINATES],
-                omega_rad_s: [Vector3::zeros(); MAX_COORDINATES],
-                alpha_bias_rad_s2: [Vector3::zeros(); MAX_COORDINATES],
-                a_bias_m_s2: [Vector3::zeros(); MAX_COORDINATES],
+                r_floor_frame: [Matrix3::identity(); MAX_AXIS_TREE_COORDINATES],
+                p_floor_m: [Vector3::zeros(); MAX_AXIS_TREE_COORDINATES],
+                axis_floor: [Vector3::zeros(); MAX_AXIS_TREE_COORDINATES],
+                omega_rad_s: [Vector3::zeros(); MAX_AXIS_TREE_COORDINATES],
+                alpha_bias_rad_s2: [Vector3::zeros(); MAX_AXIS_TREE_COORDINATES],
+                a_bias_m_s2: [Vector3::zeros(); MAX_AXIS_TREE_COORDINATES],
             },
-            mass_matrix: [[0.0; MAX_COORDINATES]; MAX_COORDINATES],
-            force: [0.0; MAX_COORDINATES],
-            assembled: [false; MAX_COORDINATES],
-            needed: [true; MAX_COORDINATES],
-            work_m: [[0.0; MAX_COORDINATES]; MAX_COORDINATES],
-            work_b: [0.0; MAX_COORDINATES],
-            work_idx: [0; MAX_COORDINATES],
-            cols: [(0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros()); MAX_COORDINATES],
+            mass_matrix: [[0.0; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
+            force: [0.0; MAX_AXIS_TREE_COORDINATES],
+            assembled: [false; MAX_AXIS_TREE_COORDINATES],
+            needed: [true; MAX_AXIS_TREE_COORDINATES],
+            work_m: [[0.0; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
+            work_b: [0.0; MAX_AXIS_TREE_COORDINATES],
+            work_idx: [0; MAX_AXIS_TREE_COORDINATES],
+            cols: [(0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+                MAX_AXIS_TREE_COORDINATES],
         })
     }
 
@@ -331,7 +332,7 @@ impl AxisTree {
     fn assemble(&mut self, q: &[f64], qd: &[f64]) {
         self.kinematics(q, qd);
         let n = self.dof;
-        const S: usize = MAX_COORDINATES;
+        const S: usize = MAX_AXIS_TREE_COORDINATES;
         self.assembled = self.needed;
         self.mass_matrix = [[0.0; S]; S];
         self.force = [0.0; S];
@@ -528,7 +529,7 @@ impl AxisTree {
         qd: &DVector<f64>,
     ) -> (Vec<f64>, Vec<f64>) {
         let n = self.dof;
-        self.needed = [true; MAX_COORDINATES];
+        self.needed = [true; MAX_AXIS_TREE_COORDINATES];
         self.assemble(q.as_slice(), qd.as_slice());
         let m = (0..n)
             .flat_map(|i| (0..n).map(move |j| (i, j)))
@@ -549,9 +550,9 @@ impl AxisTree {
 /// fixed-size rows, with the block's size a constant so that its loops unroll. Returns false
 /// if `A` is not positive definite (NaN included) or `k` is larger than the capacity.
 fn cholesky_solve(
-    a: &mut [[f64; MAX_COORDINATES]; MAX_COORDINATES],
+    a: &mut [[f64; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
     k: usize,
-    b: &mut [f64; MAX_COORDINATES],
+    b: &mut [f64; MAX_AXIS_TREE_COORDINATES],
 ) -> bool {
     match k {
         0 => true,
@@ -571,13 +572,13 @@ fn cholesky_solve(
     }
 }
 
-/// [`cholesky_solve`] for a block of `K` rows (`K ≤ MAX_COORDINATES`). Indexed loops: the
+/// [`cholesky_solve`] for a block of `K` rows (`K ≤ MAX_AXIS_TREE_COORDINATES`). Indexed loops: the
 /// same operations in the same order as the general engine's solve.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
 fn cholesky_solve_k<const K: usize>(
-    a: &mut [[f64; MAX_COORDINATES]; MAX_COORDINATES],
-    b: &mut [f64; MAX_COORDINATES],
+    a: &mut [[f64; MAX_AXIS_TREE_COORDINATES]; MAX_AXIS_TREE_COORDINATES],
+    b: &mut [f64; MAX_AXIS_TREE_COORDINATES],
 ) -> bool {
     for j in 0..K {
         let mut d = a[j][j];

@@ -7,6 +7,7 @@
 
 use crate::stride::{
     Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings,
+    StrideWorkspace,
 };
 use crate::variational::VariationalError;
 use crate::walker::Walker;
@@ -182,9 +183,18 @@ impl<'a> GaitSearch<'a> {
         &self,
         v: &DVector<f64>,
     ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+        self.stride_map_in(&mut StrideWorkspace::new(self.walker), v)
+    }
+
+    /// [`Self::stride_map`] on `workspace` (of this search's walker).
+    fn stride_map_in(
+        &self,
+        workspace: &mut StrideWorkspace<'_>,
+        v: &DVector<f64>,
+    ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
         let w = self.walker;
         let (q, qd) = w.unpack(v);
-        let r = w.stride(&q, &qd, StrideRequest::new(self.settings))?;
+        let r = workspace.stride(&q, &qd, StrideRequest::new(self.settings))?;
         Ok((w.pack(&r.q_next, &r.qd_next), r))
     }
 
@@ -228,41 +238,46 @@ impl<'a> GaitSearch<'a> {
             let (q, qd) = w.unpack(v);
             let request =
                 StrideRequest::new(self.settings).schedule(Schedule::Record(&mut schedule));
-            let r = w.stride(&q, &qd, request)?;
+            let r = StrideWorkspace::new(w).stride(&q, &qd, request)?;
             Some(w.pack(&r.q_next, &r.qd_next))
         } else {
             None
         };
         let s_v = nominal.as_ref().unwrap_or(s_v);
-        let map = |x: &DVector<f64>| -> Result<DVector<f64>, StrideFailure> {
+        let map = |ws: &mut StrideWorkspace<'_>,
+                   x: &DVector<f64>|
+         -> Result<DVector<f64>, StrideFailure> {
             if settings.frozen_steps {
                 let (q, qd) = w.unpack(x);
                 let request =
                     StrideRequest::new(self.settings).schedule(Schedule::Replay(&schedule));
-                let r = w.stride(&q, &qd, request)?;
+                let r = ws.stride(&q, &qd, request)?;
                 Ok(w.pack(&r.q_next, &r.qd_next))
             } else {
-                Ok(self.stride_map(x)?.0)
+                Ok(self.stride_map_in(ws, x)?.0)
             }
         };
         // The columns are independent strides: computed in parallel (rayon), each with the
         // same arithmetic as a sequential loop, so the Jacobian is bit-identical to it. The
         // first failure in column order is reported, as a sequential loop would.
-        let column = |k: usize| -> Result<DVector<f64>, StrideFailure> {
-            let mut vp = v.clone();
-            vp[k] += d;
-            let sp = map(&vp)?;
-            Ok(if settings.central {
-                let mut vm = v.clone();
-                vm[k] -= d;
-                let sm = map(&vm)?;
-                (sp - sm) / (2.0 * d)
-            } else {
-                (sp - s_v) / d
-            })
-        };
-        let columns: Vec<Result<DVector<f64>, StrideFailure>> =
-            (0..n).into_par_iter().map(column).collect();
+        let column =
+            |ws: &mut StrideWorkspace<'_>, k: usize| -> Result<DVector<f64>, StrideFailure> {
+                let mut vp = v.clone();
+                vp[k] += d;
+                let sp = map(ws, &vp)?;
+                Ok(if settings.central {
+                    let mut vm = v.clone();
+                    vm[k] -= d;
+                    let sm = map(ws, &vm)?;
+                    (sp - sm) / (2.0 * d)
+                } else {
+                    (sp - s_v) / d
+                })
+            };
+        let columns: Vec<Result<DVector<f64>, StrideFailure>> = (0..n)
+            .into_par_iter()
+            .map_init(|| StrideWorkspace::new(w), column)
+            .collect();
         let mut j = DMatrix::zeros(n, n);
         for (k, col) in columns.into_iter().enumerate() {
             j.set_column(k, &col?);

@@ -26,34 +26,15 @@ mod three_link;
 mod trig;
 mod two_link;
 
+pub use crate::stride::EvaluationPath;
 pub(crate) use chain::Joints;
 pub use trig::sin_cos;
 
-/// Most coordinates a tree may have to take the fast path.
-pub const MAX_COORDINATES: usize = 6;
+/// Most coordinates a planar tree may have to take the planar fast path (and the fixed-size
+/// states of the stride loop: one size per count, 1 to this).
+pub const MAX_PLANAR_COORDINATES: usize = 6;
 /// Most links (welds included) a tree may have to take the fast path.
 pub const MAX_LINKS: usize = 12;
-
-/// Which evaluation of the equations of motion a phase uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EvaluationPath {
-    /// The planar fast path when the model qualifies ([`PlanarTree::of`]), else the 3D fast
-    /// path when it qualifies ([`crate::axis_tree::AxisTree::of`]), else the general one; and
-    /// the fixed-size stride loop where it covers the stride (`crate::stride`'s `fast`).
-    #[default]
-    Auto,
-    /// The planar (or 3D) fast path when the model qualifies, inside the general stride loop
-    /// (no fixed-size stride): the reference the fixed-size stride is measured against.
-    GeneralLoop,
-    /// Always the general 3D engine (the reference the fast paths are tested against).
-    General,
-    /// As [`Self::Auto`] (the fixed-size stride where it covers the stride), but the planar
-    /// evaluation always by its link pass, without the closed forms of particular trees (the
-    /// two-link chain's, `planar/two_link.rs`, and the three-link chain's, `planar/three_link.rs`):
-    /// what those are measured and tested against.
-    LinkPass,
-}
 
 /// One link of a planar tree, with what its kinematics needs. Links are stored parents first;
 /// index 0 of the evaluation's link state is the ground, link `i` is slot `i + 1`.
@@ -82,7 +63,7 @@ struct PlanarBody {
     infinitesimal: bool,
     /// `(coordinate, slot of the owning link, axis sign)` along its ancestry; the first
     /// `chain_len` entries are used.
-    chain: [(usize, usize, f64); MAX_COORDINATES],
+    chain: [(usize, usize, f64); MAX_PLANAR_COORDINATES],
     /// Number of joints in the chain.
     chain_len: usize,
 }
@@ -183,11 +164,11 @@ struct Assembled<const N: usize> {
 
 impl PlanarTree {
     /// The planar tree of `model`, or `None` when it does not qualify: more than
-    /// [`MAX_COORDINATES`] coordinates or [`MAX_LINKS`] links, a prismatic joint, a revolute
+    /// [`MAX_PLANAR_COORDINATES`] coordinates or [`MAX_LINKS`] links, a prismatic joint, a revolute
     /// axis not along the floor's z axis, or gravity out of the x-y plane.
     pub fn of(model: &Model) -> Option<Self> {
         let dof = model.dof();
-        if dof == 0 || dof > MAX_COORDINATES || model.links.len() > MAX_LINKS {
+        if dof == 0 || dof > MAX_PLANAR_COORDINATES || model.links.len() > MAX_LINKS {
             return None;
         }
         if model.gravity_floor_m_s2.z != 0.0 {
@@ -228,7 +209,7 @@ impl PlanarTree {
                 // Neither mass nor inertia: skipped, as the general engine does.
                 continue;
             }
-            let mut chain = [(0, 0, 0.0); MAX_COORDINATES];
+            let mut chain = [(0, 0, 0.0); MAX_PLANAR_COORDINATES];
             let mut chain_len = 0;
             let mut cur = Some(i);
             while let Some(l) = cur {
@@ -619,7 +600,7 @@ impl PlanarTree {
             let part = usize::from(body.infinitesimal);
             let chain = &body.chain[..body.chain_len];
             // Jv = sign · z × (p − o), Jw = sign, per joint of the chain.
-            let mut jv = [(0.0, 0.0); MAX_COORDINATES];
+            let mut jv = [(0.0, 0.0); MAX_PLANAR_COORDINATES];
             for (v, &(_, slot, sign)) in jv.iter_mut().zip(chain) {
                 let o = st[slot].origin_m;
                 *v = (-sign * (py - o[1]), sign * (px - o[0]));

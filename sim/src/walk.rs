@@ -12,7 +12,9 @@ use crate::control::AnkleController;
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
 use crate::math::{rotation_about, sagittal_reflection};
-use crate::stride::{FailureKind, StrideEvent, StrideOptions, StrideRequest, StrideSettings};
+use crate::stride::{
+    FailureKind, StrideEvent, StrideOptions, StrideRequest, StrideSettings, StrideWorkspace,
+};
 use crate::walker::Walker;
 use nalgebra::{DVector, Matrix3, Vector3};
 use serde::Serialize;
@@ -235,6 +237,7 @@ pub fn walk(
     let mut t0 = 0.0;
     let hip = &walker.model.points[walker.fall.hip.0];
     let mut samples = Vec::new();
+    let mut workspace = StrideWorkspace::new(walker);
     for step in 0..steps {
         samples.clear();
         let options = StrideOptions {
@@ -247,7 +250,7 @@ pub fn walk(
         if let Some(c) = controller.as_deref_mut() {
             request = request.controlled(c, t0);
         }
-        let result = walker.stride(&q, &qd, request);
+        let result = workspace.stride(&q, &qd, request);
         for s in &samples {
             out.path
                 .push(path_sample(walker, &mut kin, &frame, step, t0, s));

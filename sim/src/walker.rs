@@ -59,7 +59,58 @@ pub struct Walker {
     pub relabel_reference_q: DVector<f64>,
 }
 
+/// A walker's rules besides its model: what [`Walker::new`] builds a walker from.
+#[derive(Clone, Debug)]
+pub struct WalkerRules {
+    /// Heel strike.
+    pub heel_strike: HeelStrikeRule,
+    /// Knee locks (empty for straight legs).
+    pub knees: Vec<KneeLock>,
+    /// Falls.
+    pub fall: FallRule,
+    /// Relabelling after heel strike (its `fixed` coordinates are set by [`Walker::new`]).
+    pub relabel: Relabel,
+    /// The stance ankle's stretch reflex, if the walker has one.
+    pub ankle: Option<crate::actuator::AnkleReflex>,
+    /// Coordinates only the 3D model has (for eigenvalue reports).
+    pub three_d_freedoms: Vec<String>,
+    /// The relabelling's reference pose ([`Walker::relabel_reference_q`]).
+    pub relabel_reference_q: DVector<f64>,
+}
+
 impl Walker {
+    /// A walker named `name` from its single-stance `model` and its `rules`, without a scene
+    /// file: the impact model (the stance contact released as the heel-strike rule says) and
+    /// the coordinates locked at the start of a stride (the toe pitch of an ankle reflex's
+    /// flat foot, also held by the relabelling) are derived here.
+    pub fn new(name: impl Into<String>, model: Model, rules: WalkerRules) -> Self {
+        let WalkerRules {
+            heel_strike,
+            knees,
+            fall,
+            mut relabel,
+            ankle,
+            three_d_freedoms,
+            relabel_reference_q,
+        } = rules;
+        let initially_locked: Vec<CoordIndex> = ankle.iter().map(|a| a.toe_pitch).collect();
+        relabel.fixed = initially_locked.clone();
+        let impact_model = model.with_released_root(&heel_strike.release);
+        Self {
+            name: name.into(),
+            model,
+            impact_model,
+            heel_strike,
+            knees,
+            fall,
+            relabel,
+            ankle,
+            initially_locked,
+            three_d_freedoms,
+            relabel_reference_q,
+        }
+    }
+
     /// The coordinates that enter the stride map (all but the cyclic ones).
     pub fn map_coordinates(&self) -> Vec<CoordIndex> {
         (0..self.model.dof())

@@ -5,7 +5,7 @@
 //! (`two_link.rs`, `three_link.rs`) and the fixed-size stride's witnesses
 //! (`stride/fast/witness.rs`) read them.
 
-use super::{LinkFrame, PlanarTree, MAX_COORDINATES, MAX_LINKS};
+use super::{LinkFrame, PlanarTree, MAX_LINKS, MAX_PLANAR_COORDINATES};
 use nalgebra::SVector;
 
 /// One joint of a planar tree.
@@ -26,18 +26,18 @@ pub(crate) struct ChainJoint {
 /// included).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Joints {
-    joints: [ChainJoint; MAX_COORDINATES],
+    joints: [ChainJoint; MAX_PLANAR_COORDINATES],
     len: usize,
     /// Per link: its nearest joint above (itself included), an index into `joints`.
     owner: [Option<usize>; MAX_LINKS],
 }
 
 impl Joints {
-    /// The joints of `tree`; `None` when it has more than [`MAX_COORDINATES`] joints or
+    /// The joints of `tree`; `None` when it has more than [`MAX_PLANAR_COORDINATES`] joints or
     /// [`MAX_LINKS`] links.
     pub(crate) fn of(tree: &PlanarTree) -> Option<Self> {
         let mut j = Self {
-            joints: [ChainJoint::default(); MAX_COORDINATES],
+            joints: [ChainJoint::default(); MAX_PLANAR_COORDINATES],
             len: 0,
             owner: [None; MAX_LINKS],
         };

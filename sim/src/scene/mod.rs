@@ -15,7 +15,7 @@ use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSetting
 use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
 use crate::relabel::Relabel;
 use crate::stride::StrideSettings;
-use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker};
+use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker, WalkerRules};
 use file::{Num, SceneFile};
 use nalgebra::{DVector, Matrix3, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
@@ -631,23 +631,19 @@ impl Scene {
                 })
             }
         };
-        let initially_locked: Vec<CoordIndex> = ankle.iter().map(|a| a.toe_pitch).collect();
-        let mut relabel = relabel;
-        relabel.fixed = initially_locked.clone();
-        let impact_model = model.with_released_root(&release);
-        let walker = Walker {
-            name: self.name().to_string(),
+        let walker = Walker::new(
+            self.name(),
             model,
-            impact_model,
-            heel_strike,
-            knees,
-            fall,
-            relabel,
-            relabel_reference_q: guess_q.clone(),
-            ankle,
-            initially_locked,
-            three_d_freedoms: f.three_d_freedoms.clone(),
-        };
+            WalkerRules {
+                heel_strike,
+                knees,
+                fall,
+                relabel,
+                ankle,
+                three_d_freedoms: f.three_d_freedoms.clone(),
+                relabel_reference_q: guess_q.clone(),
+            },
+        );
         let settings = StrideSettings {
             integrator,
             event_tolerance: EventTolerance::default(),

@@ -1,6 +1,7 @@
 //! Energy accounting over a stride: the ankle actuator's work and the joint dampers'
 //! dissipation.
 
+use super::engine::StrideState;
 use crate::dynamics::Dynamics;
 use crate::integrators::Sample;
 use crate::model::Model;
@@ -20,7 +21,8 @@ pub(super) struct Power {
     pub(super) dissipation_j: f64,
     /// Energy and dissipation so far at the start of the open engaged interval.
     open: Option<(f64, f64)>,
-    dynamics: Dynamics,
+    /// The workspace of the energy's evaluations (made at the first engaged interval).
+    dynamics: Option<Dynamics>,
     /// `(coordinate, damping coefficient)` of every damped joint.
     damping: Vec<(usize, f64)>,
 }
@@ -37,7 +39,7 @@ impl Power {
             work_j: 0.0,
             dissipation_j: 0.0,
             open: None,
-            dynamics: Dynamics::new(model),
+            dynamics: None,
             damping,
         }
     }
@@ -48,26 +50,29 @@ impl Power {
     }
 
     /// An engaged interval starts at `s` (after the engagement or a knee-lock impact).
-    pub(super) fn open(&mut self, model: &Model, s: &Sample) {
-        self.open = Some((energy(&mut self.dynamics, model, s), self.dissipation_j));
+    pub(super) fn open(&mut self, model: &Model, s: &impl StrideState) {
+        let dynamics = self.dynamics.get_or_insert_with(|| Dynamics::new(model));
+        self.open = Some((energy(dynamics, model, &s.to_sample()), self.dissipation_j));
     }
 
     /// The open interval, if any, ends at `s` (before an impact or at heel strike).
-    pub(super) fn close(&mut self, model: &Model, s: &Sample) {
+    pub(super) fn close(&mut self, model: &Model, s: &impl StrideState) {
         if let Some((e0, d0)) = self.open.take() {
-            let e1 = energy(&mut self.dynamics, model, s);
+            let dynamics = self.dynamics.get_or_insert_with(|| Dynamics::new(model));
+            let e1 = energy(dynamics, model, &s.to_sample());
             self.work_j += e1 - e0 + (self.dissipation_j - d0);
         }
     }
 
     /// The dampers' dissipation over the step `from` → `to`.
-    pub(super) fn accumulate(&mut self, from: &Sample, to: &Sample) {
-        let h = to.t_s - from.t_s;
+    #[inline]
+    pub(super) fn accumulate<S: StrideState>(&mut self, from: &S, to: &S) {
+        let h = to.t_s() - from.t_s();
         let damping = &self.damping;
-        let diss = |s: &Sample| {
+        let diss = |s: &S| {
             damping
                 .iter()
-                .map(|&(i, c)| c * s.qd[i] * s.qd[i])
+                .map(|&(i, c)| c * s.qd(i) * s.qd(i))
                 .sum::<f64>()
         };
         self.dissipation_j += 0.5 * h * (diss(from) + diss(to));

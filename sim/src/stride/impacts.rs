@@ -8,7 +8,7 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::energy;
-use super::phase::{Drive, Phase};
+use super::phase::Drive;
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use crate::actuator::AnkleReflex;
 use crate::dynamics::Dynamics;
@@ -17,6 +17,7 @@ use crate::hybrid::impact::{locked_state, unit_row};
 use crate::impact::{resolve, resolve_to, ImpactError};
 use crate::integrators::Sample;
 use crate::kinematics::Kinematics;
+use crate::model::CoordIndex;
 use crate::relabel::LinkStates;
 use crate::walker::Walker;
 use nalgebra::{DVector, Vector3};
@@ -63,10 +64,10 @@ pub(super) struct Engaged {
 
 impl Walker {
     /// An inelastic impact that locks coordinate `c` at `value` (a knee at its stop, a foot
-    /// landing flat), the other free coordinates as `phase` has them.
+    /// landing flat), the other free coordinates `active`, a coordinate driven as `prescribed`.
     pub(super) fn lock_coordinate(
         &self,
-        phase: &Phase,
+        (active, prescribed): (&[bool], Option<(CoordIndex, Drive)>),
         at: &Sample,
         c: usize,
         value: f64,
@@ -74,20 +75,12 @@ impl Walker {
         let g = unit_row(self.model.dof(), c);
         let mut dynamics = Dynamics::new(&self.model);
         let before = energy(&mut dynamics, &self.model, at);
-        let imp = resolve(
-            &mut dynamics,
-            &self.model,
-            &at.q,
-            &at.qd,
-            &phase.active,
-            &g,
-            0.0,
-        )
-        .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+        let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, active, &g, 0.0)
+            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
         // A drive holding the ankle through the impact takes an impulse and does work on it
         // (impulse × its rate, which the impact does not change): the actuator's work, not part
         // of the impact's loss.
-        let drive_work_j = match phase.prescribed {
+        let drive_work_j = match prescribed {
             Some((a, _)) => {
                 let dqd = &imp.qd_plus - &at.qd;
                 (dynamics.mass_matrix.row(a.0) * dqd)[(0, 0)] * at.qd[a.0]
@@ -110,13 +103,13 @@ impl Walker {
     /// controller).
     pub(super) fn engage_string(
         &self,
-        phase: &Phase,
+        active: &[bool],
         at: &Sample,
         reflex: &AnkleReflex,
         drive: &Drive,
     ) -> Result<Engaged, StrideFailure> {
         let (a, toe) = (reflex.ankle.0, reflex.toe_pitch.0);
-        let mut act = phase.active.clone();
+        let mut act = active.to_vec();
         act[toe] = true;
         let g = unit_row(self.model.dof(), a);
         let (p_rad, v_rad_s, _) = drive.eval(at.t_s);

@@ -14,9 +14,16 @@
 //!   stride's end ([`Walker::heel_strike_impact`]);
 //! - `energy`: actuator work and damper dissipation;
 //! - `contact_figures`: [`ContactSummary`];
-//! - `run`: the loop ([`Walker::stride`]);
-//! - `fast`: the same loop on fixed-size states for the planar walkers it covers (selected
-//!   automatically, the general loop its reference and fallback);
+//! - `evaluation_path`: [`EvaluationPath`], which evaluation a stride uses;
+//! - `engine`: what the loop needs of a state's storage and its evaluation (`Engine`), and the
+//!   reference engine on `DVector` samples;
+//! - `run`: the one loop ([`Walker::stride`], [`StrideWorkspace::stride`]), written once for
+//!   every engine;
+//! - `fast`: the fixed-size engine (`SVector<N>` states, DOP853 and the planar evaluation) for
+//!   the planar walkers it covers (selected automatically, the reference engine its reference
+//!   and fallback);
+//! - `workspace`: [`StrideWorkspace`], the model-derived structures and scratch repeated
+//!   strides reuse;
 //! - `result`: [`StrideResult`], [`StrideFailure`], [`FailureKind`], [`StrideEvent`].
 //!
 //! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
@@ -28,6 +35,8 @@
 
 mod contact_figures;
 mod energy;
+mod engine;
+mod evaluation_path;
 mod fast;
 mod impacts;
 mod phase;
@@ -37,11 +46,14 @@ mod run;
 mod schedule;
 mod settings;
 mod witnesses;
+mod workspace;
 
 pub use contact_figures::ContactSummary;
+pub use evaluation_path::EvaluationPath;
 pub use impacts::HeelStrikeImpact;
 pub use phase::{linearised_limit, Drive, Phase};
 pub use request::{StrideControl, StrideOptions, StrideRequest};
 pub use result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 pub use schedule::{Schedule, StepSchedule};
 pub use settings::StrideSettings;
+pub use workspace::StrideWorkspace;

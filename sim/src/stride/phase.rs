@@ -8,7 +8,8 @@ use crate::dynamics::{Dynamics, DynamicsError};
 use crate::hybrid::phase::DriveValues;
 use crate::integrators::{Sample, SecondOrderSystem, StabilityLimit};
 use crate::model::{CoordIndex, Model};
-use crate::planar::{EvaluationPath, PlanarTree};
+use crate::planar::PlanarTree;
+use crate::stride::EvaluationPath;
 use nalgebra::{DMatrix, DVector};
 
 /// How a driven coordinate moves (times are from the start of the stride).
@@ -246,6 +247,14 @@ impl<'a> Phase<'a> {
             ),
             assembled_at: AssemblyKey::new(model.dof()),
         }
+    }
+
+    /// Back to the start of a stride: every coordinate free, none driven, no assembly to
+    /// solve on again.
+    pub(crate) fn restart(&mut self) {
+        self.active.iter_mut().for_each(|a| *a = true);
+        self.prescribed = None;
+        self.assembled_at.valid = false;
     }
 
     /// Puts the prescribed coordinate of `s` exactly on its profile.

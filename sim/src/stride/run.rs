@@ -8,16 +8,16 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
-use super::fast::Outcome;
-use super::phase::{Drive, Phase};
+use super::engine::{Engine, StrideState, WitnessEvaluator};
+use super::phase::Drive;
 use super::request::{StrideControl, StrideOptions, StrideRequest};
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
-use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
+use super::witnesses::{self, StringLimit, Watch, WitnessValues, Witnesses};
+use super::workspace::StrideWorkspace;
 use crate::control::ActuatorSegment;
-use crate::events::locate;
-use crate::integrators::{Integrator, Sample};
+use crate::integrators::Sample;
 use crate::walker::Walker;
 use nalgebra::DVector;
 
@@ -25,7 +25,9 @@ mod ticks;
 
 impl Walker {
     /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
-    /// `request` asks: its settings, what it records, its step schedule, its controller.
+    /// `request` asks: its settings, what it records, its step schedule, its controller. (A
+    /// [`StrideWorkspace`] of its own: repeated strides reuse one with
+    /// [`StrideWorkspace::stride`].)
     ///
     /// # Errors
     /// A [`StrideFailure`] saying how and when (stride time) the stride failed; samples
@@ -36,6 +38,24 @@ impl Walker {
         qd0: &DVector<f64>,
         request: StrideRequest<'_>,
     ) -> Result<StrideResult, StrideFailure> {
+        StrideWorkspace::new(self).stride(q0, qd0, request)
+    }
+}
+
+impl StrideWorkspace<'_> {
+    /// [`Walker::stride`] of this workspace's walker, on this workspace: what the model gives
+    /// the stride's evaluation path is compiled at the first stride (again only when a
+    /// request asks for another path or integrator), the evaluators' storage reused.
+    ///
+    /// # Errors
+    /// As [`Walker::stride`].
+    pub fn stride(
+        &mut self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        request: StrideRequest<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let walker = self.walker();
         let StrideRequest {
             settings,
             options,
@@ -43,7 +63,7 @@ impl Walker {
             control,
             sink,
         } = request;
-        if control.is_some() && self.ankle.is_none() {
+        if control.is_some() && walker.ankle.is_none() {
             return Err(StrideFailure::new(
                 FailureKind::NonFiniteState,
                 0.0,
@@ -56,31 +76,36 @@ impl Walker {
             Some(s) => s,
             None => &mut own,
         };
-        if let Some(tree) = super::fast::covers(self, settings, options, control.is_some()) {
-            let recorded = trajectory.len();
-            let fast_schedule = match &mut schedule {
-                Schedule::Free => Schedule::Free,
-                Schedule::Record(s) => Schedule::Record(s),
-                Schedule::Replay(s) => Schedule::Replay(s),
-            };
-            match super::fast::stride(
-                self,
-                &tree,
-                settings,
-                options,
-                fast_schedule,
-                trajectory,
-                q0,
-                qd0,
-            ) {
-                Outcome::Done(r) => {
-                    let mut r = (*r)?;
-                    if keep_in_result {
-                        r.trajectory = own;
+        if super::fast::covers(walker, settings, options, control.is_some()) {
+            let mut triggered = std::mem::take(&mut self.triggered);
+            if let Some(fixed) = self.fixed(settings.evaluation) {
+                let recorded = trajectory.len();
+                let fast_schedule = match &mut schedule {
+                    Schedule::Free => Schedule::Free,
+                    Schedule::Record(s) => Schedule::Record(s),
+                    Schedule::Replay(s) => Schedule::Replay(s),
+                };
+                let start = Start {
+                    walker,
+                    settings,
+                    options,
+                    schedule: fast_schedule,
+                    trajectory,
+                    triggered: &mut triggered,
+                };
+                let done = super::fast::stride(start, fixed, q0, qd0);
+                self.triggered = triggered;
+                match done {
+                    Some(mut r) => {
+                        if keep_in_result {
+                            r.trajectory = own;
+                        }
+                        return Ok(r);
                     }
-                    return Ok(r);
+                    None => trajectory.truncate(recorded),
                 }
-                Outcome::Fallback => trajectory.truncate(recorded),
+            } else {
+                self.triggered = triggered;
             }
         }
         let cur = Sample {
@@ -88,13 +113,48 @@ impl Walker {
             q: q0.clone(),
             qd: qd0.clone(),
         };
-        let run = Run::new(self, settings, options, schedule, control, trajectory, cur);
-        let mut r = run?.run()?;
+        let mut engine = self.reference_engine(settings);
+        engine.integrator.reset();
+        for c in &walker.initially_locked {
+            engine.phase.active[c.0] = false;
+        }
+        let wit = self
+            .witnesses
+            .take()
+            .unwrap_or_else(|| Witnesses::new(walker));
+        let start = Start {
+            walker,
+            settings,
+            options,
+            schedule,
+            trajectory,
+            triggered: &mut self.triggered,
+        };
+        let (r, parts) = match Run::new(start, engine, wit, control, cur) {
+            Ok(run) => run.run(),
+            Err(e) => return Err(e),
+        };
+        let (engine, wit) = parts;
+        self.witnesses = Some(wit);
+        self.keep_reference(settings, engine);
+        let mut r = r?;
         if keep_in_result {
             r.trajectory = own;
         }
         Ok(r)
     }
+}
+
+/// What a stride starts from, whatever its engine: the walker, the settings, what to record,
+/// the step schedule and where recorded samples go.
+pub(super) struct Start<'w, 'r, 't> {
+    pub(super) walker: &'w Walker,
+    pub(super) settings: &'r StrideSettings,
+    pub(super) options: StrideOptions,
+    pub(super) schedule: Schedule<'r>,
+    pub(super) trajectory: &'t mut Vec<Sample>,
+    /// Storage for the watches a step triggers (the workspace's).
+    pub(super) triggered: &'t mut Vec<Watch>,
 }
 
 /// What a located event did to the stride.
@@ -109,25 +169,36 @@ enum Applied {
     Done(Box<StrideResult>),
 }
 
-/// One stride in progress.
-struct Run<'w, 'r, 't> {
+/// What a step's triggered events come to.
+enum Located<S> {
+    /// No event: the step is accepted.
+    None,
+    /// Only a mid-swing scuff the walker ignores wherever it lies in the step.
+    IgnoredScuff,
+    /// The earliest event and where it lies (`None`: none applies).
+    Earliest(Option<(Watch, S)>),
+}
+
+/// One stride in progress, on the engine `E` (its state storage and evaluation).
+pub(super) struct Run<'w, 'r, 't, E: Engine> {
     walker: &'w Walker,
     settings: &'r StrideSettings,
     options: StrideOptions,
-    integrator: Box<dyn Integrator>,
+    engine: E,
     schedule: ScheduleCursor<'r>,
     /// Evaluations of earlier phases (the integrator restarts after each impact).
     evaluations: usize,
     /// Integrator steps taken so far (accepted or not), against the step budget.
     steps: usize,
-    phase: Phase<'w>,
     power: Power,
     contact: ContactSummary,
-    wit: Witnesses<'w>,
+    wit: E::Witness,
     /// Witness values at `cur`, carried over from the previous step.
     w_cached: Option<WitnessValues>,
-    /// The last accepted sample.
-    cur: Sample,
+    /// The watches the last step triggered (the workspace's storage).
+    triggered: &'t mut Vec<Watch>,
+    /// The last accepted state.
+    cur: E::State,
     events: Vec<StrideEvent>,
     event_states: Vec<(Sample, Sample)>,
     energy_loss_j: f64,
@@ -152,23 +223,25 @@ struct Run<'w, 'r, 't> {
     ticks: usize,
 }
 
-impl<'w, 'r, 't> Run<'w, 'r, 't> {
-    fn new(
-        walker: &'w Walker,
-        settings: &'r StrideSettings,
-        options: StrideOptions,
-        schedule: super::Schedule<'r>,
+impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
+    /// A stride from `cur` on `engine` (its free coordinates set), its witnesses evaluated by
+    /// `wit`.
+    pub(super) fn new(
+        start: Start<'w, 'r, 't>,
+        engine: E,
+        wit: E::Witness,
         control: Option<StrideControl<'r>>,
-        trajectory: &'t mut Vec<Sample>,
-        cur: Sample,
+        cur: E::State,
     ) -> Result<Self, StrideFailure> {
-        let mut integrator = settings.integrator.build();
-        integrator.reset();
-        let mut phase = Phase::with_path(&walker.model, settings.evaluation);
-        for c in &walker.initially_locked {
-            phase.active[c.0] = false;
-        }
-        if cur.q.iter().chain(cur.qd.iter()).any(|v| !v.is_finite()) {
+        let Start {
+            walker,
+            settings,
+            options,
+            schedule,
+            trajectory,
+            triggered,
+        } = start;
+        if !cur.is_finite() {
             return Err(StrideFailure::new(
                 FailureKind::NonFiniteState,
                 0.0,
@@ -176,16 +249,16 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             ));
         }
         if options.record {
-            trajectory.push(cur.clone());
+            trajectory.push(cur.to_sample());
         }
         let (period_s, t_walk0) = match &control {
             Some(c) => (c.controller.period_s(), c.t_walk_start_s),
             None => (f64::INFINITY, 0.0),
         };
-        let held_stepping = Self::held_stepping(
+        let held_stepping = ticks::held_stepping(
             settings.tick_stepping,
-            matches!(schedule, super::Schedule::Free),
-            integrator.interpolates(),
+            matches!(schedule, Schedule::Free),
+            engine.interpolates(),
             control.is_some(),
         );
         let next_tick_s = match &control {
@@ -196,15 +269,15 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             walker,
             settings,
             options,
-            integrator,
+            engine,
             schedule: ScheduleCursor::new(schedule),
             evaluations: 0,
             steps: 0,
-            phase,
             power: Power::new(&walker.model),
             contact: ContactSummary::default(),
-            wit: Witnesses::new(walker),
+            wit,
             w_cached: None,
+            triggered,
             cur,
             events: Vec::new(),
             event_states: Vec::new(),
@@ -221,14 +294,21 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         })
     }
 
+    /// The loop, run to its end: the stride's result, and the engine and the witnesses'
+    /// evaluator (for the next stride to reuse).
+    pub(super) fn run(mut self) -> (Result<StrideResult, StrideFailure>, (E, E::Witness)) {
+        let r = self.steps_to_the_end();
+        (r, (self.engine, self.wit))
+    }
+
     /// The loop: step, check, locate, apply, until heel strike or a failure.
-    fn run(mut self) -> Result<StrideResult, StrideFailure> {
+    fn steps_to_the_end(&mut self) -> Result<StrideResult, StrideFailure> {
         loop {
             self.control_tick()?;
-            if self.cur.t_s > self.settings.max_stride_time_s {
+            if self.cur.t_s() > self.settings.max_stride_time_s {
                 return Err(StrideFailure::new(
                     FailureKind::NoImpactWithinTime,
-                    self.cur.t_s,
+                    self.cur.t_s(),
                     format!(
                         "no heel strike within {} s",
                         self.settings.max_stride_time_s
@@ -242,16 +322,16 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             // taken (before the grazing probe and event location take other steps), run
             // before the step's events apply.
             let dense = self.held_interpolant(&next)?;
-            let stepped_to_s = next.t_s;
+            let stepped_to_s = next.t_s();
             let (next, w_cur, w_next) = self.grazing_check(next)?;
             // The probe's step was adopted: it is now the integrator's last step, and its own
             // interpolant is the one of the step the stride takes.
-            let dense = if next.t_s == stepped_to_s {
+            let dense = if next.t_s() == stepped_to_s {
                 dense
             } else {
                 self.held_interpolant(&next)?
             };
-            if self.tick_inside_without_interpolant(dense.as_ref(), next.t_s) {
+            if self.tick_inside_without_interpolant(dense.as_ref(), next.t_s()) {
                 // Not expected (a step runs across a tick only with its interpolant, kept for
                 // the step adopted above). A tick is never skipped: the step is taken again,
                 // ending at the tick.
@@ -259,39 +339,49 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 continue;
             }
             let limit = self.string_limit();
-            let triggered =
-                self.wit
-                    .triggered(&self.phase, limit, (&self.cur, &w_cur), (&next, &w_next));
-            if triggered.is_empty() {
-                let next = self
-                    .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
-                    .unwrap_or(next);
-                self.accept(next, drive_end_s)?;
-                continue;
-            }
-            if self.scuff_need_not_be_located(&triggered, &w_cur, &w_next) {
-                // Ignored wherever it is: the step is accepted as `apply` would accept it,
-                // without locating the crossing (it would only split the dampers' trapezoid,
-                // and there are none).
-                let at = self.cur.clone();
-                self.accept_ignored(&at, next);
-                continue;
-            }
-            let Some((watch, mut at)) = self.earliest(&triggered, &next)? else {
+            let mut triggered = std::mem::take(self.triggered);
+            witnesses::triggered(
+                &mut triggered,
+                self.walker,
+                (self.engine.active(), self.engine.prescribed().is_some()),
+                limit,
+                (&self.cur, &w_cur),
+                (&next, &w_next),
+            );
+            let located = self.located(&triggered, &w_cur, &w_next, &next);
+            *self.triggered = triggered;
+            let Some((watch, mut at)) = (match located? {
+                Located::None => {
+                    let next = self
+                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?
+                        .unwrap_or(next);
+                    self.accept(next, drive_end_s)?;
+                    continue;
+                }
+                Located::IgnoredScuff => {
+                    // Ignored wherever it is: the step is accepted as `apply` would accept
+                    // it, without locating the crossing (it would only split the dampers'
+                    // trapezoid, and there are none).
+                    let at = self.cur.clone();
+                    self.accept_ignored(&at, next);
+                    continue;
+                }
+                Located::Earliest(e) => e,
+            }) else {
                 continue;
             };
-            if let Some(at_tick) = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s)? {
+            if let Some(at_tick) = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), at.t_s())? {
                 // A tick before the event changed the plant's input: the step ends there.
                 self.accept(at_tick, drive_end_s)?;
                 continue;
             }
-            self.phase.snap(&mut at);
+            self.engine.snap(&mut at);
             self.power.accumulate(&self.cur, &at);
             match self.apply(watch, &at)? {
                 Applied::Done(result) => return Ok(*result),
                 Applied::Ignored => {
                     let next = self
-                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s)?
+                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?
                         .unwrap_or(next);
                     self.accept_ignored(&at, next);
                 }
@@ -305,11 +395,11 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     /// naming the budget, so that no stride loops forever (e.g. on steps that do not advance
     /// time).
     fn check_budgets(&self) -> Result<(), StrideFailure> {
-        let evaluations = self.evaluations + self.integrator.evaluations();
+        let evaluations = self.evaluations + self.engine.evaluations();
         if self.steps >= self.settings.max_steps {
             return Err(StrideFailure::new(
                 FailureKind::StepBudgetExceeded,
-                self.cur.t_s,
+                self.cur.t_s(),
                 format!(
                     "no heel strike within the step budget max_steps = {} ({} evaluations)",
                     self.settings.max_steps, evaluations
@@ -320,7 +410,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         if evaluations >= self.settings.max_evaluations {
             return Err(StrideFailure::new(
                 FailureKind::EvaluationBudgetExceeded,
-                self.cur.t_s,
+                self.cur.t_s(),
                 format!(
                     "no heel strike within the evaluation budget max_evaluations = {} ({} steps)",
                     self.settings.max_evaluations, self.steps
@@ -334,8 +424,8 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     /// straddles it (the step sizes stay smooth functions of the initial state, and replayed
     /// schedules stay accurate when the end moves). ∞ when there is none ahead.
     fn drive_end_s(&self) -> f64 {
-        match self.phase.prescribed {
-            Some((_, Drive::Profile(p))) if self.cur.t_s < p.start_s + p.duration_s - 1e-12 => {
+        match self.engine.prescribed() {
+            Some((_, Drive::Profile(p))) if self.cur.t_s() < p.start_s + p.duration_s - 1e-12 => {
                 p.start_s + p.duration_s
             }
             _ => f64::INFINITY,
@@ -344,22 +434,20 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
 
     /// One integrator step from `cur`, up to the next tick or breakpoint (replayed when the
     /// schedule says so).
-    fn step(&mut self, drive_end_s: f64) -> Result<Sample, StrideFailure> {
+    fn step(&mut self, drive_end_s: f64) -> Result<E::State, StrideFailure> {
         self.steps += 1;
         let cur = &self.cur;
-        let h_limit = (self.tick_limit_s().min(drive_end_s) - cur.t_s).max(1e-12);
+        let h_limit = (self.tick_limit_s().min(drive_end_s) - cur.t_s()).max(1e-12);
         let mut next = match self.schedule.replayed() {
-            Some(h) => self
-                .integrator
-                .step_exact(&mut self.phase, cur, h.min(h_limit)),
-            None => self.integrator.advance(&mut self.phase, cur, h_limit),
+            Some(h) => self.engine.step_exact(cur, h.min(h_limit)),
+            None => self.engine.advance(cur, h_limit),
         }
-        .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
-        self.phase.snap(&mut next);
-        if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
+        .map_err(|e| StrideFailure::from_integration(e, cur.t_s()))?;
+        self.engine.snap(&mut next);
+        if !next.is_finite() {
             return Err(StrideFailure::new(
                 FailureKind::NonFiniteState,
-                next.t_s,
+                next.t_s(),
                 "state",
             ));
         }
@@ -371,23 +459,24 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     /// rates at both ends) is checked at interior points; if the exact flow confirms a dip, the
     /// step is shortened to end inside it. Returns the step's end and the witness values at
     /// both ends.
+    #[inline]
     fn grazing_check(
         &mut self,
-        mut next: Sample,
-    ) -> Result<(Sample, WitnessValues, WitnessValues), StrideFailure> {
+        mut next: E::State,
+    ) -> Result<(E::State, WitnessValues, WitnessValues), StrideFailure> {
         let cur = &self.cur;
         let w_cur = match self.w_cached {
-            Some(w) if w.t_s == cur.t_s => w,
+            Some(w) if w.t_s == cur.t_s() => w,
             _ => self.wit.eval(cur),
         };
         let mut w_next = self.wit.eval(&next);
         let samples = self.settings.event_tolerance.grazing_samples;
         if let Some(t) = w_cur.grazing_sample_time(&w_next, samples) {
             let mut s = self
-                .integrator
-                .step_exact(&mut self.phase, cur, t - cur.t_s)
-                .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
-            self.phase.snap(&mut s);
+                .engine
+                .step_exact(cur, t - cur.t_s())
+                .map_err(|e| StrideFailure::from_integration(e, cur.t_s()))?;
+            self.engine.snap(&mut s);
             let ws = self.wit.eval(&s);
             if ws.foot_height_m <= 0.0 {
                 next = s;
@@ -396,6 +485,24 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         }
         self.w_cached = Some(w_next);
         Ok((next, w_cur, w_next))
+    }
+
+    /// The events the step `cur` → `next` triggered (`triggered`), told apart: none, a scuff
+    /// that need not be located, or the earliest located event (if any applies).
+    fn located(
+        &mut self,
+        triggered: &[Watch],
+        w_cur: &WitnessValues,
+        w_next: &WitnessValues,
+        next: &E::State,
+    ) -> Result<Located<E::State>, StrideFailure> {
+        if triggered.is_empty() {
+            return Ok(Located::None);
+        }
+        if self.scuff_need_not_be_located(triggered, w_cur, w_next) {
+            return Ok(Located::IgnoredScuff);
+        }
+        Ok(Located::Earliest(self.earliest(triggered, next)?))
     }
 
     /// The step triggered only the swing foot's crossing, which the walker ignores as a
@@ -412,7 +519,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         triggered == [Watch::Heel]
             && hs.ignore_scuffing
             && self.power.undamped()
-            && self.phase.prescribed.is_none()
+            && self.engine.prescribed().is_none()
             && self.control.is_none()
             && w_cur.scuff_anywhere_in_step(w_next, hs.min_ahead_m)
     }
@@ -428,19 +535,19 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     }
 
     /// A step without events: accepted.
-    fn accept(&mut self, next: Sample, drive_end_s: f64) -> Result<(), StrideFailure> {
+    fn accept(&mut self, next: E::State, drive_end_s: f64) -> Result<(), StrideFailure> {
         self.power.accumulate(&self.cur, &next);
         if self.options.contact {
-            self.contact
-                .add(self.walker, &mut self.phase, &mut self.wit, &next)
+            self.engine
+                .add_contact(&mut self.contact, self.walker, &mut self.wit, &next)
                 .map_err(|e| {
-                    StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
+                    StrideFailure::new(FailureKind::NonFiniteState, next.t_s(), e.to_string())
                 })?;
         }
-        self.schedule.stepped(next.t_s - self.cur.t_s);
-        if next.t_s >= drive_end_s - 1e-12 {
+        self.schedule.stepped(next.t_s() - self.cur.t_s());
+        if next.t_s() >= drive_end_s - 1e-12 {
             // A new smooth phase: the schedule and the integrator's memory restart.
-            self.integrator.system_changed();
+            self.engine.system_changed();
             self.schedule.next_phase();
         }
         self.record(next);
@@ -448,44 +555,57 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     }
 
     /// A step whose only event was an ignored scuff: accepted (its damping from the scuff on).
-    fn accept_ignored(&mut self, at: &Sample, next: Sample) {
+    fn accept_ignored(&mut self, at: &E::State, next: E::State) {
         self.power.accumulate(at, &next);
-        self.schedule.stepped(next.t_s - self.cur.t_s);
+        self.schedule.stepped(next.t_s() - self.cur.t_s());
         self.record(next);
     }
 
-    /// `s` becomes the current sample (and is recorded when asked).
-    fn record(&mut self, s: Sample) {
+    /// `s` becomes the current state (and is recorded when asked).
+    fn record(&mut self, s: E::State) {
         self.cur = s;
         if self.options.record {
-            self.trajectory.push(self.cur.clone());
+            self.trajectory.push(self.cur.to_sample());
         }
     }
 
     /// Locates each triggered event on the step `cur` → `next` and takes the earliest. A
     /// mid-swing scuff that is ignored must not hide a later event of the same step (a knee
-    /// lock, the string's engagement): that one is taken instead.
+    /// lock, the string's engagement): that one is taken instead. (An engine that hands
+    /// several events back leaves them to the reference.)
     fn earliest(
         &mut self,
         triggered: &[Watch],
-        next: &Sample,
-    ) -> Result<Option<(Watch, Sample)>, StrideFailure> {
-        let limit = self.string_limit();
-        let mut located: Vec<(Watch, Sample)> = Vec::new();
-        for &watch in triggered {
-            let wit = &mut self.wit;
-            let s = locate(
-                self.integrator.as_mut(),
-                &mut self.phase,
-                &self.cur,
-                next,
-                &mut |s: &Sample| wit.value(watch, limit, s),
-                &self.settings.event_tolerance,
-            )
-            .map_err(|e| StrideFailure::from_event(e, self.cur.t_s))?;
-            located.push((watch, s));
+        next: &E::State,
+    ) -> Result<Option<(Watch, E::State)>, StrideFailure> {
+        if E::HANDS_BACK && triggered.len() > 1 {
+            return Err(StrideFailure::new(
+                FailureKind::EventNotLocated,
+                self.cur.t_s(),
+                "several events in one step: handed back to the reference engine",
+            ));
         }
-        located.sort_by(|a, b| a.1.t_s.total_cmp(&b.1.t_s));
+        let limit = self.string_limit();
+        let locate = |run: &mut Self, watch: Watch| {
+            let (walker, wit) = (run.walker, &mut run.wit);
+            run.engine
+                .locate(
+                    &run.cur,
+                    next,
+                    |s: &E::State| witnesses::value(walker, wit, watch, limit, s),
+                    &run.settings.event_tolerance,
+                )
+                .map_err(|e| StrideFailure::from_event(e, run.cur.t_s()))
+        };
+        if let [watch] = triggered {
+            // One event: located, nothing to compare it with.
+            return Ok(Some((*watch, locate(self, *watch)?)));
+        }
+        let mut located: Vec<(Watch, E::State)> = Vec::new();
+        for &watch in triggered {
+            located.push((watch, locate(self, watch)?));
+        }
+        located.sort_by(|a, b| a.1.t_s().total_cmp(&b.1.t_s()));
         let hs = &self.walker.heel_strike;
         if located.len() > 1
             && located[0].0 == Watch::Heel
@@ -498,9 +618,9 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     }
 
     /// Applies the event `watch` located at `at`.
-    fn apply(&mut self, watch: Watch, at: &Sample) -> Result<Applied, StrideFailure> {
+    fn apply(&mut self, watch: Watch, at: &E::State) -> Result<Applied, StrideFailure> {
         let w = self.walker;
-        let fail = |kind, detail: &str| Err(StrideFailure::new(kind, at.t_s, detail));
+        let fail = |kind, detail: &str| Err(StrideFailure::new(kind, at.t_s(), detail));
         match watch {
             Watch::HipLow => {
                 let kind = if self.wit.eval(at).hip_ahead_m >= 0.0 {
@@ -515,7 +635,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 "hip moved back behind the stance contact",
             ),
             Watch::HeelDrop => {
-                if self.phase.prescribed.is_some() {
+                if self.engine.prescribed().is_some() {
                     // The drive still holds the ankle: the push has failed.
                     return fail(
                         FailureKind::HeelReturnedToFloor,
@@ -528,9 +648,14 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                     return Ok(Applied::Skipped);
                 };
                 let toe = r.toe_pitch.0;
-                let l = w.lock_coordinate(&self.phase, at, toe, 0.0)?;
-                self.phase.active[toe] = false;
-                self.cur = l.after;
+                let l = w.lock_coordinate(
+                    (self.engine.active(), self.engine.prescribed()),
+                    &at.to_sample(),
+                    toe,
+                    0.0,
+                )?;
+                self.engine.set_active(toe, false);
+                self.cur = self.state_after_impact(l.after, "heel_down")?;
                 self.energy_loss_j += l.loss_j;
                 Ok(Applied::Impact("heel_down".into()))
             }
@@ -541,27 +666,34 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 // The string's far end: fixed (ideal reflex) or moving with the actuator.
                 let drive = match (&self.control, self.segment) {
                     (Some(_), Some(seg)) => Drive::Segment(seg),
-                    _ => Drive::Profile(r.extension_from(at.t_s)),
+                    _ => Drive::Profile(r.extension_from(at.t_s())),
                 };
-                let e = w.engage_string(&self.phase, at, r, &drive)?;
+                let e = w.engage_string(self.engine.active(), &at.to_sample(), r, &drive)?;
                 self.power.work_j += e.drive_work_j;
                 self.energy_loss_j += e.drive_work_j;
-                self.cur = e.after;
+                self.cur = self.state_after_impact(e.after, "string_engaged")?;
                 self.energy_loss_j += e.dissipated_j;
-                self.phase.active = e.active;
-                self.phase.prescribed = Some((r.ankle, drive));
+                for (c, &free) in e.active.iter().enumerate() {
+                    self.engine.set_active(c, free);
+                }
+                self.engine.set_prescribed(Some((r.ankle, drive)));
                 self.power.open(&w.model, &self.cur);
                 Ok(Applied::Impact("string_engaged".into()))
             }
             Watch::Knee(k) => {
                 let c = w.knees[k].coordinate.0;
                 self.power.close(&w.model, at);
-                let l = w.lock_coordinate(&self.phase, at, c, w.knees[k].stop_rad)?;
-                self.phase.active[c] = false;
-                self.cur = l.after;
+                let l = w.lock_coordinate(
+                    (self.engine.active(), self.engine.prescribed()),
+                    &at.to_sample(),
+                    c,
+                    w.knees[k].stop_rad,
+                )?;
+                self.engine.set_active(c, false);
+                self.cur = self.state_after_impact(l.after, "knee lock")?;
                 self.power.work_j += l.drive_work_j;
                 self.energy_loss_j += l.loss_j;
-                if self.phase.prescribed.is_some() {
+                if self.engine.prescribed().is_some() {
                     self.power.open(&w.model, &self.cur);
                 }
                 Ok(Applied::Impact(format!(
@@ -573,9 +705,21 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         }
     }
 
+    /// The state after an impact named `what`, in the engine's storage.
+    fn state_after_impact(&self, after: Sample, what: &str) -> Result<E::State, StrideFailure> {
+        let t_s = after.t_s;
+        E::State::from_sample(after).ok_or_else(|| {
+            StrideFailure::new(
+                FailureKind::NonFiniteState,
+                t_s,
+                format!("state after the {what}"),
+            )
+        })
+    }
+
     /// The swing foot reached the floor at `at`: a scuff (ignored or a failure), or heel strike,
     /// which ends the stride.
-    fn heel_strike(&mut self, at: &Sample) -> Result<Applied, StrideFailure> {
+    fn heel_strike(&mut self, at: &E::State) -> Result<Applied, StrideFailure> {
         let w = self.walker;
         let ahead = self.wit.eval(at).foot_ahead_m;
         if ahead < w.heel_strike.min_ahead_m {
@@ -584,14 +728,18 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             }
             return Err(StrideFailure::new(
                 FailureKind::Scuffed,
-                at.t_s,
+                at.t_s(),
                 format!("swing foot touched the floor {ahead:.4} m ahead of the stance contact"),
             ));
         }
-        if let Some(knee) = w.knees.iter().find(|k| self.phase.active[k.coordinate.0]) {
+        if let Some(knee) = w
+            .knees
+            .iter()
+            .find(|k| self.engine.active()[k.coordinate.0])
+        {
             return Err(StrideFailure::new(
                 FailureKind::HeelStrikeBeforeKneeLock,
-                at.t_s,
+                at.t_s(),
                 format!(
                     "knee `{}` still free at heel strike",
                     w.model.coordinates[knee.coordinate.0].name
@@ -600,19 +748,22 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         }
         self.power.close(&w.model, at);
         if let Some(c) = self.control.as_mut() {
-            c.controller.heel_strike(c.t_walk_start_s + at.t_s);
+            c.controller.heel_strike(c.t_walk_start_s + at.t_s());
         }
         self.events.push(StrideEvent {
             name: "heel_strike".into(),
-            t_stride_s: at.t_s,
+            t_stride_s: at.t_s(),
         });
-        self.event_states.push((at.clone(), at.clone()));
+        let at_s = at.to_sample();
+        self.event_states.push((at_s.clone(), at_s.clone()));
         if self.options.record {
-            self.trajectory.push(at.clone());
+            self.trajectory.push(at_s.clone());
         }
-        self.evaluations += self.integrator.evaluations();
+        self.evaluations += self.engine.evaluations();
         let events = std::mem::take(&mut self.events);
-        let mut r = w.finish_stride(at.clone(), &self.phase.active, events, self.energy_loss_j)?;
+        let mut r = self
+            .engine
+            .finish(w, (at, at_s), events, self.energy_loss_j)?;
         r.actuator_work_j = self.power.work_j;
         r.event_states = std::mem::take(&mut self.event_states);
         r.evaluations = self.evaluations;
@@ -623,18 +774,19 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
 
     /// After an impact at `at` (the state after it already in `cur`): the event is written
     /// down, and the integrator and the step schedule start a new phase.
-    fn after_impact(&mut self, name: String, at: Sample) {
+    fn after_impact(&mut self, name: String, at: E::State) {
         self.events.push(StrideEvent {
             name,
-            t_stride_s: at.t_s,
+            t_stride_s: at.t_s(),
         });
-        self.event_states.push((at, self.cur.clone()));
+        self.event_states
+            .push((at.to_sample(), self.cur.to_sample()));
         // The integrator restarts after an impact; its evaluations so far are kept.
-        self.evaluations += self.integrator.evaluations();
-        self.integrator.reset();
+        self.evaluations += self.engine.evaluations();
+        self.engine.reset();
         self.schedule.next_phase();
         if self.options.record {
-            self.trajectory.push(self.cur.clone());
+            self.trajectory.push(self.cur.to_sample());
         }
     }
 }

@@ -2,10 +2,10 @@
 //! and how long it may last. Apart from the walker (the physics), so that the same walker can be
 //! run with other settings without being changed.
 
+use super::EvaluationPath;
 use crate::control::TickStepping;
 use crate::events::EventTolerance;
 use crate::integrators::{IntegratorChoice, IntegratorError};
-use crate::planar::EvaluationPath;
 use serde::Serialize;
 
 /// Solver settings of a stride (after rapier's `IntegrationParameters`: each field with its unit

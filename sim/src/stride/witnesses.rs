@@ -6,7 +6,7 @@
 //! their direction over a step, in a fixed order (heel, knees, hip low, hip back, string
 //! engagement, heel drop) that breaks ties between events located at the same time.
 
-use super::phase::Phase;
+use super::engine::{StrideState, WitnessEvaluator};
 use crate::control::ActuatorSegment;
 use crate::events::Direction;
 use crate::hermite::{self, Knot};
@@ -170,71 +170,79 @@ impl<'a> Witnesses<'a> {
             Vector3::x()
         }
     }
+}
 
-    /// The witness of `watch` at `s` (its zero is the event), with the string's `limit`.
-    pub(super) fn value(&mut self, watch: Watch, limit: StringLimit, s: &Sample) -> f64 {
-        let w = self.walker;
-        match watch {
-            Watch::Heel => self.eval(s).foot_height_m,
-            Watch::Knee(k) => s.q[w.knees[k].coordinate.0] - w.knees[k].stop_rad,
-            Watch::HipLow => self.eval(s).hip_height_margin_m,
-            Watch::HipBack => self.eval(s).hip_forward_velocity_m_s,
-            Watch::Engage => {
-                let a = w.ankle.as_ref().map_or(0, |r| r.ankle.0);
-                s.q[a] - limit.at(s.t_s).unwrap_or(0.0)
-            }
-            Watch::HeelDrop => s.q[w.ankle.as_ref().map_or(0, |r| r.toe_pitch.0)],
+/// The witness of `watch` at `s` (its zero is the event), with the string's `limit`, on any
+/// state storage.
+pub(super) fn value<S: StrideState>(
+    walker: &Walker,
+    wit: &mut impl WitnessEvaluator<S>,
+    watch: Watch,
+    limit: StringLimit,
+    s: &S,
+) -> f64 {
+    let w = walker;
+    match watch {
+        Watch::Heel => wit.eval(s).foot_height_m,
+        Watch::Knee(k) => s.q(w.knees[k].coordinate.0) - w.knees[k].stop_rad,
+        Watch::HipLow => wit.eval(s).hip_height_margin_m,
+        Watch::HipBack => wit.eval(s).hip_forward_velocity_m_s,
+        Watch::Engage => {
+            let a = w.ankle.as_ref().map_or(0, |r| r.ankle.0);
+            s.q(a) - limit.at(s.t_s()).unwrap_or(0.0)
+        }
+        Watch::HeelDrop => s.q(w.ankle.as_ref().map_or(0, |r| r.toe_pitch.0)),
+    }
+}
+
+/// The watches whose witnesses changed sign in their direction over the step `cur` → `next`
+/// (witness values `w_cur`, `w_next`), into `triggered`, in tie-breaking order; `active` the free
+/// coordinates, `driven` whether a coordinate is driven.
+pub(super) fn triggered<S: StrideState>(
+    triggered: &mut Vec<Watch>,
+    walker: &Walker,
+    (active, driven): (&[bool], bool),
+    limit: StringLimit,
+    (cur, w_cur): (&S, &WitnessValues),
+    (next, w_next): (&S, &WitnessValues),
+) {
+    let w = walker;
+    triggered.clear();
+    if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
+        triggered.push(Watch::Heel);
+    }
+    for (k, knee) in w.knees.iter().enumerate() {
+        let c = knee.coordinate.0;
+        if active[c]
+            && knee
+                .closing
+                .triggered(cur.q(c) - knee.stop_rad, next.q(c) - knee.stop_rad)
+        {
+            triggered.push(Watch::Knee(k));
         }
     }
-
-    /// The watches whose witnesses changed sign in their direction over the step `cur` →
-    /// `next` (witness values `w_cur`, `w_next`), in tie-breaking order.
-    pub(super) fn triggered(
-        &self,
-        phase: &Phase,
-        limit: StringLimit,
-        (cur, w_cur): (&Sample, &WitnessValues),
-        (next, w_next): (&Sample, &WitnessValues),
-    ) -> Vec<Watch> {
-        let w = self.walker;
-        let mut triggered: Vec<Watch> = Vec::new();
-        if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
-            triggered.push(Watch::Heel);
-        }
-        for (k, knee) in w.knees.iter().enumerate() {
-            let c = knee.coordinate.0;
-            if phase.active[c]
-                && knee
-                    .closing
-                    .triggered(cur.q[c] - knee.stop_rad, next.q[c] - knee.stop_rad)
-            {
-                triggered.push(Watch::Knee(k));
+    if Direction::Falling.triggered(w_cur.hip_height_margin_m, w_next.hip_height_margin_m) {
+        triggered.push(Watch::HipLow);
+    }
+    if w_next.hip_ahead_m < 0.0
+        && Direction::Falling.triggered(
+            w_cur.hip_forward_velocity_m_s,
+            w_next.hip_forward_velocity_m_s,
+        )
+    {
+        triggered.push(Watch::HipBack);
+    }
+    if let Some(r) = &w.ankle {
+        let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+        let flat = !active[toe] && !driven;
+        if let (true, Some(l0), Some(l1)) = (flat, limit.at(cur.t_s()), limit.at(next.t_s())) {
+            if Direction::Falling.triggered(cur.q(a) - l0, next.q(a) - l1) {
+                triggered.push(Watch::Engage);
             }
         }
-        if Direction::Falling.triggered(w_cur.hip_height_margin_m, w_next.hip_height_margin_m) {
-            triggered.push(Watch::HipLow);
+        if active[toe] && Direction::Rising.triggered(cur.q(toe), next.q(toe)) {
+            triggered.push(Watch::HeelDrop);
         }
-        if w_next.hip_ahead_m < 0.0
-            && Direction::Falling.triggered(
-                w_cur.hip_forward_velocity_m_s,
-                w_next.hip_forward_velocity_m_s,
-            )
-        {
-            triggered.push(Watch::HipBack);
-        }
-        if let Some(r) = &w.ankle {
-            let (a, toe) = (r.ankle.0, r.toe_pitch.0);
-            let flat = !phase.active[toe] && phase.prescribed.is_none();
-            if let (true, Some(l0), Some(l1)) = (flat, limit.at(cur.t_s), limit.at(next.t_s)) {
-                if Direction::Falling.triggered(cur.q[a] - l0, next.q[a] - l1) {
-                    triggered.push(Watch::Engage);
-                }
-            }
-            if phase.active[toe] && Direction::Rising.triggered(cur.q[toe], next.q[toe]) {
-                triggered.push(Watch::HeelDrop);
-            }
-        }
-        triggered
     }
 }
 

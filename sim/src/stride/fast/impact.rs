@@ -6,11 +6,11 @@
 //! elimination may differ from nalgebra's in the last bits (`tests/fast_stride.rs` compares
 //! the strides with the general loop's, whose heel strike is the general one).
 
-use crate::planar::MAX_COORDINATES;
+use crate::planar::MAX_PLANAR_COORDINATES;
 
 /// The impact model's largest number of velocities: the coordinates and the root's
 /// translation in x and y.
-pub(super) const MAX_VELOCITIES: usize = MAX_COORDINATES + 2;
+pub(super) const MAX_VELOCITIES: usize = MAX_PLANAR_COORDINATES + 2;
 /// The largest number of constraint rows (the contact's x and y).
 pub(super) const MAX_ROWS: usize = 2;
 /// The largest system: free velocities and impulses.

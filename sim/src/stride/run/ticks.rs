@@ -18,10 +18,10 @@
 use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
 use crate::hermite::{self, Knot};
-use crate::integrators::{DenseOutput, Sample};
-use crate::stride::phase::{Drive, Phase};
+use crate::stride::engine::{Engine, Interpolant, StrideState, WitnessEvaluator};
+use crate::stride::phase::Drive;
 use crate::stride::result::{FailureKind, StrideEvent, StrideFailure};
-use crate::stride::witnesses::{WitnessValues, Witnesses};
+use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
 
 /// A tick's time is reached when a sample is within this of it [s].
@@ -137,31 +137,31 @@ fn continue_at_tick(
 /// What the stance ankle's sensors see at `s` (stride time; `t_walk_start_s` the walk time
 /// at the start of the stride). `swing_foot_on_floor`: when already known (the witnesses of
 /// this sample, or a foot clear of the floor), else from the kinematics.
-fn sense(
+fn sense<E: Engine>(
     walker: &Walker,
-    wit: &mut Witnesses<'_>,
-    phase: &mut Phase<'_>,
+    wit: &mut E::Witness,
+    engine: &mut E,
     t_walk_start_s: f64,
-    s: &Sample,
+    s: &E::State,
     swing_foot_on_floor: Option<bool>,
 ) -> Result<AnkleSensing, StrideFailure> {
     let swing_foot_on_floor =
         swing_foot_on_floor.unwrap_or_else(|| wit.eval(s).foot_height_m <= ON_FLOOR_M);
     let (a, engaged) = match &walker.ankle {
-        Some(r) => (r.ankle.0, phase.prescribed.is_some()),
+        Some(r) => (r.ankle.0, engine.prescribed().is_some()),
         None => (0, false),
     };
     Ok(AnkleSensing {
-        t_walk_s: t_walk_start_s + s.t_s,
-        stance_ankle_rad: s.q[a],
-        stance_ankle_rate_rad_s: s.qd[a],
+        t_walk_s: t_walk_start_s + s.t_s(),
+        stance_ankle_rad: s.q(a),
+        stance_ankle_rate_rad_s: s.qd(a),
         stance_foot_on_floor: true,
         swing_foot_on_floor,
         string_engaged: engaged,
         string_torque_n_m: if engaged {
-            phase
+            engine
                 .actuator_torque(s)
-                .map_err(|e| tick_failure(s.t_s, e.to_string()))?
+                .map_err(|e| tick_failure(s.t_s(), e.to_string()))?
                 .0
         } else {
             0.0
@@ -169,21 +169,18 @@ fn sense(
     })
 }
 
-impl Run<'_, '_, '_> {
-    /// Whether this stride steps across ticks at all: a controller, `HeldAcrossTicks`, the
-    /// integrator's own steps (no schedule) and an integrator with an interpolant.
-    pub(super) fn held_stepping(
-        tick_stepping: TickStepping,
-        free_schedule: bool,
-        interpolates: bool,
-        controlled: bool,
-    ) -> bool {
-        tick_stepping == TickStepping::HeldAcrossTicks
-            && free_schedule
-            && interpolates
-            && controlled
-    }
+/// Whether a stride steps across ticks at all: a controller, `HeldAcrossTicks`, the
+/// integrator's own steps (no schedule) and an integrator with an interpolant.
+pub(super) fn held_stepping(
+    tick_stepping: TickStepping,
+    free_schedule: bool,
+    interpolates: bool,
+    controlled: bool,
+) -> bool {
+    tick_stepping == TickStepping::HeldAcrossTicks && free_schedule && interpolates && controlled
+}
 
+impl<E: Engine> Run<'_, '_, '_, E> {
     /// The next step may run across the next tick: held stepping, no tick output waiting to
     /// take effect, and a limit in force that does not move.
     pub(super) fn held_ahead(&self) -> bool {
@@ -202,7 +199,7 @@ impl Run<'_, '_, '_> {
         }
         Err(StrideFailure::new(
             FailureKind::StepBudgetExceeded,
-            self.cur.t_s,
+            self.cur.t_s(),
             format!(
                 "no heel strike within the step budget max_steps = {} of control ticks \
                  (period {} s)",
@@ -215,7 +212,7 @@ impl Run<'_, '_, '_> {
     /// step has no interpolant to run it on.
     pub(super) fn tick_inside_without_interpolant(
         &self,
-        dense: Option<&DenseOutput>,
+        dense: Option<&E::Interpolant>,
         end_s: f64,
     ) -> bool {
         self.control.is_some() && dense.is_none() && self.next_tick_s < end_s - TICK_SLACK_S
@@ -237,14 +234,14 @@ impl Run<'_, '_, '_> {
         let Some(control) = self.control.as_ref() else {
             return Ok(());
         };
-        if self.cur.t_s < self.next_tick_s - TICK_SLACK_S {
+        if self.cur.t_s() < self.next_tick_s - TICK_SLACK_S {
             return Ok(());
         }
-        if self.cur.t_s > self.next_tick_s + TICK_SLACK_S {
+        if self.cur.t_s() > self.next_tick_s + TICK_SLACK_S {
             // Each step ends at or before the next tick, or runs its ticks on its interpolant:
             // a stride past a tick that did not run is a defect, not a result.
             return Err(tick_failure(
-                self.cur.t_s,
+                self.cur.t_s(),
                 format!(
                     "the control tick at stride time {} s was passed without running",
                     self.next_tick_s
@@ -259,10 +256,10 @@ impl Run<'_, '_, '_> {
                 // impact since changes the velocities, not the foot's height).
                 let on_floor = self
                     .w_cached
-                    .filter(|w| w.t_s == self.cur.t_s)
+                    .filter(|w| w.t_s == self.cur.t_s())
                     .map(|w| w.foot_height_m <= ON_FLOOR_M);
-                let (wit, phase) = (&mut self.wit, &mut self.phase);
-                let sensing = sense(self.walker, wit, phase, t0, &self.cur, on_floor)?;
+                let (wit, engine) = (&mut self.wit, &mut self.engine);
+                let sensing = sense(self.walker, wit, engine, t0, &self.cur, on_floor)?;
                 self.tick_controller(&sensing)?
             }
         };
@@ -294,32 +291,33 @@ impl Run<'_, '_, '_> {
 
     /// The tick's segment takes effect at `cur`.
     fn apply_segment(&mut self, mut seg: ActuatorSegment) {
-        let (cur, phase) = (&mut self.cur, &mut self.phase);
-        if let Some((coord, Drive::Segment(_))) = phase.prescribed {
+        let (cur, engine) = (&mut self.cur, &mut self.engine);
+        if let Some((coord, Drive::Segment(_))) = engine.prescribed() {
             if seg.released {
                 // The string goes slack during the push (an emergency stop, a fault): no
                 // impulse, the ankle is free again, and the foot keeps pivoting about its toe
                 // until the heel comes back down or the stride ends.
                 self.power.close(&self.walker.model, cur);
-                phase.prescribed = None;
-                phase.active[coord.0] = true;
-                self.integrator.system_changed();
+                engine.set_prescribed(None);
+                engine.set_active(coord.0, true);
+                engine.system_changed();
                 self.events.push(StrideEvent {
                     name: "string_released".into(),
-                    t_stride_s: cur.t_s,
+                    t_stride_s: cur.t_s(),
                 });
-                self.event_states.push((cur.clone(), cur.clone()));
+                let at = cur.to_sample();
+                self.event_states.push((at.clone(), at));
             } else {
-                seg = continue_at_tick(self.segment.as_ref(), seg, cur.t_s);
-                phase.prescribed = Some((coord, Drive::Segment(seg)));
-                phase.snap(cur);
+                seg = continue_at_tick(self.segment.as_ref(), seg, cur.t_s());
+                engine.set_prescribed(Some((coord, Drive::Segment(seg))));
+                engine.snap(cur);
             }
         }
         // Only an engaged string's new segment changes the vector field; while the ankle is
         // free the tick only moves the engagement witness, and the integrator keeps its last
         // stage (first same as last).
-        if phase.prescribed.is_some() {
-            self.integrator.system_changed();
+        if engine.prescribed().is_some() {
+            engine.system_changed();
         }
         self.segment = Some(seg);
         self.end_at_next_tick = false;
@@ -330,16 +328,16 @@ impl Run<'_, '_, '_> {
     /// event location takes other steps).
     pub(super) fn held_interpolant(
         &mut self,
-        next: &Sample,
-    ) -> Result<Option<DenseOutput>, StrideFailure> {
-        if !self.held_ahead() || self.next_tick_s >= next.t_s - TICK_SLACK_S {
+        next: &E::State,
+    ) -> Result<Option<E::Interpolant>, StrideFailure> {
+        if !self.held_ahead() || self.next_tick_s >= next.t_s() - TICK_SLACK_S {
             return Ok(None);
         }
         let cur = &self.cur;
-        self.integrator
-            .interpolant(&mut self.phase, cur, next)
+        self.engine
+            .interpolant(cur, next)
             .transpose()
-            .map_err(|e| StrideFailure::from_integration(e, cur.t_s))
+            .map_err(|e| StrideFailure::from_integration(e, cur.t_s()))
     }
 
     /// Runs the ticks strictly before `end_s` on the step's interpolant, in order. While their
@@ -354,10 +352,10 @@ impl Run<'_, '_, '_> {
     /// failures.
     pub(super) fn held_ticks(
         &mut self,
-        dense: Option<&DenseOutput>,
+        dense: Option<&E::Interpolant>,
         ends: (&WitnessValues, &WitnessValues),
         end_s: f64,
-    ) -> Result<Option<Sample>, StrideFailure> {
+    ) -> Result<Option<E::State>, StrideFailure> {
         let Some(control) = self.control.as_ref() else {
             return Ok(None);
         };
@@ -367,7 +365,7 @@ impl Run<'_, '_, '_> {
         }
         let Some(dense) = dense else {
             return Err(tick_failure(
-                self.cur.t_s,
+                self.cur.t_s(),
                 format!(
                     "the control tick at stride time {} s lies inside a step without an \
                      interpolant",
@@ -378,9 +376,9 @@ impl Run<'_, '_, '_> {
         while self.next_tick_s < end_s - TICK_SLACK_S {
             self.check_tick_budget()?;
             let mut s = dense.eval(self.next_tick_s);
-            self.phase.snap(&mut s);
-            let clear = clear_of_floor(ends.0, ends.1, s.t_s).then_some(false);
-            let sensing = sense(self.walker, &mut self.wit, &mut self.phase, t0, &s, clear)?;
+            self.engine.snap(&mut s);
+            let clear = clear_of_floor(ends.0, ends.1, s.t_s()).then_some(false);
+            let sensing = sense(self.walker, &mut self.wit, &mut self.engine, t0, &s, clear)?;
             let seg = self.tick_controller(&sensing)?;
             match self.segment {
                 Some(held) if held.same_held_input(&seg) => {

@@ -1,4 +1,4 @@
-//! The stride's witnesses on the planar kinematics: the same [`WitnessValues`] as the general
+//! The witness evaluator of the fixed-size engine, on the planar kinematics: the same [`WitnessValues`] as the general
 //! loop's `Witnesses::eval` (swing-foot height, its rate and how far ahead, the hip's height
 //! margin, how far ahead and its forward velocity), from the planar tree's joints alone.
 //!
@@ -10,7 +10,8 @@
 //! products per arm, instead of every link's frame.
 
 use super::dop853::State;
-use crate::planar::{sin_cos, Joints, PlanarTree, MAX_COORDINATES};
+use crate::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::stride::engine::WitnessEvaluator;
 use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
 use nalgebra::SVector;
@@ -21,16 +22,17 @@ use nalgebra::SVector;
 #[derive(Clone, Copy, Debug)]
 struct Arms {
     base_m: [f64; 2],
-    arms: [(usize, [f64; 2]); MAX_COORDINATES],
+    arms: [(usize, [f64; 2]); MAX_PLANAR_COORDINATES],
     len: usize,
     link_joint: Option<usize>,
 }
 
 /// The angle's cos and sin and the angular rate of each joint's link.
-type JointFrames = [(f64, f64, f64); MAX_COORDINATES];
+type JointFrames = [(f64, f64, f64); MAX_PLANAR_COORDINATES];
 
 impl Arms {
     /// Position and velocity (floor frame, x and y) at the joints' frames.
+    #[inline]
     fn point(&self, jf: &JointFrames) -> ([f64; 2], [f64; 2]) {
         let (mut p, mut v) = (self.base_m, [0.0; 2]);
         for &(j, [x, y]) in &self.arms[..self.len] {
@@ -62,7 +64,7 @@ impl PlanarWitnesses {
     pub(super) fn new<const N: usize>(walker: &Walker, tree: &PlanarTree) -> Option<Self> {
         let fr = tree.frames(&SVector::<f64, N>::zeros(), &SVector::zeros());
         let joints = Joints::of(tree)?;
-        let mut origin = [[0.0; 2]; MAX_COORDINATES];
+        let mut origin = [[0.0; 2]; MAX_PLANAR_COORDINATES];
         for (o, j) in origin.iter_mut().zip(joints.all()) {
             *o = fr.get(j.link + 1)?.origin_m;
         }
@@ -75,7 +77,7 @@ impl PlanarWitnesses {
             let link_joint = joints.owner(link);
             let mut arms = Arms {
                 base_m: at,
-                arms: [(0, [0.0; 2]); MAX_COORDINATES],
+                arms: [(0, [0.0; 2]); MAX_PLANAR_COORDINATES],
                 len: 0,
                 link_joint,
             };
@@ -102,12 +104,13 @@ impl PlanarWitnesses {
     }
 
     /// Every joint's link angle (cos, sin) and rate at `q`, `q̇`, parents first.
+    #[inline]
     fn joint_frames<const N: usize>(
         &self,
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
     ) -> JointFrames {
-        let mut jf = [(1.0, 0.0, 0.0); MAX_COORDINATES];
+        let mut jf = [(1.0, 0.0, 0.0); MAX_PLANAR_COORDINATES];
         for (j, joint) in self.joints.all().iter().enumerate() {
             let (s, co) = sin_cos(joint.sign * q[joint.coordinate]);
             let rate = joint.sign * qd[joint.coordinate];
@@ -123,6 +126,7 @@ impl PlanarWitnesses {
     }
 
     /// Every witness at `s`.
+    #[inline]
     pub(super) fn eval<const N: usize>(&self, s: &State<N>) -> WitnessValues {
         let jf = self.joint_frames(&s.q, &s.qd);
         let (p_foot, v_foot) = self.foot.point(&jf);
@@ -142,5 +146,12 @@ impl PlanarWitnesses {
             hip_ahead_m: (p_hip[0] - p_contact[0]) * heading_x,
             hip_forward_velocity_m_s: v_hip[0] * heading_x,
         }
+    }
+}
+
+impl<const N: usize> WitnessEvaluator<State<N>> for PlanarWitnesses {
+    #[inline]
+    fn eval(&mut self, s: &State<N>) -> WitnessValues {
+        PlanarWitnesses::eval(self, s)
     }
 }
