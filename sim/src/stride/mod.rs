@@ -17,7 +17,8 @@
 //! - `run`: the loop ([`Walker::stride`]);
 //! - `fast`: the same loop on fixed-size states for the planar walkers it covers (selected
 //!   automatically, the general loop its reference and fallback);
-//! - `result`: [`StrideResult`], [`StrideFailure`], [`FailureKind`], [`StrideEvent`].
+//! - `result`: [`StrideResult`], [`StrideEvent`];
+//! - `failure`: [`StrideFailure`], its [`FailureKind`] and [`FailureCause`] (with the values).
 //!
 //! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
 //! model-level methods; walks are [`crate::walk::walk`], gait searches
@@ -28,6 +29,7 @@
 
 mod contact_figures;
 mod energy;
+mod failure;
 mod fast;
 mod impacts;
 mod phase;
@@ -39,9 +41,10 @@ mod settings;
 mod witnesses;
 
 pub use contact_figures::ContactSummary;
+pub use failure::{FailureCause, FailureKind, StrideFailure};
 pub use impacts::HeelStrikeImpact;
 pub use phase::{linearised_limit, Drive, Phase};
 pub use request::{StrideControl, StrideOptions, StrideRequest};
-pub use result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+pub use result::{StrideEvent, StrideResult};
 pub use schedule::{Schedule, StepSchedule};
 pub use settings::StrideSettings;

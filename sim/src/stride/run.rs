@@ -8,10 +8,11 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
+use super::failure::{FailureCause, StrideFailure};
 use super::fast::Outcome;
 use super::phase::{Drive, Phase};
 use super::request::{StrideControl, StrideOptions, StrideRequest};
-use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+use super::result::{StrideEvent, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::witnesses::{StringLimit, Watch, WitnessValues, Witnesses};
@@ -44,11 +45,7 @@ impl Walker {
             sink,
         } = request;
         if control.is_some() && self.ankle.is_none() {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                0.0,
-                "a controlled stride needs a scene with an ankle_reflex section",
-            ));
+            return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
         }
         let mut own = Vec::new();
         let keep_in_result = sink.is_none();
@@ -169,11 +166,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             phase.active[c.0] = false;
         }
         if cur.q.iter().chain(cur.qd.iter()).any(|v| !v.is_finite()) {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                0.0,
-                "initial state",
-            ));
+            return Err(StrideFailure::new(0.0, FailureCause::NonFiniteInitialState));
         }
         if options.record {
             trajectory.push(cur.clone());
@@ -227,12 +220,10 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
             self.control_tick()?;
             if self.cur.t_s > self.settings.max_stride_time_s {
                 return Err(StrideFailure::new(
-                    FailureKind::NoImpactWithinTime,
                     self.cur.t_s,
-                    format!(
-                        "no heel strike within {} s",
-                        self.settings.max_stride_time_s
-                    ),
+                    FailureCause::TimeBudget {
+                        max_stride_time_s: self.settings.max_stride_time_s,
+                    },
                 ));
             }
             self.check_budgets()?;
@@ -308,23 +299,21 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         let evaluations = self.evaluations + self.integrator.evaluations();
         if self.steps >= self.settings.max_steps {
             return Err(StrideFailure::new(
-                FailureKind::StepBudgetExceeded,
                 self.cur.t_s,
-                format!(
-                    "no heel strike within the step budget max_steps = {} ({} evaluations)",
-                    self.settings.max_steps, evaluations
-                ),
+                FailureCause::StepBudget {
+                    max_steps: self.settings.max_steps,
+                    evaluations,
+                },
             ));
         }
         self.check_tick_budget()?;
         if evaluations >= self.settings.max_evaluations {
             return Err(StrideFailure::new(
-                FailureKind::EvaluationBudgetExceeded,
                 self.cur.t_s,
-                format!(
-                    "no heel strike within the evaluation budget max_evaluations = {} ({} steps)",
-                    self.settings.max_evaluations, self.steps
-                ),
+                FailureCause::EvaluationBudget {
+                    max_evaluations: self.settings.max_evaluations,
+                    steps: self.steps,
+                },
             ));
         }
         Ok(())
@@ -357,11 +346,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         .map_err(|e| StrideFailure::from_integration(e, cur.t_s))?;
         self.phase.snap(&mut next);
         if next.q.iter().chain(next.qd.iter()).any(|v| !v.is_finite()) {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                next.t_s,
-                "state",
-            ));
+            return Err(StrideFailure::new(next.t_s, FailureCause::NonFiniteState));
         }
         Ok(next)
     }
@@ -433,9 +418,7 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
         if self.options.contact {
             self.contact
                 .add(self.walker, &mut self.phase, &mut self.wit, &next)
-                .map_err(|e| {
-                    StrideFailure::new(FailureKind::NonFiniteState, next.t_s, e.to_string())
-                })?;
+                .map_err(|e| StrideFailure::new(next.t_s, e))?;
         }
         self.schedule.stepped(next.t_s - self.cur.t_s);
         if next.t_s >= drive_end_s - 1e-12 {
@@ -500,27 +483,16 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
     /// Applies the event `watch` located at `at`.
     fn apply(&mut self, watch: Watch, at: &Sample) -> Result<Applied, StrideFailure> {
         let w = self.walker;
-        let fail = |kind, detail: &str| Err(StrideFailure::new(kind, at.t_s, detail));
+        let fail = |cause| Err(StrideFailure::new(at.t_s, cause));
         match watch {
-            Watch::HipLow => {
-                let kind = if self.wit.eval(at).hip_ahead_m >= 0.0 {
-                    FailureKind::FellForward
-                } else {
-                    FailureKind::FellBackward
-                };
-                fail(kind, "hip below its minimum height")
-            }
-            Watch::HipBack => fail(
-                FailureKind::FellBackward,
-                "hip moved back behind the stance contact",
-            ),
+            Watch::HipLow => fail(FailureCause::HipTooLow {
+                hip_ahead_m: self.wit.eval(at).hip_ahead_m,
+            }),
+            Watch::HipBack => fail(FailureCause::HipBehindStance),
             Watch::HeelDrop => {
                 if self.phase.prescribed.is_some() {
                     // The drive still holds the ankle: the push has failed.
-                    return fail(
-                        FailureKind::HeelReturnedToFloor,
-                        "the stance heel came back down during push-off",
-                    );
+                    return fail(FailureCause::HeelReturnedToFloor);
                 }
                 // The string is slack: the heel lands, an inelastic impact that stops the
                 // foot's pitch about its toe; the foot is flat again, the ankle free.
@@ -583,19 +555,18 @@ impl<'w, 'r, 't> Run<'w, 'r, 't> {
                 return Ok(Applied::Ignored);
             }
             return Err(StrideFailure::new(
-                FailureKind::Scuffed,
                 at.t_s,
-                format!("swing foot touched the floor {ahead:.4} m ahead of the stance contact"),
+                FailureCause::Scuff {
+                    foot_ahead_m: ahead,
+                },
             ));
         }
         if let Some(knee) = w.knees.iter().find(|k| self.phase.active[k.coordinate.0]) {
             return Err(StrideFailure::new(
-                FailureKind::HeelStrikeBeforeKneeLock,
                 at.t_s,
-                format!(
-                    "knee `{}` still free at heel strike",
-                    w.model.coordinates[knee.coordinate.0].name
-                ),
+                FailureCause::KneeFreeAtHeelStrike {
+                    knee: w.model.coordinates[knee.coordinate.0].name.clone(),
+                },
             ));
         }
         self.power.close(&w.model, at);

@@ -434,9 +434,8 @@ impl<const N: usize> Run<'_, N> {
         let l = w.lock_coordinate(&phase, &at_s, c, stop)?;
         let Some(after) = state::<N>(l.after.t_s, &l.after.q, &l.after.qd) else {
             return Err(StrideFailure::new(
-                crate::stride::FailureKind::NonFiniteState,
                 at.t_s,
-                "state after the knee lock",
+                crate::stride::FailureCause::NonFiniteAfterKneeLock,
             ));
         };
         if let Some(a) = self.sys.active.get_mut(c) {
