@@ -163,6 +163,21 @@ pub enum FailureCause {
         /// Walk time at the start of the stride [s].
         t_walk_start_s: f64,
     },
+    /// The controller's period does not advance the next tick's time (inside a step).
+    #[error("the control period {period_s} s does not advance")]
+    ControlPeriodStalls {
+        /// The period [s].
+        period_s: f64,
+    },
+    /// A control tick lies inside a step that has no interpolant to run it on (a defect of
+    /// the stride loop, not a result).
+    #[error(
+        "the control tick at stride time {tick_s} s lies inside a step without an interpolant"
+    )]
+    TickInsideStep {
+        /// The tick's time [s, stride time].
+        tick_s: f64,
+    },
     /// A control tick was passed without running (a defect of the stride loop, not a result).
     #[error("the control tick at stride time {tick_s} s was passed without running")]
     TickPassed {
@@ -265,12 +280,13 @@ impl FailureCause {
             Self::Event(EventError::NotLocated { .. }) => FailureKind::EventNotLocated,
             Self::Impact(_) => FailureKind::ImpactSingular,
             Self::Relabel(_) => FailureKind::RelabelFailed,
-            Self::Control(_) | Self::TickPassed { .. } | Self::TickWithoutController => {
-                FailureKind::ControlFailed
-            }
-            Self::ControlPeriodNotPositive { .. } | Self::ControlPeriodTooShort { .. } => {
-                FailureKind::InvalidControlPeriod
-            }
+            Self::Control(_)
+            | Self::TickInsideStep { .. }
+            | Self::TickPassed { .. }
+            | Self::TickWithoutController => FailureKind::ControlFailed,
+            Self::ControlPeriodNotPositive { .. }
+            | Self::ControlPeriodTooShort { .. }
+            | Self::ControlPeriodStalls { .. } => FailureKind::InvalidControlPeriod,
             Self::TimeBudget { .. } => FailureKind::NoImpactWithinTime,
             Self::StepBudget { .. } | Self::TickBudget { .. } => FailureKind::StepBudgetExceeded,
             Self::EvaluationBudget { .. } => FailureKind::EvaluationBudgetExceeded,

@@ -359,13 +359,11 @@ impl Run<'_, '_, '_> {
             return Ok(None);
         }
         let Some(dense) = dense else {
-            return Err(tick_failure(
+            return Err(StrideFailure::new(
                 self.cur.t_s,
-                format!(
-                    "the control tick at stride time {} s lies inside a step without an \
-                     interpolant",
-                    self.next_tick_s
-                ),
+                FailureCause::TickInsideStep {
+                    tick_s: self.next_tick_s,
+                },
             ));
         };
         while self.next_tick_s < end_s - TICK_SLACK_S {
@@ -379,9 +377,11 @@ impl Run<'_, '_, '_> {
                 Some(held) if held.same_held_input(&seg) => {
                     let after_s = self.next_tick_s + self.period_s;
                     if after_s <= self.next_tick_s {
-                        return Err(tick_failure(
+                        return Err(StrideFailure::new(
                             self.next_tick_s,
-                            format!("the control period {} s does not advance", self.period_s),
+                            FailureCause::ControlPeriodStalls {
+                                period_s: self.period_s,
+                            },
                         ));
                     }
                     self.next_tick_s = after_s;
