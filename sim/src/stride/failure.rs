@@ -66,8 +66,9 @@ pub struct StrideFailure {
     pub kind: FailureKind,
     /// When, from the start of the stride [s] (stride time; serialised as `time_s`).
     pub t_stride_s: f64,
-    /// Why, with the values that were wrong.
-    pub cause: FailureCause,
+    /// Why, with the values that were wrong (boxed: a failure stays as small as a result's
+    /// error should be).
+    pub cause: Box<FailureCause>,
 }
 
 impl StrideFailure {
@@ -78,7 +79,7 @@ impl StrideFailure {
         Self {
             kind: cause.kind(),
             t_stride_s,
-            cause,
+            cause: Box::new(cause),
         }
     }
 

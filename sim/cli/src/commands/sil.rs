@@ -15,6 +15,7 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::Gait;
 use sim::report::{IdealGaitRecord, WalkGaitRecord};
 use sim::scene::Setup;
 use sim::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
@@ -138,34 +139,12 @@ struct SilWalkReport<'a, Bus: Serialize> {
 /// walker fell (the report's `failure`). The stages: the options checked, the firmware's
 /// configuration, the ideal-actuator gait, the firmware started, the walk, the report.
 pub fn run(args: SilArgs) -> Result<ExitCode> {
-    let SilArgs {
-        common,
-        steps,
-        faults,
-        sensor_faults,
-        estop_at,
-        candump,
-        socketcand,
-        wait_client,
-        realtime,
-        keep_steps,
-        firmware_params,
-        actuator,
-        animate,
-    } = args;
-    let Some(actuator_choice) = sil::ActuatorChoice::from_name(&actuator) else {
-        return Err(InputError::Other(format!(
-            "--actuator `{actuator}`: expected `motor` or `servo`"
-        ))
-        .into());
-    };
-    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
-    check_estop_at(estop_at)?;
-    if let Some(r) = realtime {
-        limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
-    }
-    let animation = animation::open(animate.as_deref(), steps)?;
-    let wait_client = wait_client_timeout(wait_client, socketcand.is_some())?;
+    let (actuator_choice, steps) =
+        check_options(&args.actuator, args.steps, args.estop_at, args.realtime)?;
+    let animation = animation::open(args.animate.as_deref(), steps)?;
+    let wait_client = wait_client_timeout(args.wait_client, args.socketcand.is_some())?;
+    let common = &args.common;
+    let candump = &args.candump;
     let scene = common.scene()?;
     let Setup {
         walker,
@@ -179,55 +158,36 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         ))
         .into());
     };
-    let bus = BusOptions {
-        faults: &faults,
-        sensor_faults: &sensor_faults,
-        candump: &candump,
-        socketcand,
-    };
-    let (config, firmware_params_written) = sil_config(actuator_choice, &firmware_params, bus)?;
-    // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
-    // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
-    // per 1 ms control tick) unless an integrator is given on the command line.
-    let ideal_setup = scene.setup()?;
-    let ideal = match ideal_setup.find_gait(&common.newton()) {
-        Ok(g) => g,
-        Err(e) => {
-            output::note(format_args!(
-                "error: no ideal-actuator gait to start from: {e}"
-            ));
-            return Ok(ExitCode::from(1));
-        }
+    let (config, firmware_params_written) = sil_config(actuator_choice, &args)?;
+    let Some((ideal_setup, ideal)) = ideal_gait(&scene, common)? else {
+        return Ok(ExitCode::from(1));
     };
     if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
         stride_settings.integrator = sil::SIL_INTEGRATOR;
     }
-    let mut ctl = start_firmware(config, &candump, estop_at, wait_client)?;
+    let mut ctl = start_firmware(config, candump, args.estop_at, wait_client)?;
     let plan = WalkPlan {
         steps,
-        keep_steps,
+        keep_steps: args.keep_steps,
         record: animation.is_some(),
-        realtime,
+        realtime: args.realtime,
         show_progress: !common.json,
     };
     let (q, qd) = walker.unpack(&ideal.fixed_point);
     let walk = walk_with_firmware(&walker, (&q, &qd), &stride_settings, &mut ctl, &plan);
-    let firmware = ctl.finish().map_err(|e| match candump_error(&candump, e) {
+    let firmware = ctl.finish().map_err(|e| match candump_error(candump, e) {
         // Only the log's flush can fail here: not bad input.
         InputError::Other(m) => anyhow::anyhow!(m),
         other => anyhow::Error::from(other),
     })?;
     let emergency_stop_sent_s = timeline::emergency_stop_sent_s(&firmware);
     if let Some(file) = animation {
-        let mut events = timeline::walk_events(&walk);
-        events.extend(timeline::firmware_events(&firmware));
-        events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
         file.write(&Animation {
             scene: &scene,
             walker: &walker,
             walk: &walk,
             command: "sil",
-            events,
+            events: walk_and_firmware_events(&walk, &firmware),
             firmware: true,
             emergency_stop_sent_s,
         })?;
@@ -242,7 +202,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         integrator: &stride_settings.integrator,
         ideal: IdealGaitRecord::of(&ideal_setup.walker, &ideal),
         walk: &walk,
-        keep_steps,
+        keep_steps: args.keep_steps,
         firmware: &firmware,
         emergency_stop_sent_s,
         firmware_params_written,
@@ -251,6 +211,52 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     };
     write_report(&ran.report(), common.json, steps)?;
     Ok(walk_exit_code(&walk))
+}
+
+/// The walk's and the firmware's events in time order, for the animation.
+fn walk_and_firmware_events(walk: &Walk, firmware: &sil::SilReport) -> Vec<timeline::Event> {
+    let mut events = timeline::walk_events(walk);
+    events.extend(timeline::firmware_events(firmware));
+    events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    events
+}
+
+/// The options checked in order: the actuator's name, the number of steps, the emergency
+/// stop's time, the pace against real time. The actuator and the steps.
+fn check_options(
+    actuator: &str,
+    steps: usize,
+    estop_at: Option<f64>,
+    realtime: Option<f64>,
+) -> Result<(sil::ActuatorChoice, usize), InputError> {
+    let Some(actuator_choice) = sil::ActuatorChoice::from_name(actuator) else {
+        return Err(InputError::Other(format!(
+            "--actuator `{actuator}`: expected `motor` or `servo`"
+        )));
+    };
+    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
+    check_estop_at(estop_at)?;
+    if let Some(r) = realtime {
+        limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
+    }
+    Ok((actuator_choice, steps))
+}
+
+/// The ideal-actuator gait with the scene's own (accurate) integrator (the walk with the
+/// firmware uses `sil::SIL_INTEGRATOR`, DOPRI5 at 1e-6, at most one step per 1 ms control
+/// tick, unless an integrator is given on the command line); `None`, said on standard error,
+/// when there is none to start from.
+fn ideal_gait(scene: &sim::scene::Scene, common: &Common) -> Result<Option<(Setup, Gait)>> {
+    let ideal_setup = scene.setup()?;
+    match ideal_setup.find_gait(&common.newton()) {
+        Ok(g) => Ok(Some((ideal_setup, g))),
+        Err(e) => {
+            output::note(format_args!(
+                "error: no ideal-actuator gait to start from: {e}"
+            ));
+            Ok(None)
+        }
+    }
 }
 
 /// The host's emergency stop time: a finite walk time of 0 s or more.
@@ -279,27 +285,18 @@ fn wait_client_timeout(
     }
 }
 
-/// What the bus is given: its faults, the encoders' faults, the candump log and the
-/// socketcand address.
-struct BusOptions<'a> {
-    faults: &'a [String],
-    sensor_faults: &'a [String],
-    candump: &'a Option<std::path::PathBuf>,
-    socketcand: Option<String>,
-}
-
-/// The firmware in the loop's configuration (the firmware's own parameters unless some are
-/// written) and the parameters written, by name [SI units].
+/// The firmware in the loop's configuration from the options (the firmware's own parameters
+/// unless some are written; the bus's and the encoders' faults, the candump log and the
+/// socketcand address) and the parameters written, by name [SI units].
 fn sil_config(
     actuator_choice: sil::ActuatorChoice,
-    firmware_params: &[String],
-    bus: BusOptions<'_>,
+    args: &SilArgs,
 ) -> Result<(sil::config::SilConfig, BTreeMap<&'static str, f64>), InputError> {
     let mut config = sil::config::SilConfig {
         actuator_choice,
         ..sil::config::SilConfig::default()
     };
-    for p in firmware_params {
+    for p in &args.firmware_params {
         config = config
             .with_firmware_param_str(p)
             .map_err(|e| InputError::Other(format!("--firmware-param `{p}`: {e}")))?;
@@ -309,17 +306,17 @@ fn sil_config(
         .iter()
         .map(|w| (sil::firmware_param::param_name(w.id), w.wire_value_f64()))
         .collect();
-    for f in bus.faults {
+    for f in &args.faults {
         config = config
             .with_fault_str(f)
             .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
     }
-    for f in bus.sensor_faults {
+    for f in &args.sensor_faults {
         config = config
             .with_sensor_fault_str(f)
             .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
     }
-    if let Some(addr) = &bus.socketcand {
+    if let Some(addr) = &args.socketcand {
         let parsed: std::net::SocketAddr = addr
             .parse()
             .map_err(|_| InputError::Other(format!("--socketcand `{addr}`: expected IP:PORT")))?;
@@ -329,8 +326,8 @@ fn sil_config(
             )));
         }
     }
-    config.candump = bus.candump.clone();
-    config.socketcand = bus.socketcand;
+    config.candump = args.candump.clone();
+    config.socketcand = args.socketcand.clone();
     Ok((config, firmware_params_written))
 }
 
