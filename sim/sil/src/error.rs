@@ -25,7 +25,7 @@ pub enum SilError {
     /// The control period is not a positive number of microseconds.
     #[error("control period {period_s} s is not a positive whole number of microseconds")]
     Period {
-        /// The offending period [s].
+        /// The offending period \[s\].
         period_s: f64,
     },
     /// The candump log could not be written.
@@ -42,15 +42,15 @@ pub enum TickError {
     /// The tick's time is not a finite, non-negative walk time.
     #[error("tick at t = {t_s} s")]
     InvalidTime {
-        /// The tick's walk time [s].
+        /// The tick's walk time \[s\].
         t_s: f64,
     },
     /// The tick comes before the previous one.
     #[error("tick at {t_s} s is before the previous tick at {previous_s} s")]
     BeforePrevious {
-        /// The tick's walk time [s].
+        /// The tick's walk time \[s\].
         t_s: f64,
-        /// The previous tick's walk time (on the bus's nanosecond clock) [s].
+        /// The previous tick's walk time (on the bus's nanosecond clock) \[s\].
         previous_s: f64,
     },
     /// The bus refused to run or to take a frame.

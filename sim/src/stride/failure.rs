@@ -64,7 +64,7 @@ pub enum FailureKind {
 pub struct StrideFailure {
     /// What happened (the cause's [`FailureCause::kind`]).
     pub kind: FailureKind,
-    /// When, from the start of the stride [s] (stride time; serialised as `time_s`).
+    /// When, from the start of the stride \[s\] (stride time; serialised as `time_s`).
     pub t_stride_s: f64,
     /// Why, with the values that were wrong (boxed: a failure stays as small as a result's
     /// error should be).
@@ -149,7 +149,7 @@ pub enum FailureCause {
     /// The controller's period is not a finite positive time.
     #[error("control period {period_s} s is not a finite positive time")]
     ControlPeriodNotPositive {
-        /// The period [s].
+        /// The period \[s\].
         period_s: f64,
     },
     /// The controller's period is too short for the tick grid to advance from the walk time
@@ -159,15 +159,15 @@ pub enum FailureCause {
          {t_walk_start_s} s"
     )]
     ControlPeriodTooShort {
-        /// The period [s].
+        /// The period \[s\].
         period_s: f64,
-        /// Walk time at the start of the stride [s].
+        /// Walk time at the start of the stride \[s\].
         t_walk_start_s: f64,
     },
     /// The controller's period does not advance the next tick's time (inside a step).
     #[error("the control period {period_s} s does not advance")]
     ControlPeriodStalls {
-        /// The period [s].
+        /// The period \[s\].
         period_s: f64,
     },
     /// A control tick lies inside a step that has no interpolant to run it on (a defect of
@@ -191,7 +191,7 @@ pub enum FailureCause {
     /// No heel strike within the stride's time budget.
     #[error("no heel strike within {max_stride_time_s} s")]
     TimeBudget {
-        /// The budget, [`super::StrideSettings::max_stride_time_s`] [s].
+        /// The budget, [`super::StrideSettings::max_stride_time_s`] \[s\].
         max_stride_time_s: f64,
     },
     /// No heel strike within the stride's step budget.
@@ -212,7 +212,7 @@ pub enum FailureCause {
     TickBudget {
         /// The budget, [`super::StrideSettings::max_steps`].
         max_steps: usize,
-        /// The controller's period [s].
+        /// The controller's period \[s\].
         period_s: f64,
     },
     /// No heel strike within the stride's evaluation budget.
@@ -227,7 +227,7 @@ pub enum FailureCause {
     /// ahead of the stance contact (or level with it), backward otherwise.
     #[error("hip below its minimum height")]
     HipTooLow {
-        /// How far the hip is ahead of the stance contact [m].
+        /// How far the hip is ahead of the stance contact \[m\].
         hip_ahead_m: f64,
     },
     /// The hip moved back behind the stance contact.
@@ -246,7 +246,7 @@ pub enum FailureCause {
     /// The swing foot touched the floor too close to the stance contact (a scuff).
     #[error("swing foot touched the floor {foot_ahead_m:.4} m ahead of the stance contact")]
     Scuff {
-        /// How far the swing foot is ahead of the stance contact [m].
+        /// How far the swing foot is ahead of the stance contact \[m\].
         foot_ahead_m: f64,
     },
     /// Heel strike with a knee still free.

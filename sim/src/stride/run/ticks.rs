@@ -33,9 +33,9 @@ const TICK_SLACK_S: f64 = 1e-12;
 /// ticks before its heel strike's time − [`TICK_SLACK_S`], so each tick runs in one stride).
 ///
 /// # Errors
-/// [`FailureKind::InvalidControlPeriod`] when the period is not a finite positive time, or so
-/// short against the walk time that the tick grid does not advance over the stride's time
-/// budget `max_stride_time_s` (the stride's ticks would never end).
+/// [`crate::stride::FailureKind::InvalidControlPeriod`] when the period is not a finite
+/// positive time, or so short against the walk time that the tick grid does not advance over
+/// the stride's time budget `max_stride_time_s` (the stride's ticks would never end).
 pub(super) fn first_tick_s(
     period_s: f64,
     t_walk_start_s: f64,
