@@ -355,6 +355,20 @@ mod tests {
     }
 
     #[test]
+    fn a_failure_serialises_as_its_kind_time_and_the_cause_s_text() {
+        let f = StrideFailure::new(0.5, FailureCause::HipTooLow { hip_ahead_m: 0.1 });
+        assert_eq!(f.kind, FailureKind::FellForward);
+        assert_eq!(
+            serde_json::to_string(&f).ok().as_deref(),
+            Some(r#"{"kind":"fell_forward","time_s":0.5,"detail":"hip below its minimum height"}"#)
+        );
+        assert_eq!(
+            f.to_string(),
+            "FellForward at t = 0.500000 s: hip below its minimum height"
+        );
+    }
+
+    #[test]
     fn a_request_that_does_not_fit_the_walker_is_not_a_non_finite_state() {
         let cause = FailureCause::NoAnkleReflex;
         assert_eq!(cause.kind(), FailureKind::InvalidConfiguration);
