@@ -88,6 +88,15 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_refused_node_keeps_the_firmware_s_error() {
+        let e = SilError::Node {
+            node: NodeId::Host,
+            reason: ConfigError::NotAnAnkle(NodeId::Host),
+        };
+        assert_eq!(e.to_string(), "firmware node Host: NotAnAnkle(Host)");
+    }
+
+    #[test]
     fn a_tick_s_failure_reads_as_the_firmware_in_the_loop_s() {
         let e = ControlError::from(TickError::NoStanceAnkle);
         assert_eq!(
