@@ -211,6 +211,35 @@ impl Outbox<'_> {
     }
 }
 
+/// The contact switch's edges in one tick.
+#[derive(Clone, Copy)]
+struct ContactEdges {
+    /// Open → closed: the own heel strike.
+    heel_strike: bool,
+    /// Closed → open: the own lift-off.
+    lift_off: bool,
+}
+
+/// A tick's transmissions in priority order, stable (insertion sort over at most
+/// [`MAX_TX_PER_TICK`] entries). Every message of this node carries the same node field, so the
+/// class orders the identifiers. Pairs are taken with `get_mut` and a slice pattern: no
+/// indexing, no bounds-check panic path.
+fn sort_by_priority(transmit: &mut Vec<Message, MAX_TX_PER_TICK>) {
+    for i in 1..transmit.len() {
+        let mut j = i;
+        while j > 0 {
+            let Some([a, b]) = transmit.get_mut(j - 1..=j) else {
+                break;
+            };
+            if a.class() <= b.class() {
+                break;
+            }
+            core::mem::swap(a, b);
+            j -= 1;
+        }
+    }
+}
+
 impl AnkleNode {
     /// A disabled node with default parameters.
     ///
@@ -519,7 +548,11 @@ impl AnkleNode {
         }
     }
 
-    /// One control tick: constant work plus at most [`MAX_RX_PER_TICK`] messages.
+    /// One control tick: constant work plus at most [`MAX_RX_PER_TICK`] messages. The stages,
+    /// in order: the received messages, the sensors, the peer's liveness and the drivers, the
+    /// contact edges, the peer's state and the receive overflow (then the safe state on any
+    /// safety-relevant fault), the reflex, the reports due, the periodic messages; the
+    /// transmissions in priority order.
     pub fn tick(&mut self, now: Instant, inputs: &TickInputs) -> TickOutputs {
         let mut dropped = self.dropped_tx;
         let mut out = Outbox {
@@ -532,12 +565,37 @@ impl AnkleNode {
         if let Some(a) = self.pending_ack.take() {
             out.push(Message::CommandAck(a));
         }
+        let peer_heel_strike = self.read_messages(&mut out, now, inputs);
+        self.check_sensors(&mut out, now, inputs);
+        self.check_peer_liveness_and_drivers(&mut out, now, started, inputs);
+        let edges = self.contact_edges(&mut out, now, contact);
+        self.check_peer_state_and_receive(&mut out, now, inputs);
+        // Safe state on any safety-relevant fault.
+        if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
+            self.enter(NodeState::Safe, contact);
+        }
+        let actuator = self.run_reflex(&mut out, now, edges, peer_heel_strike);
+        self.send_due_reports(&mut out, now);
+        self.send_periodic(&mut out, now);
+        sort_by_priority(&mut out.list);
+        let outputs = TickOutputs {
+            actuator,
+            transmit: out.list,
+            state: self.state,
+            phase: self.reflex.phase(),
+            request: self.request.take(),
+        };
+        self.dropped_tx = dropped;
+        outputs
+    }
 
-        // 1. Messages: commands to this node, the peer's heartbeat and heel strike.
+    /// Tick stage 1, messages: commands to this node, the peer's heartbeat and heel strike
+    /// (at most [`MAX_RX_PER_TICK`]). Whether the peer announced its heel strike.
+    fn read_messages(&mut self, out: &mut Outbox, now: Instant, inputs: &TickInputs) -> bool {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(&mut out, c, inputs),
+                Message::Command(c) => self.handle_command(out, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
                     let before = self.peer_state.map(|(_, st)| st);
@@ -561,12 +619,15 @@ impl AnkleNode {
                 _ => {}
             }
         }
+        peer_heel_strike
+    }
 
-        // 2. Sensors: plausibility, then the estimator on good samples. The stuck check counts
-        // ticks where the actuator moves the ankle: the whole push (the setpoint profile moves
-        // it), and hold ticks in which the spool turned (`DriverHealth::string_moving`). A
-        // still ankle with a still spool in hold is no fault: a healthy encoder may sit on one
-        // code then.
+    /// Tick stage 2, sensors: plausibility, then the estimator on good samples. The stuck check
+    /// counts ticks where the actuator moves the ankle: the whole push (the setpoint profile
+    /// moves it), and hold ticks in which the spool turned (`DriverHealth::string_moving`). A
+    /// still ankle with a still spool in hold is no fault: a healthy encoder may sit on one
+    /// code then.
+    fn check_sensors(&mut self, out: &mut Outbox, now: Instant, inputs: &TickInputs) {
         let driving = match self.reflex.phase() {
             ReflexPhase::Push => true,
             ReflexPhase::Hold => inputs.drivers.string_moving,
@@ -575,17 +636,17 @@ impl AnkleNode {
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
-        self.set_fault(&mut out, now, FaultCode::EncoderComms, found.comms);
-        self.set_fault(&mut out, now, FaultCode::EncoderRange, found.range);
-        self.set_fault(&mut out, now, FaultCode::EncoderRate, found.rate);
-        self.set_fault(&mut out, now, FaultCode::EncoderStuck, found.stuck);
+        self.set_fault(out, now, FaultCode::EncoderComms, found.comms);
+        self.set_fault(out, now, FaultCode::EncoderRange, found.range);
+        self.set_fault(out, now, FaultCode::EncoderRate, found.rate);
+        self.set_fault(out, now, FaultCode::EncoderStuck, found.stuck);
         // Following error against the previous tick's setpoint, on a plausible reading.
         let measured = match inputs.angle {
             Ok(s) if found.range.is_none() && found.rate.is_none() => Some(s.angle_rad),
             _ => None,
         };
         let following = self.following.check(now, self.driven_setpoint, measured);
-        self.set_fault(&mut out, now, FaultCode::FollowingError, following);
+        self.set_fault(out, now, FaultCode::FollowingError, following);
         match inputs.angle {
             Ok(s) if found.range.is_none() && found.rate.is_none() => {
                 let dt = self
@@ -600,26 +661,35 @@ impl AnkleNode {
                 self.last_sample_at = None;
             }
         }
+    }
 
-        // 3. Peer liveness (counted from start-up until the first heartbeat) and drivers.
+    /// Tick stage 3: the peer's liveness (counted from start-up, `started`, until the first
+    /// heartbeat) and the drivers' health.
+    fn check_peer_liveness_and_drivers(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        started: Instant,
+        inputs: &TickInputs,
+    ) {
         let peer_seen = self.last_peer_heartbeat.unwrap_or(started);
         let silent_s = now.secs_since(peer_seen);
         let lost = silent_s > self.params.peer_heartbeat_timeout_s();
         let silent_ms = (silent_s * 1000.0) as i16;
         self.set_fault(
-            &mut out,
+            out,
             now,
             FaultCode::PeerHeartbeatLost,
             lost.then_some(silent_ms),
         );
         self.set_fault(
-            &mut out,
+            out,
             now,
             FaultCode::Actuator,
             inputs.drivers.actuator_error.then_some(0),
         );
         self.set_fault(
-            &mut out,
+            out,
             now,
             FaultCode::CanBus,
             if inputs.drivers.can_bus_off {
@@ -630,12 +700,16 @@ impl AnkleNode {
                 None
             },
         );
+    }
 
-        // 4. Contact edges; the own heel strike is announced in every state.
+    /// Tick stage 4, the contact's edges; the own heel strike is announced in every state.
+    fn contact_edges(&mut self, out: &mut Outbox, now: Instant, contact: bool) -> ContactEdges {
         let previous_contact = self.contact.replace(contact);
-        let heel_strike = previous_contact == Some(false) && contact;
-        let lift_off = previous_contact == Some(true) && !contact;
-        if heel_strike {
+        let edges = ContactEdges {
+            heel_strike: previous_contact == Some(false) && contact,
+            lift_off: previous_contact == Some(true) && !contact,
+        };
+        if edges.heel_strike {
             self.step_count = self.step_count.wrapping_add(1);
             out.push(Message::HeelStrike(HeelStrike {
                 node: self.config.node,
@@ -643,79 +717,97 @@ impl AnkleNode {
                 time_us: now.uptime_us(),
             }));
         }
+        edges
+    }
 
-        // 5. The peer's own state: a peer that dropped from `Enabled` to its safe state or
-        // emergency stop while this node walked cannot walk, so neither can this one. Only
-        // that transition counts (not the level), so after a safe event the ankles can be
-        // enabled one at a time.
+    /// Tick stage 5, the peer's own state: a peer that dropped from `Enabled` to its safe state
+    /// or emergency stop while this node walked cannot walk, so neither can this one. Only that
+    /// transition counts (not the level), so after a safe event the ankles can be enabled one
+    /// at a time. Then the receive overflow: every lost frame counted, reported as
+    /// `CanRxOverflow` with the total (not safety-relevant).
+    fn check_peer_state_and_receive(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        inputs: &TickInputs,
+    ) {
         if self.state != NodeState::Enabled {
             self.peer_dropped_out = None;
         }
         let peer_detail = self.peer_dropped_out.map(|st| st.raw() as i16);
-        self.set_fault(&mut out, now, FaultCode::PeerSafe, peer_detail);
-
-        // Receive overflow: every lost frame counted, reported as `CanRxOverflow` with the
-        // total (not safety-relevant).
+        self.set_fault(out, now, FaultCode::PeerSafe, peer_detail);
         self.rx_lost_total = self.rx_lost_total.wrapping_add(inputs.drivers.rx_lost);
         let lost_detail = i16::try_from(self.rx_lost_total).unwrap_or(i16::MAX);
         self.set_fault(
-            &mut out,
+            out,
             now,
             FaultCode::CanRxOverflow,
             (inputs.drivers.rx_lost > 0).then_some(lost_detail),
         );
+    }
 
-        // Safe state on any safety-relevant fault.
-        if self.state == NodeState::Enabled && self.faults.any_safety_relevant() {
-            self.enter(NodeState::Safe, contact);
-        }
-
-        // 6. The reflex.
+    /// Tick stage 6, the reflex on the estimated angle and the contact edges; a release by the
+    /// own lift-off before the peer's heel strike raises `PeerHeelStrikeLate`. The actuator's
+    /// command.
+    fn run_reflex(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        edges: ContactEdges,
+        peer_heel_strike: bool,
+    ) -> ActuatorCommand {
         let angle_rad = self.estimator.angle_rad().unwrap_or(0.0);
         let (actuator, event) = self.reflex.step(
             &ReflexInputs {
                 now,
                 angle_rad,
-                heel_strike,
-                lift_off,
+                heel_strike: edges.heel_strike,
+                lift_off: edges.lift_off,
                 peer_heel_strike,
             },
             &self.params,
         );
         match event {
             Some(ReflexEvent::Released(ReleaseCause::OwnLiftOff)) => {
-                self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, Some(0));
+                self.set_fault(out, now, FaultCode::PeerHeelStrikeLate, Some(0));
             }
             Some(ReflexEvent::Released(ReleaseCause::PeerHeelStrike)) => {
-                self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+                self.set_fault(out, now, FaultCode::PeerHeelStrikeLate, None);
             }
             _ => {}
         }
         if self.state != NodeState::Enabled {
-            self.set_fault(&mut out, now, FaultCode::PeerHeelStrikeLate, None);
+            self.set_fault(out, now, FaultCode::PeerHeelStrikeLate, None);
         }
         self.driven_setpoint = match actuator {
             ActuatorCommand::Position { ankle_angle_rad } => Some(ankle_angle_rad),
             ActuatorCommand::Released => None,
         };
-        // Fault events held back by their inhibit time.
+        actuator
+    }
+
+    /// Tick stage 7, the reports due: fault events held back by their inhibit time, the state
+    /// each of this tick's raises left the node in (into the history), the identity and the
+    /// history when asked for.
+    fn send_due_reports(&mut self, out: &mut Outbox, now: Instant) {
         let faults = self.faults;
         for r in self.reporter.due(now, |c| faults.contains(c)) {
-            self.send_fault(&mut out, now, r.code, r.transition, r.detail);
+            self.send_fault(out, now, r.code, r.transition, r.detail);
         }
-        // The history records the state each raise left the node in.
         let state = self.state;
         for r in self.history.iter_mut().take(self.raised_this_tick) {
             r.state_after = state;
         }
         if core::mem::take(&mut self.identity_due) {
-            self.send_identity(&mut out);
+            self.send_identity(out);
         }
         if core::mem::take(&mut self.history_due) {
-            self.send_history(&mut out);
+            self.send_history(out);
         }
+    }
 
-        // 7. Periodic messages.
+    /// Tick stage 8, the periodic messages that are due: ankle state, heartbeat, version.
+    fn send_periodic(&mut self, out: &mut Outbox, now: Instant) {
         if now >= self.next_state_at {
             let (a, r) = self.estimate().unwrap_or((0.0, 0.0));
             out.push(Message::AnkleState(AnkleState {
@@ -748,33 +840,5 @@ impl AnkleNode {
             }));
             self.next_version_at = Instant(now.0.saturating_add(self.config.version_period_us));
         }
-
-        // Priority order, stable (insertion sort over at most MAX_TX_PER_TICK entries). Every
-        // message of this node carries the same node field, so the class orders the
-        // identifiers. Pairs are taken with `get_mut` and a slice pattern: no indexing, no
-        // bounds-check panic path.
-        let transmit = &mut out.list;
-        for i in 1..transmit.len() {
-            let mut j = i;
-            while j > 0 {
-                let Some([a, b]) = transmit.get_mut(j - 1..=j) else {
-                    break;
-                };
-                if a.class() <= b.class() {
-                    break;
-                }
-                core::mem::swap(a, b);
-                j -= 1;
-            }
-        }
-        let outputs = TickOutputs {
-            actuator,
-            transmit: out.list,
-            state: self.state,
-            phase: self.reflex.phase(),
-            request: self.request.take(),
-        };
-        self.dropped_tx = dropped;
-        outputs
     }
 }

@@ -123,9 +123,60 @@ pub enum TickStepping {
 }
 
 /// Why a controller could not run a tick.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("controller: {0}")]
-pub struct ControlError(pub String);
+///
+/// A controller lives outside this crate (the firmware in the loop of crate `sil`, a test's
+/// controller), so its failure is its own typed error, kept whole: [`Self::source_error`]
+/// downcasts to it (e.g. `sil::TickError`).
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ControlError {
+    /// The controller `controller` failed a tick.
+    #[error("controller: {controller}: {source}")]
+    Controller {
+        /// Which controller (`firmware in the loop`).
+        controller: &'static str,
+        /// Its error.
+        source: std::sync::Arc<dyn std::error::Error + Send + Sync + 'static>,
+    },
+}
+
+impl ControlError {
+    /// The controller `controller` failed a tick with `error`.
+    pub fn controller(
+        controller: &'static str,
+        error: impl std::error::Error + Send + Sync + 'static,
+    ) -> Self {
+        Self::Controller {
+            controller,
+            source: std::sync::Arc::new(error),
+        }
+    }
+
+    /// The controller's own error (downcast it to the controller's error type).
+    pub fn source_error(&self) -> &(dyn std::error::Error + Send + Sync + 'static) {
+        match self {
+            Self::Controller { source, .. } => source.as_ref(),
+        }
+    }
+}
+
+/// Two controller failures are equal when the same controller failed with the same error
+/// (the same value, or errors that read the same: an error need not be comparable).
+impl PartialEq for ControlError {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Self::Controller {
+                    controller: a,
+                    source: e,
+                },
+                Self::Controller {
+                    controller: b,
+                    source: f,
+                },
+            ) => a == b && (std::sync::Arc::ptr_eq(e, f) || e.to_string() == f.to_string()),
+        }
+    }
+}
 
 /// A controller of the stance ankle's string, sampled every `period_s`.
 pub trait AnkleController {

@@ -261,7 +261,7 @@ pub fn walk(
                     kind: f.kind,
                     step,
                     t_walk_s: t0 + f.t_stride_s,
-                    detail: f.detail,
+                    detail: f.detail(),
                 });
                 break;
             }

@@ -208,7 +208,7 @@ fn a_stride_that_exceeds_its_step_budget_fails_naming_it() {
     w.settings.max_steps = 10;
     let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::StepBudgetExceeded, "{e}");
-    assert!(e.detail.contains("max_steps = 10"), "{}", e.detail);
+    assert!(e.detail().contains("max_steps = 10"), "{}", e.detail());
     assert_eq!(
         serde_json::to_value(e.kind).unwrap(),
         serde_json::json!("step_budget_exceeded")
@@ -221,7 +221,11 @@ fn a_stride_that_exceeds_its_evaluation_budget_fails_naming_it() {
     w.settings.max_evaluations = 100;
     let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::EvaluationBudgetExceeded, "{e}");
-    assert!(e.detail.contains("max_evaluations = 100"), "{}", e.detail);
+    assert!(
+        e.detail().contains("max_evaluations = 100"),
+        "{}",
+        e.detail()
+    );
     assert_eq!(
         serde_json::to_value(e.kind).unwrap(),
         serde_json::json!("evaluation_budget_exceeded")

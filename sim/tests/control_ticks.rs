@@ -171,7 +171,7 @@ fn a_period_far_too_short_for_the_stride_ends_in_the_step_budget() {
         let request = StrideRequest::new(&settings).controlled(&mut ctl, 0.0);
         let e = w.walker.stride(&q, &qd, request).unwrap_err();
         assert_eq!(e.kind, FailureKind::StepBudgetExceeded, "{stepping:?}: {e}");
-        assert!(e.detail.contains("max_steps = 2000"), "{}", e.detail);
+        assert!(e.detail().contains("max_steps = 2000"), "{}", e.detail());
         assert!(ctl.ticks_s.len() <= 2_000, "{}", ctl.ticks_s.len());
     }
 }

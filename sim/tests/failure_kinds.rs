@@ -174,3 +174,67 @@ fn a_drive_that_retracts_lets_the_heel_back_down() {
     // The same start with the scene's own drive walks on.
     assert!(common::stride_map(&w, &g.fixed_point).is_ok());
 }
+
+/// A controller that fails its first tick with an error of its own.
+struct Broken;
+
+#[derive(Debug, thiserror::Error)]
+#[error("the bus is down")]
+struct BusDown;
+
+impl sim::control::AnkleController for Broken {
+    fn period_s(&self) -> f64 {
+        1e-3
+    }
+    fn tick(
+        &mut self,
+        _: &sim::control::AnkleSensing,
+    ) -> Result<sim::control::ActuatorSegment, sim::control::ControlError> {
+        Err(sim::control::ControlError::controller("broken", BusDown))
+    }
+    fn heel_strike(&mut self, _: f64) {}
+}
+
+#[test]
+fn a_controlled_stride_on_a_walker_without_an_ankle_reflex_is_a_configuration_error() {
+    let (_, w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let mut ctl = Broken;
+    let e = w
+        .walker
+        .stride(
+            &q,
+            &qd,
+            sim::stride::StrideRequest::new(&w.settings).controlled(&mut ctl, 0.0),
+        )
+        .unwrap_err();
+    assert_eq!(e.kind, FailureKind::InvalidConfiguration, "{e}");
+    assert_eq!(*e.cause, sim::stride::FailureCause::NoAnkleReflex);
+    assert_eq!(
+        e.detail(),
+        "a controlled stride needs a scene with an ankle_reflex section"
+    );
+}
+
+#[test]
+fn a_controller_s_failure_is_its_own_typed_error_not_a_non_finite_state() {
+    let (_, w) = common::walker("wisse3d");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let mut ctl = Broken;
+    let e = w
+        .walker
+        .stride(
+            &q,
+            &qd,
+            sim::stride::StrideRequest::new(&w.settings).controlled(&mut ctl, 0.0),
+        )
+        .unwrap_err();
+    assert_eq!(e.kind, FailureKind::ControlFailed, "{e}");
+    assert_eq!(e.detail(), "controller: broken: the bus is down");
+    let sim::stride::FailureCause::Control(c) = &*e.cause else {
+        panic!("{e}");
+    };
+    assert!(c.source_error().downcast_ref::<BusDown>().is_some());
+}

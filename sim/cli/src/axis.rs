@@ -2,7 +2,7 @@
 //! or base-10 logarithmic), the range it shows, the ticks (values, labels, major or minor) and
 //! the SVG of the tick marks, grid lines and tick labels along an edge of the plot area.
 
-use crate::plot::escape;
+use crate::svg_text::escape;
 use std::fmt::Write as _;
 
 /// How values map onto an axis.

@@ -3,7 +3,8 @@
 //! there is no value, a colour bar and labelled axes.
 
 use crate::axis::{self, fmt_tick, nice_step, Edge, Rect, Scale};
-use crate::plot::{escape, frame, header};
+use crate::plot::{frame, header};
+use crate::svg_text::escape;
 use std::fmt::Write as _;
 
 /// A heat map: `z[j][i]` at `(x[i], y[j])`, `None` where there is no value.

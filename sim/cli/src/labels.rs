@@ -134,6 +134,8 @@ fn failure_clause(kind: FailureKind) -> String {
         FailureKind::StepBudgetExceeded => "the stride used its integrator-step budget".into(),
         FailureKind::EvaluationBudgetExceeded => "the stride used its evaluation budget".into(),
         FailureKind::InvalidControlPeriod => "the controller's period is not usable".into(),
+        FailureKind::ControlFailed => "the controller could not run a tick".into(),
+        FailureKind::InvalidConfiguration => "the scene does not fit the request".into(),
     }
 }
 

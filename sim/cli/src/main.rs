@@ -23,6 +23,7 @@ mod plot;
 mod progress;
 #[cfg(test)]
 mod readme_commands;
+mod svg_text;
 mod sweep_figures;
 
 use anyhow::Result;

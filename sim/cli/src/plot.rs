@@ -3,6 +3,7 @@
 //! legend outside the data area, optional equal (or stated) aspect, notes on the data.
 
 use crate::axis::{self, Edge, Rect, Scale};
+use crate::svg_text::escape;
 use std::fmt::Write as _;
 
 /// How the points of a series are joined.
@@ -227,13 +228,6 @@ pub(crate) fn header(
             escape(c)
         );
     }
-}
-
-/// Text escaped for SVG.
-pub(crate) fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 /// The SVG of `marker` centred at `(cx, cy)` [px].

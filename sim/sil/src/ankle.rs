@@ -14,13 +14,13 @@ use firmware::drivers::encoder::MagneticEncoder;
 use firmware::runner::AnkleDrivers;
 use firmware::{AnkleNode, Instant, NodeConfig, TickOutputs};
 use protocol::Message;
-use sim::control::{ActuatorSegment, ControlError};
+use sim::control::ActuatorSegment;
 
 use crate::actuator::ActuatorModel;
 use crate::bus_side::BusSide;
 use crate::config::ActuatorChoice;
 use crate::config::SilConfig;
-use crate::error::{control_error, SilError};
+use crate::error::{SilError, TickError};
 use crate::gait::AnkleScene;
 use crate::hal::{
     ActuatorLink, AnkleActuator, CanLink, PlantLink, Shaft, SimActuator, SimBridges, SimCan,
@@ -100,7 +100,7 @@ impl Ankle {
         let node =
             AnkleNode::new(NodeConfig::nominal(side.node())).map_err(|e| SilError::Node {
                 node: side.node(),
-                reason: format!("{e:?}"),
+                reason: e,
             })?;
         let faults = config
             .sensor_faults
@@ -240,11 +240,7 @@ impl Ankle {
     ///
     /// # Errors
     /// A refusal of the bus other than bus-off or a full queue.
-    pub fn transmit(
-        &mut self,
-        bus: &mut BusSide,
-        t_ns: u64,
-    ) -> Result<TransmitTally, ControlError> {
+    pub fn transmit(&mut self, bus: &mut BusSide, t_ns: u64) -> Result<TransmitTally, TickError> {
         let mut tally = TransmitTally::default();
         for frame in self.wiring.can.borrow_mut().take_tx() {
             match bus.send(self.handle, frame, t_ns) {
@@ -255,7 +251,7 @@ impl Ankle {
                 Ok(SendOutcome::BusOff) | Err(BusError::QueueFull { .. }) => {
                     tally.lost_at_bus += 1;
                 }
-                Err(e) => return Err(control_error(e)),
+                Err(e) => return Err(TickError::Bus(e)),
             }
         }
         Ok(tally)
@@ -265,7 +261,7 @@ impl Ankle {
     ///
     /// # Errors
     /// When the firmware applied no actuator command.
-    pub fn take_segment(&mut self) -> Result<ActuatorSegment, ControlError> {
+    pub fn take_segment(&mut self) -> Result<ActuatorSegment, TickError> {
         if let Some(plant) = &self.wiring.plant {
             // The duty the firmware set in this step, integrated over the tick.
             return Ok(plant.borrow_mut().finish_tick());
@@ -274,7 +270,7 @@ impl Ankle {
             .actuator
             .borrow_mut()
             .take_segment()
-            .ok_or_else(|| control_error("the firmware applied no actuator command"))
+            .ok_or(TickError::NoActuatorCommand)
     }
 
     /// What the power stage did in the last tick (motor plant only).

@@ -12,9 +12,8 @@ use canbus::{
     Bus, BusConfig, BusError, BusEvent, ErrorState, FaultSpec, Frame, NodeHandle, SendOutcome,
 };
 use protocol::NodeId;
-use sim::control::ControlError;
 
-use crate::error::{control_error, SilError};
+use crate::error::{SilError, TickError};
 use crate::history::BoundedLog;
 use crate::report::SocketcandReport;
 use crate::side::Side;
@@ -94,17 +93,17 @@ impl BusSide {
     ///
     /// # Errors
     /// The bus's or the log's error.
-    pub fn advance_to(&mut self, t_ns: u64) -> Result<Vec<BusEvent>, ControlError> {
-        let events = self.bus.advance_to(t_ns).map_err(control_error)?;
+    pub fn advance_to(&mut self, t_ns: u64) -> Result<Vec<BusEvent>, TickError> {
+        let events = self.bus.advance_to(t_ns)?;
         for ev in &events {
             if let Some(w) = self.candump.as_mut() {
-                w.write_event(ev).map_err(control_error)?;
+                w.write_event(ev)?;
             }
             match ev {
                 BusEvent::Delivered(d) => {
                     self.frames_delivered += 1;
                     if let Some(s) = &self.server {
-                        s.publish(&d.frame, d.t_end_ns).map_err(control_error)?;
+                        s.publish(&d.frame, d.t_end_ns)?;
                     }
                 }
                 BusEvent::BusOff { node, t_ns } => {
@@ -127,10 +126,10 @@ impl BusSide {
     ///
     /// # Errors
     /// Any other refusal of the bus.
-    pub fn send_from_host(&mut self, frame: Frame, t_ns: u64) -> Result<(), ControlError> {
+    pub fn send_from_host(&mut self, frame: Frame, t_ns: u64) -> Result<(), TickError> {
         self.bus
             .send_lossy(self.host, frame, t_ns)
-            .map_err(control_error)
+            .map_err(TickError::Bus)
     }
 
     /// Queue a frame from `node` at `t_ns`.

@@ -265,7 +265,7 @@ impl SilConfig {
                 protocol::CommandKind::SetParam { param, value } => Some(FirmwareParam {
                     id: param,
                     // The f32 nearest the wire's decimal (−0.07, not −0.0700000003).
-                    value_si: crate::host::param_si(value) as f32,
+                    value_si: crate::firmware_param::param_si(value) as f32,
                 }),
                 _ => None,
             })

@@ -3,7 +3,7 @@
 
 use std::str::FromStr;
 
-use protocol::ParamId;
+use protocol::{ParamId, ParamValue};
 
 /// The name of each firmware parameter on the command line and in the report (`nodes.<side>.
 /// parameters`): snake case with the unit, in [`ParamId`]'s order.
@@ -125,11 +125,17 @@ impl FirmwareParam {
     }
 }
 
+/// A parameter's wire value in its SI unit, as the nearest `f64` to the decimal the wire
+/// holds (`-80000` counts of 1e-6 is −0.08, not `f32`'s −0.07999999821).
+pub(crate) fn param_si(v: ParamValue) -> f64 {
+    f64::from(v.0) / (1.0 / ParamValue::SCALE)
+}
+
 impl FirmwareParam {
     /// The value as the wire carries it, as the nearest `f64` to that decimal (−0.07 for
     /// −0.07, where `f64::from(-0.07_f32)` is −0.0700000003) [SI unit].
     pub fn wire_value_f64(&self) -> f64 {
-        crate::host::param_si(protocol::ParamValue::saturating_from_si(self.value_si))
+        param_si(ParamValue::saturating_from_si(self.value_si))
     }
 }
 

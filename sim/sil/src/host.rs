@@ -5,11 +5,11 @@ use canbus::Frame;
 use std::collections::BTreeMap;
 
 use protocol::{Command, CommandKind, DecodeError, Message, ParamId, ParamValue, Target};
-use sim::control::ControlError;
 
 use crate::bus_side::BusSide;
 use crate::config::{HostCommand, SilConfig, READ_BACK_PARAMS};
-use crate::error::control_error;
+use crate::error::TickError;
+use crate::firmware_param::param_si;
 use crate::history::BoundedLog;
 use crate::report::{fault_names, HostReport, NodeParameters};
 use crate::side::Side;
@@ -70,7 +70,7 @@ impl Host {
     ///
     /// # Errors
     /// A command that does not encode, a frame the bus refuses.
-    pub fn send_due(&mut self, t: TickTime, bus: &mut BusSide) -> Result<(), ControlError> {
+    pub fn send_due(&mut self, t: TickTime, bus: &mut BusSide) -> Result<(), TickError> {
         if !self.enabled_sent {
             self.enabled_sent = true;
             for c in self.setup.clone() {
@@ -103,8 +103,8 @@ impl Host {
         Ok(())
     }
 
-    fn send(&mut self, t: TickTime, bus: &mut BusSide, m: &Message) -> Result<(), ControlError> {
-        let raw = m.encode().map_err(|e| control_error(format!("{e:?}")))?;
+    fn send(&mut self, t: TickTime, bus: &mut BusSide, m: &Message) -> Result<(), TickError> {
+        let raw = m.encode().map_err(TickError::Encode)?;
         bus.send_from_host(Frame::from(raw), t.t_ns)?;
         self.commands_sent.push((t.t_s, format!("{m:?}")));
         Ok(())
@@ -181,10 +181,4 @@ fn get_param(target: Target, param: ParamId) -> Message {
         target,
         kind: CommandKind::GetParam { param },
     })
-}
-
-/// A parameter's wire value in its SI unit, as the nearest `f64` to the decimal the wire
-/// holds (`-80000` counts of 1e-6 is −0.08, not `f32`'s −0.07999999821).
-pub(crate) fn param_si(v: ParamValue) -> f64 {
-    f64::from(v.0) / (1.0 / ParamValue::SCALE)
 }

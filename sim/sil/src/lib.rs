@@ -53,7 +53,7 @@ mod tests;
 pub use actuator::{ActuatorModel, ActuatorParams, ActuatorStats};
 pub use canbus::wait_client::{wait_client_timeout, MAX_WAIT_CLIENT_S};
 pub use config::{ActuatorChoice, HostCommand, SilConfig, SupplyDropInHold, READ_BACK_PARAMS};
-pub use error::SilError;
+pub use error::{SilError, TickError};
 /// What the firmware's spool-motor driver set the power stage to.
 pub use firmware::drivers::spool_motor::StageOutput;
 pub use firmware_param::{FirmwareParam, FirmwareParamError};

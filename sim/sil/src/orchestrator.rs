@@ -9,7 +9,7 @@ use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError}
 use crate::ankle::{Ankle, BusAccess};
 use crate::bus_side::BusSide;
 use crate::config::SilConfig;
-use crate::error::{control_error, SilError};
+use crate::error::{SilError, TickError};
 use crate::gait::Gait;
 use crate::host::Host;
 use crate::records::Records;
@@ -171,7 +171,7 @@ impl FirmwareInTheLoop {
 
     /// Step 1: the bus up to the tick; each delivered frame to the host (unless it sent it)
     /// and into the receive FIFO of every ankle but its sender and a bus-off one.
-    fn run_bus(&mut self, t: TickTime) -> Result<(), ControlError> {
+    fn run_bus(&mut self, t: TickTime) -> Result<(), TickError> {
         // A bus-off controller takes no part in the bus: it receives nothing from then on.
         let mut off = self
             .ankles
@@ -217,7 +217,7 @@ impl FirmwareInTheLoop {
         side: Side,
         t: TickTime,
         sensing: &AnkleSensing,
-    ) -> Result<ActuatorSegment, ControlError> {
+    ) -> Result<ActuatorSegment, TickError> {
         let scene = self.gait.scene(side, sensing);
         let ankle = &mut self.ankles[side.index()];
         let access = BusAccess {
@@ -239,6 +239,17 @@ impl AnkleController for FirmwareInTheLoop {
     }
 
     fn tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, ControlError> {
+        self.run_tick(sensing).map_err(ControlError::from)
+    }
+
+    fn heel_strike(&mut self, t_s: f64) {
+        self.gait.heel_strike(t_s);
+    }
+}
+
+impl FirmwareInTheLoop {
+    /// One control tick: the bus, the host, each ankle; the stance ankle's segment.
+    fn run_tick(&mut self, sensing: &AnkleSensing) -> Result<ActuatorSegment, TickError> {
         let t = self.clock.start(sensing.t_walk_s)?;
         self.gait.start_tick(t.t_s, sensing);
         self.run_bus(t)?;
@@ -251,10 +262,6 @@ impl AnkleController for FirmwareInTheLoop {
             }
         }
         self.clock.finish();
-        stance_segment.ok_or_else(|| control_error("no stance ankle"))
-    }
-
-    fn heel_strike(&mut self, t_s: f64) {
-        self.gait.heel_strike(t_s);
+        stance_segment.ok_or(TickError::NoStanceAnkle)
     }
 }

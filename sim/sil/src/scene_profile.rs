@@ -82,8 +82,9 @@ mod tests {
                 ParamId::PushDuration,
             ),
         ] {
-            let firmware =
-                crate::host::param_si(protocol::ParamValue::saturating_from_si(id.default_si()));
+            let firmware = crate::firmware_param::param_si(
+                protocol::ParamValue::saturating_from_si(id.default_si()),
+            );
             assert!(
                 (scene_value - firmware).abs() <= PROFILE_TOLERANCE,
                 "wisse3d's {scene_name} = {scene_value}, the firmware's {id:?} default = {firmware}"

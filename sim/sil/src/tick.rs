@@ -1,8 +1,6 @@
 //! The control clock: the period and the time of each tick, which must not run backwards.
 
-use sim::control::ControlError;
-
-use crate::error::{control_error, SilError};
+use crate::error::{SilError, TickError};
 
 /// The time of one control tick, in the walker's seconds and the bus's nanoseconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,17 +49,17 @@ impl TickClock {
     ///
     /// # Errors
     /// A time that is not finite and non-negative, or before the previous tick's.
-    pub fn start(&mut self, t_s: f64) -> Result<TickTime, ControlError> {
+    pub fn start(&mut self, t_s: f64) -> Result<TickTime, TickError> {
         if !(t_s.is_finite() && t_s >= 0.0) {
-            return Err(control_error(format!("tick at t = {t_s} s")));
+            return Err(TickError::InvalidTime { t_s });
         }
         let t_ns = (t_s * 1e9).round() as u64;
         if let Some(prev) = self.last_t_ns {
             if t_ns < prev {
-                return Err(control_error(format!(
-                    "tick at {t_s} s is before the previous tick at {} s",
-                    prev as f64 * 1e-9
-                )));
+                return Err(TickError::BeforePrevious {
+                    t_s,
+                    previous_s: prev as f64 * 1e-9,
+                });
             }
         }
         self.last_t_ns = Some(t_ns);

@@ -92,7 +92,7 @@ impl OrbitDiagramReport {
                             kind: failure.kind,
                             stride: *stride,
                             time_s: failure.t_stride_s,
-                            detail: failure.detail.clone(),
+                            detail: failure.detail(),
                         }),
                     ),
                 };

@@ -11,8 +11,9 @@
 //! knee locks, budgets, control ticks) are written once, in the loop, on top of these traits.
 
 use super::contact_figures::ContactSummary;
+use super::failure::StrideFailure;
 use super::phase::{Drive, Phase};
-use super::result::{StrideEvent, StrideFailure, StrideResult};
+use super::result::{StrideEvent, StrideResult};
 use super::witnesses::{WitnessValues, Witnesses};
 use crate::dynamics::DynamicsError;
 use crate::events::{locate, EventError, EventTolerance};

@@ -8,8 +8,9 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::energy;
+use super::failure::{FailureCause, StrideFailure};
 use super::phase::Drive;
-use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+use super::result::{StrideEvent, StrideResult};
 use crate::actuator::AnkleReflex;
 use crate::dynamics::Dynamics;
 use crate::hybrid::contact_rows::{heel_strike_rows, HeelStrikeRows};
@@ -76,7 +77,7 @@ impl Walker {
         let mut dynamics = Dynamics::new(&self.model);
         let before = energy(&mut dynamics, &self.model, at);
         let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, active, &g, 0.0)
-            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+            .map_err(|e| StrideFailure::new(at.t_s, e))?;
         // A drive holding the ankle through the impact takes an impulse and does work on it
         // (impulse × its rate, which the impact does not change): the actuator's work, not part
         // of the impact's loss.
@@ -117,19 +118,17 @@ impl Walker {
         let before = energy(&mut dynamics, &self.model, at);
         let target = DVector::from_element(1, v_rad_s);
         let imp = resolve_to(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, &target)
-            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, at.t_s, e.to_string()))?;
+            .map_err(|e| StrideFailure::new(at.t_s, e))?;
         // The string's impulse on the ankle, with its far end moving at the drive's rate, is
         // work the actuator does (zero for the ideal drive, which starts at rest).
         let drive_work_j = imp.impulse[0] * v_rad_s;
         let (q, qd) = locked_state(&at.q, imp.qd_plus, a, p_rad, v_rad_s);
         if qd[toe] > 0.0 {
             return Err(StrideFailure::new(
-                FailureKind::HeelDidNotLift,
                 at.t_s,
-                format!(
-                    "at string engagement the heel moves down ({:.3e} rad/s)",
-                    qd[toe]
-                ),
+                FailureCause::HeelMovesDown {
+                    toe_pitch_rate_rad_s: qd[toe],
+                },
             ));
         }
         let after = Sample { t_s: at.t_s, q, qd };
@@ -210,7 +209,7 @@ impl Walker {
             ..
         } = self
             .heel_strike_impact(&at, active)
-            .map_err(|e| StrideFailure::new(FailureKind::ImpactSingular, t, e.to_string()))?;
+            .map_err(|e| StrideFailure::new(t, e))?;
         energy_loss += energy_loss_j;
         let mut kin = Kinematics::new(m);
         kin.update(m, &q, &qd_plus);
@@ -219,9 +218,8 @@ impl Walker {
         let lift = kin.velocity_of(sc.link, &p_sc).y;
         if lift <= 0.0 {
             return Err(StrideFailure::new(
-                FailureKind::StanceFootDidNotLift,
                 t,
-                format!("old stance contact moves {lift:.3e} m/s upward after impact"),
+                FailureCause::StanceFootDidNotLift { lift_m_s: lift },
             ));
         }
         let states = LinkStates::from_kinematics(&kin, nr, &p_foot);
@@ -229,7 +227,7 @@ impl Walker {
             .relabel
             .solve(&self.model, &states, &self.relabel_reference_q)
             .or_else(|_| self.relabel.solve(&self.model, &states, &at.q))
-            .map_err(|e| StrideFailure::new(FailureKind::RelabelFailed, t, e.to_string()))?;
+            .map_err(|e| StrideFailure::new(t, e))?;
         Ok(StrideResult {
             q_next: solved.q,
             qd_next: solved.qd,

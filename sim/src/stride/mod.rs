@@ -24,7 +24,8 @@
 //!   and fallback);
 //! - `workspace`: [`StrideWorkspace`], the model-derived structures and scratch repeated
 //!   strides reuse;
-//! - `result`: [`StrideResult`], [`StrideFailure`], [`FailureKind`], [`StrideEvent`].
+//! - `result`: [`StrideResult`], [`StrideEvent`];
+//! - `failure`: [`StrideFailure`], its [`FailureKind`] and [`FailureCause`] (with the values).
 //!
 //! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
 //! model-level methods; walks are [`crate::walk::walk`], gait searches
@@ -37,6 +38,7 @@ mod contact_figures;
 mod energy;
 mod engine;
 mod evaluation_path;
+mod failure;
 mod fast;
 mod impacts;
 mod phase;
@@ -50,10 +52,11 @@ mod workspace;
 
 pub use contact_figures::ContactSummary;
 pub use evaluation_path::EvaluationPath;
+pub use failure::{FailureCause, FailureKind, StrideFailure};
 pub use impacts::HeelStrikeImpact;
 pub use phase::{linearised_limit, Drive, Phase};
 pub use request::{StrideControl, StrideOptions, StrideRequest};
-pub use result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+pub use result::{StrideEvent, StrideResult};
 pub use schedule::{Schedule, StepSchedule};
 pub use settings::StrideSettings;
 pub use workspace::StrideWorkspace;

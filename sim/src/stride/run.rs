@@ -9,9 +9,10 @@
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
 use super::engine::{Engine, StrideState, WitnessEvaluator};
+use super::failure::{FailureCause, StrideFailure};
 use super::phase::Drive;
 use super::request::{StrideControl, StrideOptions, StrideRequest};
-use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};
+use super::result::{StrideEvent, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::witnesses::{self, StringLimit, Watch, WitnessValues, Witnesses};
@@ -64,11 +65,7 @@ impl StrideWorkspace<'_> {
             sink,
         } = request;
         if control.is_some() && walker.ankle.is_none() {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                0.0,
-                "a controlled stride needs a scene with an ankle_reflex section",
-            ));
+            return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
         }
         let mut own = Vec::new();
         let keep_in_result = sink.is_none();
@@ -242,11 +239,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             triggered,
         } = start;
         if !cur.is_finite() {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                0.0,
-                "initial state",
-            ));
+            return Err(StrideFailure::new(0.0, FailureCause::NonFiniteInitialState));
         }
         if options.record {
             trajectory.push(cur.to_sample());
@@ -307,12 +300,10 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             self.control_tick()?;
             if self.cur.t_s() > self.settings.max_stride_time_s {
                 return Err(StrideFailure::new(
-                    FailureKind::NoImpactWithinTime,
                     self.cur.t_s(),
-                    format!(
-                        "no heel strike within {} s",
-                        self.settings.max_stride_time_s
-                    ),
+                    FailureCause::TimeBudget {
+                        max_stride_time_s: self.settings.max_stride_time_s,
+                    },
                 ));
             }
             self.check_budgets()?;
@@ -398,23 +389,21 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         let evaluations = self.evaluations + self.engine.evaluations();
         if self.steps >= self.settings.max_steps {
             return Err(StrideFailure::new(
-                FailureKind::StepBudgetExceeded,
                 self.cur.t_s(),
-                format!(
-                    "no heel strike within the step budget max_steps = {} ({} evaluations)",
-                    self.settings.max_steps, evaluations
-                ),
+                FailureCause::StepBudget {
+                    max_steps: self.settings.max_steps,
+                    evaluations,
+                },
             ));
         }
         self.check_tick_budget()?;
         if evaluations >= self.settings.max_evaluations {
             return Err(StrideFailure::new(
-                FailureKind::EvaluationBudgetExceeded,
                 self.cur.t_s(),
-                format!(
-                    "no heel strike within the evaluation budget max_evaluations = {} ({} steps)",
-                    self.settings.max_evaluations, self.steps
-                ),
+                FailureCause::EvaluationBudget {
+                    max_evaluations: self.settings.max_evaluations,
+                    steps: self.steps,
+                },
             ));
         }
         Ok(())
@@ -445,11 +434,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         .map_err(|e| StrideFailure::from_integration(e, cur.t_s()))?;
         self.engine.snap(&mut next);
         if !next.is_finite() {
-            return Err(StrideFailure::new(
-                FailureKind::NonFiniteState,
-                next.t_s(),
-                "state",
-            ));
+            return Err(StrideFailure::new(next.t_s(), FailureCause::NonFiniteState));
         }
         Ok(next)
     }
@@ -540,9 +525,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         if self.options.contact {
             self.engine
                 .add_contact(&mut self.contact, self.walker, &mut self.wit, &next)
-                .map_err(|e| {
-                    StrideFailure::new(FailureKind::NonFiniteState, next.t_s(), e.to_string())
-                })?;
+                .map_err(|e| StrideFailure::new(next.t_s(), e))?;
         }
         self.schedule.stepped(next.t_s() - self.cur.t_s());
         if next.t_s() >= drive_end_s - 1e-12 {
@@ -580,9 +563,8 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     ) -> Result<Option<(Watch, E::State)>, StrideFailure> {
         if E::HANDS_BACK && triggered.len() > 1 {
             return Err(StrideFailure::new(
-                FailureKind::EventNotLocated,
                 self.cur.t_s(),
-                "several events in one step: handed back to the reference engine",
+                FailureCause::SeveralEventsHandedBack,
             ));
         }
         let limit = self.string_limit();
@@ -620,27 +602,16 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     /// Applies the event `watch` located at `at`.
     fn apply(&mut self, watch: Watch, at: &E::State) -> Result<Applied, StrideFailure> {
         let w = self.walker;
-        let fail = |kind, detail: &str| Err(StrideFailure::new(kind, at.t_s(), detail));
+        let fail = |cause| Err(StrideFailure::new(at.t_s(), cause));
         match watch {
-            Watch::HipLow => {
-                let kind = if self.wit.eval(at).hip_ahead_m >= 0.0 {
-                    FailureKind::FellForward
-                } else {
-                    FailureKind::FellBackward
-                };
-                fail(kind, "hip below its minimum height")
-            }
-            Watch::HipBack => fail(
-                FailureKind::FellBackward,
-                "hip moved back behind the stance contact",
-            ),
+            Watch::HipLow => fail(FailureCause::HipTooLow {
+                hip_ahead_m: self.wit.eval(at).hip_ahead_m,
+            }),
+            Watch::HipBack => fail(FailureCause::HipBehindStance),
             Watch::HeelDrop => {
                 if self.engine.prescribed().is_some() {
                     // The drive still holds the ankle: the push has failed.
-                    return fail(
-                        FailureKind::HeelReturnedToFloor,
-                        "the stance heel came back down during push-off",
-                    );
+                    return fail(FailureCause::HeelReturnedToFloor);
                 }
                 // The string is slack: the heel lands, an inelastic impact that stops the
                 // foot's pitch about its toe; the foot is flat again, the ankle free.
@@ -706,14 +677,14 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     }
 
     /// The state after an impact named `what`, in the engine's storage.
-    fn state_after_impact(&self, after: Sample, what: &str) -> Result<E::State, StrideFailure> {
+    fn state_after_impact(
+        &self,
+        after: Sample,
+        what: &'static str,
+    ) -> Result<E::State, StrideFailure> {
         let t_s = after.t_s;
         E::State::from_sample(after).ok_or_else(|| {
-            StrideFailure::new(
-                FailureKind::NonFiniteState,
-                t_s,
-                format!("state after the {what}"),
-            )
+            StrideFailure::new(t_s, FailureCause::NonFiniteAfterImpact { impact: what })
         })
     }
 
@@ -727,9 +698,10 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 return Ok(Applied::Ignored);
             }
             return Err(StrideFailure::new(
-                FailureKind::Scuffed,
                 at.t_s(),
-                format!("swing foot touched the floor {ahead:.4} m ahead of the stance contact"),
+                FailureCause::Scuff {
+                    foot_ahead_m: ahead,
+                },
             ));
         }
         if let Some(knee) = w
@@ -738,12 +710,10 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             .find(|k| self.engine.active()[k.coordinate.0])
         {
             return Err(StrideFailure::new(
-                FailureKind::HeelStrikeBeforeKneeLock,
                 at.t_s(),
-                format!(
-                    "knee `{}` still free at heel strike",
-                    w.model.coordinates[knee.coordinate.0].name
-                ),
+                FailureCause::KneeFreeAtHeelStrike {
+                    knee: w.model.coordinates[knee.coordinate.0].name.clone(),
+                },
             ));
         }
         self.power.close(&w.model, at);

@@ -15,9 +15,10 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sim::integrators::IntegratorChoice;
+use sim::limit_cycle::Gait;
 use sim::report::{IdealGaitRecord, WalkGaitRecord};
 use sim::scene::Setup;
-use sim::walk::{StepSummary, WalkFailure, WalkRequest};
+use sim::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
@@ -135,51 +136,15 @@ struct SilWalkReport<'a, Bus: Serialize> {
 }
 
 /// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
-/// walker fell (the report's `failure`).
+/// walker fell (the report's `failure`). The stages: the options checked, the firmware's
+/// configuration, the ideal-actuator gait, the firmware started, the walk, the report.
 pub fn run(args: SilArgs) -> Result<ExitCode> {
-    let SilArgs {
-        common,
-        steps,
-        faults,
-        sensor_faults,
-        estop_at,
-        candump,
-        socketcand,
-        wait_client,
-        realtime,
-        keep_steps,
-        firmware_params,
-        actuator,
-        animate,
-    } = args;
-    let Some(actuator_choice) = sil::ActuatorChoice::from_name(&actuator) else {
-        return Err(InputError::Other(format!(
-            "--actuator `{actuator}`: expected `motor` or `servo`"
-        ))
-        .into());
-    };
-    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
-    if let Some(t) = estop_at {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(InputError::Other(format!(
-                "--estop-at must be a finite walk time of 0 s or more, got {t}"
-            ))
-            .into());
-        }
-    }
-    if let Some(r) = realtime {
-        limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
-    }
-    let animation = animation::open(animate.as_deref(), steps)?;
-    let wait_client = match wait_client {
-        None => None,
-        Some(_) if socketcand.is_none() => {
-            return Err(
-                InputError::Other("--wait-client needs --socketcand ADDR".to_owned()).into(),
-            )
-        }
-        Some(w) => Some(sil::wait_client_timeout(w).map_err(InputError::Other)?),
-    };
+    let (actuator_choice, steps) =
+        check_options(&args.actuator, args.steps, args.estop_at, args.realtime)?;
+    let animation = animation::open(args.animate.as_deref(), steps)?;
+    let wait_client = wait_client_timeout(args.wait_client, args.socketcand.is_some())?;
+    let common = &args.common;
+    let candump = &args.candump;
     let scene = common.scene()?;
     let Setup {
         walker,
@@ -193,12 +158,145 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         ))
         .into());
     };
-    // The firmware's own parameters unless some are written.
+    let (config, firmware_params_written) = sil_config(actuator_choice, &args)?;
+    let Some((ideal_setup, ideal)) = ideal_gait(&scene, common)? else {
+        return Ok(ExitCode::from(1));
+    };
+    if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
+        stride_settings.integrator = sil::SIL_INTEGRATOR;
+    }
+    let mut ctl = start_firmware(config, candump, args.estop_at, wait_client)?;
+    let plan = WalkPlan {
+        steps,
+        keep_steps: args.keep_steps,
+        record: animation.is_some(),
+        realtime: args.realtime,
+        show_progress: !common.json,
+    };
+    let (q, qd) = walker.unpack(&ideal.fixed_point);
+    let walk = walk_with_firmware(&walker, (&q, &qd), &stride_settings, &mut ctl, &plan);
+    let firmware = ctl.finish().map_err(|e| match candump_error(candump, e) {
+        // Only the log's flush can fail here: not bad input.
+        InputError::Other(m) => anyhow::anyhow!(m),
+        other => anyhow::Error::from(other),
+    })?;
+    let emergency_stop_sent_s = timeline::emergency_stop_sent_s(&firmware);
+    if let Some(file) = animation {
+        file.write(&Animation {
+            scene: &scene,
+            walker: &walker,
+            walk: &walk,
+            command: "sil",
+            events: walk_and_firmware_events(&walk, &firmware),
+            firmware: true,
+            emergency_stop_sent_s,
+        })?;
+    }
+    let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
+    for w in &warnings {
+        output::note(format_args!("warning: {w}"));
+    }
+    let ran = WalkRun {
+        scene: scene.name(),
+        walker: &walker,
+        integrator: &stride_settings.integrator,
+        ideal: IdealGaitRecord::of(&ideal_setup.walker, &ideal),
+        walk: &walk,
+        keep_steps: args.keep_steps,
+        firmware: &firmware,
+        emergency_stop_sent_s,
+        firmware_params_written,
+        warnings: &warnings,
+        actuator: actuator_choice.name(),
+    };
+    write_report(&ran.report(), common.json, steps)?;
+    Ok(walk_exit_code(&walk))
+}
+
+/// The walk's and the firmware's events in time order, for the animation.
+fn walk_and_firmware_events(walk: &Walk, firmware: &sil::SilReport) -> Vec<timeline::Event> {
+    let mut events = timeline::walk_events(walk);
+    events.extend(timeline::firmware_events(firmware));
+    events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    events
+}
+
+/// The options checked in order: the actuator's name, the number of steps, the emergency
+/// stop's time, the pace against real time. The actuator and the steps.
+fn check_options(
+    actuator: &str,
+    steps: usize,
+    estop_at: Option<f64>,
+    realtime: Option<f64>,
+) -> Result<(sil::ActuatorChoice, usize), InputError> {
+    let Some(actuator_choice) = sil::ActuatorChoice::from_name(actuator) else {
+        return Err(InputError::Other(format!(
+            "--actuator `{actuator}`: expected `motor` or `servo`"
+        )));
+    };
+    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
+    check_estop_at(estop_at)?;
+    if let Some(r) = realtime {
+        limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
+    }
+    Ok((actuator_choice, steps))
+}
+
+/// The ideal-actuator gait with the scene's own (accurate) integrator (the walk with the
+/// firmware uses `sil::SIL_INTEGRATOR`, DOPRI5 at 1e-6, at most one step per 1 ms control
+/// tick, unless an integrator is given on the command line); `None`, said on standard error,
+/// when there is none to start from.
+fn ideal_gait(scene: &sim::scene::Scene, common: &Common) -> Result<Option<(Setup, Gait)>> {
+    let ideal_setup = scene.setup()?;
+    match ideal_setup.find_gait(&common.newton()) {
+        Ok(g) => Ok(Some((ideal_setup, g))),
+        Err(e) => {
+            output::note(format_args!(
+                "error: no ideal-actuator gait to start from: {e}"
+            ));
+            Ok(None)
+        }
+    }
+}
+
+/// The host's emergency stop time: a finite walk time of 0 s or more.
+fn check_estop_at(estop_at: Option<f64>) -> Result<(), InputError> {
+    match estop_at {
+        Some(t) if !(t.is_finite() && t >= 0.0) => Err(InputError::Other(format!(
+            "--estop-at must be a finite walk time of 0 s or more, got {t}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// How long to wait for a socketcand client: only with a socketcand server.
+fn wait_client_timeout(
+    wait_client: Option<f64>,
+    serving: bool,
+) -> Result<Option<std::time::Duration>, InputError> {
+    match wait_client {
+        None => Ok(None),
+        Some(_) if !serving => Err(InputError::Other(
+            "--wait-client needs --socketcand ADDR".to_owned(),
+        )),
+        Some(w) => Ok(Some(
+            sil::wait_client_timeout(w).map_err(InputError::Other)?,
+        )),
+    }
+}
+
+/// The firmware in the loop's configuration from the options (the firmware's own parameters
+/// unless some are written; the bus's and the encoders' faults, the candump log and the
+/// socketcand address) and the parameters written, by name [SI units].
+fn sil_config(
+    actuator_choice: sil::ActuatorChoice,
+    args: &SilArgs,
+) -> Result<(sil::config::SilConfig, BTreeMap<&'static str, f64>), InputError> {
     let mut config = sil::config::SilConfig {
         actuator_choice,
         ..sil::config::SilConfig::default()
     };
-    for p in &firmware_params {
+    for p in &args.firmware_params {
         config = config
             .with_firmware_param_str(p)
             .map_err(|e| InputError::Other(format!("--firmware-param `{p}`: {e}")))?;
@@ -208,48 +306,41 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         .iter()
         .map(|w| (sil::firmware_param::param_name(w.id), w.wire_value_f64()))
         .collect();
-    for f in &faults {
+    for f in &args.faults {
         config = config
             .with_fault_str(f)
             .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
     }
-    for f in &sensor_faults {
+    for f in &args.sensor_faults {
         config = config
             .with_sensor_fault_str(f)
             .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
     }
-    if let Some(addr) = &socketcand {
+    if let Some(addr) = &args.socketcand {
         let parsed: std::net::SocketAddr = addr
             .parse()
             .map_err(|_| InputError::Other(format!("--socketcand `{addr}`: expected IP:PORT")))?;
         if !parsed.ip().is_loopback() {
             return Err(InputError::Other(format!(
                 "--socketcand `{addr}`: only loopback addresses are served"
-            ))
-            .into());
+            )));
         }
     }
-    config.candump = candump.clone();
-    config.socketcand = socketcand;
-    // The ideal-actuator gait with the scene's own (accurate) integrator; the walk with
-    // the firmware uses `sil::SIL_INTEGRATOR` (DOPRI5 at 1e-6, at most one step
-    // per 1 ms control tick) unless an integrator is given on the command line.
-    let ideal_setup = scene.setup()?;
-    let ideal_walker = &ideal_setup.walker;
-    let ideal = match ideal_setup.find_gait(&common.newton()) {
-        Ok(g) => g,
-        Err(e) => {
-            output::note(format_args!(
-                "error: no ideal-actuator gait to start from: {e}"
-            ));
-            return Ok(ExitCode::from(1));
-        }
-    };
-    if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
-        stride_settings.integrator = sil::SIL_INTEGRATOR;
-    }
-    // Its errors are about the configuration given (fault nodes, log path, address).
-    let mut ctl = sil::FirmwareInTheLoop::new(config).map_err(|e| candump_error(&candump, e))?;
+    config.candump = args.candump.clone();
+    config.socketcand = args.socketcand.clone();
+    Ok((config, firmware_params_written))
+}
+
+/// The firmware in the loop, built from `config` (its errors are about the configuration
+/// given: fault nodes, log path, address), the emergency stop scheduled, the socketcand
+/// server announced and, when asked, a client waited for.
+fn start_firmware(
+    config: sil::config::SilConfig,
+    candump: &Option<std::path::PathBuf>,
+    estop_at: Option<f64>,
+    wait_client: Option<std::time::Duration>,
+) -> Result<sil::FirmwareInTheLoop, InputError> {
+    let mut ctl = sil::FirmwareInTheLoop::new(config).map_err(|e| candump_error(candump, e))?;
     if let Some(t) = estop_at {
         ctl.emergency_stop_at(t);
     }
@@ -273,34 +364,60 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             )),
         }
     }
-    let (q, qd) = walker.unpack(&ideal.fixed_point);
+    Ok(ctl)
+}
+
+/// How the walk with the firmware runs: its steps, the summaries kept, whether it records
+/// the path (for the animation), its pace against real time, a progress bar.
+struct WalkPlan {
+    steps: usize,
+    keep_steps: Option<usize>,
+    record: bool,
+    realtime: Option<f64>,
+    show_progress: bool,
+}
+
+/// The walk from the ideal gait's start state `(q, qd)` with the firmware actuating the
+/// ankles (paced to real time when the plan says so).
+fn walk_with_firmware(
+    walker: &sim::walker::Walker,
+    (q, qd): (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
+    stride_settings: &sim::stride::StrideSettings,
+    ctl: &mut sil::FirmwareInTheLoop,
+    plan: &WalkPlan,
+) -> Walk {
     // The gait figures average the last 10 steps: keep at least those; keeping more than
     // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
     let options = sim::walk::WalkOptions {
-        record: animation.is_some(),
-        keep_steps: keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
+        record: plan.record,
+        keep_steps: plan.keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
-    let progress = Progress::after(PROGRESS_DELAY, steps, "sil walk (steps)", !common.json);
+    let progress = Progress::after(
+        PROGRESS_DELAY,
+        plan.steps,
+        "sil walk (steps)",
+        plan.show_progress,
+    );
     let mut tick = |_: &StepSummary| progress.tick();
-    let walk = match realtime {
+    let walk = match plan.realtime {
         None => sim::walk::walk(
-            &walker,
-            &q,
-            &qd,
-            WalkRequest::new(&stride_settings, steps)
+            walker,
+            q,
+            qd,
+            WalkRequest::new(stride_settings, plan.steps)
                 .options(options)
-                .controlled(&mut ctl)
+                .controlled(ctl)
                 .on_step(&mut tick),
         ),
         Some(factor) => {
             // Step by step, sleeping so that walk time keeps pace with wall time.
             let start = std::time::Instant::now();
-            let mut paced = sim::control::Paced::new(&mut ctl, factor, start);
+            let mut paced = sim::control::Paced::new(ctl, factor, start);
             sim::walk::walk(
-                &walker,
-                &q,
-                &qd,
-                WalkRequest::new(&stride_settings, steps)
+                walker,
+                q,
+                qd,
+                WalkRequest::new(stride_settings, plan.steps)
                     .options(options)
                     .controlled(&mut paced)
                     .on_step(&mut tick),
@@ -308,69 +425,76 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         }
     };
     progress.finish();
-    let kept = keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
-    let steps_kept = &walk.steps[walk.steps.len() - kept..];
-    let firmware = ctl.finish().map_err(|e| match candump_error(&candump, e) {
-        // Only the log's flush can fail here: not bad input.
-        InputError::Other(m) => anyhow::anyhow!(m),
-        other => anyhow::Error::from(other),
-    })?;
-    let emergency_stop_sent_s = timeline::emergency_stop_sent_s(&firmware);
-    // The firmware's gait: the steps that ended by the emergency stop (one under way at the
-    // stop, or begun after it, is not walked with the ankles actuating throughout).
-    let actuated_steps = match emergency_stop_sent_s {
-        Some(t_stop) => {
-            let before = walk
-                .steps
-                .partition_point(|s| s.start_t_walk_s + s.duration_s <= t_stop);
-            &walk.steps[..before]
-        }
-        None => &walk.steps[..],
-    };
-    if let Some(file) = animation {
-        let mut events = timeline::walk_events(&walk);
-        events.extend(timeline::firmware_events(&firmware));
-        events.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-        file.write(&Animation {
-            scene: &scene,
-            walker: &walker,
-            walk: &walk,
-            command: "sil",
-            events,
-            firmware: true,
+    walk
+}
+
+/// What the walk with the firmware gave, for its report.
+struct WalkRun<'a> {
+    scene: &'a str,
+    walker: &'a sim::walker::Walker,
+    integrator: &'a IntegratorChoice,
+    ideal: IdealGaitRecord,
+    walk: &'a Walk,
+    keep_steps: Option<usize>,
+    firmware: &'a sil::SilReport,
+    emergency_stop_sent_s: Option<f64>,
+    firmware_params_written: BTreeMap<&'static str, f64>,
+    warnings: &'a [String],
+    actuator: &'static str,
+}
+
+impl<'a> WalkRun<'a> {
+    /// The `walker sil` report. The firmware's gait: the steps that ended by the emergency
+    /// stop (one under way at the stop, or begun after it, is not walked with the ankles
+    /// actuating throughout).
+    fn report(self) -> SilWalkReport<'a, impl Serialize + 'a> {
+        let walk = self.walk;
+        let kept = self.keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
+        let emergency_stop_sent_s = self.emergency_stop_sent_s;
+        let actuated_steps = match emergency_stop_sent_s {
+            Some(t_stop) => {
+                let before = walk
+                    .steps
+                    .partition_point(|s| s.start_t_walk_s + s.duration_s <= t_stop);
+                &walk.steps[..before]
+            }
+            None => &walk.steps[..],
+        };
+        SilWalkReport {
+            scene: self.scene,
+            integrator: self.integrator,
+            steps_completed: walk.steps_completed,
+            failure: walk.failure.as_ref(),
+            gait: WalkGaitRecord::of_steps(self.walker, actuated_steps, 10),
             emergency_stop_sent_s,
-        })?;
+            steps_before_emergency_stop: actuated_steps.len(),
+            ideal_gait: self.ideal,
+            node_faults: &self.firmware.faults,
+            nodes: &self.firmware.nodes,
+            firmware_params_written: self.firmware_params_written,
+            warnings: self.warnings,
+            bus_load: self.firmware.bus.load,
+            bus: &self.firmware.bus,
+            frames: self.firmware.frames_delivered,
+            steps: &walk.steps[walk.steps.len() - kept..],
+            sensor_faults_applied: &self.firmware.sensor_faults_applied,
+            actuator: self.actuator,
+        }
     }
-    let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
-    for w in &warnings {
-        output::note(format_args!("warning: {w}"));
-    }
-    let report = SilWalkReport {
-        scene: scene.name(),
-        integrator: &stride_settings.integrator,
-        steps_completed: walk.steps_completed,
-        failure: walk.failure.as_ref(),
-        gait: WalkGaitRecord::of_steps(&walker, actuated_steps, 10),
-        emergency_stop_sent_s,
-        steps_before_emergency_stop: actuated_steps.len(),
-        ideal_gait: IdealGaitRecord::of(ideal_walker, &ideal),
-        node_faults: &firmware.faults,
-        nodes: &firmware.nodes,
-        firmware_params_written,
-        warnings: &warnings,
-        bus_load: firmware.bus.load,
-        bus: &firmware.bus,
-        frames: firmware.frames_delivered,
-        steps: steps_kept,
-        sensor_faults_applied: &firmware.sensor_faults_applied,
-        actuator: actuator_choice.name(),
-    };
-    if common.json {
-        print_json(&report)?;
+}
+
+/// The report as JSON or as text.
+fn write_report<Bus: Serialize>(
+    report: &SilWalkReport<'_, Bus>,
+    json: bool,
+    steps: usize,
+) -> Result<()> {
+    if json {
+        print_json(report)?;
     } else {
-        output::text(|out| print_text(out, &report, steps))?;
+        output::text(|out| print_text(out, report, steps))?;
     }
-    Ok(walk_exit_code(&walk))
+    Ok(())
 }
 
 /// An error of the firmware in the loop's set-up as bad input; a candump log's error names

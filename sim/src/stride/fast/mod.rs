@@ -19,9 +19,10 @@ mod planar_witnesses;
 
 use super::contact_figures::ContactSummary;
 use super::engine::{Engine, NoInterpolant, StrideState};
+use super::failure::StrideFailure;
 use super::phase::Drive;
 use super::request::StrideOptions;
-use super::result::{StrideEvent, StrideFailure, StrideResult};
+use super::result::{StrideEvent, StrideResult};
 use super::run::{Run, Start};
 use super::settings::StrideSettings;
 use super::EvaluationPath;

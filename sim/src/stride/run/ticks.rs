@@ -19,8 +19,9 @@ use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
 use crate::hermite::{self, Knot};
 use crate::stride::engine::{Engine, Interpolant, StrideState, WitnessEvaluator};
+use crate::stride::failure::{FailureCause, StrideFailure};
 use crate::stride::phase::Drive;
-use crate::stride::result::{FailureKind, StrideEvent, StrideFailure};
+use crate::stride::result::StrideEvent;
 use crate::stride::witnesses::WitnessValues;
 use crate::walker::Walker;
 
@@ -32,37 +33,32 @@ const TICK_SLACK_S: f64 = 1e-12;
 /// ticks before its heel strike's time − [`TICK_SLACK_S`], so each tick runs in one stride).
 ///
 /// # Errors
-/// [`FailureKind::InvalidControlPeriod`] when the period is not a finite positive time, or so
-/// short against the walk time that the tick grid does not advance over the stride's time
-/// budget `max_stride_time_s` (the stride's ticks would never end).
+/// [`crate::stride::FailureKind::InvalidControlPeriod`] when the period is not a finite
+/// positive time, or so short against the walk time that the tick grid does not advance over
+/// the stride's time budget `max_stride_time_s` (the stride's ticks would never end).
 pub(super) fn first_tick_s(
     period_s: f64,
     t_walk_start_s: f64,
     max_stride_time_s: f64,
 ) -> Result<f64, StrideFailure> {
-    let invalid = |why: &str| {
-        Err(StrideFailure::new(
-            FailureKind::InvalidControlPeriod,
-            0.0,
-            format!("control period {period_s} s {why}"),
-        ))
-    };
     if !(period_s.is_finite() && period_s > 0.0) {
-        return invalid("is not a finite positive time");
+        return Err(StrideFailure::new(
+            0.0,
+            FailureCause::ControlPeriodNotPositive { period_s },
+        ));
     }
     let first_s = ((t_walk_start_s - TICK_SLACK_S) / period_s).ceil() * period_s - t_walk_start_s;
     let last_s = first_s.max(0.0) + max_stride_time_s.max(0.0);
     if !first_s.is_finite() || !last_s.is_finite() || last_s + period_s <= last_s {
-        return invalid(&format!(
-            "does not advance the tick grid from walk time {t_walk_start_s} s"
+        return Err(StrideFailure::new(
+            0.0,
+            FailureCause::ControlPeriodTooShort {
+                period_s,
+                t_walk_start_s,
+            },
         ));
     }
     Ok(first_s)
-}
-
-/// A failure of the controller or of the sensing at stride time `t_s`.
-fn tick_failure(t_s: f64, detail: String) -> StrideFailure {
-    StrideFailure::new(FailureKind::NonFiniteState, t_s, detail)
 }
 
 /// The swing foot is on the floor at this height [m] or below.
@@ -161,7 +157,7 @@ fn sense<E: Engine>(
         string_torque_n_m: if engaged {
             engine
                 .actuator_torque(s)
-                .map_err(|e| tick_failure(s.t_s(), e.to_string()))?
+                .map_err(|e| StrideFailure::new(s.t_s(), e))?
                 .0
         } else {
             0.0
@@ -198,13 +194,11 @@ impl<E: Engine> Run<'_, '_, '_, E> {
             return Ok(());
         }
         Err(StrideFailure::new(
-            FailureKind::StepBudgetExceeded,
             self.cur.t_s(),
-            format!(
-                "no heel strike within the step budget max_steps = {} of control ticks \
-                 (period {} s)",
-                self.settings.max_steps, self.period_s
-            ),
+            FailureCause::TickBudget {
+                max_steps: self.settings.max_steps,
+                period_s: self.period_s,
+            },
         ))
     }
 
@@ -240,12 +234,11 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         if self.cur.t_s() > self.next_tick_s + TICK_SLACK_S {
             // Each step ends at or before the next tick, or runs its ticks on its interpolant:
             // a stride past a tick that did not run is a defect, not a result.
-            return Err(tick_failure(
+            return Err(StrideFailure::new(
                 self.cur.t_s(),
-                format!(
-                    "the control tick at stride time {} s was passed without running",
-                    self.next_tick_s
-                ),
+                FailureCause::TickPassed {
+                    tick_s: self.next_tick_s,
+                },
             ));
         }
         let t0 = control.t_walk_start_s;
@@ -273,9 +266,9 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         sensing: &AnkleSensing,
     ) -> Result<ActuatorSegment, StrideFailure> {
         let Some(control) = self.control.as_mut() else {
-            return Err(tick_failure(
+            return Err(StrideFailure::new(
                 sensing.t_walk_s,
-                "a control tick without a controller".into(),
+                FailureCause::TickWithoutController,
             ));
         };
         self.ticks += 1;
@@ -283,7 +276,7 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         let mut seg = control
             .controller
             .tick(sensing)
-            .map_err(|e| tick_failure(sensing.t_walk_s - t0, e.to_string()))?;
+            .map_err(|e| StrideFailure::new(sensing.t_walk_s - t0, e))?;
         seg.t0_s -= t0;
         seg.t1_s -= t0;
         Ok(seg)
@@ -364,13 +357,11 @@ impl<E: Engine> Run<'_, '_, '_, E> {
             return Ok(None);
         }
         let Some(dense) = dense else {
-            return Err(tick_failure(
+            return Err(StrideFailure::new(
                 self.cur.t_s(),
-                format!(
-                    "the control tick at stride time {} s lies inside a step without an \
-                     interpolant",
-                    self.next_tick_s
-                ),
+                FailureCause::TickInsideStep {
+                    tick_s: self.next_tick_s,
+                },
             ));
         };
         while self.next_tick_s < end_s - TICK_SLACK_S {
@@ -384,9 +375,11 @@ impl<E: Engine> Run<'_, '_, '_, E> {
                 Some(held) if held.same_held_input(&seg) => {
                     let after_s = self.next_tick_s + self.period_s;
                     if after_s <= self.next_tick_s {
-                        return Err(tick_failure(
+                        return Err(StrideFailure::new(
                             self.next_tick_s,
-                            format!("the control period {} s does not advance", self.period_s),
+                            FailureCause::ControlPeriodStalls {
+                                period_s: self.period_s,
+                            },
                         ));
                     }
                     self.next_tick_s = after_s;
