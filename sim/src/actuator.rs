@@ -21,16 +21,16 @@ pub struct AnkleReflex {
     /// The toe point (the contact during push-off).
     #[serde(skip)]
     pub toe: PointIndex,
-    /// Ankle angle at which the string becomes taut [rad].
+    /// Ankle angle at which the string becomes taut \[rad\].
     pub engage_rad: f64,
-    /// Ankle angle the actuator extends to [rad].
+    /// Ankle angle the actuator extends to \[rad\].
     pub final_rad: f64,
-    /// Duration of the extension [s].
+    /// Duration of the extension \[s\].
     pub duration_s: f64,
 }
 
 impl AnkleReflex {
-    /// The ideal actuator's extension started at `start_s` (stride time [s], the string's
+    /// The ideal actuator's extension started at `start_s` (stride time \[s\], the string's
     /// engagement): from the engagement angle to the final angle over the reflex's duration.
     pub fn extension_from(&self, start_s: f64) -> AnkleProfile {
         AnkleProfile {
@@ -46,18 +46,18 @@ impl AnkleReflex {
 /// from `from_rad` at `start_s` to `to_rad` at `start_s + duration_s`, held after.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AnkleProfile {
-    /// Start time [s].
+    /// Start time \[s\].
     pub start_s: f64,
-    /// Duration [s].
+    /// Duration \[s\].
     pub duration_s: f64,
-    /// Start angle [rad].
+    /// Start angle \[rad\].
     pub from_rad: f64,
-    /// Final angle [rad].
+    /// Final angle \[rad\].
     pub to_rad: f64,
 }
 
 impl AnkleProfile {
-    /// Angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s`.
+    /// Angle \[rad\], rate [rad/s] and acceleration [rad/s²] at `t_s`.
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
         crate::hybrid::profile::extension(self, t_s, self.start_s)
     }

@@ -26,7 +26,7 @@ pub struct HeelStrikeRule {
     /// The link carrying the swing foot (for the yaw constraint).
     pub swing_foot_link: LinkIndex,
     /// A crossing counts only when the swing foot is at least this far ahead of the stance
-    /// contact along x [m]; crossings behind it are mid-swing scuffs.
+    /// contact along x \[m\]; crossings behind it are mid-swing scuffs.
     pub min_ahead_m: f64,
     /// Mid-swing scuffs are ignored (the foot passes through the floor, as in Garcia et al.'s
     /// and McGeer's analyses) rather than ending the stride as a failure.
@@ -46,7 +46,7 @@ pub struct HeelStrikeRule {
 pub struct KneeLock {
     /// The knee coordinate.
     pub coordinate: CoordIndex,
-    /// Stop angle [rad].
+    /// Stop angle \[rad\].
     pub stop_rad: f64,
     /// Direction of `q − stop` that means reaching the stop.
     pub closing: Direction,
@@ -57,7 +57,7 @@ pub struct KneeLock {
 pub struct FallRule {
     /// A point at the hip.
     pub hip: PointIndex,
-    /// Fallen when the hip is lower than this above the floor [m].
+    /// Fallen when the hip is lower than this above the floor \[m\].
     pub min_hip_height_m: f64,
 }
 

@@ -22,7 +22,7 @@ pub struct Common {
     /// Integrator: meijaard, rk4, dopri5 or dop853 (default: the scene's).
     #[arg(long)]
     pub integrator: Option<String>,
-    /// Fixed step for meijaard/rk4 [s].
+    /// Fixed step for meijaard/rk4 \[s\].
     #[arg(long)]
     pub step_s: Option<f64>,
     /// Relative and absolute tolerance for dopri5 and dop853.

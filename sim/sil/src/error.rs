@@ -22,7 +22,7 @@ pub enum SilError {
     /// The control period is not a positive number of microseconds.
     #[error("control period {period_s} s is not a positive whole number of microseconds")]
     Period {
-        /// The offending period [s].
+        /// The offending period \[s\].
         period_s: f64,
     },
     /// The candump log could not be written.

@@ -66,7 +66,7 @@ pub struct ContinuationSettings {
     /// Stride settings for every parameter value instead of the scene's (`None`: the
     /// scene's own at each value).
     pub stride_settings: Option<crate::stride::StrideSettings>,
-    /// Largest turn of the tangent in one accepted step [degrees]; a step that turns more is
+    /// Largest turn of the tangent in one accepted step \[degrees\]; a step that turns more is
     /// halved, and at the smallest step the branch ends (`not_converged`) rather than jump.
     pub max_turn_deg: f64,
     /// Grid values tried (from `from` on) for a first gait ([`long_period_gait`]).

@@ -5,8 +5,8 @@ use super::konst;
 use crate::actuator::AnkleProfile;
 use nalgebra::RealField;
 
-/// Angle [rad], rate [rad/s] and acceleration [rad/s²] of `profile` at time `t_s` [s] for an
-/// extension started at `start_s` [s] (which may differ from `profile.start_s`: the variational
+/// Angle \[rad\], rate [rad/s] and acceleration [rad/s²] of `profile` at time `t_s` \[s\] for an
+/// extension started at `start_s` \[s\] (which may differ from `profile.start_s`: the variational
 /// code gives the start its own sensitivity). Before the start the angle is `from_rad`, after
 /// the end `to_rad`, both at rest.
 pub fn extension<T: RealField + Copy>(profile: &AnkleProfile, t_s: T, start_s: T) -> (T, T, T) {

@@ -13,7 +13,7 @@ pub struct StabilityLimit {
 }
 
 impl StabilityLimit {
-    /// `h_max = (1 − β) 2 / λ_max` [s].
+    /// `h_max = (1 − β) 2 / λ_max` \[s\].
     pub fn h_max_s(&self) -> f64 {
         if self.lambda_max_rad_s <= 0.0 {
             f64::INFINITY
@@ -34,7 +34,7 @@ pub struct Meijaard {
 }
 
 impl Meijaard {
-    /// Fixed step `h_s` [s]; eq. (12) is checked every `check_every` steps (0: never).
+    /// Fixed step `h_s` \[s\]; eq. (12) is checked every `check_every` steps (0: never).
     pub fn new(h_s: f64, check_every: usize) -> Self {
         Self {
             h_s,

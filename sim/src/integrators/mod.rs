@@ -65,7 +65,7 @@ pub trait SecondOrderSystem {
 /// Positions and velocities at a time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sample {
-    /// Time [s].
+    /// Time \[s\].
     pub t_s: f64,
     /// Generalised coordinates.
     pub q: DVector<f64>,
@@ -82,9 +82,9 @@ pub enum IntegrationError {
     /// The fixed step exceeds the stability limit of eq. (12).
     #[error("step {h_s:e} s exceeds the stability limit h_max = {h_max_s:e} s (λ_max = {lambda_max_rad_s:.3} rad/s, β = {beta:.3})")]
     StepTooLarge {
-        /// The step [s].
+        /// The step \[s\].
         h_s: f64,
-        /// The limit [s].
+        /// The limit \[s\].
         h_max_s: f64,
         /// Largest undamped eigenfrequency [rad/s].
         lambda_max_rad_s: f64,
@@ -94,9 +94,9 @@ pub enum IntegrationError {
     /// The adaptive step fell below its floor.
     #[error("adaptive step size fell to {h_s:e} s at t = {t_s} s")]
     StepUnderflow {
-        /// The step [s].
+        /// The step \[s\].
         h_s: f64,
-        /// Time [s].
+        /// Time \[s\].
         t_s: f64,
     },
 }
@@ -123,11 +123,11 @@ pub enum IntegratorError {
         kind: &'static str,
         /// The setting (`h_s` or `h_max_s`).
         setting: &'static str,
-        /// Its value [s].
+        /// Its value \[s\].
         value: f64,
         /// Steps the time budget needs at this step.
         steps: f64,
-        /// The stride time budget [s].
+        /// The stride time budget \[s\].
         max_stride_time_s: f64,
         /// The stride step budget.
         max_steps: usize,
@@ -135,7 +135,7 @@ pub enum IntegratorError {
     /// A stride time budget that is zero, negative, NaN or infinite.
     #[error("stride time budget max_stride_time_s = {value} s must be a positive, finite number")]
     BadTimeBudget {
-        /// Its value [s].
+        /// Its value \[s\].
         value: f64,
     },
 }
@@ -192,14 +192,14 @@ pub(crate) struct StepLimits {
 pub enum IntegratorChoice {
     /// Meijaard's one-evaluation scheme, eq. (11).
     Meijaard {
-        /// Step [s].
+        /// Step \[s\].
         h_s: f64,
         /// Check eq. (12) every this many steps (0: never).
         check_every: usize,
     },
     /// Classical fourth-order Runge-Kutta.
     Rk4 {
-        /// Step [s].
+        /// Step \[s\].
         h_s: f64,
     },
     /// Dormand-Prince 8(5,3), adaptive (Hairer's DOP853).
@@ -208,7 +208,7 @@ pub enum IntegratorChoice {
         rtol: f64,
         /// Absolute tolerance.
         atol: f64,
-        /// Largest step [s].
+        /// Largest step \[s\].
         h_max_s: f64,
     },
     /// Dormand-Prince 5(4), adaptive.
@@ -217,7 +217,7 @@ pub enum IntegratorChoice {
         rtol: f64,
         /// Absolute tolerance.
         atol: f64,
-        /// Largest step [s].
+        /// Largest step \[s\].
         h_max_s: f64,
     },
 }
@@ -311,7 +311,7 @@ impl IntegratorChoice {
 
     /// Checks that these settings can run a stride: every step, largest step and tolerance
     /// positive and finite, and the (largest) step long enough to cover `max_stride_time_s`
-    /// [s] within `max_steps` steps (a smaller one could only end in a budget failure, after
+    /// \[s\] within `max_steps` steps (a smaller one could only end in a budget failure, after
     /// a long time).
     ///
     /// # Errors
@@ -387,7 +387,7 @@ pub trait Integrator {
     fn name(&self) -> &'static str;
     /// Clears any per-trajectory memory (step-size history, counters). Call at a new start.
     fn reset(&mut self);
-    /// The step this integrator would take next from `t_s` [s].
+    /// The step this integrator would take next from `t_s` \[s\].
     fn proposed_step_s(&self) -> f64;
     /// Takes one accepted step from `from` of size at most `h_limit_s`, returning the new sample.
     fn advance(
