@@ -103,6 +103,9 @@ pub enum SceneError {
     /// An expression failed.
     #[error("{0}")]
     Expr(#[from] expr::ExprError),
+    /// A `[variant]` names something its base does not have.
+    #[error("{0}")]
+    Variant(#[from] variant::VariantError),
     /// An expression gave NaN or infinity.
     #[error("`{what}` evaluates to {value}, not a finite number")]
     NonFinite {
@@ -258,8 +261,9 @@ impl Scene {
             .map(|(_, t)| *t)
             .ok_or_else(|| file_err(format!("variant base `{base}` is not a built-in scene")))?;
         let (base_table, mut bases) = Self::resolve(&base, base_text, depth + 1)?;
+        let table = variant::apply(&base, base_table, table)?;
         bases.insert(0, base);
-        Ok((variant::apply(base_table, table)?, bases))
+        Ok((table, bases))
     }
 
     /// The scene's name.
