@@ -1,4 +1,5 @@
-//! The TOML schema of scene files (see `sim/scenes/*.toml`).
+//! The TOML schema of scene files (see `sim/scenes/*.toml`; docs/scenes.md is the reference,
+//! checked against these types by `sim/tests/scene_reference.rs`).
 
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -266,7 +267,7 @@ pub struct RelabelDef {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorDef {
-    /// `meijaard`, `rk4` or `dopri5`.
+    /// `meijaard`, `rk4`, `dopri5` or `dop853`.
     #[serde(default = "default_kind")]
     pub kind: String,
     /// Fixed step \[s\] (meijaard, rk4).
