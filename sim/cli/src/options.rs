@@ -53,7 +53,12 @@ impl Common {
     pub fn scene(&self) -> Result<Scene, InputError> {
         let mut scene = Scene::load(&self.scene)?;
         for s in &self.set {
-            scene.set_text(s)?;
+            scene.set_text(s).map_err(|e| match e {
+                SceneError::NotAnAssignment { text } => {
+                    InputError::Other(format!("`--set {text}`: expected key=value"))
+                }
+                other => other.into(),
+            })?;
         }
         Ok(scene)
     }

@@ -68,7 +68,7 @@ pub enum SceneError {
         /// Parser message.
         message: String,
     },
-    /// `--set` named a parameter the scene does not have.
+    /// A parameter name the scene does not have.
     #[error("scene `{scene}` has no parameter `{name}` (parameters: {available})")]
     UnknownParameter {
         /// Scene.
@@ -120,6 +120,12 @@ pub enum SceneError {
     /// A reference to something undefined, or a bad keyword.
     #[error("{0}")]
     Invalid(String),
+    /// An assignment ([`Scene::set_text`]) that is not `key=value`.
+    #[error("`{text}`: expected key=value")]
+    NotAnAssignment {
+        /// The text given.
+        text: String,
+    },
     /// The `[integrator]` settings cannot run a stride.
     #[error("scene `{scene}` [integrator]: {error}")]
     Integrator {
@@ -128,7 +134,7 @@ pub enum SceneError {
         /// What is wrong.
         error: IntegratorError,
     },
-    /// `--set` of a parameter that acts on nothing of this walker.
+    /// Setting a parameter that acts on nothing of this walker.
     #[error("scene `{scene}`: parameter `{name}` acts on nothing of this walker (no expression uses it{}), so setting it would change nothing", variant_of.as_ref().map(|b| format!("; the variant of `{b}` removed or welded the bodies it belongs to")).unwrap_or_default())]
     UnusedParameter {
         /// Scene.
@@ -353,9 +359,11 @@ impl Scene {
 
     /// Sets a parameter from `key=value` text.
     pub fn set_text(&mut self, assignment: &str) -> Result<(), SceneError> {
-        let (k, v) = assignment.split_once('=').ok_or_else(|| {
-            SceneError::Invalid(format!("`--set {assignment}`: expected key=value"))
-        })?;
+        let (k, v) = assignment
+            .split_once('=')
+            .ok_or_else(|| SceneError::NotAnAssignment {
+                text: assignment.to_string(),
+            })?;
         let (k, v) = (k.trim(), v.trim());
         // Name first, so an unknown key is reported as such even with a bad value.
         let name = self.parameter_name(k)?;
