@@ -93,18 +93,18 @@ pub fn blend<T: Scalar>(x: T, lift: impl Fn(f32) -> T) -> Blend<T> {
 /// rad and s for both users).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Extension<T> {
-    /// Angle at the start [rad].
+    /// Angle at the start \[rad\].
     pub from: T,
-    /// Angle at the end, held after [rad].
+    /// Angle at the end, held after \[rad\].
     pub to: T,
-    /// Duration [s], positive.
+    /// Duration \[s\], positive.
     pub duration: T,
 }
 
 /// The extension at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample<T> {
-    /// Angle [rad].
+    /// Angle \[rad\].
     pub angle: T,
     /// Rate [rad/s].
     pub rate: T,
@@ -118,13 +118,13 @@ impl<T: Scalar> Extension<T> {
         elapsed / self.duration
     }
 
-    /// The angle `elapsed` [s] after the start (`from` before it, `to` after the end).
+    /// The angle `elapsed` \[s\] after the start (`from` before it, `to` after the end).
     pub fn angle(&self, elapsed: T, lift: impl Fn(f32) -> T) -> T {
         let b = blend(self.x(elapsed), lift);
         self.from + (self.to - self.from) * b.s
     }
 
-    /// Angle, rate and acceleration `elapsed` [s] after the start (at rest before the start
+    /// Angle, rate and acceleration `elapsed` \[s\] after the start (at rest before the start
     /// and after the end).
     pub fn sample(&self, elapsed: T, lift: impl Fn(f32) -> T) -> Sample<T> {
         let d = self.duration;
@@ -138,7 +138,7 @@ impl<T: Scalar> Extension<T> {
     }
 }
 
-/// The duration [s] an extension over `span` [rad] needs so that its peak rate
+/// The duration \[s\] an extension over `span` \[rad\] needs so that its peak rate
 /// (`PEAK_SLOPE · span / duration`) stays within `max_rate` [rad/s]: `duration` itself when
 /// that is long enough, else the stretched one (the firmware's rate bound; the host's report
 /// of it).

@@ -109,13 +109,13 @@ pub fn stuff_bit_count(frame: &Frame) -> u32 {
     count
 }
 
-/// Length of the frame on the wire [bits], with its actual stuff bits and the 3-bit
+/// Length of the frame on the wire \[bits\], with its actual stuff bits and the 3-bit
 /// interframe space.
 pub fn actual_frame_bits(frame: &Frame) -> u32 {
     STUFFED_HEADER_BITS + 8 * u32::from(frame.dlc()) + TAIL_BITS + stuff_bit_count(frame)
 }
 
-/// Worst-case length [bits] (Davis et al. 2007), as [`protocol::busload::worst_case_frame_bits`].
+/// Worst-case length \[bits\] (Davis et al. 2007), as [`protocol::busload::worst_case_frame_bits`].
 pub fn worst_case_frame_bits(dlc: u8) -> u32 {
     protocol::busload::worst_case_frame_bits(dlc)
 }

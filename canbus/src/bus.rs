@@ -93,9 +93,9 @@ pub enum BusError {
     /// A time before the bus's current time.
     #[error("time {t_ns} ns is before the bus's current time {now_ns} ns")]
     TimeWentBack {
-        /// The offending time [ns].
+        /// The offending time \[ns\].
         t_ns: u64,
-        /// The bus's time [ns].
+        /// The bus's time \[ns\].
         now_ns: u64,
     },
     /// No node with that handle.
@@ -116,7 +116,7 @@ pub enum BusError {
     QueueFull {
         /// The node's name.
         node: String,
-        /// Its capacity [frames].
+        /// Its capacity \[frames\].
         capacity: usize,
     },
 }
@@ -137,9 +137,9 @@ pub enum SendOutcome {
 pub struct Delivered {
     /// The frame.
     pub frame: Frame,
-    /// Start of frame [ns].
+    /// Start of frame \[ns\].
     pub t_start_ns: u64,
-    /// End of the interframe space [ns] (the receivers have the frame a few bits earlier).
+    /// End of the interframe space \[ns\] (the receivers have the frame a few bits earlier).
     pub t_end_ns: u64,
     /// The transmitter.
     pub from: NodeHandle,
@@ -154,9 +154,9 @@ pub enum BusEvent {
     ErrorFrame {
         /// The frame whose transmission failed (it will be retransmitted unless bus-off).
         frame: Frame,
-        /// Start of the failed transmission [ns].
+        /// Start of the failed transmission \[ns\].
         t_start_ns: u64,
-        /// End of the error frame's interframe space [ns].
+        /// End of the error frame's interframe space \[ns\].
         t_end_ns: u64,
         /// The transmitter.
         from: NodeHandle,
@@ -167,7 +167,7 @@ pub enum BusEvent {
     BusOff {
         /// The node.
         node: NodeHandle,
-        /// When [ns].
+        /// When \[ns\].
         t_ns: u64,
     },
 }
@@ -181,7 +181,7 @@ impl BusEvent {
         }
     }
 
-    /// The time the event completed [ns].
+    /// The time the event completed \[ns\].
     pub fn t_end_ns(&self) -> u64 {
         match self {
             BusEvent::Delivered(d) => d.t_end_ns,
@@ -196,13 +196,13 @@ impl BusEvent {
 pub struct IdStats {
     /// Frames delivered.
     pub frames: u64,
-    /// Bits on the wire of the delivered frames [bits].
+    /// Bits on the wire of the delivered frames \[bits\].
     pub bits: u64,
     /// Failed transmissions (error frames).
     pub errors: u64,
     /// Frames discarded by `drop` faults.
     pub dropped: u64,
-    /// Delivery rate over the elapsed time [Hz].
+    /// Delivery rate over the elapsed time \[Hz\].
     pub rate_hz: f64,
 }
 
@@ -234,9 +234,9 @@ pub struct NodeStats {
 pub struct BusStats {
     /// Bit rate [bit/s].
     pub bitrate_bps: u32,
-    /// Simulated time covered [ns].
+    /// Simulated time covered \[ns\].
     pub elapsed_ns: u64,
-    /// Time the bus carried frames, error frames or interframe spaces [ns].
+    /// Time the bus carried frames, error frames or interframe spaces \[ns\].
     pub busy_ns: u64,
     /// `busy_ns / elapsed_ns` (0 when no time elapsed).
     pub load: f64,
@@ -352,7 +352,7 @@ impl Bus {
         &self.config
     }
 
-    /// The bus's current simulated time [ns].
+    /// The bus's current simulated time \[ns\].
     pub fn now_ns(&self) -> u64 {
         self.now_ns
     }
@@ -453,13 +453,13 @@ impl Bus {
         Ok(())
     }
 
-    /// Duration of `bits` bits [ns], rounded to the nearest nanosecond.
+    /// Duration of `bits` bits \[ns\], rounded to the nearest nanosecond.
     pub fn bits_to_ns(&self, bits: u32) -> u64 {
         let bps = u128::from(self.config.bitrate_bps);
         ((u128::from(bits) * 1_000_000_000 + bps / 2) / bps) as u64
     }
 
-    /// Length of `frame` on the wire under this bus's stuffing model [bits].
+    /// Length of `frame` on the wire under this bus's stuffing model \[bits\].
     pub fn frame_bits(&self, frame: &Frame) -> u32 {
         match self.config.stuffing {
             Stuffing::Actual => actual_frame_bits(frame),

@@ -17,15 +17,15 @@ use crate::bus::{Bus, BusConfig, BusError, BusEvent, NodeHandle};
 use crate::fault::FaultSpec;
 use crate::frame::Frame;
 
-/// Control tick of the demo [ns] (1 kHz, as the firmware's).
+/// Control tick of the demo \[ns\] (1 kHz, as the firmware's).
 pub const TICK_NS: u64 = 1_000_000;
-/// AnkleState period [ns] (200 Hz).
+/// AnkleState period \[ns\] (200 Hz).
 pub const ANKLE_STATE_PERIOD_NS: u64 = 5_000_000;
-/// Heartbeat period [ns] (20 Hz).
+/// Heartbeat period \[ns\] (20 Hz).
 pub const HEARTBEAT_PERIOD_NS: u64 = 50_000_000;
-/// HeelStrike period per ankle [ns] (2 Hz).
+/// HeelStrike period per ankle \[ns\] (2 Hz).
 pub const HEEL_STRIKE_PERIOD_NS: u64 = 500_000_000;
-/// Version period [ns] (0.2 Hz).
+/// Version period \[ns\] (0.2 Hz).
 pub const VERSION_PERIOD_NS: u64 = 5_000_000_000;
 
 #[derive(Clone, Debug)]
@@ -87,7 +87,7 @@ impl Demo {
         })
     }
 
-    /// Simulated time [ns].
+    /// Simulated time \[ns\].
     pub fn now_ns(&self) -> u64 {
         self.t_ns
     }

@@ -72,7 +72,7 @@ pub enum FaultKind {
     Delay {
         /// Which frames.
         filter: FrameFilter,
-        /// Extra latency [ns].
+        /// Extra latency \[ns\].
         delay_ns: u64,
     },
     /// A bit error in matching transmissions: every receiver answers with an error frame, the
@@ -103,9 +103,9 @@ pub enum FaultKind {
 pub struct FaultSpec {
     /// What it does.
     pub kind: FaultKind,
-    /// Active from this simulated time [ns] (inclusive).
+    /// Active from this simulated time \[ns\] (inclusive).
     pub from_ns: u64,
-    /// Active until this simulated time [ns] (exclusive); `None` = forever.
+    /// Active until this simulated time \[ns\] (exclusive); `None` = forever.
     pub until_ns: Option<u64>,
 }
 

@@ -15,7 +15,7 @@ pub enum FrameError {
     /// More than 8 data bytes.
     #[error("{len} data bytes, a classic CAN frame carries at most 8")]
     DataTooLong {
-        /// The offending length [bytes].
+        /// The offending length \[bytes\].
         len: usize,
     },
 }

@@ -94,7 +94,7 @@ const MAX_WAIT: Duration = Duration::from_secs(7 * 86_400);
 const FLUSH_STALL: Duration = Duration::from_millis(100);
 
 impl ServerConfig {
-    /// An upper bound of the memory the clients hold at once [bytes]: per client, its frame
+    /// An upper bound of the memory the clients hold at once \[bytes\]: per client, its frame
     /// queue (at most twice its capacity in frames, as a growing `VecDeque`), its output and
     /// input buffers (each at most twice its limit) and its thread's stack, times
     /// [`ServerConfig::max_clients`].

@@ -182,7 +182,7 @@ impl<'a> Spec<'a> {
     }
 }
 
-/// A time in milliseconds (finite, not negative) [ms], for [`Spec::optional`] and
+/// A time in milliseconds (finite, not negative) \[ms\], for [`Spec::optional`] and
 /// [`Spec::required`].
 pub fn parse_ms(value: &str) -> Option<f64> {
     value

@@ -1,5 +1,5 @@
 //! Wall-clock timestamps of simulated events: an origin [ns since the Unix epoch] plus the
-//! simulated time [ns], checked so that a far origin is an error instead of a wrapped time.
+//! simulated time \[ns\], checked so that a far origin is an error instead of a wrapped time.
 
 use thiserror::Error;
 
@@ -13,7 +13,7 @@ use thiserror::Error;
 pub struct TimestampOverflow {
     /// The origin [ns since the Unix epoch].
     pub origin_ns: u64,
-    /// The simulated time [ns].
+    /// The simulated time \[ns\].
     pub t_ns: u64,
 }
 

@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-/// Longest wait for a client that `--wait-client` accepts [s] (a day).
+/// Longest wait for a client that `--wait-client` accepts \[s\] (a day).
 pub const MAX_WAIT_CLIENT_S: f64 = 86_400.0;
 
 /// The wait for a client that `--wait-client SECONDS` asks for: finite, from 0 to

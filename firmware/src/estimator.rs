@@ -57,7 +57,7 @@ impl AngleEstimator {
         self.x = Some(x);
     }
 
-    /// Estimated angle [rad], `None` before the first sample.
+    /// Estimated angle \[rad\], `None` before the first sample.
     pub fn angle_rad(&self) -> Option<f32> {
         self.x.map(|x| x.x)
     }

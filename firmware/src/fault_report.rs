@@ -8,7 +8,7 @@ use protocol::{FaultCode, FaultTransition};
 
 use crate::time::Instant;
 
-/// Inhibit time between two events of the same fault code [µs] (50 ms).
+/// Inhibit time between two events of the same fault code \[µs\] (50 ms).
 pub const FAULT_INHIBIT_US: u64 = 50_000;
 
 const CODES: usize = FaultCode::ALL.len();

@@ -7,11 +7,11 @@
 
 use crate::time::Instant;
 
-/// Largest tolerated shortfall of the measured angle below the setpoint [rad]: 12 × the
+/// Largest tolerated shortfall of the measured angle below the setpoint \[rad\]: 12 × the
 /// profile's one-tick step at its peak rate (4 rad/s × 1 ms), 3 × the simulated servo's lag
 /// at that rate (4 rad/s × 5 ms).
 pub const FOLLOWING_ERROR_LIMIT_RAD: f32 = 0.05;
-/// How long the shortfall may last [s].
+/// How long the shortfall may last \[s\].
 pub const FOLLOWING_ERROR_TIME_S: f32 = 0.03;
 
 /// Watches the shortfall across ticks.

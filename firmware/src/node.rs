@@ -66,11 +66,11 @@ pub const FIRMWARE_VERSION: (u8, u8, u8) = (0, 1, 0);
 pub struct NodeConfig {
     /// Which ankle this is.
     pub node: NodeId,
-    /// Period of [`AnkleState`] telemetry [µs] (nominal 5 000: 200 Hz).
+    /// Period of [`AnkleState`] telemetry \[µs\] (nominal 5 000: 200 Hz).
     pub state_period_us: u64,
-    /// Period of the heartbeat [µs] (nominal 50 000: 20 Hz).
+    /// Period of the heartbeat \[µs\] (nominal 50 000: 20 Hz).
     pub heartbeat_period_us: u64,
-    /// Period of the version message [µs] (nominal 5 000 000; also sent at start).
+    /// Period of the version message \[µs\] (nominal 5 000 000; also sent at start).
     pub version_period_us: u64,
     /// Build identifier sent in the version message (the board: the first 8 hex digits of
     /// the git commit).
@@ -326,7 +326,7 @@ impl AnkleNode {
     pub fn dropped_tx(&self) -> u32 {
         self.dropped_tx
     }
-    /// Estimated ankle angle [rad] and rate [rad/s], `None` before a good sample.
+    /// Estimated ankle angle \[rad\] and rate [rad/s], `None` before a good sample.
     pub fn estimate(&self) -> Option<(f32, f32)> {
         self.estimator
             .angle_rad()
@@ -395,7 +395,7 @@ impl AnkleNode {
         }
     }
 
-    /// Fault-history entries held (newest first): code, detail, uptime [ms], state after.
+    /// Fault-history entries held (newest first): code, detail, uptime \[ms\], state after.
     pub fn fault_history(&self) -> impl Iterator<Item = (FaultCode, i16, u32, NodeState)> + '_ {
         self.history
             .iter()

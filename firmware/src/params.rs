@@ -31,22 +31,22 @@ impl Default for ReflexParams {
     }
 }
 
-/// Smallest allowed gap between the taut and the extended angle [rad].
+/// Smallest allowed gap between the taut and the extended angle \[rad\].
 pub const MIN_EXTENSION_RAD: f32 = 0.05;
 
-/// Mechanical range of the ankle: an angle beyond ±this is an encoder fault [rad].
+/// Mechanical range of the ankle: an angle beyond ±this is an encoder fault \[rad\].
 pub const ANKLE_ANGLE_LIMIT_RAD: f32 = 1.0;
 
 impl ReflexParams {
-    /// Ankle angle at which the string becomes taut [rad] (paper: −0.08).
+    /// Ankle angle at which the string becomes taut \[rad\] (paper: −0.08).
     pub fn taut_angle_rad(&self) -> f32 {
         self.taut_angle_rad
     }
-    /// Ankle angle the actuator extends to [rad] (paper: 0.2).
+    /// Ankle angle the actuator extends to \[rad\] (paper: 0.2).
     pub fn extended_angle_rad(&self) -> f32 {
         self.extended_angle_rad
     }
-    /// Nominal duration of the extension profile [s].
+    /// Nominal duration of the extension profile \[s\].
     pub fn push_duration_s(&self) -> f32 {
         self.push_duration_s
     }
@@ -54,7 +54,7 @@ impl ReflexParams {
     pub fn max_push_rate_rad_per_s(&self) -> f32 {
         self.max_push_rate_rad_per_s
     }
-    /// Peer declared lost after this long without a heartbeat [s].
+    /// Peer declared lost after this long without a heartbeat \[s\].
     pub fn peer_heartbeat_timeout_s(&self) -> f32 {
         self.peer_heartbeat_timeout_s
     }
@@ -62,7 +62,7 @@ impl ReflexParams {
     pub fn max_angular_rate_rad_per_s(&self) -> f32 {
         self.max_angular_rate_rad_per_s
     }
-    /// Encoder declared stuck after this long without change while pushing [s].
+    /// Encoder declared stuck after this long without change while pushing \[s\].
     pub fn stuck_timeout_s(&self) -> f32 {
         self.stuck_timeout_s
     }
@@ -112,7 +112,7 @@ impl ReflexParams {
         Ok(())
     }
 
-    /// Duration of the extension profile actually used [s]: the nominal duration, stretched
+    /// Duration of the extension profile actually used \[s\]: the nominal duration, stretched
     /// so that the minimum-jerk profile's peak rate (1.875 × extension / duration) stays
     /// within [`Self::max_push_rate_rad_per_s`] ([`ankle_profile::duration_within_rate`]).
     pub fn effective_push_duration_s(&self) -> f32 {

@@ -25,9 +25,9 @@ use crate::time::Instant;
 pub enum ActuatorCommand {
     /// String released: the ankle is free (safe state).
     Released,
-    /// Hold the string so that the ankle angle cannot fall below this [rad].
+    /// Hold the string so that the ankle angle cannot fall below this \[rad\].
     Position {
-        /// Setpoint as an ankle angle [rad].
+        /// Setpoint as an ankle angle \[rad\].
         ankle_angle_rad: f32,
     },
 }
@@ -72,7 +72,7 @@ pub enum ReflexEvent {
 pub struct ReflexInputs {
     /// Time of the step.
     pub now: Instant,
-    /// Estimated ankle angle [rad].
+    /// Estimated ankle angle \[rad\].
     pub angle_rad: f32,
     /// The own contact switch closed this tick (debounced rising edge).
     pub heel_strike: bool,
@@ -113,7 +113,7 @@ impl Reflex {
         self.phase
     }
 
-    /// Last position setpoint [rad] (kept after release, for telemetry).
+    /// Last position setpoint \[rad\] (kept after release, for telemetry).
     pub fn last_setpoint_rad(&self) -> f32 {
         self.last_setpoint_rad
     }

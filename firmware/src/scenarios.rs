@@ -25,15 +25,15 @@ use crate::reflex::ActuatorCommand;
 use crate::sensors::{with_simulated_noise, AngleCalibration, AngleSample, EncoderError};
 use crate::time::Instant;
 
-/// Control period [µs].
+/// Control period \[µs\].
 pub const TICK_US: u64 = 1_000;
-/// First stride's heel strike [tick].
+/// First stride's heel strike \[tick\].
 pub const FIRST_STRIDE_TICK: u32 = 100;
-/// Stride period [ticks].
+/// Stride period \[ticks\].
 pub const STRIDE_TICKS: u32 = 1_000;
-/// Stance duration [ticks].
+/// Stance duration \[ticks\].
 pub const STANCE_TICKS: u32 = 700;
-/// The peer's heel strike, from the start of the own stance [ticks].
+/// The peer's heel strike, from the start of the own stance \[ticks\].
 pub const PEER_HEEL_STRIKE_TICK: u32 = 650;
 /// Encoder calibration of the scripted sensor: every simulated ankle's,
 /// [`crate::sensors::SIMULATED_CALIBRATION`].
@@ -60,7 +60,7 @@ pub enum Glitch {
     Jump {
         /// The tick.
         at: u32,
-        /// Offset [counts].
+        /// Offset \[counts\].
         counts: i16,
     },
 }
@@ -87,7 +87,7 @@ pub struct Expect {
 pub struct Scenario {
     /// Name printed in the trace.
     pub name: &'static str,
-    /// Length [ticks].
+    /// Length \[ticks\].
     pub ticks: u32,
     /// Host commands to the left ankle, by tick.
     pub commands: &'static [(u32, CommandKind)],
@@ -296,7 +296,7 @@ pub struct Summary {
     pub actuator_digest: u64,
     /// FNV-1a digest of every transmitted frame (id, length, payload).
     pub frame_digest: u64,
-    /// Largest setpoint commanded [rad] (bits, for exact comparison).
+    /// Largest setpoint commanded \[rad\] (bits, for exact comparison).
     pub max_setpoint_bits: u32,
 }
 
@@ -418,7 +418,7 @@ pub struct World {
     angle_rad: f32,
 }
 
-/// Largest change of the plant's ankle angle per tick [rad] (10 rad/s, below the
+/// Largest change of the plant's ankle angle per tick \[rad\] (10 rad/s, below the
 /// plausibility limit).
 pub const PLANT_MAX_STEP_RAD: f32 = 0.01;
 

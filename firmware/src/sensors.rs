@@ -12,7 +12,7 @@ pub const ENCODER_COUNTS_PER_REV: u16 = 1 << 14;
 pub struct AngleSample {
     /// Raw encoder counts (0..16383).
     pub counts: u16,
-    /// Ankle angle after calibration [rad], negative when the hip is ahead of the ankle.
+    /// Ankle angle after calibration \[rad\], negative when the hip is ahead of the ankle.
     pub angle_rad: f32,
 }
 
@@ -60,7 +60,7 @@ pub struct AngleCalibration {
 }
 
 impl AngleCalibration {
-    /// Ankle angle for a reading [rad], wrapped to (−π, π].
+    /// Ankle angle for a reading \[rad\], wrapped to (−π, π].
     pub fn angle_rad(&self, counts: u16) -> f32 {
         let n = ENCODER_COUNTS_PER_REV as i32;
         let mut d = (counts as i32 - self.zero_counts as i32).rem_euclid(n);
@@ -96,7 +96,7 @@ pub const SIMULATED_CALIBRATION: AngleCalibration = AngleCalibration {
     reversed: false,
 };
 
-/// Output noise of a simulated magnetic encoder at sample `n` [counts]: −1, 0 or +1 from a
+/// Output noise of a simulated magnetic encoder at sample `n` \[counts\]: −1, 0 or +1 from a
 /// fixed integer hash, so that host, QEMU and simulator runs stay bit-identical. A real
 /// AS5047P-class sensor's reading moves by a few counts of noise at 14 bits; a reading that
 /// does not move at all for the stuck timeout is a failed sensor ([`Plausibility`]). Every

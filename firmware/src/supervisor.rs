@@ -53,7 +53,7 @@ impl LoopSupervisor {
         self.late_ticks
     }
 
-    /// Longest interval between two tick starts seen [µs].
+    /// Longest interval between two tick starts seen \[µs\].
     pub fn worst_interval_us(&self) -> u64 {
         self.worst_interval_us
     }

@@ -1,6 +1,6 @@
 //! Monotonic time in microseconds.
 
-/// A point in time since the node started [µs]. 64 bits: no wrap in the robot's lifetime.
+/// A point in time since the node started \[µs\]. 64 bits: no wrap in the robot's lifetime.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Instant(pub u64);
@@ -18,11 +18,11 @@ impl Instant {
     pub const fn as_micros(self) -> u64 {
         self.0
     }
-    /// Time since `earlier` [µs], 0 if `earlier` is later.
+    /// Time since `earlier` \[µs\], 0 if `earlier` is later.
     pub const fn micros_since(self, earlier: Instant) -> u64 {
         self.0.saturating_sub(earlier.0)
     }
-    /// Time since `earlier` [s].
+    /// Time since `earlier` \[s\].
     pub fn secs_since(self, earlier: Instant) -> f32 {
         self.micros_since(earlier) as f32 * 1.0e-6
     }

@@ -17,13 +17,13 @@ use crate::signal::MessageSpec;
 /// Stuffable header bits of a standard-identifier data frame.
 const G_STANDARD: u32 = 34;
 
-/// Worst-case length of a standard data frame with `dlc` data bytes [bits], stuffing included.
+/// Worst-case length of a standard data frame with `dlc` data bytes \[bits\], stuffing included.
 pub const fn worst_case_frame_bits(dlc: u8) -> u32 {
     let exposed = G_STANDARD + 8 * dlc as u32;
     exposed + 13 + (exposed - 1) / 4
 }
 
-/// Length of the same frame without any stuff bits [bits].
+/// Length of the same frame without any stuff bits \[bits\].
 pub const fn unstuffed_frame_bits(dlc: u8) -> u32 {
     G_STANDARD + 8 * dlc as u32 + 13
 }
@@ -35,7 +35,7 @@ pub struct MessageLoad {
     pub spec: &'static MessageSpec,
     /// How many identifiers carry it at the nominal rate.
     pub identifiers: u32,
-    /// Worst-case frame length [bits].
+    /// Worst-case frame length \[bits\].
     pub frame_bits: u32,
     /// Bits per second over all its identifiers [bit/s].
     pub bits_per_s: f64,

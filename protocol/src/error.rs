@@ -16,9 +16,9 @@ pub enum DecodeError {
     WrongLength {
         /// The raw 11-bit identifier.
         id: u16,
-        /// The message's fixed length [bytes].
+        /// The message's fixed length \[bytes\].
         expected: u8,
-        /// The received length [bytes].
+        /// The received length \[bytes\].
         actual: usize,
     },
     /// A remote-transmission-request frame; this protocol uses none.

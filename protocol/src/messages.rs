@@ -62,7 +62,7 @@ const fn enum_sig(
 pub mod layout {
     use super::*;
 
-    /// [`Command`](super::Command) with opcode `EmergencyStop` (class `EmergencyStop`).
+    /// [`Command`] with opcode `EmergencyStop` (class `EmergencyStop`).
     pub mod emergency_stop {
         use super::*;
         /// Always `EmergencyStop`.
@@ -72,7 +72,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[OPCODE];
     }
 
-    /// [`HeelStrike`](super::HeelStrike).
+    /// [`HeelStrike`].
     pub mod heel_strike {
         use super::*;
         /// Heel strikes since power-up, wrapping.
@@ -97,7 +97,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[STEP_COUNT, TIME_US];
     }
 
-    /// [`FaultEvent`](super::FaultEvent).
+    /// [`FaultEvent`].
     pub mod fault {
         use super::*;
         /// Fault code.
@@ -131,7 +131,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[CODE, TRANSITION, DETAIL, UPTIME_MS];
     }
 
-    /// [`Command`](super::Command) other than emergency stop.
+    /// [`Command`] other than emergency stop.
     pub mod command {
         use super::*;
         /// Opcode.
@@ -156,7 +156,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[OPCODE, PARAM_ID, PARAM_VALUE];
     }
 
-    /// [`ParamAck`](super::ParamAck).
+    /// [`ParamAck`].
     pub mod param_ack {
         use super::*;
         /// Parameter.
@@ -178,7 +178,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[PARAM_ID, STATUS, PARAM_VALUE];
     }
 
-    /// [`Heartbeat`](super::Heartbeat).
+    /// [`Heartbeat`].
     pub mod heartbeat {
         use super::*;
         /// Node state.
@@ -206,7 +206,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[STATE, FAULT_FLAGS, UPTIME_MS];
     }
 
-    /// [`AnkleState`](super::AnkleState).
+    /// [`AnkleState`].
     pub mod ankle_state {
         use super::*;
         /// Estimated ankle angle.
@@ -247,7 +247,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[ANGLE, RATE, ACTUATOR_POSITION, PHASE];
     }
 
-    /// [`Version`](super::Version).
+    /// [`Version`].
     pub mod version {
         use super::*;
         /// Protocol version.
@@ -278,7 +278,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[PROTOCOL, MAJOR, MINOR, PATCH, BUILD];
     }
 
-    /// [`Identity`](super::Identity).
+    /// [`Identity`].
     pub mod identity {
         use super::*;
         /// UID bits 0–31.
@@ -303,7 +303,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[UID_LOW, UID_MID];
     }
 
-    /// [`BootInfo`](super::BootInfo).
+    /// [`BootInfo`].
     pub mod boot_info {
         use super::*;
         /// UID bits 64–95.
@@ -355,7 +355,7 @@ pub mod layout {
         ];
     }
 
-    /// [`CommandAck`](super::CommandAck).
+    /// [`CommandAck`].
     pub mod command_ack {
         use super::*;
         /// The command answered.
@@ -372,7 +372,7 @@ pub mod layout {
         pub const SIGNALS: &[SignalSpec] = &[OPCODE, RESULT];
     }
 
-    /// [`FaultHistoryEntry`](super::FaultHistoryEntry).
+    /// [`FaultHistoryEntry`].
     pub mod fault_history {
         use super::*;
         /// Entry index, 0 = newest.
@@ -538,7 +538,7 @@ pub struct HeelStrike {
     pub node: NodeId,
     /// Heel strikes of this foot since power-up (wraps).
     pub step_count: u16,
-    /// Sender's uptime at the strike [µs] (wraps).
+    /// Sender's uptime at the strike \[µs\] (wraps).
     pub time_us: u32,
 }
 
@@ -568,7 +568,7 @@ pub struct Heartbeat {
     pub state: NodeState,
     /// Its active faults.
     pub faults: FaultFlags,
-    /// Its uptime [ms] (wraps).
+    /// Its uptime \[ms\] (wraps).
     pub uptime_ms: u32,
 }
 
@@ -676,7 +676,7 @@ pub struct FaultEvent {
     pub transition: FaultTransition,
     /// Offending raw value, 0 if none.
     pub detail: i16,
-    /// Sender's uptime [ms] (wraps).
+    /// Sender's uptime \[ms\] (wraps).
     pub uptime_ms: u32,
 }
 
@@ -754,7 +754,7 @@ pub struct FaultHistoryEntry {
     pub state_after: NodeState,
     /// Offending raw value.
     pub detail: i16,
-    /// Uptime at the raise [ms], 24 bits on the wire (wraps after 4.66 h).
+    /// Uptime at the raise \[ms\], 24 bits on the wire (wraps after 4.66 h).
     pub uptime_ms: u32,
 }
 
@@ -792,7 +792,7 @@ pub enum Message {
 pub struct RawFrame {
     /// Identifier.
     pub id: CanId,
-    /// Payload length [bytes].
+    /// Payload length \[bytes\].
     pub len: u8,
     /// Payload; bytes past `len` are zero.
     pub data: [u8; 8],
@@ -904,7 +904,7 @@ impl Message {
         })
     }
 
-    /// Encode the payload into `buf`, returning its length [bytes].
+    /// Encode the payload into `buf`, returning its length \[bytes\].
     ///
     /// # Errors
     /// [`EncodeError::BufferTooShort`] when `buf` is shorter than the message's DLC;

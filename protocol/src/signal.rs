@@ -21,7 +21,7 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// Width [bytes].
+    /// Width \[bytes\].
     pub const fn bytes(self) -> u8 {
         match self {
             Kind::U8 => 1,
@@ -81,7 +81,7 @@ impl SignalSpec {
     pub const fn start_bit(&self) -> u32 {
         self.byte as u32 * 8
     }
-    /// Length [bits].
+    /// Length \[bits\].
     pub const fn bits(&self) -> u32 {
         self.kind.bytes() as u32 * 8
     }
@@ -146,13 +146,13 @@ pub struct MessageSpec {
     pub class: MessageClass,
     /// Name stem in the DBC file; the node name is appended (`AnkleState_LEFT_ANKLE`).
     pub name: &'static str,
-    /// Fixed payload length [bytes].
+    /// Fixed payload length \[bytes\].
     pub dlc: u8,
     /// The signals, in byte order.
     pub signals: &'static [SignalSpec],
     /// Whose the node field is, and which node fields exist.
     pub direction: Direction,
-    /// Nominal transmission rate of each identifier of this message [Hz], for the bus-load
+    /// Nominal transmission rate of each identifier of this message \[Hz\], for the bus-load
     /// budget (event messages: a generous upper estimate).
     pub nominal_rate_hz: f64,
     /// One-line description (DBC comment).

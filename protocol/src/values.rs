@@ -285,22 +285,22 @@ wire_enum!(
     /// Reflex parameters that the host may set. Ranges and defaults: [`ParamId::range_si`],
     /// [`ParamId::default_si`].
     ParamId {
-        /// Ankle angle at which the string becomes taut [rad]; default −0.08.
+        /// Ankle angle at which the string becomes taut \[rad\]; default −0.08.
         TautAngle = 1,
-        /// Ankle angle the actuator extends to [rad]; default 0.2.
+        /// Ankle angle the actuator extends to \[rad\]; default 0.2.
         ExtendedAngle = 2,
-        /// Duration of the extension profile [s]; default 0.27 (the paper gives none; the
+        /// Duration of the extension profile \[s\]; default 0.27 (the paper gives none; the
         /// simulator's `wisse3d` scene extends over the same 0.27 s, docs/model-identification.md).
         PushDuration = 3,
         /// Bound on the profile's angular rate [rad/s]; the profile is slowed to respect it;
         /// default 4.0.
         MaxPushRate = 4,
-        /// The other ankle is declared lost after this long without a heartbeat [s];
+        /// The other ankle is declared lost after this long without a heartbeat \[s\];
         /// default 0.3.
         PeerHeartbeatTimeout = 5,
         /// Plausibility limit on the measured angular rate [rad/s]; default 40.
         MaxAngularRate = 6,
-        /// Encoder declared stuck after this long without any change while pushing [s];
+        /// Encoder declared stuck after this long without any change while pushing \[s\];
         /// default 0.05.
         StuckTimeout = 7,
     }

@@ -23,9 +23,9 @@ pub struct AccuracyPoint {
     pub integrator: String,
     /// The setting.
     pub setting: IntegratorChoice,
-    /// Step [s] (fixed-step integrators) or relative tolerance (dopri5).
+    /// Step \[s\] (fixed-step integrators) or relative tolerance (dopri5).
     pub step_or_tolerance: f64,
-    /// CPU time of one stride from the reference fixed point [µs]: the minimum of
+    /// CPU time of one stride from the reference fixed point \[µs\]: the minimum of
     /// [`TIMING_REPEATS`] repeats, so that other work on a loaded machine inflates it less.
     pub cpu_us_per_stride: f64,
     /// Right-hand-side evaluations per stride.
@@ -35,7 +35,7 @@ pub struct AccuracyPoint {
     /// Largest error of an eigenvalue of modulus at least [`EIGENVALUE_FLOOR`] (each reference
     /// eigenvalue matched to the nearest computed one).
     pub eigenvalue_error: Option<f64>,
-    /// Error of the heel-strike time of the stride from the reference fixed point [s].
+    /// Error of the heel-strike time of the stride from the reference fixed point \[s\].
     pub heel_strike_time_error_s: Option<f64>,
     /// Why no gait was found, if none was.
     pub failure: Option<String>,
@@ -48,7 +48,7 @@ pub struct AccuracyStudy {
     pub scene: String,
     /// The reference integrator.
     pub reference: IntegratorChoice,
-    /// Reference stride duration [s].
+    /// Reference stride duration \[s\].
     pub reference_step_period_s: f64,
     /// Points.
     pub points: Vec<AccuracyPoint>,

@@ -22,16 +22,16 @@ pub struct AnkleReflex {
     /// The toe point (the contact during push-off).
     #[serde(skip)]
     pub toe: PointIndex,
-    /// Ankle angle at which the string becomes taut [rad].
+    /// Ankle angle at which the string becomes taut \[rad\].
     pub engage_rad: f64,
-    /// Ankle angle the actuator extends to [rad].
+    /// Ankle angle the actuator extends to \[rad\].
     pub final_rad: f64,
-    /// Duration of the extension [s].
+    /// Duration of the extension \[s\].
     pub duration_s: f64,
 }
 
 impl AnkleReflex {
-    /// The ideal actuator's extension started at `start_s` (stride time [s], the string's
+    /// The ideal actuator's extension started at `start_s` (stride time \[s\], the string's
     /// engagement): from the engagement angle to the final angle over the reflex's duration.
     pub fn extension_from(&self, start_s: f64) -> AnkleProfile {
         AnkleProfile {

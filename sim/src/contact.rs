@@ -10,7 +10,7 @@ use nalgebra::{DVector, Vector3};
 /// Ground reaction on the walker at the floor origin (the stance contact).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactLoad {
-    /// Force [N], floor frame.
+    /// Force \[N\], floor frame.
     pub force_n: Vector3<f64>,
     /// Moment about the floor origin [N·m], floor frame.
     pub moment_n_m: Vector3<f64>,
@@ -45,7 +45,7 @@ impl ContactLoad {
         }
     }
 
-    /// Lateral offset of the centre of pressure from the origin [m], to the right of the
+    /// Lateral offset of the centre of pressure from the origin \[m\], to the right of the
     /// horizontal walking direction `heading` (unit, floor plane): the normal force at that
     /// offset carries the moment about the walking direction, `e = −M·d / F_y`.
     pub fn lateral_cop_m(&self, heading: &Vector3<f64>) -> f64 {

@@ -17,10 +17,10 @@ use serde::Serialize;
 /// and filters them as its hardware would).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct AnkleSensing {
-    /// Time since the start of the walk [s] (walk time; serialised as `t_s`).
+    /// Time since the start of the walk \[s\] (walk time; serialised as `t_s`).
     #[serde(rename = "t_s")]
     pub t_walk_s: f64,
-    /// Stance ankle angle [rad] (negative with the hip ahead of the ankle).
+    /// Stance ankle angle \[rad\] (negative with the hip ahead of the ankle).
     pub stance_ankle_rad: f64,
     /// Stance ankle rate [rad/s].
     pub stance_ankle_rate_rad_s: f64,
@@ -40,16 +40,16 @@ pub struct AnkleSensing {
 /// `(p1, v1)` at `t1` (continuous position and rate across ticks), or released.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ActuatorSegment {
-    /// Start of the tick [s] (walk time as a controller returns it; a stride shifts its
+    /// Start of the tick \[s\] (walk time as a controller returns it; a stride shifts its
     /// segments to stride time).
     pub t0_s: f64,
-    /// End of the tick [s] (same clock as [`Self::t0_s`]).
+    /// End of the tick \[s\] (same clock as [`Self::t0_s`]).
     pub t1_s: f64,
-    /// Limit angle at the start [rad].
+    /// Limit angle at the start \[rad\].
     pub p0_rad: f64,
     /// Limit rate at the start [rad/s].
     pub v0_rad_s: f64,
-    /// Limit angle at the end [rad].
+    /// Limit angle at the end \[rad\].
     pub p1_rad: f64,
     /// Limit rate at the end [rad/s].
     pub v1_rad_s: f64,
@@ -88,7 +88,7 @@ impl ActuatorSegment {
         }
     }
 
-    /// Limit angle [rad], rate [rad/s] and acceleration [rad/s²] at `t_s` (the clock of
+    /// Limit angle \[rad\], rate [rad/s] and acceleration [rad/s²] at `t_s` (the clock of
     /// [`Self::t0_s`]; clamped to the tick).
     pub fn eval(&self, t_s: f64) -> (f64, f64, f64) {
         let h = self.t1_s - self.t0_s;
@@ -180,7 +180,7 @@ impl PartialEq for ControlError {
 
 /// A controller of the stance ankle's string, sampled every `period_s`.
 pub trait AnkleController {
-    /// Control period [s]: a finite positive time (a controlled stride refuses any other, as
+    /// Control period \[s\]: a finite positive time (a controlled stride refuses any other, as
     /// `FailureKind::InvalidControlPeriod`).
     fn period_s(&self) -> f64;
     /// One tick at `sensing.t_walk_s`: returns the string's limit until the next tick.
@@ -239,13 +239,13 @@ impl AnkleController for Paced<'_> {
 /// differs from the ideal actuator only by the sample-and-hold delay.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampledReflex {
-    /// Control period [s].
+    /// Control period \[s\].
     pub period_s: f64,
-    /// Engagement (taut) angle [rad].
+    /// Engagement (taut) angle \[rad\].
     pub engage_rad: f64,
-    /// Final angle [rad].
+    /// Final angle \[rad\].
     pub final_rad: f64,
-    /// Extension duration [s].
+    /// Extension duration \[s\].
     pub duration_s: f64,
     started_at_s: Option<f64>,
 }

@@ -507,7 +507,7 @@ impl Dynamics {
         Ok(qdd)
     }
 
-    /// Mechanical energy of the finite bodies and joint springs [J], with the potential taken
+    /// Mechanical energy of the finite bodies and joint springs \[J\], with the potential taken
     /// relative to the floor origin. Call after `assemble` at the same state.
     pub fn energy_j(&self, model: &Model, q: &DVector<f64>, qd: &DVector<f64>) -> f64 {
         let kinetic = 0.5 * qd.dot(&(&self.mass_matrix * qd));

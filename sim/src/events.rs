@@ -29,7 +29,7 @@ impl Direction {
 /// Tolerances for event location.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct EventTolerance {
-    /// Stop refining when the bracket is this narrow [s].
+    /// Stop refining when the bracket is this narrow \[s\].
     pub time_s: f64,
     /// Or when the witness is this close to zero (its own unit).
     pub witness: f64,
@@ -76,7 +76,7 @@ pub enum EventError {
     NotLocated {
         /// Iterations used.
         iterations: usize,
-        /// Final bracket width [s].
+        /// Final bracket width \[s\].
         bracket_s: f64,
     },
 }

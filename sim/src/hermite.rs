@@ -54,7 +54,7 @@ pub struct Knot {
 }
 
 /// The scalar interpolant between `a` at the start and `b` at the end of an interval of `h_s`
-/// [s], at normalised time `x`: value, rate and acceleration.
+/// \[s\], at normalised time `x`: value, rate and acceleration.
 pub fn scalar(a: Knot, b: Knot, h_s: f64, x: f64) -> (f64, f64, f64) {
     let HermiteBasis {
         value: w,
@@ -69,7 +69,7 @@ pub fn scalar(a: Knot, b: Knot, h_s: f64, x: f64) -> (f64, f64, f64) {
 }
 
 /// The vector interpolant of `q` between `(q0, qd0)` at the start and `(q1, qd1)` at the end of
-/// an interval of `h_s` [s], at normalised time `x`: `q` and its rate.
+/// an interval of `h_s` \[s\], at normalised time `x`: `q` and its rate.
 pub fn vector(
     (q0, qd0): (&DVector<f64>, &DVector<f64>),
     (q1, qd1): (&DVector<f64>, &DVector<f64>),

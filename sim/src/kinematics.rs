@@ -14,7 +14,7 @@ pub type Kinematics = KinematicsOf<f64>;
 pub struct KinematicsOf<T: Scalar> {
     /// Rotation link frame → floor frame.
     pub r_floor_link: Vec<Matrix3<T>>,
-    /// Link origin in the floor frame [m].
+    /// Link origin in the floor frame \[m\].
     pub p_floor_link_m: Vec<Vector3<T>>,
     /// Joint axis in the floor frame (zero for welds).
     pub axis_floor: Vec<Vector3<T>>,
@@ -160,12 +160,12 @@ impl<T: RealField + Copy> KinematicsOf<T> {
         }
     }
 
-    /// Position in the floor frame of a point given in a link frame [m].
+    /// Position in the floor frame of a point given in a link frame \[m\].
     pub fn position_of(&self, link: LinkIndex, p_link_m: &Vector3<f64>) -> Vector3<T> {
         self.p_floor_link_m[link.0] + self.r_floor_link[link.0] * lift::<T>(p_link_m)
     }
 
-    /// Position of a marker point [m].
+    /// Position of a marker point \[m\].
     pub fn point_position(&self, model: &Model, point: PointIndex) -> Vector3<T> {
         let p = &model.points[point.0];
         self.position_of(p.link, &p.p_link_m)
@@ -243,7 +243,7 @@ impl<T: RealField + Copy> KinematicsOf<T> {
         }
     }
 
-    /// Centre of mass of the whole model (infinitesimal bodies excluded) [m].
+    /// Centre of mass of the whole model (infinitesimal bodies excluded) \[m\].
     pub fn centre_of_mass(&self, model: &Model) -> Vector3<T> {
         let mut sum = Vector3::zeros();
         let mut m = 0.0;

@@ -39,9 +39,9 @@ pub enum JointKind {
 /// Mass properties of the body carried by a link.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BodyInertia {
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass_kg: f64,
-    /// Centre of mass in the link frame [m].
+    /// Centre of mass in the link frame \[m\].
     pub p_link_com_m: Vector3<f64>,
     /// Inertia tensor about the centre of mass, link frame axes [kg·m²].
     pub inertia_com_kg_m2: Matrix3<f64>,
@@ -67,7 +67,7 @@ impl BodyInertia {
 pub struct JointForce {
     /// Stiffness [N·m/rad] or [N/m].
     pub stiffness: f64,
-    /// Rest position [rad] or [m].
+    /// Rest position \[rad\] or \[m\].
     pub rest_position: f64,
     /// Damping [N·m·s/rad] or [N·s/m].
     pub damping: f64,
@@ -80,7 +80,7 @@ pub struct Link {
     pub name: String,
     /// Parent link, or `None` for the ground.
     pub parent: Option<LinkIndex>,
-    /// Joint origin in the parent frame (or the floor frame for a root link) [m].
+    /// Joint origin in the parent frame (or the floor frame for a root link) \[m\].
     pub p_parent_joint_m: Vector3<f64>,
     /// The joint kind.
     pub joint: JointKind,
@@ -108,7 +108,7 @@ pub struct Point {
     pub name: String,
     /// Link carrying it.
     pub link: LinkIndex,
-    /// Position in the link frame [m].
+    /// Position in the link frame \[m\].
     pub p_link_m: Vector3<f64>,
 }
 
@@ -292,7 +292,7 @@ impl Model {
             .map(PointIndex)
     }
 
-    /// Total mass [kg] (infinitesimal bodies count as zero).
+    /// Total mass \[kg\] (infinitesimal bodies count as zero).
     pub fn total_mass_kg(&self) -> f64 {
         self.links
             .iter()

@@ -61,7 +61,7 @@ pub struct OrbitSettings {
     /// States repeat when they agree to this, relative (`|Δv|∞ ≤ tol (1 + |v|∞)`).
     pub period_tolerance: f64,
     /// A period `p` counts only when the states repeat after `p` strides this many times
-    /// better than after every shorter period dividing `p` (see [`period_of`]).
+    /// better than after every shorter period dividing `p` (see `period_of`).
     pub cycle_contrast: f64,
     /// Consecutive values computed in sequence from one seed.
     pub chunk_points: usize,

@@ -100,7 +100,7 @@ pub struct LinkFrame {
     pub sin: f64,
     /// Angular rate about the floor's z axis [rad/s].
     pub omega_rad_s: f64,
-    /// Origin in the floor frame, x and y [m].
+    /// Origin in the floor frame, x and y \[m\].
     pub origin_m: [f64; 2],
     /// Velocity of the origin, x and y [m/s].
     pub velocity_m_s: [f64; 2],
@@ -450,7 +450,7 @@ impl PlanarTree {
         (a.m, a.m_eps)
     }
 
-    /// The whole tree's mass [kg] and the Jacobian of its linear momentum `Σ m Jv` (x and y
+    /// The whole tree's mass \[kg\] and the Jacobian of its linear momentum `Σ m Jv` (x and y
     /// rows) at the frames `fr` ([`Self::frames`] at `q`; only their positions enter): the
     /// coupling of a translation of the root with the coordinates; over the finite bodies, or
     /// the infinitesimal ones (`infinitesimal`, their `ε` parts).

@@ -42,7 +42,7 @@ pub struct Relabelled {
     pub q: DVector<f64>,
     /// Velocities in the new labelling.
     pub qd: DVector<f64>,
-    /// Values the cyclic coordinates had before zeroing [rad].
+    /// Values the cyclic coordinates had before zeroing \[rad\].
     pub cyclic_values: Vec<f64>,
     /// Gauss-Newton iterations used.
     pub iterations: usize,

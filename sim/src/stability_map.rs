@@ -40,7 +40,7 @@ pub struct MapCell {
     pub max_abs_eigenvalue: f64,
     /// All eigenvalues strictly inside the unit circle.
     pub stable: bool,
-    /// Step period [s].
+    /// Step period \[s\].
     pub step_period_s: f64,
     /// The fixed point (stride-map vector).
     pub fixed_point: DVector<f64>,

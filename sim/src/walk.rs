@@ -24,7 +24,7 @@ use serde::Serialize;
 pub struct FloorFrame {
     /// Stance frame → floor frame (det = ±1).
     pub r: Matrix3<f64>,
-    /// Stance-frame origin in the floor frame [m].
+    /// Stance-frame origin in the floor frame \[m\].
     pub p_m: Vector3<f64>,
 }
 
@@ -65,24 +65,24 @@ impl FloorFrame {
 pub struct StepSummary {
     /// 0-based step number.
     pub step: usize,
-    /// Walk time at the start of the step [s] (serialised as `start_time_s`).
+    /// Walk time at the start of the step \[s\] (serialised as `start_time_s`).
     #[serde(rename = "start_time_s")]
     pub start_t_walk_s: f64,
-    /// Duration [s].
+    /// Duration \[s\].
     pub duration_s: f64,
-    /// Distance between the contacts [m].
+    /// Distance between the contacts \[m\].
     pub step_length_m: f64,
     /// Yaw of the new stance foot relative to the old one, in the step's own (mirrored) stance
-    /// frame [rad]: for a 3D walker the world heading alternates in sign from step to step, so a
+    /// frame \[rad\]: for a 3D walker the world heading alternates in sign from step to step, so a
     /// constant value here is a straight zigzag, not a turn.
     pub heading_change_rad: f64,
-    /// Hip position in the floor frame at the end of the step [m].
+    /// Hip position in the floor frame at the end of the step \[m\].
     pub hip_floor_m: [f64; 3],
     /// Largest deviation of the state from the start state of the walk (∞-norm).
     pub state_deviation: f64,
-    /// Impact energy loss [J].
+    /// Impact energy loss \[J\].
     pub impact_energy_loss_j: f64,
-    /// Work of the ankle actuator [J].
+    /// Work of the ankle actuator \[J\].
     pub actuator_work_j: f64,
     /// Right-hand-side evaluations the step cost (event location and impacts included).
     pub evaluations: usize,
@@ -99,7 +99,7 @@ pub struct WalkFailure {
     pub kind: FailureKind,
     /// 0-based step in which it happened.
     pub step: usize,
-    /// Time from the start of the walk [s] (walk time; serialised as `time_s`).
+    /// Time from the start of the walk \[s\] (walk time; serialised as `time_s`).
     #[serde(rename = "time_s")]
     pub t_walk_s: f64,
     /// Details.
@@ -111,13 +111,13 @@ pub struct WalkFailure {
 pub struct PathSample {
     /// Step number.
     pub step: usize,
-    /// Time from the start of the walk [s] (walk time).
+    /// Time from the start of the walk \[s\] (walk time).
     pub t_walk_s: f64,
     /// Coordinates (stance labelling of that step).
     pub q: DVector<f64>,
     /// Velocities.
     pub qd: DVector<f64>,
-    /// Hip in the floor frame [m].
+    /// Hip in the floor frame \[m\].
     pub hip_floor_m: Vector3<f64>,
     /// The stance frame of its step in the floor frame: maps the sample's link poses
     /// ([`Kinematics`] of `q`) to the floor frame.

@@ -12,7 +12,7 @@ use nalgebra::DVector;
 pub struct KneeLock {
     /// The knee coordinate.
     pub coordinate: CoordIndex,
-    /// Stop angle [rad].
+    /// Stop angle \[rad\].
     pub stop_rad: f64,
     /// Direction of `q − stop` that means reaching the stop.
     pub closing: Direction,
@@ -23,7 +23,7 @@ pub struct KneeLock {
 pub struct FallRule {
     /// A point at the hip.
     pub hip: PointIndex,
-    /// Fallen when the hip is lower than this above the floor [m].
+    /// Fallen when the hip is lower than this above the floor \[m\].
     pub min_hip_height_m: f64,
 }
 

@@ -29,7 +29,7 @@ enum StuffingArg {
 #[derive(Parser, Debug)]
 #[command(about = "Simulated walker CAN bus: a host and two fake ankle nodes at nominal rates")]
 struct Cli {
-    /// Simulated duration [s].
+    /// Simulated duration \[s\].
     #[arg(long, default_value_t = 5.0)]
     seconds: f64,
     /// Serve the bus with the socketcand protocol on this loopback address (port 0: any free
@@ -39,7 +39,7 @@ struct Cli {
     /// socketcand channel name.
     #[arg(long, default_value = "vcan0")]
     channel: String,
-    /// With --socketcand: wait up to this long [s] for a client in rawmode before starting
+    /// With --socketcand: wait up to this long \[s\] for a client in rawmode before starting
     /// (0 to 86400).
     #[arg(long, value_name = "SECONDS")]
     wait_client: Option<f64>,
@@ -124,7 +124,7 @@ fn origin_ns(origin: &str) -> Result<u64> {
     })
 }
 
-/// The checked options: (end of the run [ns], origin [ns], speed, wait for a client).
+/// The checked options: (end of the run \[ns\], origin \[ns\], speed, wait for a client).
 struct Checked {
     end_ns: u64,
     origin_ns: u64,

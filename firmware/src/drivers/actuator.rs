@@ -110,7 +110,7 @@ impl<P: SetDutyCycle, D: OutputPin> PwmDirActuator<P, D> {
         (self.pwm, self.dir)
     }
 
-    /// The signed duty fraction for an error [rad] (positive: shorten the string).
+    /// The signed duty fraction for an error \[rad\] (positive: shorten the string).
     pub fn duty_for_error(&self, error_rad: f32) -> f32 {
         let d = self.gains.kp_per_rad * error_rad;
         d.clamp(-self.gains.max_duty, self.gains.max_duty)
@@ -156,15 +156,15 @@ impl<P: SetDutyCycle, D: OutputPin> Actuator for PwmDirActuator<P, D> {
 /// Pulse widths of a position servo.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ServoRange {
-    /// PWM period [µs] (20 000 for 50 Hz servos).
+    /// PWM period \[µs\] (20 000 for 50 Hz servos).
     pub period_us: f32,
-    /// Pulse for `min_angle_rad` [µs].
+    /// Pulse for `min_angle_rad` \[µs\].
     pub min_pulse_us: f32,
-    /// Pulse for `max_angle_rad` [µs].
+    /// Pulse for `max_angle_rad` \[µs\].
     pub max_pulse_us: f32,
-    /// Ankle angle at the shortest pulse [rad].
+    /// Ankle angle at the shortest pulse \[rad\].
     pub min_angle_rad: f32,
-    /// Ankle angle at the longest pulse [rad].
+    /// Ankle angle at the longest pulse \[rad\].
     pub max_angle_rad: f32,
 }
 
@@ -193,7 +193,7 @@ impl<P: SetDutyCycle> ServoActuator<P> {
         ServoActuator { pwm, range }
     }
 
-    /// Pulse width for a setpoint [µs], the setpoint clamped to the servo's range.
+    /// Pulse width for a setpoint \[µs\], the setpoint clamped to the servo's range.
     pub fn pulse_us(&self, ankle_angle_rad: f32) -> f32 {
         let r = &self.range;
         let a = ankle_angle_rad.clamp(r.min_angle_rad, r.max_angle_rad);

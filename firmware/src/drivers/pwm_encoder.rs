@@ -25,9 +25,9 @@ pub const MAX_ANGLE_12: u32 = 4095;
 /// One captured PWM frame, in timer ticks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PwmFrame {
-    /// High time of the frame [ticks].
+    /// High time of the frame \[ticks\].
     pub high_ticks: u32,
-    /// Period of the frame [ticks].
+    /// Period of the frame \[ticks\].
     pub period_ticks: u32,
 }
 

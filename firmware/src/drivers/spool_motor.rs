@@ -75,7 +75,7 @@ pub trait HalfBridges {
 
 /// The spool's position sensor (a quadrature encoder on the motor shaft).
 pub trait SpoolEncoder {
-    /// Spool position [counts], growing as the string winds in.
+    /// Spool position \[counts\], growing as the string winds in.
     ///
     /// # Errors
     /// [`HardwareError`] when the position cannot be read.
@@ -84,7 +84,7 @@ pub trait SpoolEncoder {
 
 /// The motor-current measurement.
 pub trait CurrentSense {
-    /// Magnitude of the motor current [A].
+    /// Magnitude of the motor current \[A\].
     ///
     /// # Errors
     /// [`HardwareError`] when the converter failed.
@@ -99,7 +99,7 @@ pub struct SpoolMotorConfig {
     /// Duty per radian per second of error rate (setpoint rate − the spool's rate as an
     /// ankle rate) [s/rad].
     pub kd_s_per_rad: f32,
-    /// Control period [s] (the rates are differences over one tick).
+    /// Control period \[s\] (the rates are differences over one tick).
     pub tick_s: f32,
     /// Spool counts per radian of ankle angle while the string is taut: the build's gearing
     /// (encoder counts per motor turn × gear ratio × lever arm / spool radius / 2π). Measured
@@ -107,7 +107,7 @@ pub struct SpoolMotorConfig {
     pub counts_per_ankle_rad: f32,
     /// Largest duty while holding (0..1].
     pub max_duty: f32,
-    /// Current limit [A].
+    /// Current limit \[A\].
     pub current_limit_a: f32,
     /// Level of the leaky over-current count (one up per reading over the limit, one down per
     /// driven reading under it) at which the actuator latches off.
@@ -131,7 +131,7 @@ pub struct SpoolMotorConfig {
     pub release_timeout_ticks: u16,
     /// Pay-out aborted when its error has not improved for this many ticks.
     pub release_stall_ticks: u16,
-    /// Largest pay-out [counts] below the spool position where a hold began, while holding.
+    /// Largest pay-out \[counts\] below the spool position where a hold began, while holding.
     pub hold_payout_counts: i32,
     /// Soft limit: no drive below this spool position [counts from power-up].
     pub spool_min_counts: i32,

@@ -187,13 +187,13 @@ pub enum Edge {
 /// The plot area in pixels: left, top, width and height.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rect {
-    /// Left edge [px].
+    /// Left edge \[px\].
     pub x: f64,
-    /// Top edge [px].
+    /// Top edge \[px\].
     pub y: f64,
-    /// Width [px].
+    /// Width \[px\].
     pub w: f64,
-    /// Height [px].
+    /// Height \[px\].
     pub h: f64,
 }
 

@@ -38,9 +38,9 @@ pub enum FigureError {
     Empty {
         /// The SVG file.
         file: String,
-        /// Width [px].
+        /// Width \[px\].
         width: f32,
-        /// Height [px].
+        /// Height \[px\].
         height: f32,
     },
     /// The PNG encoder failed.

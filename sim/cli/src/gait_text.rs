@@ -9,15 +9,15 @@ use std::io::Write;
 
 /// The figures of one gait, as a report gives them.
 pub struct GaitFigures {
-    /// Step period [s].
+    /// Step period \[s\].
     pub period_s: f64,
-    /// Distance walked forward per step [m].
+    /// Distance walked forward per step \[m\].
     pub progress_m: f64,
-    /// Distance between the feet at heel strike [m].
+    /// Distance between the feet at heel strike \[m\].
     pub step_length_m: f64,
     /// Forward speed, `progress_m / period_s` [m/s].
     pub speed_m_s: f64,
-    /// Actuator work per step [J] and cost of transport [J/(kg·m)]; `None` for a walker
+    /// Actuator work per step \[J\] and cost of transport [J/(kg·m)]; `None` for a walker
     /// without an actuator.
     pub actuator: Option<(f64, f64)>,
 }

@@ -150,7 +150,7 @@ pub fn walk_end_label(kind: FailureKind) -> String {
     }
 }
 
-/// The host's emergency stop, sent at walk time `t_s` [s], in words.
+/// The host's emergency stop, sent at walk time `t_s` \[s\], in words.
 pub fn emergency_stop_label(t_s: f64) -> String {
     format!("emergency stop sent at {t_s:.3} s")
 }

@@ -22,7 +22,7 @@ pub struct Common {
     /// Integrator: meijaard, rk4, dopri5 or dop853 (default: the scene's).
     #[arg(long)]
     pub integrator: Option<String>,
-    /// Fixed step for meijaard/rk4 [s].
+    /// Fixed step for meijaard/rk4 \[s\].
     #[arg(long)]
     pub step_s: Option<f64>,
     /// Relative and absolute tolerance for dopri5 and dop853.
@@ -53,7 +53,12 @@ impl Common {
     pub fn scene(&self) -> Result<Scene, InputError> {
         let mut scene = Scene::load(&self.scene)?;
         for s in &self.set {
-            scene.set_text(s)?;
+            scene.set_text(s).map_err(|e| match e {
+                SceneError::NotAnAssignment { text } => {
+                    InputError::Other(format!("`--set {text}`: expected key=value"))
+                }
+                other => other.into(),
+            })?;
         }
         Ok(scene)
     }

@@ -90,7 +90,7 @@ pub struct Series {
 pub struct Note {
     /// The point, in data units.
     pub at: (f64, f64),
-    /// Offset of the text's start from the point [px] (y down).
+    /// Offset of the text's start from the point \[px\] (y down).
     pub offset_px: (f64, f64),
     /// The text.
     pub text: String,
@@ -146,10 +146,10 @@ pub const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 
-/// Width of one legend or label character at the 13 px font size [px] (DejaVu Sans' mean
+/// Width of one legend or label character at the 13 px font size \[px\] (DejaVu Sans' mean
 /// advance, slightly generous so that boxes never cut text).
 const CHAR_PX: f64 = 7.6;
-/// Height of one legend row [px].
+/// Height of one legend row \[px\].
 const LEGEND_ROW_PX: f64 = 19.0;
 /// Longest legend label (characters) still placed to the right of the plot area; longer ones
 /// (or a legend taller than the plot area) go below it.
@@ -166,7 +166,7 @@ pub struct Layout {
     pub x_range: (f64, f64),
     /// y range shown (axis units).
     pub y_range: (f64, f64),
-    /// Top of the x-axis label's baseline [px].
+    /// Top of the x-axis label's baseline \[px\].
     pub x_label_y: f64,
 }
 
@@ -230,7 +230,7 @@ pub(crate) fn header(
     }
 }
 
-/// The SVG of `marker` centred at `(cx, cy)` [px].
+/// The SVG of `marker` centred at `(cx, cy)` \[px\].
 pub(crate) fn marker_svg(marker: Marker, (cx, cy): (f64, f64), color: &str) -> String {
     let polygon = |pts: &[(f64, f64)], fill: bool| {
         let p: Vec<String> = pts

@@ -9,7 +9,7 @@ use crate::figures::state_label;
 use crate::labels::{parameter_label, walker_name};
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
 use nalgebra::{Complex, DVector};
-use sim::continuation::{BifurcationKind, BranchPoint, Continuation};
+use sim::continuation::{BifurcationKind, Branch, BranchPoint, Continuation};
 use sim::hermite::{self, Knot};
 use sim::scene::Scene;
 
@@ -75,11 +75,8 @@ fn mark(kind: BifurcationKind) -> (Marker, &'static str, &'static str) {
 /// The two sweep figures from the continuation `c` of `scene`: the bifurcation diagram of
 /// stride-map entry `coordinate` (index `index` in the map), and max |λ| against the parameter.
 pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: usize) -> [Plot; 2] {
-    let param = parameter_label(scene, &c.family.param);
-    let name = walker_name(scene);
     // Curves: per period, stable (solid) and unstable (dashed), in both figures.
-    let mut state: Vec<Series> = Vec::new();
-    let mut modulus: Vec<Series> = Vec::new();
+    let mut curves = Curves::default();
     let mut periods: Vec<usize> = Vec::new();
     for b in &c.branches {
         let color = match periods.iter().position(|p| *p == b.period_strides) {
@@ -89,54 +86,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
                 PALETTE[(periods.len() - 1) % PALETTE.len()]
             }
         };
-        let grid: Vec<f64> = b.grid.iter().map(|g| g.value).collect();
-        let bifs: Vec<(f64, bool)> = b
-            .bifurcations
-            .iter()
-            .map(|x| (x.value, x.kind == BifurcationKind::Fold))
-            .collect();
-        let slot = slots(&grid, &bifs);
-        let mut nodes: Vec<Node> = Vec::new();
-        // A branch switched onto at a bifurcation starts there (its parent's point: a
-        // period-2k orbit born from a period-k one repeats its states).
-        let birth = b.parent.and_then(|(parent, value)| {
-            c.branches.iter().find(|p| p.id == parent).and_then(|p| {
-                p.bifurcations
-                    .iter()
-                    .min_by(|x, y| (x.value - value).abs().total_cmp(&(y.value - value).abs()))
-            })
-        });
-        if let (Some(x), Some(first)) = (birth, b.grid.first()) {
-            let s = first.point.stable();
-            nodes.push(Node {
-                value: x.value,
-                point: &x.point,
-                stable_from_previous: s,
-                stable_to_next: s,
-            });
-        }
-        let mut next_bif = 0;
-        for i in 0..=b.grid.len() {
-            while next_bif < slot.len() && slot[next_bif] == i {
-                let x = &b.bifurcations[next_bif];
-                nodes.push(Node {
-                    value: x.value,
-                    point: &x.point,
-                    stable_from_previous: x.stable_before,
-                    stable_to_next: x.stable_after,
-                });
-                next_bif += 1;
-            }
-            if let Some(g) = b.grid.get(i) {
-                let s = g.point.stable();
-                nodes.push(Node {
-                    value: g.value,
-                    point: &g.point,
-                    stable_from_previous: s,
-                    stable_to_next: s,
-                });
-            }
-        }
+        let nodes = branch_nodes(c, b);
         let label = |stable: bool| {
             let period = if b.period_strides == 1 {
                 "period-1 gait".to_string()
@@ -146,105 +96,202 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             format!("{period}, {}", if stable { "stable" } else { "unstable" })
         };
         for stable in [true, false] {
-            // The segments of this stability, as polylines broken by NaN.
-            let mut by_phase: Vec<Vec<(f64, f64)>> = vec![Vec::new(); b.period_strides.max(1)];
-            let mut lam: Vec<(f64, f64)> = Vec::new();
-            let mut open = false;
-            // The largest |λ| along the arclength, for drawing between the points of a
-            // period-1 branch: monotone cubic slopes (it has no tangent of its own).
-            let lam_nodes: Vec<f64> = nodes.iter().map(|n| n.point.max_abs_multiplier()).collect();
-            let arc: Vec<f64> = nodes
-                .windows(2)
-                .map(|w| (w[1].point.x() - w[0].point.x()).norm())
-                .collect();
-            let lam_slopes = monotone_slopes(&arc, &lam_nodes);
-            for (i, w) in nodes.windows(2).enumerate() {
-                let seg_stable = w[0].stable_to_next && w[1].stable_from_previous;
-                if seg_stable == stable {
-                    for (k, pts) in by_phase.iter_mut().enumerate() {
-                        let y = |n: &Node| {
-                            let orbit = &n.point.orbit;
-                            orbit
-                                .get(k % orbit.len().max(1))
-                                .and_then(|s| s.get(index))
-                                .copied()
-                                .unwrap_or(f64::NAN)
-                        };
-                        if !open {
-                            pts.push((w[0].value, y(&w[0])));
-                        }
-                        // A period-1 branch between its points: the cubic through both with
-                        // the continuation's tangents (its orbit has one state, the tangent's).
-                        if b.period_strides == 1 {
-                            pts.extend(between(w[0].point, w[1].point, index));
-                        }
-                        pts.push((w[1].value, y(&w[1])));
-                    }
-                    if !open {
-                        lam.push((w[0].value, lam_nodes[i]));
-                    }
-                    if b.period_strides == 1 {
-                        let ps = between(w[0].point, w[1].point, index);
-                        let a = Knot {
-                            value: lam_nodes[i],
-                            rate: lam_slopes[i],
-                        };
-                        let z = Knot {
-                            value: lam_nodes[i + 1],
-                            rate: lam_slopes[i + 1],
-                        };
-                        lam.extend(ps.iter().enumerate().map(|(k, (p, _))| {
-                            let u = (k + 1) as f64 / (HERMITE_POINTS + 1) as f64;
-                            (*p, hermite::scalar(a, z, arc[i], u).0)
-                        }));
-                    }
-                    lam.push((w[1].value, lam_nodes[i + 1]));
-                    open = true;
-                } else if open {
-                    for pts in by_phase.iter_mut() {
-                        pts.push((f64::NAN, f64::NAN));
-                    }
-                    lam.push((f64::NAN, f64::NAN));
-                    open = false;
-                }
-            }
+            let (pts, lam) = stability_polylines(&nodes, b.period_strides, index, stable);
             if lam.iter().all(|p| p.0.is_nan()) {
                 continue;
             }
-            let existing = state
-                .iter()
-                .position(|s| s.label == label(stable) && s.color == color);
-            let style = if stable { Style::LINE } else { Style::DASHED };
-            let mut pts: Vec<(f64, f64)> = Vec::new();
-            for ph in by_phase {
-                pts.extend(ph);
-                pts.push((f64::NAN, f64::NAN));
+            curves.add(label(stable), color, stable, pts, lam);
+        }
+    }
+    let Curves { state, modulus } = add_markers(curves, c, index);
+    figures(scene, c, coordinate, state, modulus)
+}
+
+/// The curves of both figures: the state at heel strike and max |λ|, series for series.
+#[derive(Default)]
+struct Curves {
+    state: Vec<Series>,
+    modulus: Vec<Series>,
+}
+
+impl Curves {
+    /// Adds a branch's polylines of one stability to the series of its label and colour (a
+    /// new series if there is none yet), broken from what is there by NaN.
+    fn add(
+        &mut self,
+        label: String,
+        color: &'static str,
+        stable: bool,
+        by_phase: Vec<Vec<(f64, f64)>>,
+        lam: Vec<(f64, f64)>,
+    ) {
+        let existing = self
+            .state
+            .iter()
+            .position(|s| s.label == label && s.color == color);
+        let style = if stable { Style::LINE } else { Style::DASHED };
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for ph in by_phase {
+            pts.extend(ph);
+            pts.push((f64::NAN, f64::NAN));
+        }
+        match existing {
+            Some(k) => {
+                self.state[k].points.push((f64::NAN, f64::NAN));
+                self.state[k].points.extend(pts);
+                self.modulus[k].points.push((f64::NAN, f64::NAN));
+                self.modulus[k].points.extend(lam);
             }
-            match existing {
-                Some(k) => {
-                    state[k].points.push((f64::NAN, f64::NAN));
-                    state[k].points.extend(pts);
-                    modulus[k].points.push((f64::NAN, f64::NAN));
-                    modulus[k].points.extend(lam);
-                }
-                None => {
-                    state.push(Series {
-                        label: label(stable),
-                        points: pts,
-                        style,
-                        color,
-                    });
-                    modulus.push(Series {
-                        label: label(stable),
-                        points: lam,
-                        style,
-                        color,
-                    });
-                }
+            None => {
+                self.state.push(Series {
+                    label: label.clone(),
+                    points: pts,
+                    style,
+                    color,
+                });
+                self.modulus.push(Series {
+                    label,
+                    points: lam,
+                    style,
+                    color,
+                });
             }
         }
     }
-    // Markers: every located bifurcation, one series per kind.
+}
+
+/// A branch's points in arclength order: where it was born (a branch switched onto at a
+/// bifurcation starts at its parent's point), then its grid points with its bifurcations
+/// among them ([`slots`]).
+fn branch_nodes<'a>(c: &'a Continuation, b: &'a Branch) -> Vec<Node<'a>> {
+    let grid: Vec<f64> = b.grid.iter().map(|g| g.value).collect();
+    let bifs: Vec<(f64, bool)> = b
+        .bifurcations
+        .iter()
+        .map(|x| (x.value, x.kind == BifurcationKind::Fold))
+        .collect();
+    let slot = slots(&grid, &bifs);
+    let mut nodes: Vec<Node> = Vec::new();
+    // A branch switched onto at a bifurcation starts there (its parent's point: a
+    // period-2k orbit born from a period-k one repeats its states).
+    let birth = b.parent.and_then(|(parent, value)| {
+        c.branches.iter().find(|p| p.id == parent).and_then(|p| {
+            p.bifurcations
+                .iter()
+                .min_by(|x, y| (x.value - value).abs().total_cmp(&(y.value - value).abs()))
+        })
+    });
+    if let (Some(x), Some(first)) = (birth, b.grid.first()) {
+        let s = first.point.stable();
+        nodes.push(Node {
+            value: x.value,
+            point: &x.point,
+            stable_from_previous: s,
+            stable_to_next: s,
+        });
+    }
+    let mut next_bif = 0;
+    for i in 0..=b.grid.len() {
+        while next_bif < slot.len() && slot[next_bif] == i {
+            let x = &b.bifurcations[next_bif];
+            nodes.push(Node {
+                value: x.value,
+                point: &x.point,
+                stable_from_previous: x.stable_before,
+                stable_to_next: x.stable_after,
+            });
+            next_bif += 1;
+        }
+        if let Some(g) = b.grid.get(i) {
+            let s = g.point.stable();
+            nodes.push(Node {
+                value: g.value,
+                point: &g.point,
+                stable_from_previous: s,
+                stable_to_next: s,
+            });
+        }
+    }
+    nodes
+}
+
+/// The segments of one stability of a branch (its `nodes`, of period `period_strides`) as
+/// polylines broken by NaN: stride-map entry `index` against the parameter, one per phase of
+/// the orbit, and max |λ| against the parameter.
+#[allow(clippy::type_complexity)]
+fn stability_polylines(
+    nodes: &[Node],
+    period_strides: usize,
+    index: usize,
+    stable: bool,
+) -> (Vec<Vec<(f64, f64)>>, Vec<(f64, f64)>) {
+    let mut by_phase: Vec<Vec<(f64, f64)>> = vec![Vec::new(); period_strides.max(1)];
+    let mut lam: Vec<(f64, f64)> = Vec::new();
+    let mut open = false;
+    // The largest |λ| along the arclength, for drawing between the points of a
+    // period-1 branch: monotone cubic slopes (it has no tangent of its own).
+    let lam_nodes: Vec<f64> = nodes.iter().map(|n| n.point.max_abs_multiplier()).collect();
+    let arc: Vec<f64> = nodes
+        .windows(2)
+        .map(|w| (w[1].point.x() - w[0].point.x()).norm())
+        .collect();
+    let lam_slopes = monotone_slopes(&arc, &lam_nodes);
+    for (i, w) in nodes.windows(2).enumerate() {
+        let seg_stable = w[0].stable_to_next && w[1].stable_from_previous;
+        if seg_stable == stable {
+            for (k, pts) in by_phase.iter_mut().enumerate() {
+                let y = |n: &Node| {
+                    let orbit = &n.point.orbit;
+                    orbit
+                        .get(k % orbit.len().max(1))
+                        .and_then(|s| s.get(index))
+                        .copied()
+                        .unwrap_or(f64::NAN)
+                };
+                if !open {
+                    pts.push((w[0].value, y(&w[0])));
+                }
+                // A period-1 branch between its points: the cubic through both with
+                // the continuation's tangents (its orbit has one state, the tangent's).
+                if period_strides == 1 {
+                    pts.extend(between(w[0].point, w[1].point, index));
+                }
+                pts.push((w[1].value, y(&w[1])));
+            }
+            if !open {
+                lam.push((w[0].value, lam_nodes[i]));
+            }
+            if period_strides == 1 {
+                let ps = between(w[0].point, w[1].point, index);
+                let a = Knot {
+                    value: lam_nodes[i],
+                    rate: lam_slopes[i],
+                };
+                let z = Knot {
+                    value: lam_nodes[i + 1],
+                    rate: lam_slopes[i + 1],
+                };
+                lam.extend(ps.iter().enumerate().map(|(k, (p, _))| {
+                    let u = (k + 1) as f64 / (HERMITE_POINTS + 1) as f64;
+                    (*p, hermite::scalar(a, z, arc[i], u).0)
+                }));
+            }
+            lam.push((w[1].value, lam_nodes[i + 1]));
+            open = true;
+        } else if open {
+            for pts in by_phase.iter_mut() {
+                pts.push((f64::NAN, f64::NAN));
+            }
+            lam.push((f64::NAN, f64::NAN));
+            open = false;
+        }
+    }
+    (by_phase, lam)
+}
+
+/// The curves with a marker series per bifurcation kind found: at each state of its orbit
+/// in the diagram, at its crossing multiplier's modulus in the stability figure.
+fn add_markers(mut curves: Curves, c: &Continuation, index: usize) -> Curves {
     for kind in [
         BifurcationKind::Fold,
         BifurcationKind::PeriodDoubling,
@@ -261,7 +308,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             continue;
         }
         let (marker, color, label) = mark(kind);
-        state.push(Series {
+        curves.state.push(Series {
             label: label.into(),
             points: found
                 .iter()
@@ -275,7 +322,7 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             style: Style::markers(marker),
             color,
         });
-        modulus.push(Series {
+        curves.modulus.push(Series {
             label: label.into(),
             points: found
                 .iter()
@@ -285,8 +332,21 @@ pub fn sweep_figures(scene: &Scene, c: &Continuation, coordinate: &str, index: u
             color,
         });
     }
-    // The boundary across the values the branches reach; a log axis when max |λ| spans more
-    // than a decade.
+    curves
+}
+
+/// The two figures around the series: the stability boundary under the curves across the
+/// values the branches reach, a log axis when max |λ| spans more than a decade, titles,
+/// captions and axis labels.
+fn figures(
+    scene: &Scene,
+    c: &Continuation,
+    coordinate: &str,
+    state: Vec<Series>,
+    mut modulus: Vec<Series>,
+) -> [Plot; 2] {
+    let param = parameter_label(scene, &c.family.param);
+    let name = walker_name(scene);
     let finite = |f: fn(&(f64, f64)) -> f64| {
         modulus
             .iter()

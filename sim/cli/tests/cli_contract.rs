@@ -121,6 +121,19 @@ fn bad_input_is_named_and_exits_2() {
     }
 }
 
+/// The library's error for an assignment without `=` names no option; the command names
+/// `--set`, as it always has.
+#[test]
+fn a_set_without_a_value_names_the_option() {
+    let out = walker(&["gait", "--scene", "compass", "--set", "slope_rad"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`--set slope_rad`: expected key=value"),
+        "{err}"
+    );
+}
+
 #[test]
 fn walk_json_reports_steps_and_the_first_failure() {
     let ok = json(&walker(&[

@@ -31,10 +31,10 @@ pub struct ActuatorParams {
     /// healthy servo follows the profile without saturating, while a setpoint step (the
     /// string taking up slack at engagement) is still spread over milliseconds.
     pub max_rate_rad_per_s: f64,
-    /// Time constant of the servo's first-order lag [s]. Default 5 ms (a position loop of
+    /// Time constant of the servo's first-order lag \[s\]. Default 5 ms (a position loop of
     /// about 30 Hz bandwidth, typical of a small geared DC motor with an encoder).
     pub time_constant_s: f64,
-    /// Slack left when a released string is taken up [rad]: the limit starts this far below
+    /// Slack left when a released string is taken up \[rad\]: the limit starts this far below
     /// the ankle angle. Default 0.1 mrad (a quarter of an encoder count). The simulator
     /// engages the string as an event, the ankle reaching the limit from above; a limit
     /// starting exactly at the ankle would be a grazing start that it does not detect, and
@@ -66,9 +66,9 @@ pub struct ActuatorStats {
     pub position_ticks: u64,
     /// Ticks in which the rate limit was reached.
     pub saturated_ticks: u64,
-    /// First time the rate limit was reached [s], if ever.
+    /// First time the rate limit was reached \[s\], if ever.
     pub first_saturation_s: Option<f64>,
-    /// Largest |setpoint − limit| at the end of a tick [rad].
+    /// Largest |setpoint − limit| at the end of a tick \[rad\].
     pub max_tracking_error_rad: f64,
     /// Largest |limit rate| at the end of a tick [rad/s].
     pub max_rate_rad_per_s: f64,
@@ -77,7 +77,7 @@ pub struct ActuatorStats {
     /// Ticks with a setpoint at which |string torque| exceeded
     /// [`ActuatorParams::max_torque_n_m`] (the servo stalled).
     pub over_torque_ticks: u64,
-    /// First time the torque limit was exceeded [s], if ever.
+    /// First time the torque limit was exceeded \[s\], if ever.
     pub first_over_torque_s: Option<f64>,
 }
 
@@ -150,7 +150,7 @@ impl ActuatorModel {
         &self.stats
     }
 
-    /// Limit [rad] and rate [rad/s] at `t_s` on the last segment (its end when `t_s` is past
+    /// Limit \[rad\] and rate [rad/s] at `t_s` on the last segment (its end when `t_s` is past
     /// it); `None` while released.
     pub fn limit_at(&self, t_s: f64) -> Option<(f64, f64)> {
         let s = self.last?;

@@ -28,7 +28,7 @@ pub const READ_BACK_PARAMS: [protocol::ParamId; 4] = [
 /// A host command to put on the bus at a given time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HostCommand {
-    /// When [s] (sent at the first tick at or after it).
+    /// When \[s\] (sent at the first tick at or after it).
     pub at_s: f64,
     /// What.
     pub command: protocol::Command,
@@ -86,14 +86,14 @@ impl ActuatorChoice {
 pub struct SupplyDropInHold {
     /// Which ankle.
     pub side: Side,
-    /// The supply after the drop [V].
+    /// The supply after the drop \[V\].
     pub supply_v: f64,
 }
 
 /// Everything a [`crate::FirmwareInTheLoop`] run needs.
 #[derive(Clone, Debug)]
 pub struct SilConfig {
-    /// Control period of both nodes [s]. Default 1 ms (the board's 1 kHz).
+    /// Control period of both nodes \[s\]. Default 1 ms (the board's 1 kHz).
     pub period_s: f64,
     /// The bus (bit rate default 500 kbit/s, stuffing, seed of the probabilistic faults,
     /// transmit queue capacity).
@@ -109,7 +109,7 @@ pub struct SilConfig {
     /// board's).
     pub debounce_samples: u8,
     /// The trailing foot's contact switch stays closed this long after the other foot's heel
-    /// strike [s]. Default 10 ms. The model's double support is instantaneous; a real foot
+    /// strike \[s\]. Default 10 ms. The model's double support is instantaneous; a real foot
     /// unloads over milliseconds. With 0 the own lift-off is debounced in the same tick as
     /// the other foot's heel strike and beats its message by one tick: the firmware then
     /// releases every stride by its fallback and raises `PeerHeelStrikeLate`.
@@ -126,7 +126,7 @@ pub struct SilConfig {
     /// [`ActuatorChoice::SpoolMotor`]); default the board's, whose `counts_per_ankle_rad`
     /// matches [`SpoolPlantParams::default`].
     pub spool_motor: SpoolMotorConfig,
-    /// Depth of each node's CAN receive FIFO [frames]. Default 16: a quarter of the board's
+    /// Depth of each node's CAN receive FIFO \[frames\]. Default 16: a quarter of the board's
     /// software buffer (`RxBuf<64>` in `firmware/board-g431`), so the simulator is the more
     /// pessimistic; a frame that finds it full is lost and counted (`NodeReport::rx_overflows`).
     pub rx_queue_frames: usize,

@@ -85,13 +85,13 @@ pub enum FirmwareParamError {
     Inconsistent {
         /// The parameter's name.
         name: &'static str,
-        /// The value requested [rad].
+        /// The value requested \[rad\].
         value: f32,
         /// The parameter it conflicts with (the other of the taut and extended angles).
         other: &'static str,
-        /// That parameter's value in force when the write comes [rad].
+        /// That parameter's value in force when the write comes \[rad\].
         other_value: f32,
-        /// The firmware's minimum extension [rad].
+        /// The firmware's minimum extension \[rad\].
         min_extension: f32,
     },
 }

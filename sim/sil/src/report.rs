@@ -13,7 +13,7 @@ use crate::side::Side;
 /// bus delivered it).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FaultRecord {
-    /// Tick time [s].
+    /// Tick time \[s\].
     pub t_s: f64,
     /// The node.
     pub side: Side,
@@ -28,7 +28,7 @@ pub struct FaultRecord {
 /// A node-state change.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StateChange {
-    /// Tick time [s].
+    /// Tick time \[s\].
     pub t_s: f64,
     /// The node.
     pub side: Side,
@@ -39,7 +39,7 @@ pub struct StateChange {
 /// A reflex-phase change.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PhaseChange {
-    /// Tick time [s].
+    /// Tick time \[s\].
     pub t_s: f64,
     /// The node.
     pub side: Side,
@@ -53,11 +53,11 @@ pub struct PhaseChange {
 /// first tick of the run).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Landing {
-    /// Tick time [s].
+    /// Tick time \[s\].
     pub t_s: f64,
     /// The foot that landed.
     pub side: Side,
-    /// Its ankle angle [rad].
+    /// Its ankle angle \[rad\].
     pub angle_rad: f64,
 }
 
@@ -66,15 +66,15 @@ pub struct Landing {
 /// after each write). `null` for one the node never reported (a dropped frame, say).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct NodeParameters {
-    /// Ankle angle at which the string becomes taut [rad] (`TautAngle`).
+    /// Ankle angle at which the string becomes taut \[rad\] (`TautAngle`).
     pub taut_angle_rad: Option<f64>,
-    /// Ankle angle the actuator extends to [rad] (`ExtendedAngle`).
+    /// Ankle angle the actuator extends to \[rad\] (`ExtendedAngle`).
     pub extended_angle_rad: Option<f64>,
-    /// Nominal duration of the extension [s] (`PushDuration`).
+    /// Nominal duration of the extension \[s\] (`PushDuration`).
     pub push_duration_s: Option<f64>,
     /// Bound on the profile's rate [rad/s] (`MaxPushRate`).
     pub max_push_rate_rad_per_s: Option<f64>,
-    /// The duration the node's profile takes with these values [s]: the nominal one,
+    /// The duration the node's profile takes with these values \[s\]: the nominal one,
     /// stretched by the rate bound when needed (`ankle_profile::duration_within_rate`, the
     /// firmware's own rule).
     pub effective_push_duration_s: Option<f64>,
@@ -179,14 +179,14 @@ pub struct HostReport {
     pub undecodable_frames: u64,
     /// Frames seen per message class.
     pub per_class: BTreeMap<String, u64>,
-    /// Last heartbeat per ankle: (time [s], state, fault names).
+    /// Last heartbeat per ankle: (time \[s\], state, fault names).
     pub last_heartbeat: BTreeMap<String, (f64, String, Vec<String>)>,
     /// `Fault` events seen.
     pub fault_events_seen: u64,
     /// Parameter acknowledgements seen (time, node, parameter, status, value in force; bounded
     /// like the histories).
     pub param_acks: Vec<String>,
-    /// Commands the host put on the bus: (time [s], command; bounded like the histories).
+    /// Commands the host put on the bus: (time \[s\], command; bounded like the histories).
     pub commands_sent: Vec<(f64, String)>,
     /// Frames injected by socketcand clients.
     pub frames_from_clients: u64,
@@ -247,7 +247,7 @@ pub struct SilReport {
     pub heel_strikes: u64,
     /// Stance side at the end.
     pub stance: Side,
-    /// Time of the last tick [s].
+    /// Time of the last tick \[s\].
     pub t_end_s: f64,
     /// The left and the right node.
     pub nodes: BTreeMap<Side, NodeReport>,
@@ -262,7 +262,7 @@ pub struct SilReport {
     pub landings: Vec<Landing>,
     /// Frames delivered on the bus.
     pub frames_delivered: u64,
-    /// Bus-off events: (time [s], node name).
+    /// Bus-off events: (time \[s\], node name).
     pub bus_off: Vec<(f64, String)>,
     /// Entries each history left out to stay within its capacity.
     pub history_elided: HistoryElided,
@@ -277,7 +277,7 @@ pub struct SilReport {
 }
 
 impl SilReport {
-    /// First time `side` entered `state` at or after `t_s` [s].
+    /// First time `side` entered `state` at or after `t_s` \[s\].
     pub fn first_state_at_or_after(&self, side: Side, state: &str, t_s: f64) -> Option<f64> {
         self.state_history
             .iter()
@@ -285,7 +285,7 @@ impl SilReport {
             .map(|c| c.t_s)
     }
 
-    /// First time `side` raised fault `code` [s].
+    /// First time `side` raised fault `code` \[s\].
     pub fn first_raise(&self, side: Side, code: &str) -> Option<f64> {
         self.faults
             .iter()

@@ -23,7 +23,7 @@ pub struct AppliedSensorFault {
     pub side: Side,
     /// The fault's kind (`glitch`, `stuck`, `spi`, `parity`).
     pub kind: &'static str,
-    /// Walk time it took effect [s].
+    /// Walk time it took effect \[s\].
     pub t_s: f64,
 }
 

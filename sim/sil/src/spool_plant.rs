@@ -43,12 +43,12 @@ use sim::control::ActuatorSegment;
 /// motor has been chosen; docs/sil.md gives the reasoning).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SpoolPlantParams {
-    /// Supply of the power stage [V]. Default 12 V.
+    /// Supply of the power stage \[V\]. Default 12 V.
     pub supply_v: f64,
     /// Torque constant [N·m/A] (= back-EMF constant in V·s/rad). Default 0.012: a 12 V
     /// motor of about 10 000 rpm at no load.
     pub torque_constant_n_m_per_a: f64,
-    /// Winding resistance [Ω]. Default 2.5 Ω: the stall current at the firmware's largest
+    /// Winding resistance \[Ω\]. Default 2.5 Ω: the stall current at the firmware's largest
     /// duty (80 % of 12 V) is 3.84 A, under its 4 A limit, so a stalled push is chopped by
     /// the duty limit and not latched off.
     pub resistance_ohm: f64,
@@ -61,9 +61,9 @@ pub struct SpoolPlantParams {
     pub coulomb_n_m: f64,
     /// Gear ratio (motor turns per spool turn). Default 25.
     pub gear_ratio: f64,
-    /// Spool radius [m]. Default 5 mm.
+    /// Spool radius \[m\]. Default 5 mm.
     pub spool_radius_m: f64,
-    /// Lever arm of the string about the ankle axis [m]. Default 20 mm.
+    /// Lever arm of the string about the ankle axis \[m\]. Default 20 mm.
     pub lever_arm_m: f64,
     /// Encoder counts per motor turn (quadrature). Default 1024 (a 256-line encoder).
     pub counts_per_motor_turn: f64,
@@ -75,7 +75,7 @@ pub struct SpoolPlantParams {
     /// nominal walk shows (`SpoolPlantStats::max_seen_inertia_kg_m2`, 0.0017: driving the
     /// ankle angle mostly turns the light foot about its toe, the heavy leg is free).
     pub walker_inertia_kg_m2: f64,
-    /// The string's limit at power-up, as an ankle angle [rad]. Default −0.081: the
+    /// The string's limit at power-up, as an ankle angle \[rad\]. Default −0.081: the
     /// firmware's taut angle (−0.08) less its pay-out's tolerance (16 counts, 1 mrad), as the
     /// firmware leaves it after a release (it re-spools to the push's start geometry, no
     /// slack; the nominal walk's rests lie 1.1–2.9 mrad below the taut angle, docs/sil.md).
@@ -120,7 +120,7 @@ impl SpoolPlantParams {
 pub struct SpoolPlantStats {
     /// Ticks with the stage driving.
     pub driven_ticks: u64,
-    /// Largest |current| at a tick's end [A].
+    /// Largest |current| at a tick's end \[A\].
     pub peak_current_a: f64,
     /// Largest string torque on the ankle seen at a tick [N·m].
     pub peak_torque_n_m: f64,
@@ -139,13 +139,13 @@ pub struct SpoolPlantStats {
 /// What the walker's stance ankle is doing at a tick's start (0 load for the swing foot).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlantTick {
-    /// Tick start [s].
+    /// Tick start \[s\].
     pub t0_s: f64,
-    /// Tick end [s].
+    /// Tick end \[s\].
     pub t1_s: f64,
     /// The ankle is the stance ankle (the swing foot is massless: its limit binds nothing).
     pub stance: bool,
-    /// True ankle angle [rad].
+    /// True ankle angle \[rad\].
     pub ankle_rad: f64,
     /// The walker holds the ankle on the string's limit.
     pub engaged: bool,
@@ -215,7 +215,7 @@ impl SpoolPlant {
         c.floor() as i32
     }
 
-    /// The current-sense reading now: |i|, quantised [A].
+    /// The current-sense reading now: |i|, quantised \[A\].
     pub fn current_reading_a(&self) -> f64 {
         let lsb = self.params.current_lsb_a;
         if lsb > 0.0 {
@@ -235,7 +235,7 @@ impl SpoolPlant {
         self.supply_override_v = Some(supply_v);
     }
 
-    /// The supply now [V].
+    /// The supply now \[V\].
     pub fn supply_v(&self) -> f64 {
         self.supply_override_v.unwrap_or(self.params.supply_v)
     }

@@ -7,11 +7,11 @@ use serde::Serialize;
 /// its ankle angle is not simulated.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum SwingAnkleModel {
-    /// A fixed angle [rad]. A step between this and the stance angle at every heel strike
+    /// A fixed angle \[rad\]. A step between this and the stance angle at every heel strike
     /// and lift-off: with 0 rad and the stance ankle at 0.2 rad that is 200 rad/s at 1 kHz,
     /// which trips the firmware's 40 rad/s plausibility check (`EncoderRate`) every stride.
     Fixed {
-        /// The angle [rad].
+        /// The angle \[rad\].
         angle_rad: f64,
     },
     /// From its angle at lift-off, the ankle moves at `rate_rad_per_s` towards the angle this
@@ -51,7 +51,7 @@ impl SwingAnkle {
         }
     }
 
-    /// The angle at `t_s` given the landing angle of the last heel strike [rad].
+    /// The angle at `t_s` given the landing angle of the last heel strike \[rad\].
     pub fn angle_at(&mut self, t_s: f64, landing_rad: f64) -> f64 {
         let dt = (t_s - self.last_t_s).max(0.0);
         self.last_t_s = t_s;

@@ -117,7 +117,7 @@ pub struct StepControl {
     pub min: f64,
     /// Corrector iteration budget.
     pub max_iterations: usize,
-    /// Largest turn of the tangent in one accepted step [degrees] (60 by default); more says
+    /// Largest turn of the tangent in one accepted step \[degrees\] (60 by default); more says
     /// the step skipped over structure or jumped to another branch.
     pub max_turn_deg: f64,
 }

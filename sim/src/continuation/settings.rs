@@ -144,7 +144,7 @@ impl ContinuationSettings {
         self.corrector_iterations
     }
 
-    /// Largest turn of the tangent in one accepted step [degrees]; a step that turns more is
+    /// Largest turn of the tangent in one accepted step \[degrees\]; a step that turns more is
     /// halved, and at the smallest step the branch ends (`not_converged`) rather than jump.
     /// Default 60.
     pub fn max_turn_deg(&self) -> f64 {

@@ -23,7 +23,7 @@ pub struct HeelStrikeRows<T: nalgebra::Scalar> {
     pub active: Vec<bool>,
     /// Constraint rows `G` (k × n of the impact model), zero rows dropped.
     pub g: DMatrix<T>,
-    /// The new contact point, the swing foot, in the floor frame [m].
+    /// The new contact point, the swing foot, in the floor frame \[m\].
     pub p_contact_m: Vector3<T>,
 }
 

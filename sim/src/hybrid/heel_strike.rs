@@ -26,7 +26,7 @@ pub struct HeelStrikeRule {
     /// The link carrying the swing foot (for the yaw constraint).
     pub swing_foot_link: LinkIndex,
     /// A crossing counts only when the swing foot is at least this far ahead of the stance
-    /// contact along x [m]; crossings behind it are mid-swing scuffs.
+    /// contact along x \[m\]; crossings behind it are mid-swing scuffs.
     pub min_ahead_m: f64,
     /// Mid-swing scuffs are ignored (the foot passes through the floor, as in Garcia et al.'s
     /// and McGeer's analyses) rather than ending the stride as a failure.

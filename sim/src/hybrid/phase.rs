@@ -57,7 +57,7 @@ impl<const N: usize> EngineScalar for DualSVec64<N> {
 pub struct DriveValues<T> {
     /// The driven coordinate (an index into `q`).
     pub coordinate: usize,
-    /// Its angle [rad].
+    /// Its angle \[rad\].
     pub angle_rad: T,
     /// Its rate [rad/s].
     pub rate_rad_s: T,

@@ -37,7 +37,7 @@ pub struct Relabel {
 pub struct LinkStatesOf<T: Scalar> {
     /// Rotations link frame → floor frame.
     pub r: Vec<Matrix3<T>>,
-    /// Origins [m].
+    /// Origins \[m\].
     pub p: Vec<Vector3<T>>,
     /// Angular velocities [rad/s].
     pub w: Vec<Vector3<T>>,
@@ -52,7 +52,7 @@ fn reflection<T: RealField + Copy>() -> Matrix3<T> {
 
 impl<T: RealField + Copy> LinkStatesOf<T> {
     /// Takes the link states from a kinematics workspace, dropping the first `skip` links
-    /// (the released-root links of an impact model), and moving the origin to `origin` [m].
+    /// (the released-root links of an impact model), and moving the origin to `origin` \[m\].
     pub fn from_kinematics(kin: &KinematicsOf<T>, skip: usize, origin: &Vector3<T>) -> Self {
         Self {
             r: kin.r_floor_link[skip..].to_vec(),
@@ -85,7 +85,7 @@ pub struct RelabelTargets<T: Scalar> {
     pub r: Vec<Matrix3<T>>,
     /// Angular velocity of each pair's old link [rad/s].
     pub w: Vec<Vector3<T>>,
-    /// Position of each point pair's old point [m].
+    /// Position of each point pair's old point \[m\].
     pub points_m: Vec<Vector3<T>>,
     /// Velocity of each point pair's old point [m/s].
     pub point_velocities_m_s: Vec<Vector3<T>>,

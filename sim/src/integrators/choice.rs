@@ -26,11 +26,11 @@ pub enum IntegratorError {
         kind: &'static str,
         /// The setting (`h_s` or `h_max_s`).
         setting: &'static str,
-        /// Its value [s].
+        /// Its value \[s\].
         value: f64,
         /// Steps the time budget needs at this step.
         steps: f64,
-        /// The stride time budget [s].
+        /// The stride time budget \[s\].
         max_stride_time_s: f64,
         /// The stride step budget.
         max_steps: usize,
@@ -38,7 +38,7 @@ pub enum IntegratorError {
     /// A stride time budget that is zero, negative, NaN or infinite.
     #[error("stride time budget max_stride_time_s = {value} s must be a positive, finite number")]
     BadTimeBudget {
-        /// Its value [s].
+        /// Its value \[s\].
         value: f64,
     },
 }
@@ -49,14 +49,14 @@ pub enum IntegratorError {
 pub enum IntegratorChoice {
     /// Meijaard's one-evaluation scheme, eq. (11).
     Meijaard {
-        /// Step [s].
+        /// Step \[s\].
         h_s: f64,
         /// Check eq. (12) every this many steps (0: never).
         check_every: usize,
     },
     /// Classical fourth-order Runge-Kutta.
     Rk4 {
-        /// Step [s].
+        /// Step \[s\].
         h_s: f64,
     },
     /// Dormand-Prince 8(5,3), adaptive (Hairer's DOP853).
@@ -65,7 +65,7 @@ pub enum IntegratorChoice {
         rtol: f64,
         /// Absolute tolerance.
         atol: f64,
-        /// Largest step [s].
+        /// Largest step \[s\].
         h_max_s: f64,
     },
     /// Dormand-Prince 5(4), adaptive.
@@ -74,7 +74,7 @@ pub enum IntegratorChoice {
         rtol: f64,
         /// Absolute tolerance.
         atol: f64,
-        /// Largest step [s].
+        /// Largest step \[s\].
         h_max_s: f64,
     },
 }
@@ -168,7 +168,7 @@ impl IntegratorChoice {
 
     /// Checks that these settings can run a stride: every step, largest step and tolerance
     /// positive and finite, and the (largest) step long enough to cover `max_stride_time_s`
-    /// [s] within `max_steps` steps (a smaller one could only end in a budget failure, after
+    /// \[s\] within `max_steps` steps (a smaller one could only end in a budget failure, after
     /// a long time).
     ///
     /// # Errors

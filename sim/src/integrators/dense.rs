@@ -22,9 +22,9 @@ pub struct DenseCoefficients {
 /// Hairer's form `y0 + θ(F0 + (1−θ)(F1 + θ(F2 + (1−θ)(F3 + …))))`.
 #[derive(Clone, Debug)]
 pub struct DenseOutput {
-    /// Start of the step [s].
+    /// Start of the step \[s\].
     pub t0_s: f64,
-    /// Length of the step [s].
+    /// Length of the step \[s\].
     pub h_s: f64,
     /// Positions and velocities at the start.
     q0: DVector<f64>,
@@ -51,7 +51,7 @@ impl DenseOutput {
         }
     }
 
-    /// The interpolated sample at `t_s` [s] (inside the step).
+    /// The interpolated sample at `t_s` \[s\] (inside the step).
     pub fn eval(&self, t_s: f64) -> Sample {
         let x = (t_s - self.t0_s) / self.h_s;
         let n = self.q0.len();

@@ -143,7 +143,7 @@ pub trait EmbeddedPair: Clone + Debug {
     /// refinement).
     const INTERPOLANT: Option<DenseCoefficients> = Self::DENSE;
 
-    /// The scaled error norm of a step of size `h` [s] from `s` to `(q_new, v_new)` with
+    /// The scaled error norm of a step of size `h` \[s\] from `s` to `(q_new, v_new)` with
     /// stage derivatives `kq` (of the positions) and `kv` (of the velocities).
     #[allow(clippy::too_many_arguments)]
     fn error_norm(
@@ -164,7 +164,7 @@ pub struct EmbeddedRk<P: EmbeddedPair> {
     h_max_s: f64,
     h_next_s: f64,
     evaluations: usize,
-    /// Smallest step before giving up [s].
+    /// Smallest step before giving up \[s\].
     pub h_min_s: f64,
     /// A kept derivative reused as the first stage of a step from exactly that sample (same
     /// time, same state): the end of the last accepted step (FSAL pairs) or the last evaluated
@@ -180,7 +180,7 @@ pub struct EmbeddedRk<P: EmbeddedPair> {
 }
 
 impl<P: EmbeddedPair> EmbeddedRk<P> {
-    /// Tolerances on the local error, and the largest step [s].
+    /// Tolerances on the local error, and the largest step \[s\].
     pub fn new(rtol: f64, atol: f64, h_max_s: f64) -> Self {
         Self {
             tol: Tolerances { rtol, atol },

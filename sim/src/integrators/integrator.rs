@@ -9,7 +9,7 @@ pub trait Integrator {
     fn name(&self) -> &'static str;
     /// Clears any per-trajectory memory (step-size history, counters). Call at a new start.
     fn reset(&mut self);
-    /// The step this integrator would take next from `t_s` [s].
+    /// The step this integrator would take next from `t_s` \[s\].
     fn proposed_step_s(&self) -> f64;
     /// Takes one accepted step from `from` of size at most `h_limit_s`, returning the new sample.
     fn advance(

@@ -14,7 +14,7 @@ pub struct Meijaard {
 }
 
 impl Meijaard {
-    /// Fixed step `h_s` [s]; eq. (12) is checked every `check_every` steps (0: never).
+    /// Fixed step `h_s` \[s\]; eq. (12) is checked every `check_every` steps (0: never).
     pub fn new(h_s: f64, check_every: usize) -> Self {
         Self {
             h_s,

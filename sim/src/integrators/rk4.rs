@@ -10,7 +10,7 @@ pub struct Rk4 {
 }
 
 impl Rk4 {
-    /// Fixed step `h_s` [s].
+    /// Fixed step `h_s` \[s\].
     pub fn new(h_s: f64) -> Self {
         Self {
             h_s,

@@ -48,7 +48,7 @@ pub trait SecondOrderSystem {
 /// Positions and velocities at a time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sample {
-    /// Time [s].
+    /// Time \[s\].
     pub t_s: f64,
     /// Generalised coordinates.
     pub q: DVector<f64>,
@@ -65,9 +65,9 @@ pub enum IntegrationError {
     /// The fixed step exceeds the stability limit of eq. (12).
     #[error("step {h_s:e} s exceeds the stability limit h_max = {h_max_s:e} s (λ_max = {lambda_max_rad_s:.3} rad/s, β = {beta:.3})")]
     StepTooLarge {
-        /// The step [s].
+        /// The step \[s\].
         h_s: f64,
-        /// The limit [s].
+        /// The limit \[s\].
         h_max_s: f64,
         /// Largest undamped eigenfrequency [rad/s].
         lambda_max_rad_s: f64,
@@ -77,9 +77,9 @@ pub enum IntegrationError {
     /// The adaptive step fell below its floor.
     #[error("adaptive step size fell to {h_s:e} s at t = {t_s} s")]
     StepUnderflow {
-        /// The step [s].
+        /// The step \[s\].
         h_s: f64,
-        /// Time [s].
+        /// Time \[s\].
         t_s: f64,
     },
 }
@@ -94,7 +94,7 @@ pub struct StabilityLimit {
 }
 
 impl StabilityLimit {
-    /// `h_max = (1 − β) 2 / λ_max` [s].
+    /// `h_max = (1 − β) 2 / λ_max` \[s\].
     pub fn h_max_s(&self) -> f64 {
         if self.lambda_max_rad_s <= 0.0 {
             f64::INFINITY

@@ -39,7 +39,7 @@ const C4: f64 = f64::from_bits(0xbe927e4f_809c52ad);
 const C5: f64 = f64::from_bits(0x3e21ee9e_bdb4b1c4);
 const C6: f64 = f64::from_bits(0xbda8fae9_be8838d4);
 
-/// `(sin x, cos x)` for an angle `x` [rad], within an ulp of the exact values (`libm`'s
+/// `(sin x, cos x)` for an angle `x` \[rad\], within an ulp of the exact values (`libm`'s
 /// `sincos`, bit for bit).
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {

@@ -22,13 +22,13 @@ const HEEL_STRIKE: &str = "heel_strike";
 /// Times are stride time: from the start of the stride, just after the previous heel strike.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct AnkleExtension {
-    /// When the string engaged and the profile started [s]; `null` if it never engaged (the
+    /// When the string engaged and the profile started \[s\]; `null` if it never engaged (the
     /// ankle stayed free all stride, and the fractions below are 0).
     pub engaged_at_s: Option<f64>,
-    /// When the string was released [s]: the other foot's heel strike (the end of the stride),
+    /// When the string was released \[s\]: the other foot's heel strike (the end of the stride),
     /// or an earlier `string_released` event.
     pub released_at_s: f64,
-    /// The stance ankle angle just before the release [rad] (the stride's state there).
+    /// The stance ankle angle just before the release \[rad\] (the stride's state there).
     pub angle_at_release_rad: f64,
     /// The fraction of the profile's duration that had run at the release, in [0, 1]:
     /// `min(1, (released_at_s − engaged_at_s) / profile_duration_s)`.
@@ -37,9 +37,9 @@ pub struct AnkleExtension {
     /// `(angle_at_release_rad − engage) / (final − engage)` with the reflex's engagement and
     /// final angles (1 once the profile has ended).
     pub angle_fraction_completed: f64,
-    /// The profile's duration [s] (`ankle_extension_duration_s`).
+    /// The profile's duration \[s\] (`ankle_extension_duration_s`).
     pub profile_duration_s: f64,
-    /// The profile's final angle [rad] (`ankle_final_rad`).
+    /// The profile's final angle \[rad\] (`ankle_final_rad`).
     pub final_angle_rad: f64,
 }
 

@@ -55,11 +55,11 @@ pub struct FoundGait {
     pub max_abs_eigenvalue: f64,
     /// All eigenvalues strictly inside the unit circle.
     pub stable: bool,
-    /// Step period [s].
+    /// Step period \[s\].
     pub step_period_s: f64,
-    /// Distance between the contacts of one step [m].
+    /// Distance between the contacts of one step \[m\].
     pub step_length_m: f64,
-    /// Distance walked forward per step [m].
+    /// Distance walked forward per step \[m\].
     pub progress_m_per_step: f64,
     /// Forward speed [m/s].
     pub speed_m_s: f64,
@@ -71,15 +71,15 @@ pub struct FoundGait {
     pub residual: f64,
     /// Events of the stride, in order.
     pub events: Vec<StrideEvent>,
-    /// Mechanical energy lost in the impacts of a stride [J].
+    /// Mechanical energy lost in the impacts of a stride \[J\].
     pub impact_energy_loss_j: f64,
     /// Impact loss over weight times step length [-] (absent for a massless walker or a zero
     /// step).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub specific_cost_of_transport: Option<f64>,
-    /// Heading change per step [rad].
+    /// Heading change per step \[rad\].
     pub heading_change_rad_per_step: f64,
-    /// Total mass [kg].
+    /// Total mass \[kg\].
     pub total_mass_kg: f64,
     /// Each eigenvalue with the freedoms that dominate its eigenvector.
     pub eigenvalue_modes: Vec<EigenMode>,
@@ -100,16 +100,16 @@ pub struct FoundGait {
 /// Energy figures of an actuated gait, per step.
 #[derive(Clone, Debug, Serialize)]
 pub struct ActuatorFigures {
-    /// Work done by the ankle actuator [J].
+    /// Work done by the ankle actuator \[J\].
     pub actuator_work_j_per_step: f64,
-    /// Energy dissipated by the joint dampers [J].
+    /// Energy dissipated by the joint dampers \[J\].
     pub damping_dissipation_j_per_step: f64,
     /// Actuator work per unit mass and forward distance, under the keys
     /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
     /// `cost_of_transport_j_per_kg_m`.
     #[serde(flatten)]
     pub cost_of_transport: CostOfTransport,
-    /// Actuator work minus impact loss minus damper dissipation [J]: over a periodic stride on
+    /// Actuator work minus impact loss minus damper dissipation \[J\]: over a periodic stride on
     /// level ground the actuator's work is what the impacts and dampers take, so this checks
     /// the quadrature.
     pub energy_balance_residual_j: f64,
@@ -118,11 +118,11 @@ pub struct ActuatorFigures {
 /// Contact and clearance figures of the stride from the fixed point.
 #[derive(Clone, Debug, Serialize)]
 pub struct ContactFigures {
-    /// Largest |lateral centre of pressure| under the stance foot [m].
+    /// Largest |lateral centre of pressure| under the stance foot \[m\].
     pub max_lateral_cop_m: f64,
-    /// Smallest normal force on the stance foot [N].
+    /// Smallest normal force on the stance foot \[N\].
     pub min_normal_force_n: f64,
-    /// Smallest swing-ankle height near mid-swing [m] (`null` if the swing ankle never passes).
+    /// Smallest swing-ankle height near mid-swing \[m\] (`null` if the swing ankle never passes).
     pub mid_swing_clearance_m: Option<f64>,
 }
 

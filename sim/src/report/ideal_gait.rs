@@ -10,22 +10,22 @@ use serde::Serialize;
 /// the ideal-actuator gait in `walker sil`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct IdealGaitRecord {
-    /// Step period [s].
+    /// Step period \[s\].
     pub step_period_s: f64,
-    /// Distance between the contacts of a step [m].
+    /// Distance between the contacts of a step \[m\].
     pub step_length_m: f64,
     /// Forward speed [m/s].
     pub speed_m_s: f64,
-    /// Work of the ankle actuator per step [J].
+    /// Work of the ankle actuator per step \[J\].
     pub actuator_work_j_per_step: f64,
     /// Actuator work per unit mass and forward distance, under the keys
     /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
     /// `cost_of_transport_j_per_kg_m`.
     #[serde(flatten)]
     pub cost_of_transport: CostOfTransport,
-    /// Distance walked forward per step [m].
+    /// Distance walked forward per step \[m\].
     pub progress_m_per_step: f64,
-    /// Magnitude of the heading change per step [rad].
+    /// Magnitude of the heading change per step \[rad\].
     pub heading_change_rad_per_step: f64,
     /// Largest eigenvalue modulus of the stride Jacobian.
     pub max_abs_eigenvalue: f64,

@@ -59,11 +59,11 @@ pub fn to_json<T: Serialize + ?Sized>(report: &T) -> serde_json::Result<serde_js
 
 /// Gait summary numbers.
 pub struct GaitNumbers {
-    /// Step period [s].
+    /// Step period \[s\].
     pub step_period_s: f64,
-    /// Step length [m].
+    /// Step length \[m\].
     pub step_length_m: f64,
-    /// Distance walked per step, forward [m].
+    /// Distance walked per step, forward \[m\].
     pub progress_m: f64,
     /// Speed [m/s].
     pub speed_m_s: f64,
@@ -82,7 +82,7 @@ pub fn gait_numbers(walker: &Walker, gait: &Gait) -> GaitNumbers {
     }
 }
 
-/// Distance walked per step [m]: half the displacement over two periodic steps, `|c + M c| / 2`
+/// Distance walked per step \[m\]: half the displacement over two periodic steps, `|c + M c| / 2`
 /// with `c` the step between contacts and `M` the map from one stance frame to the next
 /// (reflection and heading). For a 3D walker this leaves out the sideways zigzag between the
 /// feet, which `step_length_m` (the distance between the contacts) includes.

@@ -49,7 +49,7 @@ pub struct FellRecord {
     pub kind: FailureKind,
     /// The stride that failed, counted from 1 at this value.
     pub stride: usize,
-    /// When in that stride [s].
+    /// When in that stride \[s\].
     pub time_s: f64,
     /// Details.
     pub detail: String,

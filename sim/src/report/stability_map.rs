@@ -18,7 +18,7 @@ pub struct StabilityMapReport {
     pub max_abs_eigenvalue: Vec<Vec<Option<f64>>>,
     /// All eigenvalues inside the unit circle (`null`: no gait).
     pub stable: Vec<Vec<Option<bool>>>,
-    /// Step period [s] (`null`: no gait).
+    /// Step period \[s\] (`null`: no gait).
     pub step_period_s: Vec<Vec<Option<f64>>>,
     /// Why there is no gait (`null` where there is one).
     pub no_gait_reason: Vec<Vec<Option<String>>>,

@@ -135,9 +135,9 @@ pub struct ConvergedPoint {
     pub eigenvalues: Vec<[f64; 2]>,
     /// The fixed point (`null` if the walker of this value could not be rebuilt to name it).
     pub fixed_point: Option<FixedPoint>,
-    /// Step period [s] (of the first stride of the cycle).
+    /// Step period \[s\] (of the first stride of the cycle).
     pub step_period_s: f64,
-    /// Distance between the contacts of a step [m] (of the first stride of the cycle).
+    /// Distance between the contacts of a step \[m\] (of the first stride of the cycle).
     pub step_length_m: f64,
     /// Strides per cycle (1, 2, 4, …).
     pub period_strides: usize,

@@ -11,17 +11,17 @@ use serde::Serialize;
 pub struct WalkGaitRecord {
     /// Number of steps averaged.
     pub steps_averaged: usize,
-    /// Mean step period [s].
+    /// Mean step period \[s\].
     pub step_period_s: f64,
-    /// Mean distance between the contacts of a step [m].
+    /// Mean distance between the contacts of a step \[m\].
     pub step_length_m: f64,
-    /// Distance walked per step [m]: the hip's displacement over an even number of steps (so
+    /// Distance walked per step \[m\]: the hip's displacement over an even number of steps (so
     /// that the sideways zigzag cancels) divided by that number (the mean step length with a
     /// single step).
     pub progress_m_per_step: f64,
     /// `progress_m_per_step / step_period_s` [m/s].
     pub speed_m_s: f64,
-    /// Mean work of the ankle actuator per step [J] (0 for a passive walker).
+    /// Mean work of the ankle actuator per step \[J\] (0 for a passive walker).
     pub actuator_work_j_per_step: f64,
     /// Actuator work per unit mass and forward distance, under the keys
     /// `cost_of_transport_J_per_kg_m` (original spelling, kept for compatibility) and
@@ -29,13 +29,13 @@ pub struct WalkGaitRecord {
     #[serde(flatten)]
     pub cost_of_transport: CostOfTransport,
     /// Mean magnitude of the per-step yaw in each step's mirrored stance frame (the zigzag,
-    /// not a turn) [rad].
+    /// not a turn) \[rad\].
     pub heading_change_rad_per_step: f64,
     /// Direction of travel of the hip over the steps averaged in the floor frame,
-    /// `atan2(Δz, Δx)` [rad]: 0 straight ahead along the first stance frame's x, positive
+    /// `atan2(Δz, Δx)` \[rad\]: 0 straight ahead along the first stance frame's x, positive
     /// toward +z; `null` with fewer than two steps.
     pub heading_rad: Option<f64>,
-    /// Signed mean of the per-step yaw [rad].
+    /// Signed mean of the per-step yaw \[rad\].
     pub heading_change_rad_per_step_signed: f64,
 }
 

@@ -1,4 +1,5 @@
-//! The TOML schema of scene files (see `sim/scenes/*.toml`).
+//! The TOML schema of scene files (see `sim/scenes/*.toml`; docs/scenes.md is the reference,
+//! checked against these types by `sim/tests/scene_reference.rs`).
 
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -74,11 +75,11 @@ pub enum ShapeDef {
         name: String,
         /// The link carrying it.
         link: String,
-        /// One end in the link frame [m].
+        /// One end in the link frame \[m\].
         from_m: [Num; 3],
-        /// The other end in the link frame [m].
+        /// The other end in the link frame \[m\].
         to_m: [Num; 3],
-        /// Radius [m].
+        /// Radius \[m\].
         radius_m: Num,
     },
     /// A thin circular ring (the pelvic ring).
@@ -87,11 +88,11 @@ pub enum ShapeDef {
         name: String,
         /// The link carrying it.
         link: String,
-        /// Centre in the link frame [m].
+        /// Centre in the link frame \[m\].
         centre_m: [Num; 3],
         /// Normal of its plane in the link frame (any length but zero).
         normal: [Num; 3],
-        /// Radius [m].
+        /// Radius \[m\].
         radius_m: Num,
     },
 }
@@ -145,7 +146,7 @@ pub struct ParameterDef {
 pub struct WorldDef {
     /// Gravitational acceleration [m/s²].
     pub gravity_m_s2: Num,
-    /// Floor slope, downhill in +x [rad].
+    /// Floor slope, downhill in +x \[rad\].
     pub slope_rad: Num,
 }
 
@@ -162,13 +163,13 @@ pub struct LinkDef {
     /// Joint axis in the parent frame.
     #[serde(default)]
     pub axis: Option<[Num; 3]>,
-    /// Joint origin in the parent frame [m].
+    /// Joint origin in the parent frame \[m\].
     #[serde(default)]
     pub origin_m: Option<[Num; 3]>,
-    /// Body mass [kg].
+    /// Body mass \[kg\].
     #[serde(default)]
     pub mass_kg: Option<Num>,
-    /// Centre of mass in the link frame [m].
+    /// Centre of mass in the link frame \[m\].
     #[serde(default)]
     pub com_m: Option<[Num; 3]>,
     /// Principal moments of inertia about the c.m., link axes [kg·m²].
@@ -180,7 +181,7 @@ pub struct LinkDef {
     /// Joint spring stiffness [N·m/rad].
     #[serde(default)]
     pub stiffness: Option<Num>,
-    /// Joint spring rest position [rad].
+    /// Joint spring rest position \[rad\].
     #[serde(default)]
     pub rest: Option<Num>,
     /// Joint damping [N·m·s/rad].
@@ -196,7 +197,7 @@ pub struct PointDef {
     pub name: String,
     /// Link.
     pub link: String,
-    /// Position in the link frame [m].
+    /// Position in the link frame \[m\].
     pub position_m: [Num; 3],
 }
 
@@ -208,7 +209,7 @@ pub struct HeelStrikeDef {
     pub swing_foot: String,
     /// Old stance contact point (must lift).
     pub stance_contact: String,
-    /// Minimum distance ahead of the stance contact for a crossing to count [m].
+    /// Minimum distance ahead of the stance contact for a crossing to count \[m\].
     #[serde(default)]
     pub min_ahead_m: Option<Num>,
     /// Ignore crossings behind that (mid-swing scuffing) instead of failing.
@@ -229,7 +230,7 @@ pub struct HeelStrikeDef {
 pub struct KneeDef {
     /// Knee coordinate (link name).
     pub coordinate: String,
-    /// Stop angle [rad].
+    /// Stop angle \[rad\].
     pub stop_rad: Num,
     /// `rising` or `falling`: how `q − stop` crosses zero at the stop.
     pub closing: String,
@@ -241,7 +242,7 @@ pub struct KneeDef {
 pub struct FallDef {
     /// Hip point.
     pub hip: String,
-    /// Fallen below this hip height [m].
+    /// Fallen below this hip height \[m\].
     pub min_hip_height_m: Num,
 }
 
@@ -266,10 +267,10 @@ pub struct RelabelDef {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorDef {
-    /// `meijaard`, `rk4` or `dopri5`.
+    /// `meijaard`, `rk4`, `dopri5` or `dop853`.
     #[serde(default = "default_kind")]
     pub kind: String,
-    /// Fixed step [s] (meijaard, rk4).
+    /// Fixed step \[s\] (meijaard, rk4).
     #[serde(default)]
     pub h_s: Option<f64>,
     /// Tolerances (dopri5).
@@ -278,10 +279,10 @@ pub struct IntegratorDef {
     /// Absolute tolerance (dopri5).
     #[serde(default)]
     pub atol: Option<f64>,
-    /// Largest step (dopri5) [s].
+    /// Largest step (dopri5) \[s\].
     #[serde(default)]
     pub h_max_s: Option<f64>,
-    /// Stride time budget [s].
+    /// Stride time budget \[s\].
     #[serde(default)]
     pub max_stride_time_s: Option<Num>,
 }
@@ -317,7 +318,7 @@ pub struct GuessDef {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConventionDef {
-    /// Velocities are multiplied by this [s] (e.g. `sqrt(l/g)` for dimensionless time).
+    /// Velocities are multiplied by this \[s\] (e.g. `sqrt(l/g)` for dimensionless time).
     pub time_scale_s: Num,
     /// Outputs.
     #[serde(rename = "output")]
@@ -347,10 +348,10 @@ pub struct AnkleReflexDef {
     pub toe_pitch: String,
     /// Toe point.
     pub toe: String,
-    /// Engagement angle [rad].
+    /// Engagement angle \[rad\].
     pub engage_rad: Num,
-    /// Final angle [rad].
+    /// Final angle \[rad\].
     pub final_rad: Num,
-    /// Extension duration [s].
+    /// Extension duration \[s\].
     pub duration_s: Num,
 }

@@ -3,21 +3,20 @@
 //! Built-in scenes live in `sim/scenes/` and are compiled in; `--scene` also accepts a path
 //! to a scene file of the same schema ([`file::SceneFile`]).
 
+mod build;
 pub mod expr;
 pub mod file;
 mod usage;
 pub mod variant;
 
-use crate::actuator::AnkleReflex;
 use crate::events::{Direction, EventTolerance};
-use crate::integrators::{IntegratorChoice, IntegratorError};
+use crate::integrators::IntegratorError;
 use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
-use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, Model, ModelError};
-use crate::relabel::Relabel;
+use crate::model::{CoordIndex, ModelError};
 use crate::stride::StrideSettings;
-use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker, WalkerRules};
+use crate::walker::{Walker, WalkerRules};
 use file::{Num, SceneFile};
-use nalgebra::{DVector, Matrix3, Vector3};
+use nalgebra::{DVector, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// The built-in scenes: `(name, TOML text)`.
@@ -68,7 +67,7 @@ pub enum SceneError {
         /// Parser message.
         message: String,
     },
-    /// `--set` named a parameter the scene does not have.
+    /// A parameter name the scene does not have.
     #[error("scene `{scene}` has no parameter `{name}` (parameters: {available})")]
     UnknownParameter {
         /// Scene.
@@ -103,6 +102,9 @@ pub enum SceneError {
     /// An expression failed.
     #[error("{0}")]
     Expr(#[from] expr::ExprError),
+    /// A `[variant]` names something its base does not have.
+    #[error("{0}")]
+    Variant(#[from] variant::VariantError),
     /// An expression gave NaN or infinity.
     #[error("`{what}` evaluates to {value}, not a finite number")]
     NonFinite {
@@ -117,6 +119,12 @@ pub enum SceneError {
     /// A reference to something undefined, or a bad keyword.
     #[error("{0}")]
     Invalid(String),
+    /// An assignment ([`Scene::set_text`]) that is not `key=value`.
+    #[error("`{text}`: expected key=value")]
+    NotAnAssignment {
+        /// The text given.
+        text: String,
+    },
     /// The `[integrator]` settings cannot run a stride.
     #[error("scene `{scene}` [integrator]: {error}")]
     Integrator {
@@ -125,7 +133,7 @@ pub enum SceneError {
         /// What is wrong.
         error: IntegratorError,
     },
-    /// `--set` of a parameter that acts on nothing of this walker.
+    /// Setting a parameter that acts on nothing of this walker.
     #[error("scene `{scene}`: parameter `{name}` acts on nothing of this walker (no expression uses it{}), so setting it would change nothing", variant_of.as_ref().map(|b| format!("; the variant of `{b}` removed or welded the bodies it belongs to")).unwrap_or_default())]
     UnusedParameter {
         /// Scene.
@@ -258,8 +266,9 @@ impl Scene {
             .map(|(_, t)| *t)
             .ok_or_else(|| file_err(format!("variant base `{base}` is not a built-in scene")))?;
         let (base_table, mut bases) = Self::resolve(&base, base_text, depth + 1)?;
+        let table = variant::apply(&base, base_table, table)?;
         bases.insert(0, base);
-        Ok((variant::apply(base_table, table)?, bases))
+        Ok((table, bases))
     }
 
     /// The scene's name.
@@ -349,9 +358,11 @@ impl Scene {
 
     /// Sets a parameter from `key=value` text.
     pub fn set_text(&mut self, assignment: &str) -> Result<(), SceneError> {
-        let (k, v) = assignment.split_once('=').ok_or_else(|| {
-            SceneError::Invalid(format!("`--set {assignment}`: expected key=value"))
-        })?;
+        let (k, v) = assignment
+            .split_once('=')
+            .ok_or_else(|| SceneError::NotAnAssignment {
+                text: assignment.to_string(),
+            })?;
         let (k, v) = (k.trim(), v.trim());
         // Name first, so an unknown key is reported as such even with a bad value.
         let name = self.parameter_name(k)?;
@@ -388,28 +399,6 @@ impl Scene {
         }
     }
 
-    /// A link's principal moments about its c.m., each checked to be non-negative: a scene
-    /// that computes them from other parameters (e.g. a moment about a joint less m d²) can
-    /// make one negative, and the error then names the expression and the value.
-    fn inertia_diag(&self, l: &file::LinkDef) -> Result<Vector3<f64>, SceneError> {
-        let what = format!("link `{}`.inertia_diag_kg_m2", l.name);
-        let d = self.vec3(&l.inertia_diag_kg_m2, &what)?;
-        let texts = l.inertia_diag_kg_m2.as_ref();
-        for (k, &v) in d.iter().enumerate() {
-            if v < 0.0 {
-                let text = texts.map_or_else(String::new, |t| match &t[k] {
-                    Num::Value(x) => format!("{x}"),
-                    Num::Expr(e) => format!("`{e}`"),
-                });
-                return Err(SceneError::Invalid(format!(
-                    "{what}[{k}] = {text} is {v} kg·m² with these parameter values: a moment \
-                     of inertia about the centre of mass cannot be negative"
-                )));
-            }
-        }
-        Ok(d)
-    }
-
     fn opt(&self, n: &Option<Num>, what: &str) -> Result<f64, SceneError> {
         n.as_ref().map_or(Ok(0.0), |n| self.num(n, what))
     }
@@ -420,217 +409,20 @@ impl Scene {
     }
 
     /// Builds everything the scene file sets up: the walker, its stride settings (the
-    /// `integrator` section) and its gait guess (the `guess` section).
+    /// `integrator` section) and its gait guess (the `guess` section), in stages (see
+    /// `scene/build.rs`): the model, the heel-strike, knee, fall and relabelling rules, the
+    /// integrator, the guess and the ankle reflex.
     pub fn setup(&self) -> Result<Setup, SceneError> {
         let f = &self.file;
-        let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
-        let slope = self.num(&f.world.slope_rad, "world.slope_rad")?;
-        let mut model = Model::new(Model::gravity_on_slope(g, slope));
-        for l in &f.links {
-            let what = |field: &str| format!("link `{}`.{field}", l.name);
-            let axis = self.vec3(&l.axis, &what("axis"))?;
-            let joint = match l.joint.as_str() {
-                "revolute" => JointKind::Revolute { axis_parent: axis },
-                "prismatic" => JointKind::Prismatic { axis_parent: axis },
-                "weld" => JointKind::Weld,
-                other => {
-                    return Err(SceneError::Invalid(format!(
-                        "link `{}`: joint `{other}` is not revolute, prismatic or weld",
-                        l.name
-                    )))
-                }
-            };
-            let d = self.inertia_diag(l)?;
-            let body = BodyInertia {
-                mass_kg: self.opt(&l.mass_kg, &what("mass_kg"))?,
-                p_link_com_m: self.vec3(&l.com_m, &what("com_m"))?,
-                inertia_com_kg_m2: Matrix3::from_diagonal(&d),
-                infinitesimal: l.infinitesimal,
-            };
-            let force = JointForce {
-                stiffness: self.opt(&l.stiffness, &what("stiffness"))?,
-                rest_position: self.opt(&l.rest, &what("rest"))?,
-                damping: self.opt(&l.damping, &what("damping"))?,
-            };
-            if force.stiffness < 0.0 || force.damping < 0.0 {
-                return Err(SceneError::Invalid(format!(
-                    "link `{}`: stiffness and damping must not be negative",
-                    l.name
-                )));
-            }
-            let parent = if l.parent == "ground" {
-                None
-            } else {
-                Some(l.parent.as_str())
-            };
-            model.add_link(
-                &l.name,
-                parent,
-                self.vec3(&l.origin_m, &what("origin_m"))?,
-                joint,
-                force,
-                body,
-            )?;
-        }
-        for p in &f.points {
-            model.add_point(
-                &p.name,
-                &p.link,
-                self.vec3(&Some(p.position_m.clone()), &p.name)?,
-            )?;
-        }
-        let point = |name: &str| {
-            model
-                .point_index(name)
-                .ok_or_else(|| SceneError::Invalid(format!("unknown point `{name}`")))
-        };
-        let link = |name: &str| {
-            model
-                .link_index(name)
-                .ok_or_else(|| SceneError::Invalid(format!("unknown link `{name}`")))
-        };
-        let coord = |name: &str| {
-            model
-                .coord_index(name)
-                .ok_or_else(|| SceneError::Invalid(format!("unknown coordinate `{name}`")))
-        };
-        let hs = &f.heel_strike;
-        let swing_foot = point(&hs.swing_foot)?;
-        let constraints = hs
-            .constraints
-            .iter()
-            .map(|c| match c.as_str() {
-                "x" => Ok(ContactConstraint::X),
-                "y" => Ok(ContactConstraint::Y),
-                "z" => Ok(ContactConstraint::Z),
-                "yaw" => Ok(ContactConstraint::Yaw),
-                o => Err(SceneError::Invalid(format!(
-                    "heel_strike.constraints: unknown `{o}`"
-                ))),
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let release = hs
-            .release
-            .iter()
-            .map(|r| match r.as_str() {
-                "tx" => Ok(JointKind::Prismatic {
-                    axis_parent: Vector3::x(),
-                }),
-                "ty" => Ok(JointKind::Prismatic {
-                    axis_parent: Vector3::y(),
-                }),
-                "tz" => Ok(JointKind::Prismatic {
-                    axis_parent: Vector3::z(),
-                }),
-                "rx" => Ok(JointKind::Revolute {
-                    axis_parent: Vector3::x(),
-                }),
-                "ry" => Ok(JointKind::Revolute {
-                    axis_parent: Vector3::y(),
-                }),
-                "rz" => Ok(JointKind::Revolute {
-                    axis_parent: Vector3::z(),
-                }),
-                _ => Err(SceneError::Invalid(format!(
-                    "heel_strike.release: unknown `{r}` (expected tx, ty, tz, rx, ry or rz)"
-                ))),
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let heel_strike = HeelStrikeRule {
-            swing_foot,
-            swing_foot_link: model.points[swing_foot.0].link,
-            min_ahead_m: self.opt(&hs.min_ahead_m, "heel_strike.min_ahead_m")?,
-            ignore_scuffing: hs.ignore_scuffing,
-            constraints,
-            restitution: self.opt(&hs.restitution, "heel_strike.restitution")?,
-            release: release.clone(),
-            stance_contact: point(&hs.stance_contact)?,
-        };
-        let knees = f
-            .knees
-            .iter()
-            .map(|k| {
-                Ok(KneeLock {
-                    coordinate: coord(&k.coordinate)?,
-                    stop_rad: self.num(&k.stop_rad, "knee.stop_rad")?,
-                    closing: direction(&k.closing)?,
-                })
-            })
-            .collect::<Result<Vec<_>, SceneError>>()?;
-        let fall = FallRule {
-            hip: point(&f.fall.hip)?,
-            min_hip_height_m: self.num(&f.fall.min_hip_height_m, "fall.min_hip_height_m")?,
-        };
-        let relabel = Relabel {
-            pairs: f
-                .relabel
-                .pairs
-                .iter()
-                .map(|[a, b]| Ok((link(a)?, link(b)?)))
-                .collect::<Result<Vec<_>, SceneError>>()?,
-            point_pairs: f
-                .relabel
-                .point_pairs
-                .iter()
-                .map(|[a, b]| Ok((point(a)?, point(b)?)))
-                .collect::<Result<Vec<_>, SceneError>>()?,
-            mirror: f.relabel.mirror,
-            cyclic: f
-                .relabel
-                .cyclic
-                .iter()
-                .map(|c| coord(c))
-                .collect::<Result<Vec<_>, _>>()?,
-            fixed: Vec::new(),
-            tolerance: 1e-13,
-            max_iterations: 50,
-        };
-        for c in &relabel.cyclic {
-            let l = &model.links[model.coordinates[c.0].link.0];
-            if l.parent.is_some() || slope != 0.0 {
-                return Err(SceneError::Invalid(format!(
-                    "cyclic coordinate `{}` must be a root joint on level ground",
-                    model.coordinates[c.0].name
-                )));
-            }
-        }
-        let it = &f.integrator;
-        let integrator =
-            IntegratorChoice::from_kind(&it.kind, it.h_s, it.rtol, it.atol, it.h_max_s)
-                .ok_or_else(|| {
-                    SceneError::Invalid(format!("integrator.kind: unknown `{}`", it.kind))
-                })?;
-        let max_stride_time_s = match &it.max_stride_time_s {
-            Some(n) => self.num(n, "integrator.max_stride_time_s")?,
-            None => StrideSettings::default().max_stride_time_s,
-        };
-        let mut guess_q = DVector::zeros(model.dof());
-        let mut guess_qd = DVector::zeros(model.dof());
-        for (k, v) in &f.guess.q {
-            guess_q[coord(k)?.0] = self.num(v, "guess.q")?;
-        }
-        for (k, v) in &f.guess.qd {
-            guess_qd[coord(k)?.0] = self.num(v, "guess.qd")?;
-        }
-        let ankle = match &f.ankle_reflex {
-            None => None,
-            Some(a) => {
-                let duration_s = self.num(&a.duration_s, "ankle_reflex.duration_s")?;
-                if duration_s <= 0.0 {
-                    return Err(SceneError::Invalid(format!(
-                        "ankle_reflex.duration_s must be positive, got {duration_s}"
-                    )));
-                }
-                Some(AnkleReflex {
-                    ankle: coord(&a.ankle)?,
-                    toe_pitch: coord(&a.toe_pitch)?,
-                    toe: point(&a.toe)?,
-                    engage_rad: self.num(&a.engage_rad, "ankle_reflex.engage_rad")?,
-                    final_rad: self.num(&a.final_rad, "ankle_reflex.final_rad")?,
-                    duration_s,
-                })
-            }
-        };
+        let (model, slope) = self.model()?;
+        let names = build::Names(&model);
+        let heel_strike = self.heel_strike(&names)?;
+        let knees = self.knees(&names)?;
+        let fall = self.fall(&names)?;
+        let relabel = self.relabel(&names, slope)?;
+        let (integrator, max_stride_time_s) = self.integrator()?;
+        let (guess_q, guess_qd) = self.guess(&names)?;
+        let ankle = self.ankle_reflex(&names)?;
         let walker = Walker::new(
             self.name(),
             model,

@@ -1,21 +1,27 @@
-//! Scene variants: a scene file may derive from another by welding joints (fixing freedoms)
-//! and removing bodies, so that e.g. the 2D and uncompensated walkers are the 3D walker's file
-//! with freedoms taken away, not copies of it.
+//! Scene variants: a scene file may derive from another by welding joints (fixing freedoms),
+//! removing bodies, changing parameter defaults and adding springs or dampers to joints, so
+//! that e.g. the 2D and uncompensated walkers are the 3D walker's file with freedoms taken
+//! away, not copies of it.
 //!
 //! ```toml
 //! [variant]
 //! base = "wisse3d"
 //! weld = ["stance_foot_yaw"]       # these joints become welds (their coordinates disappear)
 //! remove = ["pelvis_pitch"]         # these links and everything hanging from them go
+//! [variant.defaults]                # parameter defaults (unit, doc and range kept)
+//! ankle_engage_rad = -0.06
+//! [variant.joint.swing_knee]        # a spring and/or damper on a joint (the keys of [[link]])
+//! damping = 0.05
 //! [scene]                           # replaces the base's header
 //! ...
 //! ```
 //! Other top-level tables of the variant replace the base's (`[guess]`, `[integrator]`, ...),
-//! except `[parameters]`, which is merged entry by entry.
+//! except `[parameters]`, which is merged entry by entry. docs/scenes.md is the reference.
 
+use super::file::Num;
 use super::SceneError;
 use serde::Deserialize;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use toml::{Table, Value};
 
 /// A scene file's `[variant]` table. Unknown keys are rejected (a typo such as `wled` would
@@ -31,6 +37,99 @@ pub struct VariantDef {
     /// Links removed, with everything hanging from them.
     #[serde(default)]
     pub remove: Vec<String>,
+    /// New defaults of parameters (of the base or of this file's `[parameters]`), by name or
+    /// alias; each keeps its unit, doc and range.
+    #[serde(default)]
+    pub defaults: BTreeMap<String, f64>,
+    /// Springs and dampers put on joints, by link name: the keys given replace the link's.
+    #[serde(default)]
+    pub joint: BTreeMap<String, JointForceDef>,
+}
+
+/// A spring and damper on a joint (`[variant.joint.<link>]`): the same keys as a link's.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointForceDef {
+    /// Joint spring stiffness \[N·m/rad\] (N/m on a prismatic joint).
+    #[serde(default)]
+    pub stiffness: Option<Num>,
+    /// Joint spring rest position \[rad\] (m on a prismatic joint).
+    #[serde(default)]
+    pub rest: Option<Num>,
+    /// Joint damping \[N·m·s/rad\] (N·s/m on a prismatic joint).
+    #[serde(default)]
+    pub damping: Option<Num>,
+}
+
+impl JointForceDef {
+    /// The keys given, as TOML values for the link's table.
+    fn entries(&self) -> impl Iterator<Item = (&'static str, Value)> + '_ {
+        [
+            ("stiffness", &self.stiffness),
+            ("rest", &self.rest),
+            ("damping", &self.damping),
+        ]
+        .into_iter()
+        .filter_map(|(key, n)| {
+            n.as_ref().map(|n| {
+                let value = match n {
+                    Num::Value(v) => Value::Float(*v),
+                    Num::Expr(e) => Value::String(e.clone()),
+                };
+                (key, value)
+            })
+        })
+    }
+}
+
+/// What a `[variant]` asks for that its base cannot give. Each names the link or parameter.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum VariantError {
+    /// The variant's table has no `[variant]`.
+    #[error("variant: missing [variant] table")]
+    Missing,
+    /// The base has no `[[link]]` array.
+    #[error("base has no links")]
+    NoLinks,
+    /// `weld` or `remove` names a link the base does not have.
+    #[error("variant: unknown link `{link}`")]
+    UnknownLink {
+        /// As named.
+        link: String,
+    },
+    /// `[variant.joint.<link>]` names a link the base does not have.
+    #[error("variant of `{base}`: [variant.joint.{link}]: no link `{link}` (links: {available})")]
+    UnknownJoint {
+        /// The base scene.
+        base: String,
+        /// As named.
+        link: String,
+        /// The links there are.
+        available: String,
+    },
+    /// `[variant.joint.<link>]` on a weld (or a link the variant removes): no coordinate for a
+    /// spring or damper to act on.
+    #[error("variant of `{base}`: [variant.joint.{link}]: the link's joint is {why}, so a spring or damper has nothing to act on")]
+    NoJoint {
+        /// The base scene.
+        base: String,
+        /// The link.
+        link: String,
+        /// `a weld` or `removed by this variant`.
+        why: &'static str,
+    },
+    /// `[variant.defaults]` names a parameter that neither the base nor the variant has.
+    #[error(
+        "variant of `{base}`: [variant.defaults]: no parameter `{name}` (parameters: {available})"
+    )]
+    UnknownParameter {
+        /// The base scene.
+        base: String,
+        /// As named.
+        name: String,
+        /// The parameters there are.
+        available: String,
+    },
 }
 
 impl VariantDef {
@@ -53,12 +152,12 @@ fn invalid(msg: String) -> SceneError {
     SceneError::Invalid(msg)
 }
 
-/// Resolves a variant table against its base table (already resolved).
-pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
+/// Resolves a variant table against its base table (already resolved), the base named
+/// `base_name` in errors.
+pub fn apply(base_name: &str, base: Table, variant: Table) -> Result<Table, SceneError> {
     let mut out = base;
-    let spec = VariantDef::of(&variant)?
-        .ok_or_else(|| invalid("variant: missing [variant] table".into()))?;
-    let (weld, remove) = (spec.weld, spec.remove);
+    let spec = VariantDef::of(&variant)?.ok_or(VariantError::Missing)?;
+    let (weld, remove) = (&spec.weld, &spec.remove);
     for (k, v) in variant {
         match k.as_str() {
             "variant" => {}
@@ -77,10 +176,11 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             }
         }
     }
+    set_defaults(base_name, &mut out, &spec.defaults)?;
     let links = out
         .get_mut("link")
         .and_then(Value::as_array_mut)
-        .ok_or_else(|| invalid("base has no links".into()))?;
+        .ok_or(VariantError::NoLinks)?;
     let link_name = |l: &Value| {
         l.get("name")
             .and_then(Value::as_str)
@@ -90,11 +190,12 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
     let known: BTreeSet<String> = links.iter().map(link_name).collect();
     for n in weld.iter().chain(remove.iter()) {
         if !known.contains(n) {
-            return Err(invalid(format!("variant: unknown link `{n}`")));
+            return Err(VariantError::UnknownLink { link: n.clone() }.into());
         }
     }
     // Removing a link removes its descendants (links are parents-first).
     let mut gone: BTreeSet<String> = remove.iter().cloned().collect();
+    let available = known.iter().cloned().collect::<Vec<_>>().join(", ");
     for l in links.iter() {
         let parent = l.get("parent").and_then(Value::as_str).unwrap_or("");
         if gone.contains(parent) {
@@ -112,8 +213,34 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
             }
         }
     }
+    for (name, force) in &spec.joint {
+        let error = |why| VariantError::NoJoint {
+            base: base_name.to_string(),
+            link: name.clone(),
+            why,
+        };
+        if !known.contains(name) {
+            return Err(VariantError::UnknownJoint {
+                base: base_name.to_string(),
+                link: name.clone(),
+                available: available.clone(),
+            }
+            .into());
+        }
+        let link = links
+            .iter_mut()
+            .find(|l| link_name(l) == *name)
+            .and_then(Value::as_table_mut)
+            .ok_or_else(|| error("removed by this variant"))?;
+        if link.get("joint").and_then(Value::as_str) == Some("weld") {
+            return Err(error("a weld").into());
+        }
+        for (key, value) in force.entries() {
+            link.insert(key.into(), value);
+        }
+    }
     // Coordinates that no longer exist, and points on removed links.
-    let dead_coords: BTreeSet<String> = gone.iter().chain(weld.iter()).cloned().collect();
+    let dead_coords: BTreeSet<String> = gone.iter().chain(weld).cloned().collect();
     let mut dead_points = BTreeSet::new();
     if let Some(points) = out.get_mut("point").and_then(Value::as_array_mut) {
         points.retain(|p| {
@@ -169,4 +296,40 @@ pub fn apply(base: Table, variant: Table) -> Result<Table, SceneError> {
         });
     }
     Ok(out)
+}
+
+/// Sets the defaults of `[variant.defaults]` in the merged `[parameters]` of `out`: each name
+/// (or alias) must be a parameter there.
+fn set_defaults(
+    base_name: &str,
+    out: &mut Table,
+    defaults: &BTreeMap<String, f64>,
+) -> Result<(), SceneError> {
+    if defaults.is_empty() {
+        return Ok(());
+    }
+    let mut empty = Table::new();
+    let parameters = out
+        .get_mut("parameters")
+        .and_then(Value::as_table_mut)
+        .unwrap_or(&mut empty);
+    let available = parameters.keys().cloned().collect::<Vec<_>>().join(", ");
+    for (name, value) in defaults {
+        let has_alias = |p: &Value| {
+            p.get("aliases")
+                .and_then(Value::as_array)
+                .is_some_and(|a| a.iter().any(|x| x.as_str() == Some(name)))
+        };
+        let parameter = parameters
+            .iter_mut()
+            .find(|(k, p)| *k == name || has_alias(p))
+            .and_then(|(_, p)| p.as_table_mut())
+            .ok_or_else(|| VariantError::UnknownParameter {
+                base: base_name.to_string(),
+                name: name.clone(),
+                available: available.clone(),
+            })?;
+        parameter.insert("default".into(), Value::Float(*value));
+    }
+    Ok(())
 }

@@ -11,14 +11,14 @@ use serde::Serialize;
 /// Contact and clearance figures of a stride (with [`super::StrideOptions::contact`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ContactSummary {
-    /// Largest |lateral centre of pressure| under the stance foot [m].
+    /// Largest |lateral centre of pressure| under the stance foot \[m\].
     pub max_lateral_cop_m: f64,
-    /// Smallest normal force on the stance foot [N] (negative: the foot would have to pull).
+    /// Smallest normal force on the stance foot \[N\] (negative: the foot would have to pull).
     pub min_normal_force_n: f64,
-    /// Smallest swing-ankle height while it passes within 0.1 m of the stance contact [m].
+    /// Smallest swing-ankle height while it passes within 0.1 m of the stance contact \[m\].
     pub mid_swing_clearance_m: Option<f64>,
     /// Lateral centre of pressure at each accepted sample `(t_stride_s, cop_m)`
-    /// (stride time [s], lateral position [m]).
+    /// (stride time \[s\], lateral position \[m\]).
     pub lateral_cop_trace: Vec<(f64, f64)>,
 }
 

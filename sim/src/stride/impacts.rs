@@ -34,9 +34,9 @@ pub struct HeelStrikeImpact {
     pub qd_plus: DVector<f64>,
     /// Contact impulse per constraint row.
     pub impulse: DVector<f64>,
-    /// The new contact point in the stance frame [m].
+    /// The new contact point in the stance frame \[m\].
     pub p_contact_m: Vector3<f64>,
-    /// Mechanical energy lost [J].
+    /// Mechanical energy lost \[J\].
     pub energy_loss_j: f64,
 }
 

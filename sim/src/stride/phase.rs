@@ -22,7 +22,7 @@ pub enum Drive {
 }
 
 impl Drive {
-    /// Angle [rad], rate [rad/s], acceleration [rad/s²] at stride time `t_stride_s` [s].
+    /// Angle \[rad\], rate [rad/s], acceleration [rad/s²] at stride time `t_stride_s` \[s\].
     pub fn eval(&self, t_stride_s: f64) -> (f64, f64, f64) {
         match self {
             Drive::Profile(p) => p.eval(t_stride_s),

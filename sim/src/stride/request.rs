@@ -22,7 +22,7 @@ pub struct StrideControl<'a> {
     /// The controller, sampled at its control ticks (on the grid `k · period` of walk time)
     /// and told of the heel strike.
     pub controller: &'a mut dyn AnkleController,
-    /// Walk time at the start of this stride [s] (the controller's clock; the stride's own
+    /// Walk time at the start of this stride \[s\] (the controller's clock; the stride's own
     /// clock starts at 0).
     pub t_walk_start_s: f64,
 }
@@ -81,7 +81,7 @@ impl<'a> StrideRequest<'a> {
     }
 
     /// With the stance ankle's string moved by `controller`; `t_walk_start_s` is the walk
-    /// time at the start of the stride [s].
+    /// time at the start of the stride \[s\].
     pub fn controlled(self, controller: &'a mut dyn AnkleController, t_walk_start_s: f64) -> Self {
         let control = Some(StrideControl {
             controller,

@@ -12,7 +12,7 @@ use serde::Serialize;
 pub struct StrideEvent {
     /// `knee_lock:<coordinate>` or `heel_strike`.
     pub name: String,
-    /// Time from the start of the stride [s] (stride time; serialised as `time_s`).
+    /// Time from the start of the stride \[s\] (stride time; serialised as `time_s`).
     #[serde(rename = "time_s")]
     pub t_stride_s: f64,
 }
@@ -27,11 +27,11 @@ pub struct StrideResult {
     pub q_next: DVector<f64>,
     /// Velocities at the start of the next stride (relabelled).
     pub qd_next: DVector<f64>,
-    /// Stride duration [s].
+    /// Stride duration \[s\].
     pub duration_s: f64,
-    /// New contact point in the old stance frame [m].
+    /// New contact point in the old stance frame \[m\].
     pub step_m: Vector3<f64>,
-    /// Heading change of the relabelled cyclic coordinates [rad].
+    /// Heading change of the relabelled cyclic coordinates \[rad\].
     pub heading_change_rad: f64,
     /// Events in order.
     pub events: Vec<StrideEvent>,
@@ -39,15 +39,15 @@ pub struct StrideResult {
     pub pre_impact: Sample,
     /// Upward velocity of the old stance contact just after impact [m/s].
     pub lift_velocity_m_s: f64,
-    /// Mechanical energy lost in all impacts of the stride [J].
+    /// Mechanical energy lost in all impacts of the stride \[J\].
     pub impact_energy_loss_j: f64,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
     /// Accepted samples, when recording.
     pub trajectory: Vec<Sample>,
-    /// Work done by the ankle actuator (from the energy balance of the engaged intervals) [J].
+    /// Work done by the ankle actuator (from the energy balance of the engaged intervals) \[J\].
     pub actuator_work_j: f64,
-    /// Energy dissipated by joint dampers (trapezoidal quadrature) [J].
+    /// Energy dissipated by joint dampers (trapezoidal quadrature) \[J\].
     pub damping_dissipation_j: f64,
     /// Contact figures (with [`super::StrideOptions::contact`]).
     pub contact: ContactSummary,

@@ -8,7 +8,7 @@
 /// flip under a perturbation and make the central difference noisy.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepSchedule {
-    /// Step sizes [s] of each phase, in order.
+    /// Step sizes \[s\] of each phase, in order.
     pub phases: Vec<Vec<f64>>,
 }
 

@@ -19,7 +19,7 @@ pub struct StrideSettings {
     /// [`EventTolerance::default`] (1e-13 s, witness 1e-14, 60 iterations, 4 grazing samples).
     pub event_tolerance: EventTolerance,
     /// A stride that has not ended in heel strike after this much stride time fails with
-    /// `no_impact_within_time` [s]. Default: 10 s.
+    /// `no_impact_within_time` \[s\]. Default: 10 s.
     pub max_stride_time_s: f64,
     /// A stride that has taken this many integrator steps without ending fails with
     /// `step_budget_exceeded`, whatever its stride time (a step that does not advance time

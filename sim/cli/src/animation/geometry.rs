@@ -15,7 +15,7 @@ use sim::scene::{Scene, SceneError};
 pub struct KeyPoint {
     /// The link.
     pub link: LinkIndex,
-    /// Position in the link frame [m].
+    /// Position in the link frame \[m\].
     pub p_link_m: Vector3<f64>,
 }
 
@@ -45,7 +45,7 @@ pub enum Part {
         a: usize,
         /// The other end.
         b: usize,
-        /// Radius [m].
+        /// Radius \[m\].
         radius_m: f64,
     },
     /// A ring about key point `centre`, in the plane normal to the direction from `centre`
@@ -59,7 +59,7 @@ pub enum Part {
         centre: usize,
         /// Centre plus the unit normal.
         normal_tip: usize,
-        /// Radius [m].
+        /// Radius \[m\].
         radius_m: f64,
     },
     /// A body's mass at its centre of mass (drawn as a sphere whose volume grows with it).
@@ -70,7 +70,7 @@ pub enum Part {
         role: Role,
         /// The centre of mass.
         at: usize,
-        /// Mass [kg]; 0 for a body whose mass tends to zero (Garcia's feet).
+        /// Mass \[kg\]; 0 for a body whose mass tends to zero (Garcia's feet).
         mass_kg: f64,
     },
 }
@@ -84,7 +84,7 @@ pub struct Figure {
     pub parts: Vec<Part>,
 }
 
-/// Drawn radius of a skeleton rod (the scenes without shapes give no thickness) [m].
+/// Drawn radius of a skeleton rod (the scenes without shapes give no thickness) \[m\].
 const SKELETON_ROD_RADIUS_M: f64 = 0.012;
 
 impl Figure {

@@ -74,7 +74,7 @@ pub struct Animation<'a> {
     pub events: Vec<timeline::Event>,
     /// The firmware was in the loop (the page shows the ankle nodes).
     pub firmware: bool,
-    /// Walk time the host sent the emergency stop [s] (`None`: none sent).
+    /// Walk time the host sent the emergency stop \[s\] (`None`: none sent).
     pub emergency_stop_sent_s: Option<f64>,
 }
 
@@ -86,15 +86,15 @@ struct PageData<'a> {
     scene: &'a str,
     command: &'a str,
     firmware: bool,
-    /// Walk time the host sent the emergency stop [s] (`null`: none sent).
+    /// Walk time the host sent the emergency stop \[s\] (`null`: none sent).
     emergency_stop_sent_s: Option<f64>,
     /// The emergency stop in words (empty: none sent), for the banner.
     emergency_stop_text: String,
-    /// Turn of the floor frame about its z axis that makes gravity point down [rad].
+    /// Turn of the floor frame about its z axis that makes gravity point down \[rad\].
     world_rotation_z_rad: f64,
-    /// Floor grid spacing [m].
+    /// Floor grid spacing \[m\].
     grid_m: f64,
-    /// Radius of the sphere drawn for 1 kg [m].
+    /// Radius of the sphere drawn for 1 kg \[m\].
     mass_sphere_m: f64,
     parts: &'a [geometry::Part],
     track: track::Track,
@@ -103,7 +103,7 @@ struct PageData<'a> {
 
 impl Animation<'_> {
     /// The title: the walker by name (as the figures name it), what it did, and how the walk
-    /// ended: "then the fall" for a fall, "then simulation ended: <reason in words>" for any
+    /// ended: "then the fall" for a fall, "then simulation ended: `<reason in words>`" for any
     /// other failure; an emergency stop is named with its time. A gait's page counts steps,
     /// as its clock does.
     pub fn title(&self) -> String {

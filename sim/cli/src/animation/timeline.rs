@@ -10,7 +10,7 @@ use sim::walk::Walk;
 /// One event at a walk time.
 #[derive(Clone, Debug, Serialize)]
 pub struct Event {
-    /// Walk time [s].
+    /// Walk time \[s\].
     pub t_s: f64,
     /// `knee_lock`, `heel_strike`, `fall` (the walker fell over), `stop` (the walk ended
     /// on another failure, e.g. an impact that could not be solved), `state`, `phase`,
@@ -138,7 +138,7 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
     sorted(out)
 }
 
-/// The walk time the host sent its first emergency stop [s], from the run's report (`None`
+/// The walk time the host sent its first emergency stop \[s\], from the run's report (`None`
 /// if it sent none).
 pub fn emergency_stop_sent_s(r: &sil::SilReport) -> Option<f64> {
     r.host

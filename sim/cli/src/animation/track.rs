@@ -14,7 +14,7 @@ use sim::kinematics::Kinematics;
 use sim::walk::{FloorFrame, PathSample};
 use sim::walker::Walker;
 
-/// Largest quantum of the stored positions [m]: finer wherever the figure allows.
+/// Largest quantum of the stored positions \[m\]: finer wherever the figure allows.
 const FINEST_QUANTUM_M: f64 = 1e-4;
 
 /// One frame before encoding.
@@ -35,16 +35,16 @@ pub struct Track {
     /// For each key point of the figure ([`Figure::points`], as the parts index them), the
     /// stored point it is.
     pub point_of: Vec<usize>,
-    /// Walk time of each frame [s] (float32).
+    /// Walk time of each frame \[s\] (float32).
     pub t_s: String,
     /// Step of each frame as people number it, from 1 ([`crate::labels::step_number`];
     /// uint16, saturates at 65,535): the page shows it as it is.
     pub step_number: String,
-    /// The moving origin of each frame, the hip in the floor frame [m] (float32, x y z).
+    /// The moving origin of each frame, the hip in the floor frame \[m\] (float32, x y z).
     pub origin_m: String,
     /// Key points relative to the origin, in quanta (int16, x y z per point).
     pub rel: String,
-    /// The quantum [m].
+    /// The quantum \[m\].
     pub quantum_m: f64,
 }
 
@@ -134,7 +134,7 @@ fn frames(
     frames
 }
 
-/// Largest distance between two key points that are one stored point [m].
+/// Largest distance between two key points that are one stored point \[m\].
 const SAME_POINT_M: f64 = 1e-9;
 
 /// For each key point the index of its stored point, and for each stored point the key point

@@ -42,7 +42,7 @@ pub struct SilArgs {
     /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
-    /// Host emergency stop to every ankle at this walk time [s] (finite, not negative).
+    /// Host emergency stop to every ankle at this walk time \[s\] (finite, not negative).
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub estop_at: Option<f64>,
     /// Write the bus traffic as a candump log.
@@ -51,7 +51,7 @@ pub struct SilArgs {
     /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
     #[arg(long, value_name = "ADDR")]
     pub socketcand: Option<String>,
-    /// With `--socketcand`: before the walk starts, wait up to this long [s] for a client
+    /// With `--socketcand`: before the walk starts, wait up to this long \[s\] for a client
     /// (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk starts
     /// anyway and says so on standard error.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
@@ -105,7 +105,7 @@ struct SilWalkReport<'a, Bus: Serialize> {
     /// The firmware's gait over the last 10 steps that ended by the emergency stop (all
     /// steps without one; `null` if there is no such step).
     gait: Option<WalkGaitRecord>,
-    /// Walk time the host sent the emergency stop (`--estop-at`) [s]; `null` if none was sent.
+    /// Walk time the host sent the emergency stop (`--estop-at`) \[s\]; `null` if none was sent.
     emergency_stop_sent_s: Option<f64>,
     /// Steps completed that ended by the emergency stop (all of them without one).
     steps_before_emergency_stop: usize,

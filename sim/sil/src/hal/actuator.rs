@@ -23,7 +23,7 @@ use crate::actuator::ActuatorModel;
 use sim::control::ActuatorSegment;
 
 /// Smallest motion of the servo's string limit in one tick that its spool sensor sees, as an
-/// ankle angle [rad]: a tenth of the ankle encoder's count (2π/16384 ≈ 0.38 mrad), since the
+/// ankle angle \[rad\]: a tenth of the ankle encoder's count (2π/16384 ≈ 0.38 mrad), since the
 /// spool's quadrature encoder sits before the gearbox and resolves far finer than the ankle.
 pub const SPOOL_RESOLUTION_RAD: f64 = 3.8e-5;
 
@@ -59,7 +59,7 @@ impl ActuatorLink {
         }
     }
 
-    /// The coming tick `[t0_s, t1_s]`, the true ankle angle [rad] (where a slack string
+    /// The coming tick `[t0_s, t1_s]`, the true ankle angle \[rad\] (where a slack string
     /// becomes taut) and the string's torque on the ankle at the tick's start [N·m] (0 while
     /// slack; over the servo's limit it stalls, see [`ActuatorModel::tick`]).
     pub fn set_tick(&mut self, t0_s: f64, t1_s: f64, take_up_rad: f64, load_n_m: f64) {
@@ -79,7 +79,7 @@ impl ActuatorLink {
         &self.model
     }
 
-    /// The last command applied and the measured angle it came with [rad].
+    /// The last command applied and the measured angle it came with \[rad\].
     pub fn last_command(&self) -> Option<(ActuatorCommand, Option<f32>)> {
         self.last_command.map(|c| (c, self.last_measured_rad))
     }

@@ -32,8 +32,8 @@ const FRERR: u16 = 0x0001;
 /// ERRFL bit: parity error of a command.
 const PARERR: u16 = 0x0004;
 
-/// The true state of the ankle's shaft, set by the orchestrator before each tick: time [s] and
-/// angle [rad]. Shared with a [`SimSpi`].
+/// The true state of the ankle's shaft, set by the orchestrator before each tick: time \[s\] and
+/// angle \[rad\]. Shared with a [`SimSpi`].
 #[derive(Clone, Debug)]
 pub struct Shaft(Rc<Cell<(f64, f64)>>, Rc<Cell<ReflexPhase>>);
 
@@ -49,12 +49,12 @@ impl Shaft {
         Self::default()
     }
 
-    /// Set the time [s] and true ankle angle [rad] the next reads see.
+    /// Set the time \[s\] and true ankle angle \[rad\] the next reads see.
     pub fn set(&self, t_s: f64, angle_rad: f64) {
         self.0.set((t_s, angle_rad));
     }
 
-    /// Time [s] and true angle [rad].
+    /// Time \[s\] and true angle \[rad\].
     pub fn get(&self) -> (f64, f64) {
         self.0.get()
     }

@@ -13,16 +13,16 @@ pub enum SensorFault {
     Glitch {
         /// Which ankle.
         side: Side,
-        /// When [s].
+        /// When \[s\].
         at_s: f64,
-        /// Size of the jump [rad].
+        /// Size of the jump \[rad\].
         delta_rad: f64,
     },
     /// From `from_s` on, the counts stay frozen at the last reading before it.
     Stuck {
         /// Which ankle.
         side: Side,
-        /// From when [s].
+        /// From when \[s\].
         from_s: f64,
     },
     /// From the first tick its node is in `phase` on, the counts stay frozen at the last
@@ -37,9 +37,9 @@ pub enum SensorFault {
     SpiFailure {
         /// Which ankle.
         side: Side,
-        /// From when [s].
+        /// From when \[s\].
         from_s: f64,
-        /// Until when [s].
+        /// Until when \[s\].
         until_s: f64,
     },
     /// One angle answer (the first at or after `at_s`) arrives with a flipped bit, so its
@@ -47,7 +47,7 @@ pub enum SensorFault {
     Parity {
         /// Which ankle.
         side: Side,
-        /// When [s].
+        /// When \[s\].
         at_s: f64,
     },
 }

@@ -67,7 +67,7 @@ pub fn read_start_state(
     parse_start_state(&text, names).map_err(bad)
 }
 
-/// Largest start-state file read [bytes] (a `walker gait --json` output is a few kB).
+/// Largest start-state file read \[bytes\] (a `walker gait --json` output is a few kB).
 pub const MAX_START_STATE_BYTES: u64 = 1 << 20;
 
 /// The entries the text of a start-state file sets, as (stride-map index, value), or what is

@@ -1,0 +1,301 @@
+//! The stages of [`Scene::setup`]: each reads one part of the scene file and builds what the
+//! walker needs from it, naming in its errors the key that was wrong.
+
+use super::file::{self, Num};
+use super::{direction, Scene, SceneError};
+use crate::actuator::AnkleReflex;
+use crate::integrators::IntegratorChoice;
+use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, LinkIndex, Model, PointIndex};
+use crate::relabel::Relabel;
+use crate::stride::StrideSettings;
+use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock};
+use nalgebra::{DVector, Matrix3, Vector3};
+
+/// The model's points, links and coordinates by name; an unknown name is an error naming it.
+pub(super) struct Names<'a>(pub(super) &'a Model);
+
+impl Names<'_> {
+    pub(super) fn point(&self, name: &str) -> Result<PointIndex, SceneError> {
+        self.0
+            .point_index(name)
+            .ok_or_else(|| SceneError::Invalid(format!("unknown point `{name}`")))
+    }
+
+    pub(super) fn link(&self, name: &str) -> Result<LinkIndex, SceneError> {
+        self.0
+            .link_index(name)
+            .ok_or_else(|| SceneError::Invalid(format!("unknown link `{name}`")))
+    }
+
+    pub(super) fn coord(&self, name: &str) -> Result<CoordIndex, SceneError> {
+        self.0
+            .coord_index(name)
+            .ok_or_else(|| SceneError::Invalid(format!("unknown coordinate `{name}`")))
+    }
+}
+
+impl Scene {
+    /// The model (`[world]`, `[[link]]`, `[[point]]`) and the floor slope \[rad\].
+    pub(super) fn model(&self) -> Result<(Model, f64), SceneError> {
+        let f = &self.file;
+        let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
+        let slope = self.num(&f.world.slope_rad, "world.slope_rad")?;
+        let mut model = Model::new(Model::gravity_on_slope(g, slope));
+        for l in &f.links {
+            self.add_link(&mut model, l)?;
+        }
+        for p in &f.points {
+            model.add_point(
+                &p.name,
+                &p.link,
+                self.vec3(&Some(p.position_m.clone()), &p.name)?,
+            )?;
+        }
+        Ok((model, slope))
+    }
+
+    /// Adds one `[[link]]`: its joint, body, spring and damper.
+    fn add_link(&self, model: &mut Model, l: &file::LinkDef) -> Result<(), SceneError> {
+        let what = |field: &str| format!("link `{}`.{field}", l.name);
+        let axis = self.vec3(&l.axis, &what("axis"))?;
+        let joint = match l.joint.as_str() {
+            "revolute" => JointKind::Revolute { axis_parent: axis },
+            "prismatic" => JointKind::Prismatic { axis_parent: axis },
+            "weld" => JointKind::Weld,
+            other => {
+                return Err(SceneError::Invalid(format!(
+                    "link `{}`: joint `{other}` is not revolute, prismatic or weld",
+                    l.name
+                )))
+            }
+        };
+        let d = self.inertia_diag(l)?;
+        let body = BodyInertia {
+            mass_kg: self.opt(&l.mass_kg, &what("mass_kg"))?,
+            p_link_com_m: self.vec3(&l.com_m, &what("com_m"))?,
+            inertia_com_kg_m2: Matrix3::from_diagonal(&d),
+            infinitesimal: l.infinitesimal,
+        };
+        let force = JointForce {
+            stiffness: self.opt(&l.stiffness, &what("stiffness"))?,
+            rest_position: self.opt(&l.rest, &what("rest"))?,
+            damping: self.opt(&l.damping, &what("damping"))?,
+        };
+        if force.stiffness < 0.0 || force.damping < 0.0 {
+            return Err(SceneError::Invalid(format!(
+                "link `{}`: stiffness and damping must not be negative",
+                l.name
+            )));
+        }
+        let parent = if l.parent == "ground" {
+            None
+        } else {
+            Some(l.parent.as_str())
+        };
+        model.add_link(
+            &l.name,
+            parent,
+            self.vec3(&l.origin_m, &what("origin_m"))?,
+            joint,
+            force,
+            body,
+        )?;
+        Ok(())
+    }
+
+    /// The heel-strike rule (`[heel_strike]`), with the joints its release frees.
+    pub(super) fn heel_strike(&self, names: &Names) -> Result<HeelStrikeRule, SceneError> {
+        let hs = &self.file.heel_strike;
+        let swing_foot = names.point(&hs.swing_foot)?;
+        let constraints = hs
+            .constraints
+            .iter()
+            .map(|c| contact_constraint(c))
+            .collect::<Result<Vec<_>, _>>()?;
+        let release = hs
+            .release
+            .iter()
+            .map(|r| released_joint(r))
+            .collect::<Result<Vec<_>, _>>()?;
+        let rule = HeelStrikeRule {
+            swing_foot,
+            swing_foot_link: names.0.points[swing_foot.0].link,
+            min_ahead_m: self.opt(&hs.min_ahead_m, "heel_strike.min_ahead_m")?,
+            ignore_scuffing: hs.ignore_scuffing,
+            constraints,
+            restitution: self.opt(&hs.restitution, "heel_strike.restitution")?,
+            release,
+            stance_contact: names.point(&hs.stance_contact)?,
+        };
+        Ok(rule)
+    }
+
+    /// The knee stops (`[[knee]]`).
+    pub(super) fn knees(&self, names: &Names) -> Result<Vec<KneeLock>, SceneError> {
+        self.file
+            .knees
+            .iter()
+            .map(|k| {
+                Ok(KneeLock {
+                    coordinate: names.coord(&k.coordinate)?,
+                    stop_rad: self.num(&k.stop_rad, "knee.stop_rad")?,
+                    closing: direction(&k.closing)?,
+                })
+            })
+            .collect()
+    }
+
+    /// The fall rule (`[fall]`).
+    pub(super) fn fall(&self, names: &Names) -> Result<FallRule, SceneError> {
+        let f = &self.file.fall;
+        Ok(FallRule {
+            hip: names.point(&f.hip)?,
+            min_hip_height_m: self.num(&f.min_hip_height_m, "fall.min_hip_height_m")?,
+        })
+    }
+
+    /// The relabelling (`[relabel]`); cyclic coordinates must be root joints on level ground
+    /// (`slope_rad` 0).
+    pub(super) fn relabel(&self, names: &Names, slope_rad: f64) -> Result<Relabel, SceneError> {
+        let r = &self.file.relabel;
+        let relabel = Relabel {
+            pairs: r
+                .pairs
+                .iter()
+                .map(|[a, b]| Ok((names.link(a)?, names.link(b)?)))
+                .collect::<Result<Vec<_>, SceneError>>()?,
+            point_pairs: r
+                .point_pairs
+                .iter()
+                .map(|[a, b]| Ok((names.point(a)?, names.point(b)?)))
+                .collect::<Result<Vec<_>, SceneError>>()?,
+            mirror: r.mirror,
+            cyclic: r
+                .cyclic
+                .iter()
+                .map(|c| names.coord(c))
+                .collect::<Result<Vec<_>, _>>()?,
+            fixed: Vec::new(),
+            tolerance: 1e-13,
+            max_iterations: 50,
+        };
+        let model = names.0;
+        for c in &relabel.cyclic {
+            let l = &model.links[model.coordinates[c.0].link.0];
+            if l.parent.is_some() || slope_rad != 0.0 {
+                return Err(SceneError::Invalid(format!(
+                    "cyclic coordinate `{}` must be a root joint on level ground",
+                    model.coordinates[c.0].name
+                )));
+            }
+        }
+        Ok(relabel)
+    }
+
+    /// The integrator and the stride time budget \[s\] (`[integrator]`).
+    pub(super) fn integrator(&self) -> Result<(IntegratorChoice, f64), SceneError> {
+        let it = &self.file.integrator;
+        let integrator =
+            IntegratorChoice::from_kind(&it.kind, it.h_s, it.rtol, it.atol, it.h_max_s)
+                .ok_or_else(|| {
+                    SceneError::Invalid(format!("integrator.kind: unknown `{}`", it.kind))
+                })?;
+        let max_stride_time_s = match &it.max_stride_time_s {
+            Some(n) => self.num(n, "integrator.max_stride_time_s")?,
+            None => StrideSettings::default().max_stride_time_s,
+        };
+        Ok((integrator, max_stride_time_s))
+    }
+
+    /// The gait guess's coordinates and rates (`[guess]`; those not named are 0).
+    pub(super) fn guess(&self, names: &Names) -> Result<(DVector<f64>, DVector<f64>), SceneError> {
+        let g = &self.file.guess;
+        let mut q = DVector::zeros(names.0.dof());
+        let mut qd = DVector::zeros(names.0.dof());
+        for (k, v) in &g.q {
+            q[names.coord(k)?.0] = self.num(v, "guess.q")?;
+        }
+        for (k, v) in &g.qd {
+            qd[names.coord(k)?.0] = self.num(v, "guess.qd")?;
+        }
+        Ok((q, qd))
+    }
+
+    /// The stance ankle's stretch reflex (`[ankle_reflex]`), if the scene has one.
+    pub(super) fn ankle_reflex(&self, names: &Names) -> Result<Option<AnkleReflex>, SceneError> {
+        let Some(a) = &self.file.ankle_reflex else {
+            return Ok(None);
+        };
+        let duration_s = self.num(&a.duration_s, "ankle_reflex.duration_s")?;
+        if duration_s <= 0.0 {
+            return Err(SceneError::Invalid(format!(
+                "ankle_reflex.duration_s must be positive, got {duration_s}"
+            )));
+        }
+        Ok(Some(AnkleReflex {
+            ankle: names.coord(&a.ankle)?,
+            toe_pitch: names.coord(&a.toe_pitch)?,
+            toe: names.point(&a.toe)?,
+            engage_rad: self.num(&a.engage_rad, "ankle_reflex.engage_rad")?,
+            final_rad: self.num(&a.final_rad, "ankle_reflex.final_rad")?,
+            duration_s,
+        }))
+    }
+
+    /// A link's principal moments about its c.m., each checked to be non-negative: a scene
+    /// that computes them from other parameters (e.g. a moment about a joint less m d²) can
+    /// make one negative, and the error then names the expression and the value.
+    fn inertia_diag(&self, l: &file::LinkDef) -> Result<Vector3<f64>, SceneError> {
+        let what = format!("link `{}`.inertia_diag_kg_m2", l.name);
+        let d = self.vec3(&l.inertia_diag_kg_m2, &what)?;
+        let texts = l.inertia_diag_kg_m2.as_ref();
+        for (k, &v) in d.iter().enumerate() {
+            if v < 0.0 {
+                let text = texts.map_or_else(String::new, |t| match &t[k] {
+                    Num::Value(x) => format!("{x}"),
+                    Num::Expr(e) => format!("`{e}`"),
+                });
+                return Err(SceneError::Invalid(format!(
+                    "{what}[{k}] = {text} is {v} kg·m² with these parameter values: a moment \
+                     of inertia about the centre of mass cannot be negative"
+                )));
+            }
+        }
+        Ok(d)
+    }
+}
+
+/// A `heel_strike.constraints` entry.
+fn contact_constraint(c: &str) -> Result<ContactConstraint, SceneError> {
+    match c {
+        "x" => Ok(ContactConstraint::X),
+        "y" => Ok(ContactConstraint::Y),
+        "z" => Ok(ContactConstraint::Z),
+        "yaw" => Ok(ContactConstraint::Yaw),
+        o => Err(SceneError::Invalid(format!(
+            "heel_strike.constraints: unknown `{o}`"
+        ))),
+    }
+}
+
+/// A `heel_strike.release` entry: the joint it frees at the old stance contact.
+fn released_joint(r: &str) -> Result<JointKind, SceneError> {
+    let (prismatic, axis) = match r {
+        "tx" => (true, Vector3::x()),
+        "ty" => (true, Vector3::y()),
+        "tz" => (true, Vector3::z()),
+        "rx" => (false, Vector3::x()),
+        "ry" => (false, Vector3::y()),
+        "rz" => (false, Vector3::z()),
+        _ => {
+            return Err(SceneError::Invalid(format!(
+                "heel_strike.release: unknown `{r}` (expected tx, ty, tz, rx, ry or rz)"
+            )))
+        }
+    };
+    Ok(if prismatic {
+        JointKind::Prismatic { axis_parent: axis }
+    } else {
+        JointKind::Revolute { axis_parent: axis }
+    })
+}
