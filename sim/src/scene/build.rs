@@ -2,13 +2,15 @@
 //! walker needs from it, naming in its errors the key that was wrong.
 
 use super::file::{self, Num};
-use super::{direction, Scene, SceneError};
+use super::{direction, Scene, SceneError, Setup};
 use crate::actuator::AnkleReflex;
+use crate::events::EventTolerance;
 use crate::integrators::IntegratorChoice;
+use crate::limit_cycle::GaitGuess;
 use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, LinkIndex, Model, PointIndex};
 use crate::relabel::Relabel;
 use crate::stride::StrideSettings;
-use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock};
+use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker, WalkerRules};
 use nalgebra::{DVector, Matrix3, Vector3};
 
 /// The model's points, links and coordinates by name; an unknown name is an error naming it.
@@ -298,4 +300,62 @@ fn released_joint(r: &str) -> Result<JointKind, SceneError> {
     } else {
         JointKind::Revolute { axis_parent: axis }
     })
+}
+
+impl Scene {
+    /// Builds the walker (the physics only; [`Self::setup`] for its settings and gait guess).
+    pub fn build(&self) -> Result<Walker, SceneError> {
+        Ok(self.setup()?.walker)
+    }
+
+    /// Builds everything the scene file sets up: the walker, its stride settings (the
+    /// `integrator` section) and its gait guess (the `guess` section), in stages (see
+    /// `scene/build.rs`): the model, the heel-strike, knee, fall and relabelling rules, the
+    /// integrator, the guess and the ankle reflex.
+    pub fn setup(&self) -> Result<Setup, SceneError> {
+        let f = &self.file;
+        let (model, slope) = self.model()?;
+        let names = Names(&model);
+        let heel_strike = self.heel_strike(&names)?;
+        let knees = self.knees(&names)?;
+        let fall = self.fall(&names)?;
+        let relabel = self.relabel(&names, slope)?;
+        let (integrator, max_stride_time_s) = self.integrator()?;
+        let (guess_q, guess_qd) = self.guess(&names)?;
+        let ankle = self.ankle_reflex(&names)?;
+        let walker = Walker::new(
+            self.name(),
+            model,
+            WalkerRules {
+                heel_strike,
+                knees,
+                fall,
+                relabel,
+                ankle,
+                three_d_freedoms: f.three_d_freedoms.clone(),
+                relabel_reference_q: guess_q.clone(),
+            },
+        );
+        let settings = StrideSettings {
+            integrator,
+            event_tolerance: EventTolerance::default(),
+            max_stride_time_s,
+            ..StrideSettings::default()
+        };
+        settings
+            .validate()
+            .map_err(|error| SceneError::Integrator {
+                scene: self.name().to_string(),
+                error,
+            })?;
+        self.check_convention(&walker)?;
+        Ok(Setup {
+            walker,
+            settings,
+            guess: GaitGuess {
+                q: guess_q,
+                qd: guess_qd,
+            },
+        })
+    }
 }

@@ -4,17 +4,19 @@
 //! to a scene file of the same schema ([`file::SceneFile`]).
 
 mod build;
+mod error;
 pub mod expr;
 pub mod file;
 mod usage;
 pub mod variant;
 
-use crate::events::{Direction, EventTolerance};
-use crate::integrators::IntegratorError;
+pub use error::{SceneError, VariantError};
+
+use crate::events::Direction;
 use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
-use crate::model::{CoordIndex, ModelError};
+use crate::model::CoordIndex;
 use crate::stride::StrideSettings;
-use crate::walker::{Walker, WalkerRules};
+use crate::walker::Walker;
 use file::{Num, SceneFile};
 use nalgebra::{DVector, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
@@ -47,103 +49,6 @@ pub const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../scenes/wisse2d-uncompensated.toml"),
     ),
 ];
-
-/// Why a scene could not be loaded or built. Each variant names what was wrong.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SceneError {
-    /// No such scene.
-    #[error("unknown scene `{name}` (available: {available})")]
-    UnknownScene {
-        /// Asked for.
-        name: String,
-        /// Known names.
-        available: String,
-    },
-    /// The file could not be read or parsed.
-    #[error("scene file `{path}`: {message}")]
-    File {
-        /// Path or scene name.
-        path: String,
-        /// Parser message.
-        message: String,
-    },
-    /// A parameter name the scene does not have.
-    #[error("scene `{scene}` has no parameter `{name}` (parameters: {available})")]
-    UnknownParameter {
-        /// Scene.
-        scene: String,
-        /// Asked for.
-        name: String,
-        /// Known names.
-        available: String,
-    },
-    /// A parameter value that is not a finite number.
-    #[error("parameter `{name}`: `{value}` is not a finite number")]
-    NotANumber {
-        /// Parameter.
-        name: String,
-        /// Given text.
-        value: String,
-    },
-    /// A parameter outside its physical range.
-    #[error("parameter `{name}` = {value}{} is outside its allowed range [{min}, {max}]", unit_suffix(.unit))]
-    OutOfRange {
-        /// Parameter.
-        name: String,
-        /// Value.
-        value: f64,
-        /// Unit.
-        unit: String,
-        /// Lower bound.
-        min: f64,
-        /// Upper bound.
-        max: f64,
-    },
-    /// An expression failed.
-    #[error("{0}")]
-    Expr(#[from] expr::ExprError),
-    /// A `[variant]` names something its base does not have.
-    #[error("{0}")]
-    Variant(#[from] variant::VariantError),
-    /// An expression gave NaN or infinity.
-    #[error("`{what}` evaluates to {value}, not a finite number")]
-    NonFinite {
-        /// Where.
-        what: String,
-        /// The value.
-        value: f64,
-    },
-    /// The model is not physical or inconsistent.
-    #[error("model: {0}")]
-    Model(#[from] ModelError),
-    /// A reference to something undefined, or a bad keyword.
-    #[error("{0}")]
-    Invalid(String),
-    /// An assignment ([`Scene::set_text`]) that is not `key=value`.
-    #[error("`{text}`: expected key=value")]
-    NotAnAssignment {
-        /// The text given.
-        text: String,
-    },
-    /// The `[integrator]` settings cannot run a stride.
-    #[error("scene `{scene}` [integrator]: {error}")]
-    Integrator {
-        /// Scene.
-        scene: String,
-        /// What is wrong.
-        error: IntegratorError,
-    },
-    /// Setting a parameter that acts on nothing of this walker.
-    #[error("scene `{scene}`: parameter `{name}` acts on nothing of this walker (no expression uses it{}), so setting it would change nothing", variant_of.as_ref().map(|b| format!("; the variant of `{b}` removed or welded the bodies it belongs to")).unwrap_or_default())]
-    UnusedParameter {
-        /// Scene.
-        scene: String,
-        /// Parameter.
-        name: String,
-        /// The base scene of the variant, if the scene is one.
-        variant_of: Option<String>,
-    },
-}
 
 /// Everything a scene file sets up: the walker's physics, the solver settings of its strides,
 /// and a starting guess for its gait.
@@ -403,62 +308,6 @@ impl Scene {
         n.as_ref().map_or(Ok(0.0), |n| self.num(n, what))
     }
 
-    /// Builds the walker (the physics only; [`Self::setup`] for its settings and gait guess).
-    pub fn build(&self) -> Result<Walker, SceneError> {
-        Ok(self.setup()?.walker)
-    }
-
-    /// Builds everything the scene file sets up: the walker, its stride settings (the
-    /// `integrator` section) and its gait guess (the `guess` section), in stages (see
-    /// `scene/build.rs`): the model, the heel-strike, knee, fall and relabelling rules, the
-    /// integrator, the guess and the ankle reflex.
-    pub fn setup(&self) -> Result<Setup, SceneError> {
-        let f = &self.file;
-        let (model, slope) = self.model()?;
-        let names = build::Names(&model);
-        let heel_strike = self.heel_strike(&names)?;
-        let knees = self.knees(&names)?;
-        let fall = self.fall(&names)?;
-        let relabel = self.relabel(&names, slope)?;
-        let (integrator, max_stride_time_s) = self.integrator()?;
-        let (guess_q, guess_qd) = self.guess(&names)?;
-        let ankle = self.ankle_reflex(&names)?;
-        let walker = Walker::new(
-            self.name(),
-            model,
-            WalkerRules {
-                heel_strike,
-                knees,
-                fall,
-                relabel,
-                ankle,
-                three_d_freedoms: f.three_d_freedoms.clone(),
-                relabel_reference_q: guess_q.clone(),
-            },
-        );
-        let settings = StrideSettings {
-            integrator,
-            event_tolerance: EventTolerance::default(),
-            max_stride_time_s,
-            ..StrideSettings::default()
-        };
-        settings
-            .validate()
-            .map_err(|error| SceneError::Integrator {
-                scene: self.name().to_string(),
-                error,
-            })?;
-        self.check_convention(&walker)?;
-        Ok(Setup {
-            walker,
-            settings,
-            guess: GaitGuess {
-                q: guess_q,
-                qd: guess_qd,
-            },
-        })
-    }
-
     /// Checks the `[convention]` section against the built walker: a positive, finite time
     /// scale, finite offsets, and finite coefficients of coordinates the walker has.
     fn check_convention(&self, walker: &Walker) -> Result<(), SceneError> {
@@ -527,14 +376,5 @@ fn direction(s: &str) -> Result<Direction, SceneError> {
         o => Err(SceneError::Invalid(format!(
             "direction `{o}` is not rising or falling"
         ))),
-    }
-}
-
-/// The unit after a value in a message: nothing for a dimensionless parameter (unit `1` or
-/// empty), else a space and the unit.
-fn unit_suffix(unit: &str) -> String {
-    match unit {
-        "" | "1" => String::new(),
-        u => format!(" {u}"),
     }
 }

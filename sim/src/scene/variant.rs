@@ -18,8 +18,9 @@
 //! Other top-level tables of the variant replace the base's (`[guess]`, `[integrator]`, ...),
 //! except `[parameters]`, which is merged entry by entry. docs/scenes.md is the reference.
 
+use super::error::SceneError;
+pub use super::error::VariantError;
 use super::file::Num;
-use super::SceneError;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use toml::{Table, Value};
@@ -80,56 +81,6 @@ impl JointForceDef {
             })
         })
     }
-}
-
-/// What a `[variant]` asks for that its base cannot give. Each names the link or parameter.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum VariantError {
-    /// The variant's table has no `[variant]`.
-    #[error("variant: missing [variant] table")]
-    Missing,
-    /// The base has no `[[link]]` array.
-    #[error("base has no links")]
-    NoLinks,
-    /// `weld` or `remove` names a link the base does not have.
-    #[error("variant: unknown link `{link}`")]
-    UnknownLink {
-        /// As named.
-        link: String,
-    },
-    /// `[variant.joint.<link>]` names a link the base does not have.
-    #[error("variant of `{base}`: [variant.joint.{link}]: no link `{link}` (links: {available})")]
-    UnknownJoint {
-        /// The base scene.
-        base: String,
-        /// As named.
-        link: String,
-        /// The links there are.
-        available: String,
-    },
-    /// `[variant.joint.<link>]` on a weld (or a link the variant removes): no coordinate for a
-    /// spring or damper to act on.
-    #[error("variant of `{base}`: [variant.joint.{link}]: the link's joint is {why}, so a spring or damper has nothing to act on")]
-    NoJoint {
-        /// The base scene.
-        base: String,
-        /// The link.
-        link: String,
-        /// `a weld` or `removed by this variant`.
-        why: &'static str,
-    },
-    /// `[variant.defaults]` names a parameter that neither the base nor the variant has.
-    #[error(
-        "variant of `{base}`: [variant.defaults]: no parameter `{name}` (parameters: {available})"
-    )]
-    UnknownParameter {
-        /// The base scene.
-        base: String,
-        /// As named.
-        name: String,
-        /// The parameters there are.
-        available: String,
-    },
 }
 
 impl VariantDef {
