@@ -76,7 +76,7 @@ pub enum SceneError {
     /// A reference to something undefined, or a bad keyword.
     #[error("{0}")]
     Invalid(String),
-    /// An assignment ([`Scene::set_text`]) that is not `key=value`.
+    /// An assignment ([`super::Scene::set_text`]) that is not `key=value`.
     #[error("`{text}`: expected key=value")]
     NotAnAssignment {
         /// The text given.
