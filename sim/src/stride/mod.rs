@@ -15,6 +15,7 @@
 //! - `energy`: actuator work and damper dissipation;
 //! - `contact_figures`: [`ContactSummary`];
 //! - `evaluation_path`: [`EvaluationPath`], which evaluation a stride uses;
+//! - `state`: `StrideState`, a state of a stride in one storage (dynamic or fixed-size);
 //! - `engine`: what the loop needs of a state's storage and its evaluation (`Engine`), and the
 //!   reference engine on `DVector` samples;
 //! - `run`: the one loop ([`Walker::stride`], [`StrideWorkspace::stride`]), written once for
@@ -45,6 +46,7 @@ mod result;
 mod run;
 mod schedule;
 mod settings;
+mod state;
 mod witnesses;
 mod workspace;
 

@@ -8,7 +8,9 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
-use super::engine::{Engine, StrideState, WitnessEvaluator};
+use super::engine::Engine;
+use super::state::StrideState;
+use super::witnesses::WitnessEvaluator;
 use super::phase::Drive;
 use super::request::{StrideControl, StrideOptions, StrideRequest};
 use super::result::{FailureKind, StrideEvent, StrideFailure, StrideResult};

@@ -18,7 +18,8 @@ mod impact;
 mod planar_witnesses;
 
 use super::contact_figures::ContactSummary;
-use super::engine::{Engine, NoInterpolant, StrideState};
+use super::engine::{Engine, NoInterpolant};
+use super::state::StrideState;
 use super::phase::Drive;
 use super::request::StrideOptions;
 use super::result::{StrideEvent, StrideFailure, StrideResult};

@@ -11,8 +11,7 @@
 
 use super::dop853::State;
 use crate::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
-use crate::stride::engine::WitnessEvaluator;
-use crate::stride::witnesses::WitnessValues;
+use crate::stride::witnesses::{WitnessEvaluator, WitnessValues};
 use crate::walker::Walker;
 use nalgebra::SVector;
 

@@ -18,7 +18,9 @@
 use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
 use crate::hermite::{self, Knot};
-use crate::stride::engine::{Engine, Interpolant, StrideState, WitnessEvaluator};
+use crate::stride::engine::{Engine, Interpolant};
+use crate::stride::state::StrideState;
+use crate::stride::witnesses::WitnessEvaluator;
 use crate::stride::phase::Drive;
 use crate::stride::result::{FailureKind, StrideEvent, StrideFailure};
 use crate::stride::witnesses::WitnessValues;
