@@ -5,7 +5,7 @@
 //! (`two_link.rs`, `three_link.rs`) and the fixed-size stride's witnesses
 //! (`stride/fast/witness.rs`) read them.
 
-use super::{LinkFrame, PlanarTree, MAX_LINKS, MAX_PLANAR_COORDINATES};
+use super::links::{LinkFrame, PlanarLinks, MAX_LINKS, MAX_PLANAR_COORDINATES};
 use nalgebra::SVector;
 
 /// One joint of a planar tree.
@@ -35,7 +35,7 @@ pub(crate) struct Joints {
 impl Joints {
     /// The joints of `tree`; `None` when it has more than [`MAX_PLANAR_COORDINATES`] joints or
     /// [`MAX_LINKS`] links.
-    pub(crate) fn of(tree: &PlanarTree) -> Option<Self> {
+    pub(crate) fn of(tree: &PlanarLinks) -> Option<Self> {
         let mut j = Self {
             joints: [ChainJoint::default(); MAX_PLANAR_COORDINATES],
             len: 0,
@@ -117,7 +117,7 @@ pub(super) struct SerialChain<const K: usize> {
 impl<const K: usize> SerialChain<K> {
     /// The serial chain of `tree`, or `None` when it is not one of `K` joints on its `K`
     /// coordinates with every body with mass rigid with one of the joints' links.
-    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
+    pub(super) fn of(tree: &PlanarLinks) -> Option<Self> {
         if tree.dof != K {
             return None;
         }

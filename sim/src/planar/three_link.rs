@@ -24,7 +24,8 @@
 //! springs and dampers (`k (q − q_rest) + d q̇`), as in the link pass.
 
 use super::chain::SerialChain;
-use super::{sin_cos, Assembled, PlanarTree};
+use super::links::{Assembled, PlanarLinks};
+use super::trig::sin_cos;
 use nalgebra::{SMatrix, SVector};
 
 /// A planar three-link serial chain's equations of motion in closed form (see the module's
@@ -50,7 +51,7 @@ impl ThreeLink {
     /// bodies: three coordinates, the first joint's link on the ground through welds only,
     /// each further joint's link below the previous joint's, every body with mass rigid with
     /// one of the three, none infinitesimal.
-    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
+    pub(super) fn of(tree: &PlanarLinks) -> Option<Self> {
         if tree.has_infinitesimal {
             return None;
         }

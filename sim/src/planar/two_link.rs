@@ -44,7 +44,8 @@
 //! and infinitesimal bodies lump separately (the `ε` parts of `M̄`, `f̄`).
 
 use super::chain::{Lumped, SerialChain};
-use super::{sin_cos, Assembled, PlanarTree};
+use super::links::{Assembled, PlanarLinks};
+use super::trig::sin_cos;
 use nalgebra::{SMatrix, SVector};
 
 /// The constants of `M̄` and `f̄` for one part (finite or infinitesimal bodies).
@@ -152,7 +153,7 @@ impl TwoLink {
     /// The closed form of `tree`, or `None` when it is not a two-link chain: two coordinates,
     /// the first joint's link on the ground through welds only, the second joint's link below
     /// the first's, every body with mass on one of the two.
-    pub(super) fn of(tree: &PlanarTree) -> Option<Self> {
+    pub(super) fn of(tree: &PlanarLinks) -> Option<Self> {
         let chain = SerialChain::<2>::of(tree)?;
         let [a, b] = chain.joints;
         let [finite, eps] = chain.groups;

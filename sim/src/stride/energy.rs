@@ -1,7 +1,7 @@
 //! Energy accounting over a stride: the ankle actuator's work and the joint dampers'
 //! dissipation.
 
-use super::engine::StrideState;
+use super::state::StrideState;
 use crate::dynamics::Dynamics;
 use crate::integrators::Sample;
 use crate::model::Model;

@@ -1,7 +1,7 @@
-//! What the one stride loop (`stride::run`) needs of a state's storage and of the evaluation
-//! behind it: [`StrideState`] (a sample, dynamic `DVector` or fixed-size `SVector<N>`),
-//! [`WitnessEvaluator`] (the event witnesses at a state), and [`Engine`] (the smooth phase,
-//! its integrator, event location and the heel-strike impact on that storage).
+//! What the one stride loop (`stride::run`) needs of the evaluation behind a state's storage
+//! ([`StrideState`], in `state`; its witnesses, [`WitnessEvaluator`], in `witnesses`):
+//! [`Engine`] (the smooth phase, its integrator, event location and the heel-strike impact on
+//! that storage).
 //!
 //! Two engines: the reference (`DynamicEngine`: [`Phase`] on `DVector` samples with any
 //! integrator, the planar, axis-tree or general evaluation inside it) and the fixed-size one
@@ -14,53 +14,13 @@ use super::contact_figures::ContactSummary;
 use super::failure::StrideFailure;
 use super::phase::{Drive, Phase};
 use super::result::{StrideEvent, StrideResult};
-use super::witnesses::{WitnessValues, Witnesses};
+use super::state::StrideState;
+use super::witnesses::{WitnessEvaluator, Witnesses};
 use crate::dynamics::DynamicsError;
 use crate::events::{locate, EventError, EventTolerance};
 use crate::integrators::{DenseOutput, IntegrationError, Integrator, Sample};
 use crate::model::CoordIndex;
 use crate::walker::Walker;
-
-/// A state of a stride (stride time, positions, velocities) in one storage.
-pub(super) trait StrideState: Clone {
-    /// Stride time [s].
-    fn t_s(&self) -> f64;
-    /// Coordinate `c`.
-    fn q(&self, c: usize) -> f64;
-    /// The rate of coordinate `c`.
-    fn qd(&self, c: usize) -> f64;
-    /// Every position and velocity finite.
-    fn is_finite(&self) -> bool;
-    /// As a general sample (what the stride records and the impacts read).
-    fn to_sample(&self) -> Sample;
-    /// A general sample in this storage (`None`: another length, or not finite where the
-    /// storage requires it).
-    fn from_sample(s: Sample) -> Option<Self>;
-}
-
-impl StrideState for Sample {
-    #[inline]
-    fn t_s(&self) -> f64 {
-        self.t_s
-    }
-    #[inline]
-    fn q(&self, c: usize) -> f64 {
-        self.q[c]
-    }
-    #[inline]
-    fn qd(&self, c: usize) -> f64 {
-        self.qd[c]
-    }
-    fn is_finite(&self) -> bool {
-        self.q.iter().chain(self.qd.iter()).all(|v| v.is_finite())
-    }
-    fn to_sample(&self) -> Sample {
-        self.clone()
-    }
-    fn from_sample(s: Sample) -> Option<Self> {
-        Some(s)
-    }
-}
 
 /// The solution inside one step, for a controller's ticks there.
 pub(super) trait Interpolant<S> {
@@ -81,19 +41,6 @@ pub(super) enum NoInterpolant {}
 impl<S> Interpolant<S> for NoInterpolant {
     fn eval(&self, _t_s: f64) -> S {
         match *self {}
-    }
-}
-
-/// The witnesses of the stride's events at a state.
-pub(super) trait WitnessEvaluator<S> {
-    /// Every witness at `s`.
-    fn eval(&mut self, s: &S) -> WitnessValues;
-}
-
-impl WitnessEvaluator<Sample> for Witnesses<'_> {
-    #[inline]
-    fn eval(&mut self, s: &Sample) -> WitnessValues {
-        Witnesses::eval(self, s)
     }
 }
 

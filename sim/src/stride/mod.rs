@@ -15,19 +15,20 @@
 //! - `energy`: actuator work and damper dissipation;
 //! - `contact_figures`: [`ContactSummary`];
 //! - `evaluation_path`: [`EvaluationPath`], which evaluation a stride uses;
+//! - `state`: `StrideState`, a state of a stride in one storage (dynamic or fixed-size);
 //! - `engine`: what the loop needs of a state's storage and its evaluation (`Engine`), and the
 //!   reference engine on `DVector` samples;
-//! - `run`: the one loop ([`Walker::stride`], [`StrideWorkspace::stride`]), written once for
-//!   every engine;
+//! - `run`: the one loop, written once for every engine (its control ticks in `run/ticks`);
 //! - `fast`: the fixed-size engine (`SVector<N>` states, DOP853 and the planar evaluation) for
 //!   the planar walkers it covers (selected automatically, the reference engine its reference
 //!   and fallback);
 //! - `workspace`: [`StrideWorkspace`], the model-derived structures and scratch repeated
-//!   strides reuse;
+//!   strides reuse, and the entry points ([`Walker::stride`], [`StrideWorkspace::stride`])
+//!   that pick the engine and run the loop on it;
 //! - `result`: [`StrideResult`], [`StrideEvent`];
 //! - `failure`: [`StrideFailure`], its [`FailureKind`] and [`FailureCause`] (with the values).
 //!
-//! `impl Walker` for the stride lives here (`run` and `impacts`); [`crate::walker`] keeps the
+//! `impl Walker` for the stride lives here (`workspace` and `impacts`); [`crate::walker`] keeps the
 //! model-level methods; walks are [`crate::walk::walk`], gait searches
 //! [`crate::limit_cycle::GaitSearch`]. Times in a stride are stride time (from its start).
 //!
@@ -47,6 +48,7 @@ mod result;
 mod run;
 mod schedule;
 mod settings;
+mod state;
 mod witnesses;
 mod workspace;
 

@@ -1,4 +1,4 @@
-//! The stride loop ([`Walker::stride`]): from just after one heel strike, step the smooth
+//! The stride loop, written once for every engine ([`Walker::stride`] picks the engine): from just after one heel strike, step the smooth
 //! dynamics of the current phase; at each step run the control tick, the grazing check and
 //! the witnesses; locate the earliest triggered event and apply it (an impact, which starts
 //! a new phase; a failure; or heel strike, which ends the stride).
@@ -8,139 +8,20 @@
 
 use super::contact_figures::ContactSummary;
 use super::energy::Power;
-use super::engine::{Engine, StrideState, WitnessEvaluator};
+use super::engine::Engine;
 use super::failure::{FailureCause, StrideFailure};
 use super::phase::Drive;
-use super::request::{StrideControl, StrideOptions, StrideRequest};
+use super::request::{StrideControl, StrideOptions};
 use super::result::{StrideEvent, StrideResult};
 use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
-use super::witnesses::{self, StringLimit, Watch, WitnessValues, Witnesses};
-use super::workspace::StrideWorkspace;
-use crate::control::ActuatorSegment;
+use super::state::StrideState;
+use super::witnesses::{self, StringLimit, Watch, WitnessEvaluator, WitnessValues};
 use crate::integrators::Sample;
 use crate::walker::Walker;
-use nalgebra::DVector;
+use ticks::{Plant, TickEffect, Ticks};
 
 mod ticks;
-
-impl Walker {
-    /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
-    /// `request` asks: its settings, what it records, its step schedule, its controller. (A
-    /// [`StrideWorkspace`] of its own: repeated strides reuse one with
-    /// [`StrideWorkspace::stride`].)
-    ///
-    /// # Errors
-    /// A [`StrideFailure`] saying how and when (stride time) the stride failed; samples
-    /// recorded into the request's sink up to the failure are kept there.
-    pub fn stride(
-        &self,
-        q0: &DVector<f64>,
-        qd0: &DVector<f64>,
-        request: StrideRequest<'_>,
-    ) -> Result<StrideResult, StrideFailure> {
-        StrideWorkspace::new(self).stride(q0, qd0, request)
-    }
-}
-
-impl StrideWorkspace<'_> {
-    /// [`Walker::stride`] of this workspace's walker, on this workspace: what the model gives
-    /// the stride's evaluation path is compiled at the first stride (again only when a
-    /// request asks for another path or integrator), the evaluators' storage reused.
-    ///
-    /// # Errors
-    /// As [`Walker::stride`].
-    pub fn stride(
-        &mut self,
-        q0: &DVector<f64>,
-        qd0: &DVector<f64>,
-        request: StrideRequest<'_>,
-    ) -> Result<StrideResult, StrideFailure> {
-        let walker = self.walker();
-        let StrideRequest {
-            settings,
-            options,
-            mut schedule,
-            control,
-            sink,
-        } = request;
-        if control.is_some() && walker.ankle.is_none() {
-            return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
-        }
-        let mut own = Vec::new();
-        let keep_in_result = sink.is_none();
-        let trajectory = match sink {
-            Some(s) => s,
-            None => &mut own,
-        };
-        if super::fast::covers(walker, settings, options, control.is_some()) {
-            let mut triggered = std::mem::take(&mut self.triggered);
-            if let Some(fixed) = self.fixed(settings.evaluation) {
-                let recorded = trajectory.len();
-                let fast_schedule = match &mut schedule {
-                    Schedule::Free => Schedule::Free,
-                    Schedule::Record(s) => Schedule::Record(s),
-                    Schedule::Replay(s) => Schedule::Replay(s),
-                };
-                let start = Start {
-                    walker,
-                    settings,
-                    options,
-                    schedule: fast_schedule,
-                    trajectory,
-                    triggered: &mut triggered,
-                };
-                let done = super::fast::stride(start, fixed, q0, qd0);
-                self.triggered = triggered;
-                match done {
-                    Some(mut r) => {
-                        if keep_in_result {
-                            r.trajectory = own;
-                        }
-                        return Ok(r);
-                    }
-                    None => trajectory.truncate(recorded),
-                }
-            } else {
-                self.triggered = triggered;
-            }
-        }
-        let cur = Sample {
-            t_s: 0.0,
-            q: q0.clone(),
-            qd: qd0.clone(),
-        };
-        let mut engine = self.reference_engine(settings);
-        engine.integrator.reset();
-        for c in &walker.initially_locked {
-            engine.phase.active[c.0] = false;
-        }
-        let wit = self
-            .witnesses
-            .take()
-            .unwrap_or_else(|| Witnesses::new(walker));
-        let start = Start {
-            walker,
-            settings,
-            options,
-            schedule,
-            trajectory,
-            triggered: &mut self.triggered,
-        };
-        let (r, parts) = match Run::new(start, engine, wit, control, cur) {
-            Ok(run) => run.run(),
-            Err(e) => return Err(e),
-        };
-        let (engine, wit) = parts;
-        self.witnesses = Some(wit);
-        self.keep_reference(settings, engine);
-        let mut r = r?;
-        if keep_in_result {
-            r.trajectory = own;
-        }
-        Ok(r)
-    }
-}
 
 /// What a stride starts from, whatever its engine: the walker, the settings, what to record,
 /// the step schedule and where recorded samples go.
@@ -200,24 +81,8 @@ pub(super) struct Run<'w, 'r, 't, E: Engine> {
     event_states: Vec<(Sample, Sample)>,
     energy_loss_j: f64,
     trajectory: &'t mut Vec<Sample>,
-    control: Option<StrideControl<'r>>,
-    /// Control ticks: on the walk-time grid `k · period`, here in stride time [s].
-    period_s: f64,
-    next_tick_s: f64,
-    /// The stance string's limit over the current tick (stride time), from the controller.
-    segment: Option<ActuatorSegment>,
-    /// Steps may run across ticks ([`crate::control::TickStepping::HeldAcrossTicks`], possible
-    /// for this stride).
-    held_stepping: bool,
-    /// The output of the tick at `next_tick_s`, run on a step's interpolant, to take effect
-    /// when the stride reaches that tick.
-    pending: Option<ActuatorSegment>,
-    /// The next step ends at the next tick whatever the limit in force (a step ran across a
-    /// tick without an interpolant and is taken again); cleared when that tick runs.
-    end_at_next_tick: bool,
-    /// Control ticks run so far, against the step budget (each tick is a step of the
-    /// reference `EndAtEveryTick`).
-    ticks: usize,
+    /// The controller and its ticks.
+    ticks: Ticks<'r>,
 }
 
 impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
@@ -244,20 +109,12 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         if options.record {
             trajectory.push(cur.to_sample());
         }
-        let (period_s, t_walk0) = match &control {
-            Some(c) => (c.controller.period_s(), c.t_walk_start_s),
-            None => (f64::INFINITY, 0.0),
-        };
-        let held_stepping = ticks::held_stepping(
-            settings.tick_stepping,
+        let ticks = Ticks::new(
+            control,
+            settings,
             matches!(schedule, Schedule::Free),
             engine.interpolates(),
-            control.is_some(),
-        );
-        let next_tick_s = match &control {
-            Some(_) => ticks::first_tick_s(period_s, t_walk0, settings.max_stride_time_s)?,
-            None => f64::INFINITY,
-        };
+        )?;
         Ok(Self {
             walker,
             settings,
@@ -276,14 +133,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             event_states: Vec::new(),
             energy_loss_j: 0.0,
             trajectory,
-            control,
-            period_s,
-            next_tick_s,
-            segment: None,
-            held_stepping,
-            pending: None,
-            end_at_next_tick: false,
-            ticks: 0,
+            ticks,
         })
     }
 
@@ -312,7 +162,9 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             // Ticks the step ran across: sampled on its interpolant, built from the step just
             // taken (before the grazing probe and event location take other steps), run
             // before the step's events apply.
-            let dense = self.held_interpolant(&next)?;
+            let dense = self
+                .ticks
+                .held_interpolant(&mut self.engine, &self.cur, &next)?;
             let stepped_to_s = next.t_s();
             let (next, w_cur, w_next) = self.grazing_check(next)?;
             // The probe's step was adopted: it is now the integrator's last step, and its own
@@ -320,13 +172,17 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             let dense = if next.t_s() == stepped_to_s {
                 dense
             } else {
-                self.held_interpolant(&next)?
+                self.ticks
+                    .held_interpolant(&mut self.engine, &self.cur, &next)?
             };
-            if self.tick_inside_without_interpolant(dense.as_ref(), next.t_s()) {
+            if self
+                .ticks
+                .inside_without_interpolant(dense.is_some(), next.t_s())
+            {
                 // Not expected (a step runs across a tick only with its interpolant, kept for
                 // the step adopted above). A tick is never skipped: the step is taken again,
                 // ending at the tick.
-                self.end_at_next_tick = true;
+                self.ticks.end_at_next_tick();
                 continue;
             }
             let limit = self.string_limit();
@@ -382,6 +238,45 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         }
     }
 
+    /// A control tick, when one is due at `cur` ([`Ticks::control_tick`]); a string released
+    /// there is an event.
+    fn control_tick(&mut self) -> Result<(), StrideFailure> {
+        let plant = Plant {
+            walker: self.walker,
+            engine: &mut self.engine,
+            wit: &mut self.wit,
+            cur: &mut self.cur,
+        };
+        if self.ticks.control_tick(plant, self.w_cached)? == TickEffect::Released {
+            self.power.close(&self.walker.model, &self.cur);
+            self.events.push(StrideEvent {
+                name: "string_released".into(),
+                t_stride_s: self.cur.t_s(),
+            });
+            let at = self.cur.to_sample();
+            self.event_states.push((at.clone(), at));
+        }
+        Ok(())
+    }
+
+    /// The ticks strictly before `end_s` run on the step's interpolant `dense`
+    /// ([`Ticks::held_ticks`]): the state at the first whose output changes the plant's
+    /// input, which ends the step there.
+    fn held_ticks(
+        &mut self,
+        dense: Option<&E::Interpolant>,
+        ends: (&WitnessValues, &WitnessValues),
+        end_s: f64,
+    ) -> Result<Option<E::State>, StrideFailure> {
+        let plant = Plant {
+            walker: self.walker,
+            engine: &mut self.engine,
+            wit: &mut self.wit,
+            cur: &mut self.cur,
+        };
+        self.ticks.held_ticks(plant, dense, ends, end_s)
+    }
+
     /// The stride's step and evaluation budgets: a stride that has used either up fails,
     /// naming the budget, so that no stride loops forever (e.g. on steps that do not advance
     /// time).
@@ -396,7 +291,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 },
             ));
         }
-        self.check_tick_budget()?;
+        self.ticks.check_budget(self.cur.t_s())?;
         if evaluations >= self.settings.max_evaluations {
             return Err(StrideFailure::new(
                 self.cur.t_s(),
@@ -426,7 +321,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     fn step(&mut self, drive_end_s: f64) -> Result<E::State, StrideFailure> {
         self.steps += 1;
         let cur = &self.cur;
-        let h_limit = (self.tick_limit_s().min(drive_end_s) - cur.t_s()).max(1e-12);
+        let h_limit = (self.ticks.limit_s().min(drive_end_s) - cur.t_s()).max(1e-12);
         let mut next = match self.schedule.replayed() {
             Some(h) => self.engine.step_exact(cur, h.min(h_limit)),
             None => self.engine.advance(cur, h_limit),
@@ -505,17 +400,21 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             && hs.ignore_scuffing
             && self.power.undamped()
             && self.engine.prescribed().is_none()
-            && self.control.is_none()
+            && !self.ticks.controlled()
             && w_cur.scuff_anywhere_in_step(w_next, hs.min_ahead_m)
     }
 
     /// The string's limit the engagement witness compares with.
     fn string_limit(&self) -> StringLimit {
-        match (&self.walker.ankle, &self.control, &self.segment) {
+        match (
+            &self.walker.ankle,
+            self.ticks.controlled(),
+            self.ticks.segment(),
+        ) {
             (None, _, _) => StringLimit::Slack,
-            (Some(r), None, _) => StringLimit::Fixed(r.engage_rad),
-            (Some(_), Some(_), Some(seg)) if !seg.released => StringLimit::Moving(*seg),
-            (Some(_), Some(_), _) => StringLimit::Slack,
+            (Some(r), false, _) => StringLimit::Fixed(r.engage_rad),
+            (Some(_), true, Some(seg)) if !seg.released => StringLimit::Moving(seg),
+            (Some(_), true, _) => StringLimit::Slack,
         }
     }
 
@@ -635,8 +534,8 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                     return Ok(Applied::Skipped);
                 };
                 // The string's far end: fixed (ideal reflex) or moving with the actuator.
-                let drive = match (&self.control, self.segment) {
-                    (Some(_), Some(seg)) => Drive::Segment(seg),
+                let drive = match (self.ticks.controlled(), self.ticks.segment()) {
+                    (true, Some(seg)) => Drive::Segment(seg),
                     _ => Drive::Profile(r.extension_from(at.t_s())),
                 };
                 let e = w.engage_string(self.engine.active(), &at.to_sample(), r, &drive)?;
@@ -717,9 +616,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             ));
         }
         self.power.close(&w.model, at);
-        if let Some(c) = self.control.as_mut() {
-            c.controller.heel_strike(c.t_walk_start_s + at.t_s());
-        }
+        self.ticks.heel_strike(at.t_s());
         self.events.push(StrideEvent {
             name: "heel_strike".into(),
             t_stride_s: at.t_s(),

@@ -6,7 +6,7 @@
 //! their direction over a step, in a fixed order (heel, knees, hip low, hip back, string
 //! engagement, heel drop) that breaks ties between events located at the same time.
 
-use super::engine::{StrideState, WitnessEvaluator};
+use super::state::StrideState;
 use crate::control::ActuatorSegment;
 use crate::events::Direction;
 use crate::hermite::{self, Knot};
@@ -110,6 +110,19 @@ impl WitnessValues {
         (1..=samples)
             .find(|&k| height_at(fraction(k)) <= 0.0)
             .map(|k| self.t_s + h * k as f64 / (samples + 1) as f64)
+    }
+}
+
+/// The witnesses of the stride's events at a state.
+pub(super) trait WitnessEvaluator<S> {
+    /// Every witness at `s`.
+    fn eval(&mut self, s: &S) -> WitnessValues;
+}
+
+impl WitnessEvaluator<Sample> for Witnesses<'_> {
+    #[inline]
+    fn eval(&mut self, s: &Sample) -> WitnessValues {
+        Witnesses::eval(self, s)
     }
 }
 

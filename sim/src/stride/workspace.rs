@@ -2,20 +2,29 @@
 //! from the model for the stride's evaluation path (the planar tree and the witnesses'
 //! geometry of the fixed-size engine; the reference engine's phase, with its planar tree,
 //! axis tree and dynamics workspace; the witnesses' kinematics), compiled at the first stride
-//! that needs them, and the loop's scratch storage.
+//! that needs them, and the loop's scratch storage; and the stride's entry points
+//! ([`Walker::stride`], [`StrideWorkspace::stride`]), which pick the engine a stride runs on
+//! (the fixed-size one where it covers the stride, else the reference) and run the one loop
+//! (`stride::run`) on it.
 //!
 //! The workspace borrows its walker: the model cannot change while the workspace lives, so
 //! what it compiled stays the model's. [`Walker::stride`] makes one for a single stride; the
 //! walk loop and the gait search keep one across their strides.
 
 use super::engine::DynamicEngine;
+use super::evaluation_path::EvaluationPath;
+use super::failure::{FailureCause, StrideFailure};
 use super::fast;
 use super::phase::Phase;
+use super::request::StrideRequest;
+use super::result::StrideResult;
+use super::run::{Run, Start};
+use super::schedule::Schedule;
 use super::settings::StrideSettings;
 use super::witnesses::{Watch, Witnesses};
-use super::EvaluationPath;
-use crate::integrators::IntegratorChoice;
+use crate::integrators::{IntegratorChoice, Sample};
 use crate::walker::Walker;
+use nalgebra::DVector;
 
 /// What repeated strides of one walker reuse (see the module's documentation).
 pub struct StrideWorkspace<'w> {
@@ -78,5 +87,123 @@ impl<'w> StrideWorkspace<'w> {
     /// Keeps the reference engine of a finished stride for the next one.
     pub(super) fn keep_reference(&mut self, settings: &StrideSettings, engine: DynamicEngine<'w>) {
         self.reference = Some((settings.integrator.clone(), settings.evaluation, engine));
+    }
+}
+
+impl Walker {
+    /// Simulates one stride from `q0`, `qd0` (just after heel strike, stance labelling) as
+    /// `request` asks: its settings, what it records, its step schedule, its controller. (A
+    /// [`StrideWorkspace`] of its own: repeated strides reuse one with
+    /// [`StrideWorkspace::stride`].)
+    ///
+    /// # Errors
+    /// A [`StrideFailure`] saying how and when (stride time) the stride failed; samples
+    /// recorded into the request's sink up to the failure are kept there.
+    pub fn stride(
+        &self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        request: StrideRequest<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        StrideWorkspace::new(self).stride(q0, qd0, request)
+    }
+}
+
+impl StrideWorkspace<'_> {
+    /// [`Walker::stride`] of this workspace's walker, on this workspace: what the model gives
+    /// the stride's evaluation path is compiled at the first stride (again only when a
+    /// request asks for another path or integrator), the evaluators' storage reused.
+    ///
+    /// # Errors
+    /// As [`Walker::stride`].
+    pub fn stride(
+        &mut self,
+        q0: &DVector<f64>,
+        qd0: &DVector<f64>,
+        request: StrideRequest<'_>,
+    ) -> Result<StrideResult, StrideFailure> {
+        let walker = self.walker();
+        let StrideRequest {
+            settings,
+            options,
+            mut schedule,
+            control,
+            sink,
+        } = request;
+        if control.is_some() && walker.ankle.is_none() {
+            return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
+        }
+        let mut own = Vec::new();
+        let keep_in_result = sink.is_none();
+        let trajectory = match sink {
+            Some(s) => s,
+            None => &mut own,
+        };
+        if fast::covers(walker, settings, options, control.is_some()) {
+            let mut triggered = std::mem::take(&mut self.triggered);
+            if let Some(fixed) = self.fixed(settings.evaluation) {
+                let recorded = trajectory.len();
+                let fast_schedule = match &mut schedule {
+                    Schedule::Free => Schedule::Free,
+                    Schedule::Record(s) => Schedule::Record(s),
+                    Schedule::Replay(s) => Schedule::Replay(s),
+                };
+                let start = Start {
+                    walker,
+                    settings,
+                    options,
+                    schedule: fast_schedule,
+                    trajectory,
+                    triggered: &mut triggered,
+                };
+                let done = fast::stride(start, fixed, q0, qd0);
+                self.triggered = triggered;
+                match done {
+                    Some(mut r) => {
+                        if keep_in_result {
+                            r.trajectory = own;
+                        }
+                        return Ok(r);
+                    }
+                    None => trajectory.truncate(recorded),
+                }
+            } else {
+                self.triggered = triggered;
+            }
+        }
+        let cur = Sample {
+            t_s: 0.0,
+            q: q0.clone(),
+            qd: qd0.clone(),
+        };
+        let mut engine = self.reference_engine(settings);
+        engine.integrator.reset();
+        for c in &walker.initially_locked {
+            engine.phase.active[c.0] = false;
+        }
+        let wit = self
+            .witnesses
+            .take()
+            .unwrap_or_else(|| Witnesses::new(walker));
+        let start = Start {
+            walker,
+            settings,
+            options,
+            schedule,
+            trajectory,
+            triggered: &mut self.triggered,
+        };
+        let (r, parts) = match Run::new(start, engine, wit, control, cur) {
+            Ok(run) => run.run(),
+            Err(e) => return Err(e),
+        };
+        let (engine, wit) = parts;
+        self.witnesses = Some(wit);
+        self.keep_reference(settings, engine);
+        let mut r = r?;
+        if keep_in_result {
+            r.trajectory = own;
+        }
+        Ok(r)
     }
 }

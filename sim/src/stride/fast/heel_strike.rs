@@ -68,8 +68,8 @@ fn point_of(model: &Model, p: PointIndex) -> Option<(usize, [f64; 2], f64)> {
 /// Absolute angles of every link slot (slot 0 the ground) from `q` or rates from `qd`.
 fn link_angles<const N: usize>(tree: &PlanarTree, q: &SVector<f64, N>) -> [f64; MAX_LINKS + 1] {
     let mut a = [0.0; MAX_LINKS + 1];
-    for i in 0..tree.link_count() {
-        if let Some((parent, joint)) = tree.link_joint(i) {
+    for i in 0..tree.links().link_count() {
+        if let Some((parent, joint)) = tree.links().link_joint(i) {
             a[i + 1] = a[parent] + joint.map_or(0.0, |(c, sign)| sign * q[c]);
         }
     }
@@ -112,7 +112,7 @@ pub(super) fn heel_strike<const N: usize>(
     let model = &walker.model;
     let (foot_link, foot_p, foot_z) = point_of(model, hs.swing_foot)?;
     let (sc_link, sc_p, _) = point_of(model, hs.stance_contact)?;
-    let fr = tree.frames(&at.q, &at.qd);
+    let fr = tree.links().frames(&at.q, &at.qd);
     let (p_foot, _) = fr.get(foot_link + 1)?.point(foot_p);
     // The impact model's velocities u = (v0, q̇): the root's translation first, at rest.
     let n = N + 2;
@@ -120,8 +120,8 @@ pub(super) fn heel_strike<const N: usize>(
         return None;
     }
     let (m_q, m_q_eps) = tree.mass_matrices(&at.q);
-    let m_imp = impact_mass(tree.momentum_jacobian::<N>(&fr, false), m_q);
-    let jf = tree.point_jacobian::<N>(&fr, foot_link, foot_p);
+    let m_imp = impact_mass(tree.links().momentum_jacobian::<N>(&fr, false), m_q);
+    let jf = tree.links().point_jacobian::<N>(&fr, foot_link, foot_p);
     // Constraint rows of the contact: x and y (z and yaw rows vanish on a planar tree, and the
     // general rows drop them).
     let mut rows = [0usize; MAX_ROWS];
@@ -167,7 +167,7 @@ pub(super) fn heel_strike<const N: usize>(
         let m_imp_eps = DMatrix::from_fn(
             n,
             n,
-            impact_mass(tree.momentum_jacobian::<N>(&fr, true), m_q_eps),
+            impact_mass(tree.links().momentum_jacobian::<N>(&fr, true), m_q_eps),
         );
         let no_rows = DMatrix::zeros(k, n);
         let no_target = DVector::zeros(k);
@@ -206,7 +206,7 @@ pub(super) fn heel_strike<const N: usize>(
     let v0 = [u_plus[0], u_plus[1]];
     let qd_plus = SVector::<f64, N>::from_column_slice(&u_plus[2..n]);
     // The old stance contact must lift.
-    let fr_plus = tree.frames(&at.q, &qd_plus);
+    let fr_plus = tree.links().frames(&at.q, &qd_plus);
     let (_, v_sc) = fr_plus.get(sc_link + 1)?.point(sc_p);
     let lift_velocity_m_s = v0[1] + v_sc[1];
     if lift_velocity_m_s <= 0.0 {
@@ -240,8 +240,8 @@ fn relabel<const N: usize>(
     let mut angle_new = [0.0; MAX_LINKS + 1];
     let mut rate_new = [0.0; MAX_LINKS + 1];
     let (mut q, mut qd) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
-    for i in 0..tree.link_count() {
-        let (parent, joint) = tree.link_joint(i)?;
+    for i in 0..tree.links().link_count() {
+        let (parent, joint) = tree.links().link_joint(i)?;
         let (angle_parent, rate_parent) = (angle_new[parent], rate_new[parent]);
         if let Some((c, sign)) = joint {
             if !r.fixed.iter().any(|f| f.0 == c) {
@@ -257,7 +257,7 @@ fn relabel<const N: usize>(
         }
     }
     // The checks: link pairs' angles and rates, point pairs' positions and velocities.
-    let fr_new = tree.frames(&q, &qd);
+    let fr_new = tree.links().frames(&q, &qd);
     let mut pose = 0.0f64;
     let mut rate = 0.0f64;
     let mut target = 0.0f64;

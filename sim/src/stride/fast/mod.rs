@@ -18,13 +18,14 @@ mod impact;
 mod planar_witnesses;
 
 use super::contact_figures::ContactSummary;
-use super::engine::{Engine, NoInterpolant, StrideState};
+use super::engine::{Engine, NoInterpolant};
 use super::failure::StrideFailure;
 use super::phase::Drive;
 use super::request::StrideOptions;
 use super::result::{StrideEvent, StrideResult};
 use super::run::{Run, Start};
 use super::settings::StrideSettings;
+use super::state::StrideState;
 use super::EvaluationPath;
 use crate::dynamics::{Dynamics, DynamicsError};
 use crate::events::{refine, root_on_dense, EventError, EventTolerance};

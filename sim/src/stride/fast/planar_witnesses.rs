@@ -11,8 +11,7 @@
 
 use super::dop853::State;
 use crate::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
-use crate::stride::engine::WitnessEvaluator;
-use crate::stride::witnesses::WitnessValues;
+use crate::stride::witnesses::{WitnessEvaluator, WitnessValues};
 use crate::walker::Walker;
 use nalgebra::SVector;
 
@@ -62,8 +61,10 @@ impl PlanarWitnesses {
     /// `None` when a point's link is not in the tree or the tree has more joints than
     /// coordinates.
     pub(super) fn new<const N: usize>(walker: &Walker, tree: &PlanarTree) -> Option<Self> {
-        let fr = tree.frames(&SVector::<f64, N>::zeros(), &SVector::zeros());
-        let joints = Joints::of(tree)?;
+        let fr = tree
+            .links()
+            .frames(&SVector::<f64, N>::zeros(), &SVector::zeros());
+        let joints = Joints::of(tree.links())?;
         let mut origin = [[0.0; 2]; MAX_PLANAR_COORDINATES];
         for (o, j) in origin.iter_mut().zip(joints.all()) {
             *o = fr.get(j.link + 1)?.origin_m;

@@ -14,15 +14,20 @@
 //! Every tick runs once, at its time: a step that ran across a tick without an interpolant is
 //! taken again, ending at the tick; the controller's period is checked before the stride
 //! starts, and the ticks count against the stride's step budget.
+//!
+//! [`Ticks`] is the clock and the controller of one stride; the stride loop (`stride::run`)
+//! hands it the plant ([`Plant`]: the walker, the engine, the witnesses and the current state)
+//! at each tick.
 
-use super::Run;
 use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
 use crate::hermite::{self, Knot};
-use crate::stride::engine::{Engine, Interpolant, StrideState, WitnessEvaluator};
+use crate::stride::engine::{Engine, Interpolant};
 use crate::stride::failure::{FailureCause, StrideFailure};
 use crate::stride::phase::Drive;
-use crate::stride::result::StrideEvent;
-use crate::stride::witnesses::WitnessValues;
+use crate::stride::request::StrideControl;
+use crate::stride::settings::StrideSettings;
+use crate::stride::state::StrideState;
+use crate::stride::witnesses::{WitnessEvaluator, WitnessValues};
 use crate::walker::Walker;
 
 /// A tick's time is reached when a sample is within this of it [s].
@@ -33,10 +38,10 @@ const TICK_SLACK_S: f64 = 1e-12;
 /// ticks before its heel strike's time − [`TICK_SLACK_S`], so each tick runs in one stride).
 ///
 /// # Errors
-/// [`crate::stride::FailureKind::InvalidControlPeriod`] when the period is not a finite
-/// positive time, or so short against the walk time that the tick grid does not advance over
-/// the stride's time budget `max_stride_time_s` (the stride's ticks would never end).
-pub(super) fn first_tick_s(
+/// [`crate::stride::FailureKind::InvalidControlPeriod`] when the period is not a finite positive time, or so
+/// short against the walk time that the tick grid does not advance over the stride's time
+/// budget `max_stride_time_s` (the stride's ticks would never end).
+fn first_tick_s(
     period_s: f64,
     t_walk_start_s: f64,
     max_stride_time_s: f64,
@@ -167,7 +172,7 @@ fn sense<E: Engine>(
 
 /// Whether a stride steps across ticks at all: a controller, `HeldAcrossTicks`, the
 /// integrator's own steps (no schedule) and an integrator with an interpolant.
-pub(super) fn held_stepping(
+fn held_stepping(
     tick_stepping: TickStepping,
     free_schedule: bool,
     interpolates: bool,
@@ -176,10 +181,115 @@ pub(super) fn held_stepping(
     tick_stepping == TickStepping::HeldAcrossTicks && free_schedule && interpolates && controlled
 }
 
-impl<E: Engine> Run<'_, '_, '_, E> {
+/// The plant a tick sees and acts on: the walker, the engine (its drive), the witnesses'
+/// evaluator and the stride's current state.
+pub(super) struct Plant<'a, E: Engine> {
+    pub(super) walker: &'a Walker,
+    pub(super) engine: &'a mut E,
+    pub(super) wit: &'a mut E::Witness,
+    pub(super) cur: &'a mut E::State,
+}
+
+/// What a tick at the current state did to the string, for the stride loop to write down.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum TickEffect {
+    /// No tick was due, or its output took effect without an event.
+    Quiet,
+    /// The engaged string went slack (the ankle free again): an event at the current state.
+    Released,
+}
+
+/// The control ticks of one stride: the controller, its tick grid (stride time), the string's
+/// limit over the current tick and how steps run across ticks.
+pub(super) struct Ticks<'r> {
+    control: Option<StrideControl<'r>>,
+    /// Control ticks: on the walk-time grid `k · period`, here in stride time [s].
+    period_s: f64,
+    next_tick_s: f64,
+    /// The stance string's limit over the current tick (stride time), from the controller.
+    segment: Option<ActuatorSegment>,
+    /// Steps may run across ticks ([`TickStepping::HeldAcrossTicks`], possible for this
+    /// stride).
+    held_stepping: bool,
+    /// The output of the tick at `next_tick_s`, run on a step's interpolant, to take effect
+    /// when the stride reaches that tick.
+    pending: Option<ActuatorSegment>,
+    /// The next step ends at the next tick whatever the limit in force (a step ran across a
+    /// tick without an interpolant and is taken again); cleared when that tick runs.
+    end_at_next_tick: bool,
+    /// Control ticks run so far, against the step budget (each tick is a step of the
+    /// reference `EndAtEveryTick`).
+    count: usize,
+    /// The stride's step budget.
+    max_steps: usize,
+}
+
+impl<'r> Ticks<'r> {
+    /// The ticks of a stride run with `settings` under `control` (none: no ticks);
+    /// `free_schedule`: the integrator chooses its steps; `interpolates`: it has an
+    /// interpolant inside them.
+    ///
+    /// # Errors
+    /// [`crate::stride::FailureKind::InvalidControlPeriod`] (see [`first_tick_s`]).
+    pub(super) fn new(
+        control: Option<StrideControl<'r>>,
+        settings: &StrideSettings,
+        free_schedule: bool,
+        interpolates: bool,
+    ) -> Result<Self, StrideFailure> {
+        let (period_s, t_walk0) = match &control {
+            Some(c) => (c.controller.period_s(), c.t_walk_start_s),
+            None => (f64::INFINITY, 0.0),
+        };
+        let held_stepping = held_stepping(
+            settings.tick_stepping,
+            free_schedule,
+            interpolates,
+            control.is_some(),
+        );
+        let next_tick_s = match &control {
+            Some(_) => first_tick_s(period_s, t_walk0, settings.max_stride_time_s)?,
+            None => f64::INFINITY,
+        };
+        Ok(Self {
+            control,
+            period_s,
+            next_tick_s,
+            segment: None,
+            held_stepping,
+            pending: None,
+            end_at_next_tick: false,
+            count: 0,
+            max_steps: settings.max_steps,
+        })
+    }
+
+    /// Whether a controller runs the stride.
+    pub(super) fn controlled(&self) -> bool {
+        self.control.is_some()
+    }
+
+    /// The string's limit over the current tick (stride time), once a tick has run.
+    pub(super) fn segment(&self) -> Option<ActuatorSegment> {
+        self.segment
+    }
+
+    /// Tells the controller of the heel strike at stride time `t_s`.
+    pub(super) fn heel_strike(&mut self, t_s: f64) {
+        if let Some(c) = self.control.as_mut() {
+            c.controller.heel_strike(c.t_walk_start_s + t_s);
+        }
+    }
+
+    /// The next step ends at the next tick whatever the limit in force (a step that ran across
+    /// a tick without an interpolant is taken again).
+    pub(super) fn end_at_next_tick(&mut self) {
+        self.end_at_next_tick = true;
+    }
+
     /// The next step may run across the next tick: held stepping, no tick output waiting to
     /// take effect, and a limit in force that does not move.
-    pub(super) fn held_ahead(&self) -> bool {
+    fn held_ahead(&self) -> bool {
         self.held_stepping
             && !self.end_at_next_tick
             && self.pending.is_none()
@@ -187,33 +297,29 @@ impl<E: Engine> Run<'_, '_, '_, E> {
     }
 
     /// The stride's ticks have used its step budget (each tick is a step of the reference
-    /// `EndAtEveryTick`): a period far too short for the stride fails instead of running for
-    /// ever.
-    pub(super) fn check_tick_budget(&self) -> Result<(), StrideFailure> {
-        if self.ticks < self.settings.max_steps {
+    /// `EndAtEveryTick`): a period far too short for the stride fails (at stride time `t_s`)
+    /// instead of running for ever.
+    pub(super) fn check_budget(&self, t_s: f64) -> Result<(), StrideFailure> {
+        if self.count < self.max_steps {
             return Ok(());
         }
         Err(StrideFailure::new(
-            self.cur.t_s(),
+            t_s,
             FailureCause::TickBudget {
-                max_steps: self.settings.max_steps,
+                max_steps: self.max_steps,
                 period_s: self.period_s,
             },
         ))
     }
 
-    /// A tick lies strictly inside the step `cur` → `end_s` of a controlled stride, and the
-    /// step has no interpolant to run it on.
-    pub(super) fn tick_inside_without_interpolant(
-        &self,
-        dense: Option<&E::Interpolant>,
-        end_s: f64,
-    ) -> bool {
-        self.control.is_some() && dense.is_none() && self.next_tick_s < end_s - TICK_SLACK_S
+    /// A tick lies strictly inside a step of a controlled stride ending at `end_s`, and the
+    /// step has no interpolant (`has_interpolant` false) to run it on.
+    pub(super) fn inside_without_interpolant(&self, has_interpolant: bool, end_s: f64) -> bool {
+        self.control.is_some() && !has_interpolant && self.next_tick_s < end_s - TICK_SLACK_S
     }
 
     /// The end of the next step as the ticks allow [s]: the next tick, or ∞ across ticks.
-    pub(super) fn tick_limit_s(&self) -> f64 {
+    pub(super) fn limit_s(&self) -> f64 {
         if self.held_ahead() {
             f64::INFINITY
         } else {
@@ -221,21 +327,27 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         }
     }
 
-    /// A control tick, when one is due at `cur`: the controller sees the stance ankle (or its
-    /// output at this tick is already known, from the interpolant) and sets the string's
-    /// limit until the next tick.
-    pub(super) fn control_tick(&mut self) -> Result<(), StrideFailure> {
+    /// A control tick, when one is due at the plant's current state: the controller sees the
+    /// stance ankle (or its output at this tick is already known, from the interpolant) and
+    /// sets the string's limit until the next tick. `w_cached`: the witnesses of the last
+    /// step's end.
+    pub(super) fn control_tick<E: Engine>(
+        &mut self,
+        plant: Plant<'_, E>,
+        w_cached: Option<WitnessValues>,
+    ) -> Result<TickEffect, StrideFailure> {
         let Some(control) = self.control.as_ref() else {
-            return Ok(());
+            return Ok(TickEffect::Quiet);
         };
-        if self.cur.t_s() < self.next_tick_s - TICK_SLACK_S {
-            return Ok(());
+        let t_s = plant.cur.t_s();
+        if t_s < self.next_tick_s - TICK_SLACK_S {
+            return Ok(TickEffect::Quiet);
         }
-        if self.cur.t_s() > self.next_tick_s + TICK_SLACK_S {
+        if t_s > self.next_tick_s + TICK_SLACK_S {
             // Each step ends at or before the next tick, or runs its ticks on its interpolant:
             // a stride past a tick that did not run is a defect, not a result.
             return Err(StrideFailure::new(
-                self.cur.t_s(),
+                t_s,
                 FailureCause::TickPassed {
                     tick_s: self.next_tick_s,
                 },
@@ -247,17 +359,21 @@ impl<E: Engine> Run<'_, '_, '_, E> {
             None => {
                 // The witnesses of the step that ended here, when at this sample's time (an
                 // impact since changes the velocities, not the foot's height).
-                let on_floor = self
-                    .w_cached
-                    .filter(|w| w.t_s == self.cur.t_s())
+                let on_floor = w_cached
+                    .filter(|w| w.t_s == t_s)
                     .map(|w| w.foot_height_m <= ON_FLOOR_M);
-                let (wit, engine) = (&mut self.wit, &mut self.engine);
-                let sensing = sense(self.walker, wit, engine, t0, &self.cur, on_floor)?;
+                let sensing = sense(
+                    plant.walker,
+                    plant.wit,
+                    plant.engine,
+                    t0,
+                    plant.cur,
+                    on_floor,
+                )?;
                 self.tick_controller(&sensing)?
             }
         };
-        self.apply_segment(seg);
-        Ok(())
+        Ok(self.apply_segment(plant.engine, plant.cur, seg))
     }
 
     /// The controller's tick: its segment, shifted to stride time.
@@ -271,7 +387,7 @@ impl<E: Engine> Run<'_, '_, '_, E> {
                 FailureCause::TickWithoutController,
             ));
         };
-        self.ticks += 1;
+        self.count += 1;
         let t0 = control.t_walk_start_s;
         let mut seg = control
             .controller
@@ -283,23 +399,22 @@ impl<E: Engine> Run<'_, '_, '_, E> {
     }
 
     /// The tick's segment takes effect at `cur`.
-    fn apply_segment(&mut self, mut seg: ActuatorSegment) {
-        let (cur, engine) = (&mut self.cur, &mut self.engine);
+    fn apply_segment<E: Engine>(
+        &mut self,
+        engine: &mut E,
+        cur: &mut E::State,
+        mut seg: ActuatorSegment,
+    ) -> TickEffect {
+        let mut effect = TickEffect::Quiet;
         if let Some((coord, Drive::Segment(_))) = engine.prescribed() {
             if seg.released {
                 // The string goes slack during the push (an emergency stop, a fault): no
                 // impulse, the ankle is free again, and the foot keeps pivoting about its toe
                 // until the heel comes back down or the stride ends.
-                self.power.close(&self.walker.model, cur);
                 engine.set_prescribed(None);
                 engine.set_active(coord.0, true);
                 engine.system_changed();
-                self.events.push(StrideEvent {
-                    name: "string_released".into(),
-                    t_stride_s: cur.t_s(),
-                });
-                let at = cur.to_sample();
-                self.event_states.push((at.clone(), at));
+                effect = TickEffect::Released;
             } else {
                 seg = continue_at_tick(self.segment.as_ref(), seg, cur.t_s());
                 engine.set_prescribed(Some((coord, Drive::Segment(seg))));
@@ -315,19 +430,21 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         self.segment = Some(seg);
         self.end_at_next_tick = false;
         self.next_tick_s += self.period_s;
+        effect
     }
 
     /// The interpolant of the step `cur` → `next` when it ran across a tick (built before the
     /// event location takes other steps).
-    pub(super) fn held_interpolant(
-        &mut self,
+    pub(super) fn held_interpolant<E: Engine>(
+        &self,
+        engine: &mut E,
+        cur: &E::State,
         next: &E::State,
     ) -> Result<Option<E::Interpolant>, StrideFailure> {
         if !self.held_ahead() || self.next_tick_s >= next.t_s() - TICK_SLACK_S {
             return Ok(None);
         }
-        let cur = &self.cur;
-        self.engine
+        engine
             .interpolant(cur, next)
             .transpose()
             .map_err(|e| StrideFailure::from_integration(e, cur.t_s()))
@@ -343,8 +460,9 @@ impl<E: Engine> Run<'_, '_, '_, E> {
     /// again, ending at the tick, so this is a defect: it is not skipped), the step budget used
     /// up by ticks, or a tick grid that does not advance; the controller's and the sensing's
     /// failures.
-    pub(super) fn held_ticks(
+    pub(super) fn held_ticks<E: Engine>(
         &mut self,
+        plant: Plant<'_, E>,
         dense: Option<&E::Interpolant>,
         ends: (&WitnessValues, &WitnessValues),
         end_s: f64,
@@ -358,18 +476,18 @@ impl<E: Engine> Run<'_, '_, '_, E> {
         }
         let Some(dense) = dense else {
             return Err(StrideFailure::new(
-                self.cur.t_s(),
+                plant.cur.t_s(),
                 FailureCause::TickInsideStep {
                     tick_s: self.next_tick_s,
                 },
             ));
         };
         while self.next_tick_s < end_s - TICK_SLACK_S {
-            self.check_tick_budget()?;
+            self.check_budget(plant.cur.t_s())?;
             let mut s = dense.eval(self.next_tick_s);
-            self.engine.snap(&mut s);
+            plant.engine.snap(&mut s);
             let clear = clear_of_floor(ends.0, ends.1, s.t_s()).then_some(false);
-            let sensing = sense(self.walker, &mut self.wit, &mut self.engine, t0, &s, clear)?;
+            let sensing = sense(plant.walker, plant.wit, plant.engine, t0, &s, clear)?;
             let seg = self.tick_controller(&sensing)?;
             match self.segment {
                 Some(held) if held.same_held_input(&seg) => {
