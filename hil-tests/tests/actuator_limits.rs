@@ -12,8 +12,8 @@ mod common;
 
 use common::{matched, walk};
 use sil::{ActuatorParams, ActuatorStats, Side, SilReport};
+use sim::stride::walk::Walk;
 use sim::stride::FailureKind;
-use sim::walk::Walk;
 
 fn stats(r: &SilReport, side: Side) -> ActuatorStats {
     r.node(side).unwrap().actuator

@@ -14,8 +14,8 @@ use sil::{
     ActuatorChoice, DrivenPhase, FirmwareInTheLoop, SensorFault, Side, SilConfig, SilReport,
     StageOutput, SupplyDropInHold,
 };
-use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
-use sim::walk::{Walk, WalkRequest};
+use sim::engine::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
+use sim::stride::walk::{Walk, WalkRequest};
 
 /// One tick as the walker and the left ankle's hardware saw it.
 #[derive(Clone, Copy, Debug)]
@@ -76,7 +76,7 @@ fn walk_recorded(config: SilConfig, steps: usize) -> (Walk, SilReport, Vec<Seen>
         seen: Vec::new(),
     };
     let request = WalkRequest::new(&s.settings, steps).controlled(&mut rec);
-    let walk = sim::walk::walk(&s.walker, &s.q0, &s.qd0, request);
+    let walk = sim::stride::walk::walk(&s.walker, &s.q0, &s.qd0, request);
     let Recorder { inner, seen, .. } = rec;
     let report = inner.finish().unwrap();
     eprintln!("{}", common::summary(&walk, &report));
@@ -272,7 +272,7 @@ fn with_the_motor_the_nominal_walk_goes_200_steps_like_the_servo_s() {
     assert!(lowest > -0.0835 && highest < -0.0795, "{lowest} {highest}");
     // The slow pelvic roll (its stride-map value at each step's end) stays bounded; on the
     // way to the fall it passed 0.30 rad in step 24 and 0.9 rad before it.
-    let roll = |w: &sim::walk::Walk| {
+    let roll = |w: &sim::stride::walk::Walk| {
         w.steps
             .iter()
             .filter_map(|st| st.state.iter().find(|(n, _)| n == "pelvis_roll"))

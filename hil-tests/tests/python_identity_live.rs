@@ -15,7 +15,7 @@ use std::time::{Duration, Instant as WallClock};
 
 use protocol::{Command, CommandKind, Message, NodeId, Target};
 use sil::{FirmwareInTheLoop, SensorFault, Side, SilConfig};
-use sim::control::{AnkleController, AnkleSensing};
+use sim::engine::control::{AnkleController, AnkleSensing};
 use walker_tools::python_venv::PythonVenv;
 
 fn cansend(kind: CommandKind) -> String {

@@ -20,9 +20,9 @@ mod common;
 
 use common::{matched, setup};
 use sil::{FirmwareInTheLoop, SIL_INTEGRATOR};
-use sim::control::TickStepping;
-use sim::integrators::IntegratorChoice;
-use sim::walk::Walk;
+use sim::engine::control::TickStepping;
+use sim::engine::integrators::IntegratorChoice;
+use sim::stride::walk::Walk;
 
 const STEPS: usize = 1;
 
@@ -54,12 +54,12 @@ fn walk_with(integrator: IntegratorChoice, stepping: TickStepping) -> (Walk, Fig
         .with_integrator(integrator)
         .with_tick_stepping(stepping);
     let mut ctl = FirmwareInTheLoop::new(matched()).unwrap();
-    let request = sim::walk::WalkRequest::new(&settings, STEPS).controlled(&mut ctl);
-    let walk = sim::walk::walk(walker, &s.q0, &s.qd0, request);
+    let request = sim::stride::walk::WalkRequest::new(&settings, STEPS).controlled(&mut ctl);
+    let walk = sim::stride::walk::walk(walker, &s.q0, &s.qd0, request);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), STEPS);
     let g = sim::report::WalkGaitRecord::of(walker, &walk, STEPS).unwrap();
-    let mean = |x: &dyn Fn(&sim::walk::StepSummary) -> f64| {
+    let mean = |x: &dyn Fn(&sim::stride::walk::StepSummary) -> f64| {
         walk.steps.iter().map(x).sum::<f64>() / STEPS as f64
     };
     let figures = Figures {

@@ -22,8 +22,8 @@ mod common;
 
 use common::{matched, setup};
 use sil::FirmwareInTheLoop;
-use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
-use sim::walk::{WalkOptions, WalkRequest};
+use sim::engine::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
+use sim::stride::walk::{WalkOptions, WalkRequest};
 
 const STEPS: usize = 10_000;
 const EVERY: usize = 1_000;
@@ -137,7 +137,7 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     sampler.sample(0.0);
     // Per window: sum, min and max of the step durations.
     let mut windows: Vec<(f64, f64, f64)> = Vec::new();
-    let mut on_step = |step: &sim::walk::StepSummary| {
+    let mut on_step = |step: &sim::stride::walk::StepSummary| {
         let w = step.step / EVERY;
         if windows.len() <= w {
             windows.push((0.0, f64::INFINITY, 0.0));
@@ -155,7 +155,7 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
         })
         .controlled(&mut sampler)
         .on_step(&mut on_step);
-    let walk = sim::walk::walk(&s.walker, &s.q0, &s.qd0, request);
+    let walk = sim::stride::walk::walk(&s.walker, &s.q0, &s.qd0, request);
     let samples = std::mem::take(&mut sampler.samples);
     drop(sampler);
     let r = ctl.finish().unwrap();

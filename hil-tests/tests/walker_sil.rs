@@ -300,7 +300,7 @@ fn a_stuck_encoder_is_caught_in_the_push_and_the_node_goes_safe() {
 }
 
 /// Walk time at which the stance string went slack during stride `k`, if it did.
-fn released_in(walk: &sim::walk::Walk, k: usize) -> Option<f64> {
+fn released_in(walk: &sim::stride::walk::Walk, k: usize) -> Option<f64> {
     let s = walk.steps.iter().find(|s| s.step == k)?;
     s.events
         .iter()

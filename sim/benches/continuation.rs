@@ -4,8 +4,8 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim::continuation::{continuation, ContinuationSettings};
-use sim::limit_cycle::NewtonSettings;
+use sim::analysis::continuation::{continuation, ContinuationSettings};
+use sim::analysis::limit_cycle::NewtonSettings;
 use sim::scene::Scene;
 use std::time::Duration;
 

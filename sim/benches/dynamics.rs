@@ -2,16 +2,16 @@
 //! gait guess (just after heel strike), in the phase the stride starts in: the kinematics
 //! alone, the assembly of `M̄` and `f̄`, and the accelerations (assembly and the active-set
 //! solve), in `f64` and in the dual numbers of the variational Jacobian (six directions), and
-//! for the planar scenes the same accelerations on the planar fast path (`sim::planar`).
+//! for the planar scenes the same accelerations on the planar fast path (`sim::engine::planar`).
 //! Results and the machine: docs/performance.md.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use nalgebra::{DVector, SVector};
 use num_dual::{Derivative, DualSVec64};
-use sim::dynamics::{Dynamics, DynamicsOf};
-use sim::kinematics::Kinematics;
-use sim::planar::PlanarTree;
+use sim::engine::dynamics::{Dynamics, DynamicsOf};
+use sim::engine::kinematics::Kinematics;
+use sim::engine::PlanarTree;
 use sim::scene::Scene;
 use std::time::Duration;
 

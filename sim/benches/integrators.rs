@@ -5,7 +5,7 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim::integrators::{IntegratorChoice, Sample};
+use sim::engine::integrators::{IntegratorChoice, Sample};
 use sim::scene::Scene;
 use sim::stride::Phase;
 

@@ -5,10 +5,10 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim::homotopy::HomotopySettings;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::homotopy::HomotopySettings;
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::stability_map::{stability_map, Axis};
 use sim::scene::{Scene, Setup};
-use sim::stability_map::{stability_map, Axis};
 use std::time::Duration;
 
 fn benches(c: &mut Criterion) {

@@ -4,10 +4,10 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
-use sim::planar::EvaluationPath;
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::engine::integrators::IntegratorChoice;
 use sim::scene::Scene;
+use sim::stride::EvaluationPath;
 use sim::stride::StrideRequest;
 use std::time::Duration;
 
@@ -104,7 +104,7 @@ fn benches(c: &mut Criterion) {
                         walker.stride(black_box(&q), black_box(&qd), request)
                     })
                 });
-                if sim::planar::PlanarTree::of(&walker.model).is_some_and(|t| t.has_closed_form()) {
+                if sim::engine::PlanarTree::of(&walker.model).is_some_and(|t| t.has_closed_form()) {
                     // The fixed-size stride on the planar link pass instead of the two-link
                     // closed form: what the closed form buys.
                     let mut link_pass = settings.clone();

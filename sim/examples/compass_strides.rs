@@ -14,7 +14,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nalgebra::DVector;
-use sim::integrators::IntegratorChoice;
+use sim::engine::integrators::IntegratorChoice;
 use sim::scene::Scene;
 use sim::stride::StrideRequest;
 use std::error::Error;

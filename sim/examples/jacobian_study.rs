@@ -6,10 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nalgebra::DMatrix;
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::engine::integrators::IntegratorChoice;
+use sim::engine::walker::Walker;
 use sim::stride::{Schedule, StepSchedule, StrideRequest, StrideSettings};
-use sim::walker::Walker;
 
 fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
     let mut m: Vec<f64> = j

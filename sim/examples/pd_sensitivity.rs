@@ -5,8 +5,8 @@
 //! of slope, and the parameter shift `δλ / (dλ/dμ)` the methods' difference implies
 //! (`cargo run --release -p sim --example pd_sensitivity`).
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
-use sim::continuation::{continuation, BifurcationKind, ContinuationSettings};
-use sim::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
+use sim::analysis::continuation::{continuation, BifurcationKind, ContinuationSettings};
+use sim::analysis::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
 use sim::scene::Scene;
 
 fn near_minus_one(ev: &[nalgebra::Complex<f64>]) -> f64 {

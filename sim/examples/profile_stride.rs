@@ -14,9 +14,9 @@ fn main() {
     let scene = sim::scene::Scene::load(&name).expect("scene");
     let mut setup = scene.setup().expect("build");
     match args.next().as_deref() {
-        Some("general") => setup.settings.evaluation = sim::planar::EvaluationPath::General,
-        Some("loop") => setup.settings.evaluation = sim::planar::EvaluationPath::GeneralLoop,
-        Some("linkpass") => setup.settings.evaluation = sim::planar::EvaluationPath::LinkPass,
+        Some("general") => setup.settings.evaluation = sim::stride::EvaluationPath::General,
+        Some("loop") => setup.settings.evaluation = sim::stride::EvaluationPath::GeneralLoop,
+        Some("linkpass") => setup.settings.evaluation = sim::stride::EvaluationPath::LinkPass,
         _ => {}
     }
     if let Some(rtol) = args.next().and_then(|s| s.parse().ok()) {
@@ -27,10 +27,10 @@ fn main() {
         setup.settings = setup.settings.with_integrator(i);
     }
     if let Some(h) = args.next().and_then(|s| s.parse::<f64>().ok()) {
-        if let sim::integrators::IntegratorChoice::Dop853 { rtol, atol, .. } =
+        if let sim::engine::integrators::IntegratorChoice::Dop853 { rtol, atol, .. } =
             setup.settings.integrator
         {
-            let i = sim::integrators::IntegratorChoice::Dop853 {
+            let i = sim::engine::integrators::IntegratorChoice::Dop853 {
                 rtol,
                 atol,
                 h_max_s: h,

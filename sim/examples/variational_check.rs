@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use nalgebra::DMatrix;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
 
 fn moduli(j: &DMatrix<f64>) -> Vec<f64> {
     let mut m: Vec<f64> = j
@@ -28,7 +28,11 @@ fn main() {
         let fd = search.stride_jacobian(&g.fixed_point, &s).unwrap();
         let t_fd = t0.elapsed().as_secs_f64();
         let t0 = std::time::Instant::now();
-        let var = sim::variational::stride_jacobian(&setup.walker, &g.fixed_point, &setup.settings);
+        let var = sim::analysis::variational::stride_jacobian(
+            &setup.walker,
+            &g.fixed_point,
+            &setup.settings,
+        );
         let t_var = t0.elapsed().as_secs_f64();
         match var {
             Ok((jv, _)) => {

@@ -10,8 +10,8 @@
 //! as a parameter changes:
 //!
 //! ```
-//! use sim::continuation::sweep;
-//! use sim::limit_cycle::NewtonSettings;
+//! use sim::analysis::continuation::sweep;
+//! use sim::analysis::limit_cycle::NewtonSettings;
 //! use sim::scene::Scene;
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -42,48 +42,28 @@
 //!
 //! # Where things are
 //!
-//! - The model and its equations: [`model`] (links, joints, points), [`kinematics`],
-//!   [`dynamics`] (the TMT equations of motion), [`contact`] and [`impact`] (constraints and the
-//!   impact equations), [`integrators`], [`events`] and [`hermite`] (event location),
-//!   [`planar`] and [`axis_tree`] (fast evaluations of special walkers), [`singular_limit`]
-//!   (infinitesimal masses), [`math`].
-//! - The walker and its stride: [`walker`] (a model with its heel-strike, knee, fall and
-//!   relabelling rules), [`relabel`], [`actuator`] and [`control`] (the ankle reflex and
-//!   controllers), [`hybrid`], [`stride`] (one stride of the hybrid map), [`walk`] (many).
-//! - Analysis: [`limit_cycle`] (gaits by Newton's method), [`stability`], [`variational`]
-//!   (exact stride Jacobians), [`continuation`] (following gaits and their bifurcations),
-//!   [`census`], [`orbit_diagram`], [`stability_map`], [`tune`], [`accuracy`].
-//! - Scenes and reports: [`scene`] (the TOML scene files), [`report`] (what the `walker`
-//!   command prints, as data).
+//! Five modules, one per concern, and a [`prelude`]:
+//! - [`engine`]: the model and its equations — [`engine::model`] (links, joints, points),
+//!   [`engine::kinematics`], [`engine::dynamics`] (the TMT equations of motion),
+//!   [`engine::contact`] and [`engine::impact`] (constraints and the impact equations),
+//!   [`engine::integrators`], [`engine::events`] and [`engine::hermite`] (event location); the
+//!   walker: [`engine::walker`] (a model with its heel-strike, knee, fall and relabelling
+//!   rules), [`engine::relabel`], [`engine::actuator`] and [`engine::control`] (the ankle reflex
+//!   and controllers). The fast evaluations of special walkers ([`engine::PlanarTree`],
+//!   [`engine::AxisTree`]) are chosen by the stride; their internals are the crate's own.
+//! - [`stride`]: one stride of the hybrid map (one loop for every evaluation), the workspace
+//!   repeated strides reuse, and [`stride::walk`] (many strides).
+//! - [`analysis`]: [`analysis::limit_cycle`] (gaits by Newton's method),
+//!   [`analysis::stability`], [`analysis::variational`] (exact stride Jacobians),
+//!   [`analysis::continuation`] (following gaits and their bifurcations),
+//!   [`analysis::homotopy`], [`analysis::census`], [`analysis::orbit_diagram`],
+//!   [`analysis::stability_map`], [`analysis::tune`], [`analysis::accuracy`].
+//! - [`scene`]: the TOML scene files (docs/scenes.md) and what they build.
+//! - [`report`]: what the `walker` command prints, as data.
 
-pub mod accuracy;
-pub mod actuator;
-pub mod axis_tree;
-pub mod census;
-pub mod contact;
-pub mod continuation;
-pub mod control;
-pub mod dynamics;
-pub mod events;
-pub mod hermite;
-pub mod homotopy;
-pub mod hybrid;
-pub mod impact;
-pub mod integrators;
-pub mod kinematics;
-pub mod limit_cycle;
-pub mod math;
-pub mod model;
-pub mod orbit_diagram;
-pub mod planar;
-pub mod relabel;
+pub mod analysis;
+pub mod engine;
+pub mod prelude;
 pub mod report;
 pub mod scene;
-pub mod singular_limit;
-pub mod stability;
-pub mod stability_map;
 pub mod stride;
-pub mod tune;
-pub mod variational;
-pub mod walk;
-pub mod walker;

@@ -1,4 +1,4 @@
-//! The 3D fast path (`sim::axis_tree::AxisTree`) against the general engine it stands in for:
+//! The 3D fast path (`sim::engine::AxisTree`) against the general engine it stands in for:
 //! `M̄`, `f̄` and `q̈` over random states in every phase (each coordinate locked, one driven),
 //! on the 3D walker's scenes and on random trees the scene files do not express (joints about
 //! x, y and z, welds with offsets, full inertia tensors, bodies welded to the ground, springs
@@ -12,12 +12,12 @@
 )]
 
 use nalgebra::{DVector, Matrix3, Vector3};
-use sim::axis_tree::AxisTree;
-use sim::dynamics::Dynamics;
-use sim::limit_cycle::NewtonSettings;
-use sim::model::{BodyInertia, JointForce, JointKind, Model};
-use sim::planar::EvaluationPath;
+use sim::analysis::limit_cycle::NewtonSettings;
+use sim::engine::dynamics::Dynamics;
+use sim::engine::model::{BodyInertia, JointForce, JointKind, Model};
+use sim::engine::AxisTree;
 use sim::scene::Scene;
+use sim::stride::EvaluationPath;
 use sim::stride::Phase;
 
 fn noise(k: &mut u64) -> f64 {
@@ -363,7 +363,7 @@ fn non_finite_states_are_errors_as_on_the_general_engine() {
             let fast = tree.accelerations_into(&q, &qd, &active, None, None, &mut qdd);
             let reference = general.accelerations(model, &q, &qd, &active, None);
             assert!(
-                matches!(fast, Err(sim::dynamics::DynamicsError::NonFinite)),
+                matches!(fast, Err(sim::engine::dynamics::DynamicsError::NonFinite)),
                 "{fast:?}"
             );
             assert!(reference.is_err());

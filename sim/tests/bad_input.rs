@@ -4,7 +4,7 @@
 
 mod common;
 
-use sim::integrators::{IntegratorChoice, IntegratorError};
+use sim::engine::integrators::{IntegratorChoice, IntegratorError};
 use sim::scene::expr::ExprError;
 use sim::scene::{Scene, SceneError, BUILTIN};
 use sim::stride::{FailureKind, StrideSettings};

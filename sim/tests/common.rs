@@ -8,10 +8,10 @@
 )]
 
 use nalgebra::DVector;
-use sim::limit_cycle::{Gait, GaitSearch, NewtonSettings};
+use sim::analysis::limit_cycle::{Gait, GaitSearch, NewtonSettings};
 use sim::scene::{Scene, Setup};
+use sim::stride::walk::{Walk, WalkRequest};
 use sim::stride::{StrideFailure, StrideRequest, StrideResult};
-use sim::walk::{Walk, WalkRequest};
 
 pub fn walker(name: &str) -> (Scene, Setup) {
     let scene = Scene::load(name).expect("scene loads");
@@ -47,7 +47,7 @@ pub fn stride(
 
 /// A walk of up to `steps` strides with the setup's settings.
 pub fn walk(w: &Setup, q: &DVector<f64>, qd: &DVector<f64>, steps: usize, record: bool) -> Walk {
-    sim::walk::walk(
+    sim::stride::walk::walk(
         &w.walker,
         q,
         qd,

@@ -1,4 +1,4 @@
-//! Pseudo-arclength continuation (`sim::continuation`), checked against the hand-written Garcia
+//! Pseudo-arclength continuation (`sim::analysis::continuation`), checked against the hand-written Garcia
 //! model of the simplest walker (tests/garcia, no code shared with the engine) and against
 //! the engine's own Newton solves at single parameter values.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -7,11 +7,11 @@ mod garcia;
 
 use garcia::State;
 use nalgebra::DVector;
-use sim::continuation::{
+use sim::analysis::continuation::{
     continuation, BifurcationKind, BranchEndKind, BranchPoint, Continuation, ContinuationSettings,
     LOCATION_TOLERANCE,
 };
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::scene::Scene;
 
 const GUESS_LONG: State = State {
@@ -162,11 +162,11 @@ fn a_sweep_from_slope_0_015_starts_on_the_long_period_gait_as_walker_gait_does()
     let mut at = scene.clone();
     at.set("slope", 0.015).unwrap();
     let setup_for = |s: &Scene| s.setup();
-    let gait = sim::homotopy::long_period_gait(
+    let gait = sim::analysis::homotopy::long_period_gait(
         &at,
         &setup_for,
         &NewtonSettings::default(),
-        &sim::homotopy::HomotopySettings::default(),
+        &sim::analysis::homotopy::HomotopySettings::default(),
     )
     .unwrap()
     .unwrap();
@@ -187,7 +187,7 @@ fn a_sweep_from_slope_0_015_starts_on_the_long_period_gait_as_walker_gait_does()
 }
 
 fn fold_test(p: &BranchPoint) -> f64 {
-    sim::continuation::fold_test(&p.multipliers)
+    sim::analysis::continuation::fold_test(&p.multipliers)
 }
 
 #[test]
@@ -315,7 +315,7 @@ const SIMPLEST_PERIOD_DOUBLING_TOL: f64 = 2.2e-9 + 2.0 * LOCATION_TOLERANCE;
 /// simplest walker's period doubling.
 #[test]
 fn the_stride_jacobian_error_at_the_located_points_is_small() {
-    use sim::limit_cycle::JacobianMethod;
+    use sim::analysis::limit_cycle::JacobianMethod;
     let cases = [
         (
             "simplest",
@@ -502,11 +502,13 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
     assert_eq!(v["param"], "slope");
     assert_eq!(v["param_canonical"], "slope_rad");
     // A bifurcation detected but not located reaches the report with its bracket and why.
-    c.branches[0].unlocated.push(sim::continuation::Unlocated {
-        kind: BifurcationKind::NeimarkSacker,
-        bracket: (0.011, 0.013),
-        reason: "the corrector failed".into(),
-    });
+    c.branches[0]
+        .unlocated
+        .push(sim::analysis::continuation::Unlocated {
+            kind: BifurcationKind::NeimarkSacker,
+            bracket: (0.011, 0.013),
+            reason: "the corrector failed".into(),
+        });
     let v = report(&c);
     let u = &v["unlocated"][0];
     assert_eq!(u["kind"], "neimark_sacker");

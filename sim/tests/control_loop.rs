@@ -3,8 +3,8 @@
 
 mod common;
 
-use sim::control::SampledReflex;
-use sim::walk::WalkRequest;
+use sim::engine::control::SampledReflex;
+use sim::stride::walk::WalkRequest;
 
 #[test]
 fn a_sampled_reflex_at_1_khz_walks_like_the_ideal_actuator() {
@@ -14,7 +14,7 @@ fn a_sampled_reflex_at_1_khz_walks_like_the_ideal_actuator() {
     let reflex = w.walker.ankle.clone().unwrap();
     let mut ctl = SampledReflex::new(1e-3, &reflex);
     let request = WalkRequest::new(&w.settings, 20).controlled(&mut ctl);
-    let walk = sim::walk::walk(&w.walker, &q, &qd, request);
+    let walk = sim::stride::walk::walk(&w.walker, &q, &qd, request);
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     let ideal = g.stride.duration_s;
     for s in &walk.steps {

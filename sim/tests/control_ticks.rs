@@ -1,4 +1,4 @@
-//! The control-tick contract (`sim::control`): every tick runs, once, at its exact time, in
+//! The control-tick contract (`sim::engine::control`): every tick runs, once, at its exact time, in
 //! order, whichever way the steps meet the ticks (`TickStepping`), also over steps whose
 //! swing foot grazes the floor (the grazing probe takes another step of the integrator); and a
 //! controller whose period cannot make ticks is refused, not looped on.
@@ -7,13 +7,13 @@
 mod common;
 
 use nalgebra::DVector;
-use sim::control::{
+use sim::engine::control::{
     ActuatorSegment, AnkleController, AnkleSensing, ControlError, SampledReflex, TickStepping,
 };
-use sim::integrators::IntegratorChoice;
+use sim::engine::integrators::IntegratorChoice;
 use sim::scene::Setup;
+use sim::stride::walk::WalkRequest;
 use sim::stride::{FailureKind, StrideRequest, StrideSettings};
-use sim::walk::WalkRequest;
 
 /// The walker's sampled reflex, writing down the walk time at which each of its ticks runs
 /// (and each heel strike).
@@ -71,7 +71,7 @@ fn walk_ticks(
     let period_s = 1e-3;
     let mut ctl = Recording::new(period_s, SampledReflex::new(period_s, &reflex));
     let request = WalkRequest::new(settings, steps).controlled(&mut ctl);
-    let walk = sim::walk::walk(&w.walker, &start.0, &start.1, request);
+    let walk = sim::stride::walk::walk(&w.walker, &start.0, &start.1, request);
     assert_eq!(ctl.heel_strikes_s.len(), walk.steps_completed);
     let end_s = match (&walk.failure, walk.steps.last()) {
         (Some(f), _) => f.t_walk_s,

@@ -4,12 +4,12 @@
 mod common;
 
 use nalgebra::DVector;
-use sim::events::EventTolerance;
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{GaitSearch, NewtonError, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonError, NewtonSettings};
+use sim::engine::events::EventTolerance;
+use sim::engine::integrators::IntegratorChoice;
+use sim::engine::walker::ContactConstraint;
 use sim::scene::Setup;
 use sim::stride::FailureKind;
-use sim::walker::ContactConstraint;
 
 /// The failure of one stride from the gait's start with `name += delta`.
 fn perturbed(w: &Setup, name: &str, delta: f64) -> FailureKind {
@@ -182,15 +182,17 @@ struct Broken;
 #[error("the bus is down")]
 struct BusDown;
 
-impl sim::control::AnkleController for Broken {
+impl sim::engine::control::AnkleController for Broken {
     fn period_s(&self) -> f64 {
         1e-3
     }
     fn tick(
         &mut self,
-        _: &sim::control::AnkleSensing,
-    ) -> Result<sim::control::ActuatorSegment, sim::control::ControlError> {
-        Err(sim::control::ControlError::controller("broken", BusDown))
+        _: &sim::engine::control::AnkleSensing,
+    ) -> Result<sim::engine::control::ActuatorSegment, sim::engine::control::ControlError> {
+        Err(sim::engine::control::ControlError::controller(
+            "broken", BusDown,
+        ))
     }
     fn heel_strike(&mut self, _: f64) {}
 }

@@ -1,14 +1,14 @@
-//! The planar fast path (`sim::planar`) against the general engine, its reference: which scenes
+//! The planar fast path (`sim::engine::planar`) against the general engine, its reference: which scenes
 //! take it, the equations of motion at many states and phases, one stride, and a whole gait
 //! (fixed point and eigenvalues).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use nalgebra::DVector;
-use sim::integrators::SecondOrderSystem;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
-use sim::planar::{EvaluationPath, PlanarTree};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::engine::integrators::SecondOrderSystem;
 use sim::scene::{Scene, Setup};
 use sim::stride::{Drive, Phase, StrideRequest};
+use sim::{engine::PlanarTree, stride::EvaluationPath};
 
 /// The scenes that take the planar fast path (wisse2d too: its drive and ankle are planar).
 const PLANAR: [&str; 4] = ["simplest", "compass", "kneed2d", "wisse2d"];
@@ -66,7 +66,7 @@ fn equations_of_motion_agree_with_the_general_engine() {
                 general.active.clone_from(mask);
                 let driven = (mi > 0 && trial % 2 == 1).then(|| {
                     let c = mask.iter().position(|a| !a).unwrap();
-                    let seg = sim::control::ActuatorSegment {
+                    let seg = sim::engine::control::ActuatorSegment {
                         t0_s: 0.0,
                         t1_s: 1.0,
                         p0_rad: 0.2,
@@ -75,7 +75,7 @@ fn equations_of_motion_agree_with_the_general_engine() {
                         v1_rad_s: 2.0,
                         released: false,
                     };
-                    (sim::model::CoordIndex(c), Drive::Segment(seg))
+                    (sim::engine::model::CoordIndex(c), Drive::Segment(seg))
                 });
                 fast.prescribed = driven;
                 general.prescribed = driven;
@@ -166,7 +166,7 @@ fn events_located_on_the_dense_output_agree_with_exact_step_refinement() {
             .unwrap();
         let (q, qd) = walker.unpack(&gait.fixed_point);
         let mut reference = s.settings.clone();
-        reference.integrator = sim::integrators::IntegratorChoice::Dop853 {
+        reference.integrator = sim::engine::integrators::IntegratorChoice::Dop853 {
             rtol: 1e-14,
             atol: 1e-14,
             h_max_s: 0.05,
@@ -214,14 +214,14 @@ fn events_located_on_the_dense_output_agree_with_exact_step_refinement() {
 /// every phase (all free, each coordinate locked, one driven): the largest difference
 /// relative to `1 + |q̈|`, and the number of states compared.
 fn compare_with_general(
-    model: &sim::model::Model,
+    model: &sim::engine::model::Model,
     tree: &PlanarTree,
     center: (&DVector<f64>, &DVector<f64>),
     seed: &mut u64,
 ) -> (f64, usize) {
     let n = model.dof();
     let mut general = Phase::with_path(model, EvaluationPath::General);
-    let mut dynamics = sim::dynamics::Dynamics::new(model);
+    let mut dynamics = sim::engine::dynamics::Dynamics::new(model);
     let (mut worst, mut compared) = (0.0f64, 0);
     let mut masks = vec![vec![true; n]];
     for i in 0..n {
@@ -236,7 +236,7 @@ fn compare_with_general(
             general.active.clone_from(mask);
             let driven = mi > 0 && trial % 2 == 1;
             let c = mask.iter().position(|a| !a).unwrap_or(0);
-            let seg = sim::control::ActuatorSegment {
+            let seg = sim::engine::control::ActuatorSegment {
                 t0_s: 0.0,
                 t1_s: 1.0,
                 p0_rad: 0.2,
@@ -245,11 +245,12 @@ fn compare_with_general(
                 v1_rad_s: 2.0,
                 released: false,
             };
-            general.prescribed = driven.then_some((sim::model::CoordIndex(c), Drive::Segment(seg)));
+            general.prescribed =
+                driven.then_some((sim::engine::model::CoordIndex(c), Drive::Segment(seg)));
             let t = 0.3;
             let values = driven.then(|| {
                 let (angle_rad, rate_rad_s, acceleration_rad_s2) = seg.eval(t);
-                sim::hybrid::phase::DriveValues {
+                sim::engine::DriveValues {
                     coordinate: c,
                     angle_rad,
                     rate_rad_s,
@@ -321,7 +322,7 @@ fn the_closed_forms_agree_with_the_link_pass_and_the_general_engine() {
                     link.p_parent_joint_m.x += 0.03 * k;
                 }
                 let swing = model.links.len() - 1;
-                if let sim::model::JointKind::Revolute { axis_parent } =
+                if let sim::engine::model::JointKind::Revolute { axis_parent } =
                     &mut model.links[swing].joint
                 {
                     axis_parent.z = -1.0;
@@ -343,8 +344,8 @@ fn the_closed_forms_agree_with_the_link_pass_and_the_general_engine() {
             let mut sd = seed;
             let (mut to_pass, mut dyn_a, mut dyn_b) = (
                 0.0f64,
-                sim::dynamics::Dynamics::new(&model),
-                sim::dynamics::Dynamics::new(&model),
+                sim::engine::dynamics::Dynamics::new(&model),
+                sim::engine::dynamics::Dynamics::new(&model),
             );
             let n = model.dof();
             let free = vec![true; n];

@@ -5,9 +5,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use nalgebra::DVector;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
-use sim::planar::EvaluationPath;
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
 use sim::scene::{Scene, Setup};
+use sim::stride::EvaluationPath;
 use sim::stride::{
     Schedule, StepSchedule, StrideOptions, StrideRequest, StrideResult, StrideSettings,
 };
@@ -74,13 +74,13 @@ fn the_covered_scenes_take_it_and_the_others_do_not() {
             ..Default::default()
         };
         assert!(!w.takes_fixed_size_stride(&s.settings, contact), "{name}");
-        let dopri = s
-            .settings
-            .with_integrator(sim::integrators::IntegratorChoice::Dopri5 {
-                rtol: 1e-10,
-                atol: 1e-10,
-                h_max_s: 0.05,
-            });
+        let dopri =
+            s.settings
+                .with_integrator(sim::engine::integrators::IntegratorChoice::Dopri5 {
+                    rtol: 1e-10,
+                    atol: 1e-10,
+                    h_max_s: 0.05,
+                });
         assert!(
             !w.takes_fixed_size_stride(&dopri, StrideOptions::default()),
             "{name}"
@@ -267,7 +267,7 @@ fn gaits_equal_the_general_loop() {
         let ga = GaitSearch::new(w, &s.settings, &newton).find(&v0).unwrap();
         let gb = GaitSearch::new(w, &reference, &newton).find(&v0).unwrap();
         let fp = (&ga.fixed_point - &gb.fixed_point).amax();
-        let sort = |g: &sim::limit_cycle::Gait| {
+        let sort = |g: &sim::analysis::limit_cycle::Gait| {
             let mut e: Vec<_> = g.eigenvalues.iter().map(|z| (z.re, z.im)).collect();
             e.sort_by(|x, y| x.partial_cmp(y).unwrap());
             e

@@ -4,12 +4,12 @@
 //! `sim/cli/tests/gait_families.rs`.)
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use sim::census::{census, CensusSettings};
-use sim::homotopy::{at_defaults, is_at_defaults, SetupFor};
-use sim::limit_cycle::NewtonSettings;
-use sim::orbit_diagram::{linspace, orbit_diagram, Attractor, OrbitError, OrbitSettings};
+use sim::analysis::census::{census, CensusSettings};
+use sim::analysis::homotopy::{at_defaults, is_at_defaults, SetupFor};
+use sim::analysis::limit_cycle::NewtonSettings;
+use sim::analysis::orbit_diagram::{linspace, orbit_diagram, Attractor, OrbitError, OrbitSettings};
+use sim::analysis::stability_map::{stability_map, Axis};
 use sim::scene::{Scene, SceneError, Setup};
-use sim::stability_map::{stability_map, Axis};
 
 fn setup(s: &Scene) -> Result<Setup, SceneError> {
     s.setup()
@@ -129,7 +129,7 @@ fn the_parallel_orbit_diagram_is_the_sequential_one_on_any_number_of_threads() {
     let sequential = run(1, values.len());
     let chunked_1 = run(1, 2);
     let chunked_2 = run(2, 2);
-    let periods = |d: &[sim::orbit_diagram::OrbitPoint]| {
+    let periods = |d: &[sim::analysis::orbit_diagram::OrbitPoint]| {
         d.iter()
             .map(|p| match p.attractor {
                 Attractor::Periodic { period } => period,
@@ -143,7 +143,7 @@ fn the_parallel_orbit_diagram_is_the_sequential_one_on_any_number_of_threads() {
     // The same cycles, to the period tolerance, and bit for bit across thread counts.
     for ((a, b), c) in sequential.iter().zip(&chunked_1).zip(&chunked_2) {
         assert_eq!(b.states, c.states, "threads change nothing at {}", a.value);
-        let lo = |p: &sim::orbit_diagram::OrbitPoint| {
+        let lo = |p: &sim::analysis::orbit_diagram::OrbitPoint| {
             p.states.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min)
         };
         assert!(
@@ -191,16 +191,16 @@ fn the_secant_step_refuses_a_jump_to_another_branch() {
     scene.set("slope", 0.015).unwrap();
     let setup = scene.setup().unwrap();
     let newton = NewtonSettings::default();
-    let guard = sim::homotopy::HomotopySettings::default();
+    let guard = sim::analysis::homotopy::HomotopySettings::default();
     let short = setup.find_gait(&newton).unwrap();
-    let mut path = sim::homotopy::Secant::default();
+    let mut path = sim::analysis::homotopy::Secant::default();
     assert!(path.step(0.015, &setup, &newton, &guard).is_none());
     path.push(0.015, &short);
     let again = path.step(0.015, &setup, &newton, &guard).unwrap().unwrap();
     assert!((&again.fixed_point - &short.fixed_point).amax() < 1e-9);
     let mut disguised = short.clone();
     disguised.stride.duration_s *= 1.25;
-    let mut path = sim::homotopy::Secant::default();
+    let mut path = sim::analysis::homotopy::Secant::default();
     path.push(0.015, &disguised);
     assert!(path.step(0.015, &setup, &newton, &guard).unwrap().is_err());
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use sim::limit_cycle::NewtonSettings;
+use sim::analysis::limit_cycle::NewtonSettings;
 
 #[test]
 fn forward_stepping_finds_the_same_gait_with_fewer_strides() {

@@ -9,9 +9,9 @@
 mod common;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use sim::dynamics::Dynamics;
-use sim::math::rotation_about;
-use sim::model::{JointKind, LinkIndex, Model};
+use sim::engine::dynamics::Dynamics;
+use sim::engine::model::{JointKind, LinkIndex, Model};
+use sim::engine::rotation_about;
 
 fn noise(k: &mut u64) -> f64 {
     *k = k

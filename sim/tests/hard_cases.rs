@@ -3,8 +3,8 @@
 
 mod common;
 
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use sim::engine::integrators::IntegratorChoice;
 use sim::stride::{FailureKind, StrideOptions, StrideRequest};
 
 #[test]
@@ -71,7 +71,7 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
         .unwrap()
         .parse()
         .unwrap();
-    let mut d = sim::dynamics::Dynamics::new(&w.walker.model);
+    let mut d = sim::engine::dynamics::Dynamics::new(&w.walker.model);
     d.assemble(&w.walker.model, &w.guess.q, &w.guess.qd, None);
     let free: Vec<usize> = (0..w.walker.model.dof())
         .filter(|i| !w.walker.initially_locked.iter().any(|c| c.0 == *i))
@@ -102,7 +102,7 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
 #[test]
 fn just_past_the_period_doubling_slope_the_walker_settles_into_two_alternating_steps() {
     let (mut scene, _) = common::walker("simplest");
-    let (pts, _) = sim::continuation::sweep(
+    let (pts, _) = sim::analysis::continuation::sweep(
         &scene,
         "slope",
         0.009,
@@ -140,7 +140,7 @@ fn just_past_the_period_doubling_slope_the_walker_settles_into_two_alternating_s
 fn near_zero_slope_gaits_follow_garcias_cube_root_scaling() {
     // Garcia et al. (1998): for small slopes the stance angle at heel strike scales as γ^(1/3).
     let (scene, _) = common::walker("simplest");
-    let (pts, _) = sim::continuation::sweep(
+    let (pts, _) = sim::analysis::continuation::sweep(
         &scene,
         "slope",
         0.009,
@@ -153,7 +153,8 @@ fn near_zero_slope_gaits_follow_garcias_cube_root_scaling() {
         pts.iter().all(|p| p.gait.is_ok()),
         "a gait was lost on the way down"
     );
-    let theta = |p: &sim::continuation::SweepPoint| p.gait.as_ref().unwrap().fixed_point[0];
+    let theta =
+        |p: &sim::analysis::continuation::SweepPoint| p.gait.as_ref().unwrap().fixed_point[0];
     let (a, b) = (&pts[pts.len() - 1], &pts[pts.len() - 8]);
     let exponent = (theta(b) / theta(a)).ln() / (b.value / a.value).ln();
     assert!((exponent - 1.0 / 3.0).abs() < 0.01, "exponent {exponent}");

@@ -6,11 +6,11 @@ mod common;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 use proptest::prelude::*;
-use sim::dynamics::Dynamics;
-use sim::integrators::{IntegratorChoice, Sample, SecondOrderSystem};
-use sim::limit_cycle::GaitSearch;
-use sim::model::{BodyInertia, JointForce, JointKind, Model};
-use sim::relabel::LinkStates;
+use sim::analysis::limit_cycle::GaitSearch;
+use sim::engine::dynamics::Dynamics;
+use sim::engine::integrators::{IntegratorChoice, Sample, SecondOrderSystem};
+use sim::engine::model::{BodyInertia, JointForce, JointKind, Model};
+use sim::engine::relabel::LinkStates;
 use sim::scene::Setup;
 use sim::stride::Phase;
 
@@ -288,13 +288,13 @@ proptest! {
         // q̇ᵀ M̄ q̇ equals twice the kinetic energy summed body by body from finite differences
         // of positions and orientations: an independent check of F,q.
         let eps = 1e-6;
-        let mut kp = sim::kinematics::Kinematics::new(&m);
-        let mut km = sim::kinematics::Kinematics::new(&m);
+        let mut kp = sim::engine::kinematics::Kinematics::new(&m);
+        let mut km = sim::engine::kinematics::Kinematics::new(&m);
         kp.update(&m, &(&q + &qd * eps), &qd);
         km.update(&m, &(&q - &qd * eps), &qd);
         let mut two_t = 0.0;
         for (i, l) in m.links.iter().enumerate() {
-            let li = sim::model::LinkIndex(i);
+            let li = sim::engine::model::LinkIndex(i);
             let v = (kp.position_of(li, &l.body.p_link_com_m) - km.position_of(li, &l.body.p_link_com_m)) / (2.0 * eps);
             let rdot = (kp.r_floor_link[i] - km.r_floor_link[i]) / (2.0 * eps);
             let r = (kp.r_floor_link[i] + km.r_floor_link[i]) * 0.5;
@@ -314,9 +314,9 @@ proptest! {
         w in prop::array::uniform3(-1.0..1.0f64),
         v in prop::array::uniform3(-1.0..1.0f64),
     ) {
-        let r = sim::math::rotation_about(&Vector3::x(), angles[0])
-            * sim::math::rotation_about(&Vector3::y(), angles[1])
-            * sim::math::rotation_about(&Vector3::z(), angles[2]);
+        let r = sim::engine::rotation_about(&Vector3::x(), angles[0])
+            * sim::engine::rotation_about(&Vector3::y(), angles[1])
+            * sim::engine::rotation_about(&Vector3::z(), angles[2]);
         let s = LinkStates { r: vec![r], p: vec![p.into()], w: vec![w.into()], v: vec![v.into()] };
         let m = s.mirrored();
         // A proper rotation stays proper, and the reflection is not the identity.
@@ -344,7 +344,7 @@ fn relabelling_twice_returns_the_configuration() {
         }
         let zero = DVector::zeros(w.walker.model.dof());
         let relabel_once = |q: &DVector<f64>| {
-            let mut kin = sim::kinematics::Kinematics::new(&w.walker.model);
+            let mut kin = sim::engine::kinematics::Kinematics::new(&w.walker.model);
             kin.update(&w.walker.model, q, &zero);
             let foot = kin.point_position(&w.walker.model, w.walker.heel_strike.swing_foot);
             let states = LinkStates::from_kinematics(&kin, 0, &foot);
@@ -374,7 +374,7 @@ fn stride_jacobian_eigenvalues_converge_as_the_perturbation_shrinks() {
         let g = common::gait(&w);
         let s = common::stride_map(&w, &g.fixed_point).unwrap().0;
         let spectral = |d: f64| {
-            let set = sim::limit_cycle::NewtonSettings {
+            let set = sim::analysis::limit_cycle::NewtonSettings {
                 perturbation: d,
                 ..Default::default()
             };

@@ -110,7 +110,8 @@ fn simplest_loses_stability_by_period_doubling_near_slope_0_0151() {
     // Garcia et al. (1998): the period-one gait becomes unstable at γ ≈ 0.0151.
     let (scene, _) = common::walker("simplest");
     let (points, bounds) =
-        sim::continuation::sweep(&scene, "slope", 0.009, 0.0165, 16, &Default::default()).unwrap();
+        sim::analysis::continuation::sweep(&scene, "slope", 0.009, 0.0165, 16, &Default::default())
+            .unwrap();
     assert!(points.iter().all(|p| p.gait.is_ok()));
     assert_eq!(bounds.len(), 1, "{bounds:?}");
     assert_eq!(bounds[0].change, "lost");

@@ -4,7 +4,7 @@
 
 mod common;
 
-use sim::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
+use sim::analysis::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
 
 #[test]
 fn the_variational_jacobian_matches_central_differences_on_every_event_kind() {
@@ -18,7 +18,8 @@ fn the_variational_jacobian_matches_central_differences_on_every_event_kind() {
             .stride_jacobian(&g.fixed_point, &s)
             .unwrap();
         let (var, _) =
-            sim::variational::stride_jacobian(&w.walker, &g.fixed_point, &w.settings).unwrap();
+            sim::analysis::variational::stride_jacobian(&w.walker, &g.fixed_point, &w.settings)
+                .unwrap();
         let d = (&var - &fd).amax();
         assert!(d < bound * fd.amax(), "{name}: |J_var - J_fd| = {d:e}");
     }
@@ -32,7 +33,8 @@ fn the_variational_jacobian_has_the_exact_zero_eigenvalues() {
     let (_, w) = common::walker("kneed2d");
     let g = common::gait(&w);
     let (var, _) =
-        sim::variational::stride_jacobian(&w.walker, &g.fixed_point, &w.settings).unwrap();
+        sim::analysis::variational::stride_jacobian(&w.walker, &g.fixed_point, &w.settings)
+            .unwrap();
     let mut moduli: Vec<f64> = var.complex_eigenvalues().iter().map(|z| z.norm()).collect();
     moduli.sort_by(f64::total_cmp);
     assert!(moduli[0] < 1e-13, "{moduli:?}");

@@ -9,7 +9,7 @@
 mod common;
 
 use serde_json::{json, Value};
-use sim::limit_cycle::GaitSearch;
+use sim::analysis::limit_cycle::GaitSearch;
 use sim::stride::{FailureKind, StrideOptions, StrideRequest};
 
 #[test]
@@ -195,7 +195,7 @@ fn the_six_multipliers_nearest_the_circle_of_the_3d_walker_are_3d_modes() {
     let (_, w) = common::walker("wisse3d");
     let g = common::gait(&w);
     assert!(g.max_abs_eigenvalue() < 1.0, "{}", g.max_abs_eigenvalue());
-    let mut m = sim::stability::modes(
+    let mut m = sim::analysis::stability::modes(
         &g.jacobian,
         &g.eigenvalues,
         &w.walker.map_names(),
@@ -222,7 +222,7 @@ fn the_centre_of_mass_reading_at_table_one_is_unstable_in_a_3d_mode() {
     let w = scene.setup().unwrap();
     let g = common::gait(&w);
     assert!(!g.stable(), "max |λ| = {}", g.max_abs_eigenvalue());
-    let m = sim::stability::modes(
+    let m = sim::analysis::stability::modes(
         &g.jacobian,
         &g.eigenvalues,
         &w.walker.map_names(),
@@ -267,7 +267,7 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
 }
 
 /// Largest |stance-foot yaw| over each step of a recorded walk [rad].
-fn stance_yaw_per_step(w: &sim::scene::Setup, walk: &sim::walk::Walk) -> Vec<f64> {
+fn stance_yaw_per_step(w: &sim::scene::Setup, walk: &sim::stride::walk::Walk) -> Vec<f64> {
     let yaw = w
         .walker
         .model

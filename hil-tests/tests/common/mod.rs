@@ -5,11 +5,11 @@ use std::sync::OnceLock;
 
 use nalgebra::DVector;
 use sil::{FirmwareInTheLoop, SilConfig, SilReport};
-use sim::limit_cycle::NewtonSettings;
+use sim::analysis::limit_cycle::NewtonSettings;
+use sim::engine::walker::Walker;
 use sim::scene::Scene;
+use sim::stride::walk::{Walk, WalkRequest};
 use sim::stride::StrideSettings;
-use sim::walk::{Walk, WalkRequest};
-use sim::walker::Walker;
 
 /// The scene every test walks.
 pub const SCENE: &str = "wisse3d";
@@ -82,7 +82,7 @@ pub fn walk(config: SilConfig, steps: usize) -> (Walk, SilReport) {
 pub fn walk_with(mut ctl: FirmwareInTheLoop, steps: usize) -> (Walk, SilReport) {
     let s = setup();
     let request = WalkRequest::new(&s.settings, steps).controlled(&mut ctl);
-    let walk = sim::walk::walk(&s.walker, &s.q0, &s.qd0, request);
+    let walk = sim::stride::walk::walk(&s.walker, &s.q0, &s.qd0, request);
     let report = ctl.finish().expect("report");
     eprintln!("{}", summary(&walk, &report));
     (walk, report)

@@ -8,13 +8,13 @@ use crate::labels::{
     coordinate_label, failure_label, integrator_label, parameter_label, step_label, walker_name,
 };
 use crate::plot::{Aspect, Marker, Note, Plot, Series, Style, PALETTE};
-use sim::integrators::Sample;
-use sim::limit_cycle::Gait;
-use sim::model::JointKind;
+use sim::analysis::limit_cycle::Gait;
+use sim::analysis::stability::modes;
+use sim::engine::integrators::Sample;
+use sim::engine::model::JointKind;
+use sim::engine::walker::Walker;
 use sim::scene::Scene;
-use sim::stability::modes;
-use sim::walk::Walk;
-use sim::walker::Walker;
+use sim::stride::walk::Walk;
 
 /// Eigenvalues closer than this (in the complex plane) are drawn as one marker with a count.
 const COINCIDENT: f64 = 0.02;
@@ -40,8 +40,8 @@ const NEAR_ZERO: f64 = 0.05;
 
 /// The caption naming the eigenvalues that crowd the origin (`None` if at most one does):
 /// how many are 0, and the others' values, 3D modes marked.
-fn near_zero_caption(modes: &[sim::stability::EigenMode]) -> Option<String> {
-    let near: Vec<&sim::stability::EigenMode> = modes
+fn near_zero_caption(modes: &[sim::analysis::stability::EigenMode]) -> Option<String> {
+    let near: Vec<&sim::analysis::stability::EigenMode> = modes
         .iter()
         .filter(|e| e.eigenvalue[0].hypot(e.eigenvalue[1]) < NEAR_ZERO)
         .collect();
@@ -92,7 +92,7 @@ pub fn eigenvalues(scene: &Scene, walker: &Walker, gait: &Gait) -> Plot {
         &walker.three_d_freedoms,
     );
     let (three_d, plain): (Vec<_>, Vec<_>) = m.iter().partition(|e| e.three_d);
-    let point = |e: &&sim::stability::EigenMode| (e.eigenvalue[0], e.eigenvalue[1]);
+    let point = |e: &&sim::analysis::stability::EigenMode| (e.eigenvalue[0], e.eigenvalue[1]);
     let mut series = Vec::new();
     let mut notes = Vec::new();
     // Legend label, points, marker, offset of a count note [px].
@@ -246,7 +246,7 @@ pub fn dense(samples: &[Sample], per_s: f64) -> Vec<Sample> {
         let n = ((h * per_s).ceil() as usize).clamp(1, 1000);
         for k in 1..n {
             let x = k as f64 / n as f64;
-            let (q, qd) = sim::hermite::vector((&a.q, &a.qd), (&b.q, &b.qd), h, x);
+            let (q, qd) = sim::engine::hermite::vector((&a.q, &a.qd), (&b.q, &b.qd), h, x);
             out.push(Sample {
                 t_s: a.t_s + x * h,
                 q,
@@ -340,8 +340,8 @@ pub fn joint_angles(
 /// against CPU time per stride, one line per integrator with a marker at each setting.
 pub fn accuracy(
     scene: &Scene,
-    study: &sim::accuracy::AccuracyStudy,
-    error: fn(&sim::accuracy::AccuracyPoint) -> Option<f64>,
+    study: &sim::analysis::accuracy::AccuracyStudy,
+    error: fn(&sim::analysis::accuracy::AccuracyPoint) -> Option<f64>,
     what: &str,
 ) -> Plot {
     let mut families: Vec<String> = Vec::new();
@@ -520,7 +520,7 @@ mod tests {
 
     #[test]
     fn eigenvalues_crowding_the_origin_are_named_in_the_caption() {
-        let mode = |re: f64, three_d: bool| sim::stability::EigenMode {
+        let mode = |re: f64, three_d: bool| sim::analysis::stability::EigenMode {
             eigenvalue: [re, 0.0],
             abs: re.abs(),
             dominant: Vec::new(),
@@ -551,7 +551,7 @@ mod tests {
         Walk {
             steps_completed: 3,
             steps: Vec::new(),
-            failure: failure.map(|(step, kind)| sim::walk::WalkFailure {
+            failure: failure.map(|(step, kind)| sim::stride::walk::WalkFailure {
                 kind,
                 step,
                 t_walk_s: 1.0,
@@ -559,13 +559,13 @@ mod tests {
             }),
             path: points
                 .iter()
-                .map(|&(x, z)| sim::walk::PathSample {
+                .map(|&(x, z)| sim::stride::walk::PathSample {
                     step: 0,
                     t_walk_s: 0.0,
                     q: DVector::zeros(1),
                     qd: DVector::zeros(1),
                     hip_floor_m: nalgebra::Vector3::new(x, 0.0, z),
-                    floor: sim::walk::FloorFrame::default(),
+                    floor: sim::stride::walk::FloorFrame::default(),
                 })
                 .collect(),
         }

@@ -2,8 +2,8 @@
 
 use crate::input_error::InputError;
 use clap::Args;
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::{JacobianMethod, NewtonSettings};
+use sim::analysis::limit_cycle::{JacobianMethod, NewtonSettings};
+use sim::engine::integrators::IntegratorChoice;
 use sim::scene::{Scene, SceneError, Setup};
 use sim::stride::StrideSettings;
 
@@ -71,7 +71,7 @@ impl Common {
     }
 
     /// [`Self::setup`] as the engine's studies build a scene at other parameter values
-    /// ([`sim::homotopy::SetupFor`]); an option error (already refused by [`Self::setup`] before
+    /// ([`sim::analysis::homotopy::SetupFor`]); an option error (already refused by [`Self::setup`] before
     /// any study starts) comes back as [`SceneError::Invalid`].
     pub fn setup_for(&self) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
         move |scene: &Scene| {

@@ -9,8 +9,8 @@ use crate::figures::state_label;
 use crate::labels::{parameter_label, walker_name};
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
 use nalgebra::{Complex, DVector};
-use sim::continuation::{BifurcationKind, Branch, BranchPoint, Continuation};
-use sim::hermite::{self, Knot};
+use sim::analysis::continuation::{BifurcationKind, Branch, BranchPoint, Continuation};
+use sim::engine::hermite::{self, Knot};
 use sim::scene::Scene;
 
 /// A point of a branch in arclength order: a grid point, or a bifurcation (with the
@@ -298,7 +298,7 @@ fn add_markers(mut curves: Curves, c: &Continuation, index: usize) -> Curves {
         BifurcationKind::NeimarkSacker,
         BifurcationKind::BranchPoint,
     ] {
-        let found: Vec<&sim::continuation::Bifurcation> = c
+        let found: Vec<&sim::analysis::continuation::Bifurcation> = c
             .branches
             .iter()
             .flat_map(|b| &b.bifurcations)

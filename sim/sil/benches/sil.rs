@@ -8,9 +8,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use sil::config::SilConfig;
 use sil::FirmwareInTheLoop;
-use sim::control::TickStepping;
+use sim::engine::control::TickStepping;
 use sim::scene::Scene;
-use sim::walk::WalkRequest;
+use sim::stride::walk::WalkRequest;
 
 fn bench(c: &mut Criterion) {
     let scene = Scene::load("wisse3d").unwrap();
@@ -32,7 +32,7 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
                 let request = WalkRequest::new(&settings, 5).controlled(&mut ctl);
-                let walk = sim::walk::walk(walker, &q, &qd, request);
+                let walk = sim::stride::walk::walk(walker, &q, &qd, request);
                 assert!(walk.failure.is_none());
                 walk.steps.len()
             })

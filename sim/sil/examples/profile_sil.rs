@@ -8,9 +8,9 @@
 
 use sil::config::SilConfig;
 use sil::FirmwareInTheLoop;
-use sim::control::TickStepping;
-use sim::integrators::IntegratorChoice;
-use sim::walk::WalkRequest;
+use sim::engine::control::TickStepping;
+use sim::engine::integrators::IntegratorChoice;
+use sim::stride::walk::WalkRequest;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -45,11 +45,11 @@ fn main() {
     let mut ctl = FirmwareInTheLoop::new(SilConfig::default()).unwrap();
     let mut evals = 0usize;
     let start = std::time::Instant::now();
-    let mut count = |s: &sim::walk::StepSummary| evals += s.evaluations;
+    let mut count = |s: &sim::stride::walk::StepSummary| evals += s.evaluations;
     let request = WalkRequest::new(&settings, steps)
         .controlled(&mut ctl)
         .on_step(&mut count);
-    let walk = sim::walk::walk(w, &q, &qd, request);
+    let walk = sim::stride::walk::walk(w, &q, &qd, request);
     let wall = start.elapsed().as_secs_f64();
     let report = ctl.finish().unwrap();
     let walked: f64 = walk.steps.iter().map(|s| s.duration_s).sum();

@@ -10,7 +10,7 @@
 //!
 //! Torque limit: the simulator's string is rigid and unilateral, so it transmits whatever torque
 //! keeps the ankle at the limit. The model compares that torque (the string's torque on the
-//! stance ankle at the tick's start, [`sim::control::AnkleSensing::string_torque_n_m`]) with
+//! stance ankle at the tick's start, [`sim::engine::control::AnkleSensing::string_torque_n_m`]) with
 //! the servo's [`ActuatorParams::max_torque_n_m`]: over it, the servo cannot move its load and
 //! *stalls* for that tick — the limit stops advancing (it comes to rest within the tick, from
 //! its rate at the tick's start, C¹: `p1 = p0 + v0·h/2`, `v1 = 0`, and holds there while the
@@ -21,7 +21,7 @@
 
 use serde::Serialize;
 
-use sim::control::ActuatorSegment;
+use sim::engine::control::ActuatorSegment;
 
 /// Parameters of the actuator model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -14,7 +14,7 @@ use firmware::drivers::encoder::MagneticEncoder;
 use firmware::runner::AnkleDrivers;
 use firmware::{AnkleNode, Instant, NodeConfig, TickOutputs};
 use protocol::Message;
-use sim::control::ActuatorSegment;
+use sim::engine::control::ActuatorSegment;
 
 use crate::actuator::ActuatorModel;
 use crate::bus_side::BusSide;

@@ -280,7 +280,7 @@ impl SilConfig {
     /// A value outside the firmware's parameter range.
     pub fn with_reflex(
         self,
-        reflex: &sim::actuator::AnkleReflex,
+        reflex: &sim::engine::actuator::AnkleReflex,
     ) -> Result<Self, protocol::EncodeError> {
         use protocol::ParamId;
         self.with_param(ParamId::TautAngle, reflex.engage_rad)?

@@ -6,7 +6,7 @@ use canbus::timestamp::TimestampOverflow;
 use canbus::BusError;
 use firmware::node::ConfigError;
 use protocol::{EncodeError, NodeId};
-use sim::control::ControlError;
+use sim::engine::control::ControlError;
 
 /// Why a firmware-in-the-loop controller could not be built or finished.
 #[derive(Debug, thiserror::Error)]

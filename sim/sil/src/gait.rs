@@ -6,7 +6,7 @@
 //! reading and, for [`SilConfig::trailing_contact_s`] after the other foot's heel strike, a
 //! still closed contact. It also records each foot's landing angle.
 
-use sim::control::AnkleSensing;
+use sim::engine::control::AnkleSensing;
 
 use crate::config::SilConfig;
 use crate::history::BoundedLog;

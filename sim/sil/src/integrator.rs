@@ -1,6 +1,6 @@
 //! The integrator a firmware-in-the-loop walk uses, and how accurate it is.
 
-use sim::integrators::IntegratorChoice;
+use sim::engine::integrators::IntegratorChoice;
 
 /// The integrator of a firmware-in-the-loop walk: DOPRI5 at rtol = atol = 1e-6, steps of at
 /// most 10 ms.

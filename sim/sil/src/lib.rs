@@ -1,5 +1,5 @@
 //! Firmware in the loop: the ankle nodes' firmware, on a simulated CAN bus, controlling the
-//! simulated walker's stance ankle (see `sim::control` and `docs/sil.md`).
+//! simulated walker's stance ankle (see `sim::engine::control` and `docs/sil.md`).
 //!
 //! Two [`firmware::AnkleNode`]s (left, node 2, and right, node 3) and a host (node 1) sit on a
 //! [`canbus::Bus`]. Every control tick of [`FirmwareInTheLoop`]:
@@ -17,14 +17,14 @@
 //!    queue, steps the drivers, records what changed (`records`), queues the frames the
 //!    node's CAN controller accepted on the bus at the tick time, and takes the segment its
 //!    actuator ([`actuator`] behind [`hal::SimActuator`]) moved the string through; the stance
-//!    ankle's segment is the tick's [`ActuatorSegment`](sim::control::ActuatorSegment).
+//!    ankle's segment is the tick's [`ActuatorSegment`](sim::engine::control::ActuatorSegment).
 //!
 //! The board's `PwmDirActuator` (a P loop over PWM duty and a direction pin) is replaced by the
 //! servo model: see [`hal`] for why.
 //!
 //! The walker model always has its stance leg on the right of its mirrored frame; physically
 //! the stance alternates, starting with [`SilConfig::first_stance`], and
-//! [`AnkleController::heel_strike`](sim::control::AnkleController::heel_strike) swaps it.
+//! [`AnkleController::heel_strike`](sim::engine::control::AnkleController::heel_strike) swaps it.
 
 pub mod actuator;
 mod ankle;

@@ -4,7 +4,7 @@
 use canbus::{Bus, BusEvent};
 use firmware::AnkleNode;
 use protocol::{Command, CommandKind, Message, Target};
-use sim::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
+use sim::engine::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
 
 use crate::ankle::{Ankle, BusAccess};
 use crate::bus_side::BusSide;

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use sim::actuator::AnkleReflex;
+use sim::engine::actuator::AnkleReflex;
 
 use crate::report::NodeReport;
 use crate::side::Side;

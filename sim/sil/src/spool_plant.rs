@@ -37,7 +37,7 @@
 use serde::Serialize;
 
 use firmware::drivers::spool_motor::StageOutput;
-use sim::control::ActuatorSegment;
+use sim::engine::control::ActuatorSegment;
 
 /// Constants of the motor, gearbox, spool and string: assumptions, not a datasheet (no
 /// motor has been chosen; docs/sil.md gives the reasoning).

@@ -3,7 +3,7 @@
 //! limit is above it (the string holds the ankle).
 
 use super::*;
-use sim::control::{ActuatorSegment, AnkleController, AnkleSensing};
+use sim::engine::control::{ActuatorSegment, AnkleController, AnkleSensing};
 
 const DT_S: f64 = 1e-3;
 const RAMP_START_RAD: f64 = 0.1;

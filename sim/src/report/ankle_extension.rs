@@ -7,7 +7,7 @@
 //! ankle never reaches the profile's final angle. This record says by how much, from the
 //! stride's own events and the state at the release (it never simulates).
 
-use crate::actuator::AnkleReflex;
+use crate::engine::actuator::AnkleReflex;
 use crate::stride::StrideResult;
 use serde::Serialize;
 
@@ -112,7 +112,7 @@ impl AnkleExtension {
 #[allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 mod tests {
     use super::*;
-    use crate::limit_cycle::NewtonSettings;
+    use crate::analysis::limit_cycle::NewtonSettings;
     use crate::scene::Scene;
 
     /// The minimum-jerk smooth step written out here, independently of the engine's profile:
@@ -122,7 +122,11 @@ mod tests {
         x.powi(3) * (10.0 - 15.0 * x + 6.0 * x * x)
     }
 
-    fn table_one_gait() -> (Scene, crate::scene::Setup, crate::limit_cycle::Gait) {
+    fn table_one_gait() -> (
+        Scene,
+        crate::scene::Setup,
+        crate::analysis::limit_cycle::Gait,
+    ) {
         let scene = Scene::load("wisse3d").unwrap();
         let setup = scene.setup().unwrap();
         let gait = setup.find_gait(&NewtonSettings::default()).unwrap();

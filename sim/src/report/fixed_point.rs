@@ -1,8 +1,8 @@
 //! The fixed point of a gait by name, as the reports list it.
 
-use crate::limit_cycle::Gait;
+use crate::analysis::limit_cycle::Gait;
+use crate::engine::walker::Walker;
 use crate::scene::Scene;
-use crate::walker::Walker;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::BTreeMap;

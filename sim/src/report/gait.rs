@@ -2,12 +2,12 @@
 
 use super::{eigenvalue_pairs, gait_numbers, FixedPoint};
 use super::{AnkleExtension, CostOfTransport};
-use crate::integrators::IntegratorChoice;
-use crate::limit_cycle::{Gait, JacobianMethod, NewtonError};
+use crate::analysis::limit_cycle::{Gait, JacobianMethod, NewtonError};
+use crate::analysis::stability::{modes, EigenMode};
+use crate::engine::integrators::IntegratorChoice;
+use crate::engine::walker::Walker;
 use crate::scene::Scene;
-use crate::stability::{modes, EigenMode};
 use crate::stride::{ContactSummary, StrideEvent, StrideFailure};
-use crate::walker::Walker;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -26,7 +26,7 @@ pub struct GaitReport {
     /// `continued_from_defaults` (the scene's gait continued from its defaults); absent in
     /// `walker gaits`, which lists every gait found.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub gait_source: Option<crate::homotopy::GaitSource>,
+    pub gait_source: Option<crate::analysis::homotopy::GaitSource>,
     /// The gait, or why none was found.
     #[serde(flatten)]
     pub outcome: GaitOutcome,

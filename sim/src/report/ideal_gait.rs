@@ -2,8 +2,8 @@
 
 use super::gait_numbers;
 use super::CostOfTransport;
-use crate::limit_cycle::Gait;
-use crate::walker::Walker;
+use crate::analysis::limit_cycle::Gait;
+use crate::engine::walker::Walker;
 use serde::Serialize;
 
 /// The figures of [`WalkGaitRecord`](super::WalkGaitRecord) for a gait's fixed point (e.g.

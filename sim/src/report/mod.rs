@@ -1,7 +1,7 @@
 //! Reports of gaits, walks, sweeps and scenes: the output contract other tools read.
 //!
 //! Each report is a typed record computed from results the engine already returned (a
-//! [`Gait`], a [`Walk`](crate::walk::Walk), sweep points); no report simulates. Whatever a
+//! [`Gait`], a [`Walk`](crate::stride::walk::Walk), sweep points); no report simulates. Whatever a
 //! report needs from a further stride (e.g. the contact figures of [`GaitReport`]) the caller
 //! runs through the engine and passes in.
 //!
@@ -47,8 +47,8 @@ pub use sweep::{
 pub use walk::WalkReport;
 pub use walk_gait::WalkGaitRecord;
 
-use crate::limit_cycle::Gait;
-use crate::walker::Walker;
+use crate::analysis::limit_cycle::Gait;
+use crate::engine::walker::Walker;
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -88,7 +88,7 @@ pub fn gait_numbers(walker: &Walker, gait: &Gait) -> GaitNumbers {
 /// feet, which `step_length_m` (the distance between the contacts) includes.
 pub fn forward_progress_m(walker: &Walker, gait: &Gait) -> f64 {
     let c = gait.stride.step_m;
-    let next = crate::walk::FloorFrame::default().next(
+    let next = crate::stride::walk::FloorFrame::default().next(
         &c,
         gait.stride.heading_change_rad,
         walker.relabel.mirror,

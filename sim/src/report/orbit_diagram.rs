@@ -1,10 +1,10 @@
 //! The `walker orbit-diagram` report: the attractor at each parameter value, with its
 //! heel-strike states by coordinate name.
 
-use crate::orbit_diagram::{Attractor, OrbitPoint, OrbitSettings};
+use crate::analysis::orbit_diagram::{Attractor, OrbitPoint, OrbitSettings};
+use crate::engine::walker::Walker;
 use crate::scene::Scene;
 use crate::stride::FailureKind;
-use crate::walker::Walker;
 use serde::Serialize;
 use std::collections::BTreeMap;
 

@@ -1,7 +1,7 @@
 //! The `walker stability-map` report: the largest |eigenvalue| of the long-period gait over
 //! a grid of two parameters, `null` where there is no gait.
 
-use crate::stability_map::{Axis, StabilityMap};
+use crate::analysis::stability_map::{Axis, StabilityMap};
 use serde::Serialize;
 
 /// The `walker stability-map --json` object. Every grid has one row per y value and one entry
@@ -45,12 +45,13 @@ impl From<&Axis> for AxisRecord {
 impl StabilityMapReport {
     /// The report of `map` over `x` × `y` of scene `scene`.
     pub fn new(scene: &str, x: &Axis, y: &Axis, map: &StabilityMap) -> Self {
-        let grid = |f: &dyn Fn(&crate::stability_map::MapCell) -> f64| -> Vec<Vec<Option<f64>>> {
-            map.rows
-                .iter()
-                .map(|r| r.iter().map(|c| c.as_ref().ok().map(f)).collect())
-                .collect()
-        };
+        let grid =
+            |f: &dyn Fn(&crate::analysis::stability_map::MapCell) -> f64| -> Vec<Vec<Option<f64>>> {
+                map.rows
+                    .iter()
+                    .map(|r| r.iter().map(|c| c.as_ref().ok().map(f)).collect())
+                    .collect()
+            };
         Self {
             scene: scene.to_string(),
             x: x.into(),

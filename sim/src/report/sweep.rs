@@ -4,7 +4,7 @@
 //! located and the period doublings with no doubled branch.
 
 use super::{eigenvalue_pairs, FixedPoint};
-use crate::continuation::{Bifurcation, BranchPoint, Continuation, Family};
+use crate::analysis::continuation::{Bifurcation, BranchPoint, Continuation, Family};
 use serde::Serialize;
 
 /// The `walker sweep --json` object.
@@ -147,7 +147,7 @@ pub struct ConvergedPoint {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub orbit: Option<Vec<Option<FixedPoint>>>,
     /// How the stride Jacobians were taken (`central_differences`, `variational`).
-    pub jacobian_method: crate::limit_cycle::JacobianMethod,
+    pub jacobian_method: crate::analysis::limit_cycle::JacobianMethod,
 }
 
 /// A sweep point without a gait.

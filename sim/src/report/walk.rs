@@ -1,7 +1,7 @@
 //! The `walker walk` report: the steps of a walk and its first failure.
 
 use crate::scene::Scene;
-use crate::walk::{StepSummary, Walk, WalkFailure};
+use crate::stride::walk::{StepSummary, Walk, WalkFailure};
 use serde::Serialize;
 use std::collections::BTreeMap;
 

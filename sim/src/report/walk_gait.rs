@@ -1,8 +1,8 @@
 //! Gait figures of a walk: the means over its last steps.
 
 use super::CostOfTransport;
-use crate::walk::{StepSummary, Walk};
-use crate::walker::Walker;
+use crate::engine::walker::Walker;
+use crate::stride::walk::{StepSummary, Walk};
 use serde::Serialize;
 
 /// Gait figures averaged over the last completed steps of a walk (e.g. the firmware's gait in

@@ -3,14 +3,18 @@
 
 use super::file::{self, Num};
 use super::{direction, Scene, SceneError, Setup};
-use crate::actuator::AnkleReflex;
-use crate::events::EventTolerance;
-use crate::integrators::IntegratorChoice;
-use crate::limit_cycle::GaitGuess;
-use crate::model::{BodyInertia, CoordIndex, JointForce, JointKind, LinkIndex, Model, PointIndex};
-use crate::relabel::Relabel;
+use crate::analysis::limit_cycle::GaitGuess;
+use crate::engine::actuator::AnkleReflex;
+use crate::engine::events::EventTolerance;
+use crate::engine::integrators::IntegratorChoice;
+use crate::engine::model::{
+    BodyInertia, CoordIndex, JointForce, JointKind, LinkIndex, Model, PointIndex,
+};
+use crate::engine::relabel::Relabel;
+use crate::engine::walker::{
+    ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker, WalkerRules,
+};
 use crate::stride::StrideSettings;
-use crate::walker::{ContactConstraint, FallRule, HeelStrikeRule, KneeLock, Walker, WalkerRules};
 use nalgebra::{DVector, Matrix3, Vector3};
 
 /// The model's points, links and coordinates by name; an unknown name is an error naming it.

@@ -2,8 +2,8 @@
 //! that its base cannot give ([`VariantError`]): each names what was wrong.
 
 use super::expr::ExprError;
-use crate::integrators::IntegratorError;
-use crate::model::ModelError;
+use crate::engine::integrators::IntegratorError;
+use crate::engine::model::ModelError;
 
 /// Why a scene could not be loaded or built. Each variant names what was wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

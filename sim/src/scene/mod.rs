@@ -12,11 +12,11 @@ pub mod variant;
 
 pub use error::{SceneError, VariantError};
 
-use crate::events::Direction;
-use crate::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
-use crate::model::CoordIndex;
+use crate::analysis::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
+use crate::engine::events::Direction;
+use crate::engine::model::CoordIndex;
+use crate::engine::walker::Walker;
 use crate::stride::StrideSettings;
-use crate::walker::Walker;
 use file::{Num, SceneFile};
 use nalgebra::{DVector, Vector3};
 use std::collections::{BTreeMap, BTreeSet};

@@ -3,9 +3,9 @@
 
 use super::phase::Phase;
 use super::witnesses::Witnesses;
-use crate::dynamics::DynamicsError;
-use crate::integrators::{Sample, SecondOrderSystem};
-use crate::walker::Walker;
+use crate::engine::dynamics::DynamicsError;
+use crate::engine::integrators::{Sample, SecondOrderSystem};
+use crate::engine::walker::Walker;
 use serde::Serialize;
 
 /// Contact and clearance figures of a stride (with [`super::StrideOptions::contact`]).
@@ -35,7 +35,7 @@ impl ContactSummary {
         let mut s2 = s.clone();
         phase.snap(&mut s2);
         wit.update(&s2);
-        let load = crate::contact::ContactLoad::from_motion(&walker.model, &wit.kin, &qdd);
+        let load = crate::engine::contact::ContactLoad::from_motion(&walker.model, &wit.kin, &qdd);
         let cop = load.lateral_cop_m(&wit.heading());
         if self.lateral_cop_trace.is_empty() {
             self.min_normal_force_n = f64::INFINITY;

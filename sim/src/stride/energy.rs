@@ -2,9 +2,9 @@
 //! dissipation.
 
 use super::state::StrideState;
-use crate::dynamics::Dynamics;
-use crate::integrators::Sample;
-use crate::model::Model;
+use crate::engine::dynamics::Dynamics;
+use crate::engine::integrators::Sample;
+use crate::engine::model::Model;
 
 /// Running actuator work and damper dissipation over accepted steps.
 ///

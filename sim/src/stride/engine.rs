@@ -16,11 +16,11 @@ use super::phase::{Drive, Phase};
 use super::result::{StrideEvent, StrideResult};
 use super::state::StrideState;
 use super::witnesses::{WitnessEvaluator, Witnesses};
-use crate::dynamics::DynamicsError;
-use crate::events::{locate, EventError, EventTolerance};
-use crate::integrators::{DenseOutput, IntegrationError, Integrator, Sample};
-use crate::model::CoordIndex;
-use crate::walker::Walker;
+use crate::engine::dynamics::DynamicsError;
+use crate::engine::events::{locate, EventError, EventTolerance};
+use crate::engine::integrators::{DenseOutput, IntegrationError, Integrator, Sample};
+use crate::engine::model::CoordIndex;
+use crate::engine::walker::Walker;
 
 /// The solution inside one step, for a controller's ticks there.
 pub(super) trait Interpolant<S> {

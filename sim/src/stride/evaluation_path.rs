@@ -6,8 +6,8 @@
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EvaluationPath {
-    /// The planar fast path when the model qualifies ([`crate::planar::PlanarTree::of`]), else the 3D fast
-    /// path when it qualifies ([`crate::axis_tree::AxisTree::of`]), else the general one; and
+    /// The planar fast path when the model qualifies ([`crate::engine::planar::PlanarTree::of`]), else the 3D fast
+    /// path when it qualifies ([`crate::engine::axis_tree::AxisTree::of`]), else the general one; and
     /// the fixed-size stride loop where it covers the stride (`crate::stride`'s `fast`).
     #[default]
     Auto,

@@ -2,12 +2,12 @@
 //! values that were wrong. The cause's text is the failure's `detail`; its [`FailureKind`]
 //! follows from it ([`FailureCause::kind`]).
 
-use crate::control::ControlError;
-use crate::dynamics::DynamicsError;
-use crate::events::EventError;
-use crate::impact::ImpactError;
-use crate::integrators::IntegrationError;
-use crate::relabel::RelabelError;
+use crate::engine::control::ControlError;
+use crate::engine::dynamics::DynamicsError;
+use crate::engine::events::EventError;
+use crate::engine::impact::ImpactError;
+use crate::engine::integrators::IntegrationError;
+use crate::engine::relabel::RelabelError;
 use serde::Serialize;
 
 /// The kinds of failure a stride can end in.
@@ -48,7 +48,7 @@ pub enum FailureKind {
     /// The stride evaluated the equations of motion as often as its budget
     /// ([`super::StrideSettings::max_evaluations`]) allows without ending.
     EvaluationBudgetExceeded,
-    /// The controller's period ([`crate::control::AnkleController::period_s`]) is not a finite
+    /// The controller's period ([`crate::engine::control::AnkleController::period_s`]) is not a finite
     /// positive time, or too short for its ticks to advance over the stride.
     InvalidControlPeriod,
     /// The controller could not run a control tick (its error), or a tick could not run.

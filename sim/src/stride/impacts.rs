@@ -3,7 +3,7 @@
 //! heel-strike impact with its lift check and relabelling that end the stride.
 //!
 //! All are inelastic impacts (eq. 21 with restitution 0, or eq. 20 for heel strike) solved by
-//! [`crate::impact`]; each reports the mechanical energy it dissipates and the work a drive
+//! [`crate::engine::impact`]; each reports the mechanical energy it dissipates and the work a drive
 //! holding the ankle does through it.
 
 use super::contact_figures::ContactSummary;
@@ -11,16 +11,16 @@ use super::energy::energy;
 use super::failure::{FailureCause, StrideFailure};
 use super::phase::Drive;
 use super::result::{StrideEvent, StrideResult};
-use crate::actuator::AnkleReflex;
-use crate::dynamics::Dynamics;
-use crate::hybrid::contact_rows::{heel_strike_rows, HeelStrikeRows};
-use crate::hybrid::impact::{locked_state, unit_row};
-use crate::impact::{resolve, resolve_to, ImpactError};
-use crate::integrators::Sample;
-use crate::kinematics::Kinematics;
-use crate::model::CoordIndex;
-use crate::relabel::LinkStates;
-use crate::walker::Walker;
+use crate::engine::actuator::AnkleReflex;
+use crate::engine::dynamics::Dynamics;
+use crate::engine::hybrid::contact_rows::{heel_strike_rows, HeelStrikeRows};
+use crate::engine::hybrid::impact::{locked_state, unit_row};
+use crate::engine::impact::{resolve, resolve_to, ImpactError};
+use crate::engine::integrators::Sample;
+use crate::engine::kinematics::Kinematics;
+use crate::engine::model::CoordIndex;
+use crate::engine::relabel::LinkStates;
+use crate::engine::walker::Walker;
 use nalgebra::{DVector, Vector3};
 
 /// The heel-strike impact on the impact model (coordinates: released root first).

@@ -28,12 +28,12 @@
 //! - `result`: [`StrideResult`], [`StrideEvent`];
 //! - `failure`: [`StrideFailure`], its [`FailureKind`] and [`FailureCause`] (with the values).
 //!
-//! `impl Walker` for the stride lives here (`workspace` and `impacts`); [`crate::walker`] keeps the
-//! model-level methods; walks are [`crate::walk::walk`], gait searches
-//! [`crate::limit_cycle::GaitSearch`]. Times in a stride are stride time (from its start).
+//! `impl Walker` for the stride lives here (`workspace` and `impacts`); [`crate::engine::walker`] keeps the
+//! model-level methods; walks are [`crate::stride::walk::walk`], gait searches
+//! [`crate::analysis::limit_cycle::GaitSearch`]. Times in a stride are stride time (from its start).
 //!
-//! [`Walker::stride`]: crate::walker::Walker::stride
-//! [`Walker::heel_strike_impact`]: crate::walker::Walker::heel_strike_impact
+//! [`Walker::stride`]: crate::engine::walker::Walker::stride
+//! [`Walker::heel_strike_impact`]: crate::engine::walker::Walker::heel_strike_impact
 
 mod contact_figures;
 mod energy;
@@ -49,6 +49,7 @@ mod run;
 mod schedule;
 mod settings;
 mod state;
+pub mod walk;
 mod witnesses;
 mod workspace;
 

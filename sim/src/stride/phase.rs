@@ -1,14 +1,14 @@
 //! The smooth dynamics of one phase of a stride: which coordinates are free, which one is
 //! driven and how ([`Drive`]), and the stability limit of eq. (12) for fixed-step integrators.
 
-use crate::actuator::AnkleProfile;
-use crate::axis_tree::AxisTree;
-use crate::control::ActuatorSegment;
-use crate::dynamics::{Dynamics, DynamicsError};
-use crate::hybrid::phase::DriveValues;
-use crate::integrators::{Sample, SecondOrderSystem, StabilityLimit};
-use crate::model::{CoordIndex, Model};
-use crate::planar::PlanarTree;
+use crate::engine::actuator::AnkleProfile;
+use crate::engine::axis_tree::AxisTree;
+use crate::engine::control::ActuatorSegment;
+use crate::engine::dynamics::{Dynamics, DynamicsError};
+use crate::engine::hybrid::phase::DriveValues;
+use crate::engine::integrators::{Sample, SecondOrderSystem, StabilityLimit};
+use crate::engine::model::{CoordIndex, Model};
+use crate::engine::planar::PlanarTree;
 use crate::stride::EvaluationPath;
 use nalgebra::{DMatrix, DVector};
 
@@ -376,7 +376,7 @@ impl<'a> Phase<'a> {
     ) -> Result<DVector<f64>, DynamicsError> {
         let drive = self.drive_at(t);
         self.assembled_at.valid = false;
-        crate::hybrid::phase::accelerations(
+        crate::engine::hybrid::phase::accelerations(
             self.model,
             &mut self.dynamics,
             &self.active,
@@ -543,7 +543,7 @@ pub fn linearised_limit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limit_cycle::NewtonSettings;
+    use crate::analysis::limit_cycle::NewtonSettings;
     use crate::scene::Scene;
 
     /// The torque and the accelerations solved on the workspace's assembly (the cache taken

@@ -1,10 +1,10 @@
 //! What a stride is asked to do: [`StrideRequest`], the one argument of
-//! [`crate::walker::Walker::stride`] besides the start state.
+//! [`crate::engine::walker::Walker::stride`] besides the start state.
 
 use super::schedule::Schedule;
 use super::settings::StrideSettings;
-use crate::control::AnkleController;
-use crate::integrators::Sample;
+use crate::engine::control::AnkleController;
+use crate::engine::integrators::Sample;
 
 /// What a stride keeps besides its result.
 #[derive(Clone, Copy, Debug, Default)]

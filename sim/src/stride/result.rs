@@ -3,7 +3,7 @@
 //! stride time (from the start of the stride), as are the `t_s` of the [`Sample`]s.
 
 use super::contact_figures::ContactSummary;
-use crate::integrators::Sample;
+use crate::engine::integrators::Sample;
 use nalgebra::{DVector, Vector3};
 use serde::Serialize;
 

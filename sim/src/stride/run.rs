@@ -17,8 +17,8 @@ use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::state::StrideState;
 use super::witnesses::{self, StringLimit, Watch, WitnessEvaluator, WitnessValues};
-use crate::integrators::Sample;
-use crate::walker::Walker;
+use crate::engine::integrators::Sample;
+use crate::engine::walker::Walker;
 use ticks::{Plant, TickEffect, Ticks};
 
 mod ticks;

@@ -3,9 +3,9 @@
 //! run with other settings without being changed.
 
 use super::EvaluationPath;
-use crate::control::TickStepping;
-use crate::events::EventTolerance;
-use crate::integrators::{IntegratorChoice, IntegratorError};
+use crate::engine::control::TickStepping;
+use crate::engine::events::EventTolerance;
+use crate::engine::integrators::{IntegratorChoice, IntegratorError};
 use serde::Serialize;
 
 /// Solver settings of a stride (after rapier's `IntegrationParameters`: each field with its unit

@@ -2,7 +2,7 @@
 //! witnesses and the energy figures read of a sample, dynamic `DVector` or fixed-size
 //! `SVector<N>`.
 
-use crate::integrators::Sample;
+use crate::engine::integrators::Sample;
 
 /// A state of a stride (stride time, positions, velocities) in one storage.
 pub(super) trait StrideState: Clone {

@@ -7,12 +7,12 @@
 //! engagement, heel drop) that breaks ties between events located at the same time.
 
 use super::state::StrideState;
-use crate::control::ActuatorSegment;
-use crate::events::Direction;
-use crate::hermite::{self, Knot};
-use crate::integrators::Sample;
-use crate::kinematics::Kinematics;
-use crate::walker::Walker;
+use crate::engine::control::ActuatorSegment;
+use crate::engine::events::Direction;
+use crate::engine::hermite::{self, Knot};
+use crate::engine::integrators::Sample;
+use crate::engine::kinematics::Kinematics;
+use crate::engine::walker::Walker;
 use nalgebra::Vector3;
 
 /// An event the stride loop watches for.

@@ -22,8 +22,8 @@ use super::run::{Run, Start};
 use super::schedule::Schedule;
 use super::settings::StrideSettings;
 use super::witnesses::{Watch, Witnesses};
-use crate::integrators::{IntegratorChoice, Sample};
-use crate::walker::Walker;
+use crate::engine::integrators::{IntegratorChoice, Sample};
+use crate::engine::walker::Walker;
 use nalgebra::DVector;
 
 /// What repeated strides of one walker reuse (see the module's documentation).

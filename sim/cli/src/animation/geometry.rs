@@ -6,7 +6,7 @@
 
 use nalgebra::Vector3;
 use serde::Serialize;
-use sim::model::{LinkIndex, Model};
+use sim::engine::model::{LinkIndex, Model};
 use sim::scene::file::{Num, ShapeDef};
 use sim::scene::{Scene, SceneError};
 

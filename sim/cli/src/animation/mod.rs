@@ -12,9 +12,9 @@ pub mod track;
 use crate::labels;
 use crate::output::PathError;
 use serde::Serialize;
+use sim::engine::walker::Walker;
 use sim::scene::{Scene, SceneError};
-use sim::walk::Walk;
-use sim::walker::Walker;
+use sim::stride::walk::Walk;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

@@ -5,7 +5,7 @@
 
 use crate::labels::{event_label, failure_label, is_fall, step_label, walk_end_label};
 use serde::Serialize;
-use sim::walk::Walk;
+use sim::stride::walk::Walk;
 
 /// One event at a walk time.
 #[derive(Clone, Debug, Serialize)]

@@ -10,9 +10,9 @@
 use super::geometry::Figure;
 use nalgebra::{DVector, Vector3};
 use serde::Serialize;
-use sim::kinematics::Kinematics;
-use sim::walk::{FloorFrame, PathSample};
-use sim::walker::Walker;
+use sim::engine::kinematics::Kinematics;
+use sim::engine::walker::Walker;
+use sim::stride::walk::{FloorFrame, PathSample};
 
 /// Largest quantum of the stored positions \[m\]: finer wherever the figure allows.
 const FINEST_QUANTUM_M: f64 = 1e-4;
@@ -204,10 +204,13 @@ mod tests {
     use super::super::geometry::Part;
     use super::*;
     use sim::scene::Scene;
-    use sim::walk::{walk, WalkRequest};
+    use sim::stride::walk::{walk, WalkRequest};
 
     /// A recorded walk of `steps` steps of `scene` from its gait, with its figure's frames.
-    fn walked(scene: &str, steps: usize) -> (Scene, Walker, sim::walk::Walk, Figure, Vec<Frame>) {
+    fn walked(
+        scene: &str,
+        steps: usize,
+    ) -> (Scene, Walker, sim::stride::walk::Walk, Figure, Vec<Frame>) {
         let scene = Scene::load(scene).unwrap();
         let setup = scene.setup().unwrap();
         let gait = setup.find_gait(&Default::default()).unwrap();

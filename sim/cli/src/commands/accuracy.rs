@@ -8,8 +8,8 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::accuracy;
-use sim::integrators::IntegratorChoice;
+use sim::analysis::accuracy;
+use sim::engine::integrators::IntegratorChoice;
 use std::process::ExitCode;
 
 /// Options of `walker accuracy`.

@@ -13,12 +13,12 @@ use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use clap::Args;
-use sim::homotopy::{nominal_gait, GaitSource, HomotopySettings};
-use sim::limit_cycle::{Gait, NewtonError};
+use sim::analysis::homotopy::{nominal_gait, GaitSource, HomotopySettings};
+use sim::analysis::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
+use sim::stride::walk::WalkRequest;
 use sim::stride::{StrideOptions, StrideRequest, StrideResult};
-use sim::walk::WalkRequest;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -79,7 +79,7 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
             // Strides of the limit cycle: a walk from its fixed point.
             let (q, qd) = walker.unpack(&g.fixed_point);
             let request = WalkRequest::new(&setup.settings, ANIMATED_STRIDES).recording(true);
-            let walk = sim::walk::walk(walker, &q, &qd, request);
+            let walk = sim::stride::walk::walk(walker, &q, &qd, request);
             file.write(&Animation {
                 scene: &scene,
                 walker,

@@ -1,5 +1,5 @@
 //! `walker gaits`: the census of a scene's distinct period-1 gaits, longest step period first
-//! ([`sim::census`]).
+//! ([`sim::analysis::census`]).
 
 use super::gait::report;
 use super::{print_json, shown};
@@ -8,7 +8,7 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::census::{census_units, census_with_progress, CensusSettings};
+use sim::analysis::census::{census_units, census_with_progress, CensusSettings};
 use sim::report::{GaitOutcome, GaitsReport};
 use std::io::Write;
 use std::process::ExitCode;

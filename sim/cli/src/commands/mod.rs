@@ -31,7 +31,7 @@ pub fn print_json<T: Serialize + ?Sized>(report: &T) -> Result<()> {
 
 /// The exit code of a walk (`walk`, `sil`): 0 if it completed every step, 3 if it ended early
 /// because the walker fell (its report's `failure`).
-pub fn walk_exit_code(walk: &sim::walk::Walk) -> ExitCode {
+pub fn walk_exit_code(walk: &sim::stride::walk::Walk) -> ExitCode {
     if walk.failure.is_some() {
         ExitCode::from(FELL)
     } else {

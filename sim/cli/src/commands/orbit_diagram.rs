@@ -1,5 +1,5 @@
 //! `walker orbit-diagram`: the attractor of the stride map at each value of one parameter
-//! ([`sim::orbit_diagram`]), as text, JSON or the classic figure.
+//! ([`sim::analysis::orbit_diagram`]), as text, JSON or the classic figure.
 
 use super::print_json;
 use crate::export;
@@ -12,7 +12,7 @@ use crate::param_range::ParamRange;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::orbit_diagram::{linspace, orbit_diagram, OrbitError, OrbitSettings};
+use sim::analysis::orbit_diagram::{linspace, orbit_diagram, OrbitError, OrbitSettings};
 use sim::report::OrbitDiagramReport;
 use std::io::Write;
 use std::process::ExitCode;

@@ -14,11 +14,11 @@ use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sim::integrators::IntegratorChoice;
-use sim::limit_cycle::Gait;
+use sim::analysis::limit_cycle::Gait;
+use sim::engine::integrators::IntegratorChoice;
 use sim::report::{IdealGaitRecord, WalkGaitRecord};
 use sim::scene::Setup;
-use sim::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
+use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
@@ -380,7 +380,7 @@ struct WalkPlan {
 /// The walk from the ideal gait's start state `(q, qd)` with the firmware actuating the
 /// ankles (paced to real time when the plan says so).
 fn walk_with_firmware(
-    walker: &sim::walker::Walker,
+    walker: &sim::engine::walker::Walker,
     (q, qd): (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
     stride_settings: &sim::stride::StrideSettings,
     ctl: &mut sil::FirmwareInTheLoop,
@@ -388,7 +388,7 @@ fn walk_with_firmware(
 ) -> Walk {
     // The gait figures average the last 10 steps: keep at least those; keeping more than
     // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
-    let options = sim::walk::WalkOptions {
+    let options = sim::stride::walk::WalkOptions {
         record: plan.record,
         keep_steps: plan.keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
@@ -400,7 +400,7 @@ fn walk_with_firmware(
     );
     let mut tick = |_: &StepSummary| progress.tick();
     let walk = match plan.realtime {
-        None => sim::walk::walk(
+        None => sim::stride::walk::walk(
             walker,
             q,
             qd,
@@ -412,8 +412,8 @@ fn walk_with_firmware(
         Some(factor) => {
             // Step by step, sleeping so that walk time keeps pace with wall time.
             let start = std::time::Instant::now();
-            let mut paced = sim::control::Paced::new(ctl, factor, start);
-            sim::walk::walk(
+            let mut paced = sim::engine::control::Paced::new(ctl, factor, start);
+            sim::stride::walk::walk(
                 walker,
                 q,
                 qd,
@@ -431,7 +431,7 @@ fn walk_with_firmware(
 /// What the walk with the firmware gave, for its report.
 struct WalkRun<'a> {
     scene: &'a str,
-    walker: &'a sim::walker::Walker,
+    walker: &'a sim::engine::walker::Walker,
     integrator: &'a IntegratorChoice,
     ideal: IdealGaitRecord,
     walk: &'a Walk,

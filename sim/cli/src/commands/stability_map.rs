@@ -1,5 +1,5 @@
 //! `walker stability-map`: the largest |eigenvalue| of the long-period gait over a grid of
-//! two parameters ([`sim::stability_map`]), as text, JSON or a heat map.
+//! two parameters ([`sim::analysis::stability_map`]), as text, JSON or a heat map.
 
 use super::print_json;
 use crate::export;
@@ -12,11 +12,11 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::homotopy::HomotopySettings;
-use sim::orbit_diagram::linspace;
+use sim::analysis::homotopy::HomotopySettings;
+use sim::analysis::orbit_diagram::linspace;
+use sim::analysis::stability_map::{stability_map, Axis};
 use sim::report::StabilityMapReport;
 use sim::scene::Scene;
-use sim::stability_map::{stability_map, Axis};
 use std::io::Write;
 use std::process::ExitCode;
 

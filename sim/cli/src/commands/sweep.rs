@@ -13,7 +13,7 @@ use crate::progress::Progress;
 use crate::sweep_figures::sweep_figures;
 use anyhow::Result;
 use clap::Args;
-use sim::continuation::{continuation, ContinuationSettings, SweepError};
+use sim::analysis::continuation::{continuation, ContinuationSettings, SweepError};
 use sim::report::{SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;

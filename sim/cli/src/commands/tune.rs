@@ -8,7 +8,7 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::tune::{tune_with_progress, TuneResult, TunedParameter};
+use sim::analysis::tune::{tune_with_progress, TuneResult, TunedParameter};
 use std::io::Write;
 use std::process::ExitCode;
 

@@ -15,10 +15,10 @@ use crate::output::{self, PathError};
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
+use sim::engine::walker::Walker;
 use sim::report::{WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
-use sim::walk::WalkRequest;
-use sim::walker::Walker;
+use sim::stride::walk::WalkRequest;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -141,11 +141,11 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     }
     let (q, qd) = walker.unpack(&v);
     let progress = Progress::after(PROGRESS_DELAY, steps, "walk (steps)", !common.json);
-    let mut tick = |_: &sim::walk::StepSummary| progress.tick();
+    let mut tick = |_: &sim::stride::walk::StepSummary| progress.tick();
     let request = WalkRequest::new(&setup.settings, steps)
         .recording(out.is_some() || plot.is_some() || animation.is_some())
         .on_step(&mut tick);
-    let walk = sim::walk::walk(walker, &q, &qd, request);
+    let walk = sim::stride::walk::walk(walker, &q, &qd, request);
     progress.finish();
     if let Some(dir) = &plot {
         let mut walks = vec![(scene.clone(), walk.clone())];
@@ -161,10 +161,11 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
                 .unwrap_or(v0);
             let (oq, oqd) = ow.unpack(&start);
             let request = WalkRequest::new(&oset.settings, steps).recording(true);
-            let other_walk = sim::walk::walk(ow, &oq, &oqd, request);
+            let other_walk = sim::stride::walk::walk(ow, &oq, &oqd, request);
             walks.push((os, other_walk));
         }
-        let refs: Vec<(&Scene, &sim::walk::Walk)> = walks.iter().map(|(s, w)| (s, w)).collect();
+        let refs: Vec<(&Scene, &sim::stride::walk::Walk)> =
+            walks.iter().map(|(s, w)| (s, w)).collect();
         let size = (860.0, 480.0);
         let fig = figures::floor_paths(&refs, size);
         export::write_figure("--plot", dir, "floor_path", &fig.to_svg(size.0, size.1))?;
@@ -253,7 +254,7 @@ fn print_text(
 /// A walk's failure for people: its kind in words, the step (numbered from 1), the walk time
 /// and the engine's detail ("fell forward in step 2 at t = 1.9297 s: …"). `walker sil` prints
 /// it so too.
-pub fn failure_text(f: &sim::walk::WalkFailure) -> String {
+pub fn failure_text(f: &sim::stride::walk::WalkFailure) -> String {
     format!(
         "{} in {} at t = {:.4} s: {}",
         labels::walk_end_label(f.kind),
@@ -265,7 +266,11 @@ pub fn failure_text(f: &sim::walk::WalkFailure) -> String {
 
 /// The walk's trajectory as CSV: step, time, coordinates, rates and the hip-axle centre in the
 /// floor frame, one row per integrator sample.
-fn write_csv(file: std::fs::File, walker: &Walker, walk: &sim::walk::Walk) -> std::io::Result<()> {
+fn write_csv(
+    file: std::fs::File,
+    walker: &Walker,
+    walk: &sim::stride::walk::Walk,
+) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(file);
     let coords: Vec<&str> = walker
         .model

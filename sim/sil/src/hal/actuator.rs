@@ -20,7 +20,7 @@ use firmware::drivers::actuator::{Actuator, ActuatorError};
 use firmware::ActuatorCommand;
 
 use crate::actuator::ActuatorModel;
-use sim::control::ActuatorSegment;
+use sim::engine::control::ActuatorSegment;
 
 /// Smallest motion of the servo's string limit in one tick that its spool sensor sees, as an
 /// ankle angle \[rad\]: a tenth of the ankle encoder's count (2π/16384 ≈ 0.38 mrad), since the

@@ -1,12 +1,12 @@
 //! DOP853 on fixed-size states: the general integrator's steps, step-size controller, kept
-//! first stage and seventh-order dense output ([`crate::integrators::Dop853`]), with the state
+//! first stage and seventh-order dense output ([`crate::engine::integrators::Dop853`]), with the state
 //! `SVector<f64, N>` positions and velocities instead of `DVector`s and the system called
 //! directly instead of through `dyn`. The tableau, the error estimate and the controller are
 //! the general integrator's ([`Dop853Pair`]'s constants, `component_error`, `adaptive_step`):
 //! written once, the same arithmetic in the same order.
 
-use crate::dynamics::DynamicsError;
-use crate::integrators::{
+use crate::engine::dynamics::DynamicsError;
+use crate::engine::integrators::{
     adaptive_step, combined_error, component_error, Dop853Pair, EmbeddedPair, IntegrationError,
     StepLimits,
 };
@@ -20,7 +20,7 @@ const BUFFERS: usize = STAGES + 4;
 /// Hairer's dense-output coefficients `F0 … F6`.
 const DENSE_TERMS: usize = 7;
 
-/// Positions and velocities at a stride time (a fixed-size [`crate::integrators::Sample`]).
+/// Positions and velocities at a stride time (a fixed-size [`crate::engine::integrators::Sample`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct State<const N: usize> {
     /// Stride time [s].

@@ -12,11 +12,11 @@
 
 use super::dop853::State;
 use super::impact::{FiniteImpact, MAX_ROWS, MAX_VELOCITIES};
-use crate::hybrid::impact::kkt_system;
-use crate::model::{JointKind, Model, PointIndex};
-use crate::planar::{LinkFrame, PlanarTree, MAX_LINKS};
-use crate::singular_limit::solve_limit;
-use crate::walker::{ContactConstraint, Walker};
+use crate::engine::hybrid::impact::kkt_system;
+use crate::engine::model::{JointKind, Model, PointIndex};
+use crate::engine::planar::{LinkFrame, PlanarTree, MAX_LINKS};
+use crate::engine::singular_limit::solve_limit;
+use crate::engine::walker::{ContactConstraint, Walker};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3};
 
 /// What heel strike hands to the stride's result.

@@ -6,7 +6,7 @@
 //! elimination may differ from nalgebra's in the last bits (`tests/fast_stride.rs` compares
 //! the strides with the general loop's, whose heel strike is the general one).
 
-use crate::planar::MAX_PLANAR_COORDINATES;
+use crate::engine::planar::MAX_PLANAR_COORDINATES;
 
 /// The impact model's largest number of velocities: the coordinates and the root's
 /// translation in x and y.

@@ -27,12 +27,12 @@ use super::run::{Run, Start};
 use super::settings::StrideSettings;
 use super::state::StrideState;
 use super::EvaluationPath;
-use crate::dynamics::{Dynamics, DynamicsError};
-use crate::events::{refine, root_on_dense, EventError, EventTolerance};
-use crate::integrators::{IntegrationError, IntegratorChoice, Sample};
-use crate::model::{CoordIndex, Model};
-use crate::planar::{PlanarTree, MAX_PLANAR_COORDINATES};
-use crate::walker::Walker;
+use crate::engine::dynamics::{Dynamics, DynamicsError};
+use crate::engine::events::{refine, root_on_dense, EventError, EventTolerance};
+use crate::engine::integrators::{IntegrationError, IntegratorChoice, Sample};
+use crate::engine::model::{CoordIndex, Model};
+use crate::engine::planar::{PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::engine::walker::Walker;
 use dop853::{FixedDop853, FixedSystem, State};
 use heel_strike::heel_strike;
 use nalgebra::{DVector, SVector};
@@ -254,7 +254,7 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
         self.integrator.step_exact(&mut self.sys, cur, h_s)
     }
 
-    /// [`crate::events::locate`] on the dense output (which this engine always has after a
+    /// [`crate::engine::events::locate`] on the dense output (which this engine always has after a
     /// step).
     #[inline]
     fn locate<G: FnMut(&State<N>) -> f64>(

@@ -10,9 +10,9 @@
 //! products per arm, instead of every link's frame.
 
 use super::dop853::State;
-use crate::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::engine::planar::{sin_cos, Joints, PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::engine::walker::Walker;
 use crate::stride::witnesses::{WitnessEvaluator, WitnessValues};
-use crate::walker::Walker;
 use nalgebra::SVector;
 
 /// A point fixed in a link: a base fixed in the floor frame and an arm per joint of its chain,

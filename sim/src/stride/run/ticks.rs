@@ -19,8 +19,9 @@
 //! hands it the plant ([`Plant`]: the walker, the engine, the witnesses and the current state)
 //! at each tick.
 
-use crate::control::{ActuatorSegment, AnkleSensing, TickStepping};
-use crate::hermite::{self, Knot};
+use crate::engine::control::{ActuatorSegment, AnkleSensing, TickStepping};
+use crate::engine::hermite::{self, Knot};
+use crate::engine::walker::Walker;
 use crate::stride::engine::{Engine, Interpolant};
 use crate::stride::failure::{FailureCause, StrideFailure};
 use crate::stride::phase::Drive;
@@ -28,7 +29,6 @@ use crate::stride::request::StrideControl;
 use crate::stride::settings::StrideSettings;
 use crate::stride::state::StrideState;
 use crate::stride::witnesses::{WitnessEvaluator, WitnessValues};
-use crate::walker::Walker;
 
 /// A tick's time is reached when a sample is within this of it [s].
 const TICK_SLACK_S: f64 = 1e-12;

@@ -6,8 +6,8 @@ use crate::output;
 use anyhow::Result;
 use nalgebra::DVector;
 use serde_json::Value;
+use sim::engine::walker::Walker;
 use sim::scene::Scene;
-use sim::walker::Walker;
 use std::io::Read;
 
 /// The gait of scene `other` (with this scene's shared parameter values), mapped onto this

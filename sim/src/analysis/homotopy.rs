@@ -1,0 +1,293 @@
+//! Following a gait along a path in parameter space, and the scene's nominal gait: the one
+//! implementation of the guarded secant step ([`Secant`]) and of the homotopy from a scene's
+//! defaults ([`follow`]), which both finding a start point ([`crate::analysis::census`],
+//! [`nominal_gait`]) and following a branch ([`crate::analysis::continuation`], the stability map's
+//! rows) use. A leaf of the analysis layer: it depends on the stride map's Newton search and
+//! the scene only.
+//!
+//! The homotopy follows a gait of the scene at its default values (where its guess is known
+//! to work) to the requested values along the straight path
+//! `p(s) = p_default + s (p_requested − p_default)`, `s` from 0 to 1, by guarded secant steps
+//! (a corrector step longer than [`HomotopySettings::max_correction`] or a period change
+//! beyond [`HomotopySettings::max_period_change`] is refused as a jump to another branch) and
+//! step halving.
+
+use crate::analysis::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
+use crate::scene::{Scene, SceneError, Setup};
+use nalgebra::DVector;
+
+/// Builds the [`Setup`] of a scene at given parameter values: `Scene::setup` and whatever
+/// solver settings the caller overrides (the CLI's `--integrator`, `--rtol`, `--step-s`).
+pub type SetupFor<'a> = dyn Fn(&Scene) -> Result<Setup, SceneError> + Sync + 'a;
+
+/// How a gait is followed from the defaults to the requested values ([`follow`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HomotopySettings {
+    /// The first step along the path, as a fraction of it (0 < · ≤ 1). The default, 1, tries
+    /// the whole path at once and halves the step only when the corrector fails or jumps
+    /// (the guards below); every caller (`walker gait`, `gaits`, `sweep`, `orbit-diagram`,
+    /// `stability-map`) uses the default, so they all return the same gait.
+    pub first_step: f64,
+    /// Smallest step before the path is given up, as a fraction of it.
+    pub min_step: f64,
+    /// Largest accepted corrector step, relative: the ∞-norm of the change of the stride-map
+    /// vector from the predictor over `1 + |predictor|∞`; a longer one is taken as a jump to
+    /// another branch and the step halved.
+    pub max_correction: f64,
+    /// Largest accepted relative change of the step period in one step; a larger one is
+    /// taken as a jump to another branch (the simplest walker's two gaits differ by 25 %).
+    pub max_period_change: f64,
+    /// Newton searches allowed along one path.
+    pub max_solves: usize,
+    /// Newton iterations allowed in one step (at most the caller's own budget): from a good
+    /// predictor Newton converges in a few; more means the step is too long, and halving it
+    /// is cheaper than iterating on (a failing search of the 3D walker costs seconds).
+    pub max_corrector_iterations: usize,
+}
+
+impl HomotopySettings {
+    /// `newton` with its iteration budget cut to [`Self::max_corrector_iterations`].
+    pub fn corrector(&self, newton: &NewtonSettings) -> NewtonSettings {
+        NewtonSettings {
+            max_iterations: newton.max_iterations.min(self.max_corrector_iterations),
+            ..*newton
+        }
+    }
+}
+
+impl Default for HomotopySettings {
+    fn default() -> Self {
+        Self {
+            first_step: 1.0,
+            min_step: 1.0 / 256.0,
+            max_correction: 0.1,
+            max_period_change: 0.1,
+            max_solves: 24,
+            max_corrector_iterations: 12,
+        }
+    }
+}
+
+/// The last (at most two) gaits of a path, at path coordinates `s`: a secant predictor, and
+/// one guarded Newton step from it.
+#[derive(Clone, Debug, Default)]
+pub struct Secant {
+    /// `(s, fixed point, step period [s])`, oldest first.
+    history: Vec<(f64, DVector<f64>, f64)>,
+}
+
+impl Secant {
+    /// Appends the gait `g` at `s` (keeps the last two).
+    pub fn push(&mut self, s: f64, g: &Gait) {
+        self.history
+            .push((s, g.fixed_point.clone(), g.stride.duration_s));
+        if self.history.len() > 2 {
+            self.history.remove(0);
+        }
+    }
+
+    /// Forgets the path (the next step has no predictor).
+    pub fn clear(&mut self) {
+        self.history.clear();
+    }
+
+    /// The predictor at `s` (linear through the last two gaits, the last one alone after
+    /// the first) and the last gait's step period; `None` before the first gait.
+    pub fn predict(&self, s: f64) -> Option<(DVector<f64>, f64)> {
+        match self.history.as_slice() {
+            [.., (s0, v0, _), (s1, v1, t1)] => Some((v1 + (v1 - v0) * ((s - s1) / (s1 - s0)), *t1)),
+            [.., (_, v, t)] => Some((v.clone(), *t)),
+            [] => None,
+        }
+    }
+
+    /// Newton (budget cut to [`HomotopySettings::max_corrector_iterations`]) at `setup` from
+    /// the predictor at `s`; the gait is refused as a jump to another branch when the
+    /// corrector moved it by more than [`HomotopySettings::max_correction`] (relative) or its
+    /// step period changed by more than [`HomotopySettings::max_period_change`]. `None`
+    /// before the first gait.
+    pub fn step(
+        &self,
+        s: f64,
+        setup: &Setup,
+        newton: &NewtonSettings,
+        guard: &HomotopySettings,
+    ) -> Option<Result<Gait, NewtonError>> {
+        let (predictor, period) = self.predict(s)?;
+        let corrector = guard.corrector(newton);
+        let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).find(&predictor);
+        Some(g.and_then(|g| {
+            let moved = (&g.fixed_point - &predictor).amax();
+            let jumped = moved > guard.max_correction * (1.0 + predictor.amax())
+                || (g.stride.duration_s - period).abs() > guard.max_period_change * period;
+            if jumped {
+                Err(NewtonError::NotConverged {
+                    iterations: g.iterations,
+                    last_step: moved,
+                })
+            } else {
+                Ok(g)
+            }
+        }))
+    }
+}
+
+/// The scene at its default parameter values (parameters that act on nothing keep theirs).
+pub fn at_defaults(scene: &Scene) -> Result<Scene, SceneError> {
+    let mut s = scene.clone();
+    for (name, p) in &scene.file.parameters {
+        if !scene.is_unused(name) {
+            s.set(name, p.default)?;
+        }
+    }
+    Ok(s)
+}
+
+/// Whether every parameter of `scene` has its default value.
+pub fn is_at_defaults(scene: &Scene) -> bool {
+    scene
+        .file
+        .parameters
+        .iter()
+        .all(|(name, p)| scene.values.get(name) == Some(&p.default))
+}
+
+/// The scene on the straight path from `from` to `to` at fraction `s` (values of `to` at 1).
+fn between(from: &Scene, to: &Scene, s: f64) -> Result<Scene, SceneError> {
+    let mut scene = to.clone();
+    if s >= 1.0 {
+        return Ok(scene);
+    }
+    for (name, &b) in &to.values {
+        let a = from.values.get(name).copied().unwrap_or(b);
+        if a != b {
+            scene.set(name, a + s * (b - a))?;
+        }
+    }
+    Ok(scene)
+}
+
+/// Follows the gait `start` of `from` to the parameter values of `to` (see the
+/// [module docs](self)): the gait at `to`, or the last Newton error when the path is given up
+/// (the branch ends, folds back, or the budget runs out). Also returns the searches run.
+pub fn follow(
+    from: &Scene,
+    to: &Scene,
+    setup_for: &SetupFor<'_>,
+    start: &Gait,
+    newton: &NewtonSettings,
+    settings: &HomotopySettings,
+) -> (Result<Gait, NewtonError>, usize) {
+    let mut path = Secant::default();
+    path.push(0.0, start);
+    let mut s = 0.0;
+    let mut step = settings.first_step.clamp(settings.min_step, 1.0);
+    let mut solves = 0;
+    let mut last_error = NewtonError::NotConverged {
+        iterations: 0,
+        last_step: f64::INFINITY,
+    };
+    while solves < settings.max_solves && step >= settings.min_step {
+        let s_next = (s + step).min(1.0);
+        let Ok(setup) = between(from, to, s_next).and_then(|sc| setup_for(&sc)) else {
+            step *= 0.5;
+            continue;
+        };
+        solves += 1;
+        match path.step(s_next, &setup, newton, settings) {
+            Some(Ok(g)) => {
+                if s_next >= 1.0 {
+                    return (Ok(g), solves);
+                }
+                s = s_next;
+                path.push(s, &g);
+                step = (step * 2.0).min(1.0);
+            }
+            Some(Err(e)) => {
+                last_error = e;
+                step *= 0.5;
+            }
+            None => break,
+        }
+    }
+    (Err(last_error), solves)
+}
+
+/// Where the gait [`nominal_gait`] returns comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GaitSource {
+    /// At the scene's defaults: Newton from the scene's guess.
+    Defaults,
+    /// Off the defaults: Newton from the scene's guess at the requested values (its period is
+    /// the longer, or the defaults' gait could not be followed).
+    Guess,
+    /// Off the defaults: the scene's gait at its defaults continued to the requested values
+    /// ([`follow`]).
+    ContinuedFromDefaults,
+}
+
+impl GaitSource {
+    /// In words, for text output.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Defaults => "the scene's gait at its defaults (Newton from its guess)",
+            Self::Guess => "Newton from the scene's guess at these values",
+            Self::ContinuedFromDefaults => "the scene's gait continued from its defaults",
+        }
+    }
+}
+
+/// The gait `walker gait` reports, the scene's **nominal** gait: at the scene's defaults,
+/// Newton from its guess (as ever); elsewhere the longer-period of Newton from the guess and
+/// the defaults' gait followed to the requested values ([`follow`]) — the branch of the
+/// scene's nominal gait, which for the simplest walker is Garcia's long-period gait, wherever
+/// that branch reaches, not only near the guess. Two or three Newton searches in the usual
+/// case; every period-1 gait is [`crate::analysis::census::census`]'s job. With where it came from.
+///
+/// # Errors
+/// The scene cannot be built at its values or at its defaults.
+pub fn nominal_gait(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
+    let setup = setup_for(scene)?;
+    if is_at_defaults(scene) {
+        return Ok(setup.find_gait(newton).map(|g| (g, GaitSource::Defaults)));
+    }
+    let defaults = at_defaults(scene)?;
+    let default_setup = setup_for(&defaults)?;
+    let (from_guess, followed) = rayon::join(
+        || setup.find_gait(newton),
+        || match default_setup.find_gait(newton) {
+            Ok(g) => follow(&defaults, scene, setup_for, &g, newton, homotopy).0,
+            Err(e) => Err(e),
+        },
+    );
+    Ok(match (from_guess, followed) {
+        (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
+            (b, GaitSource::ContinuedFromDefaults)
+        } else {
+            (a, GaitSource::Guess)
+        }),
+        (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
+        (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
+        (Err(e), Err(_)) => Err(e),
+    })
+}
+
+/// [`nominal_gait`] without its source: "the long-period gait" of `walker gait`, the sweep's
+/// first gait, the orbit diagram's seed and the stability map's seeds.
+///
+/// # Errors
+/// The scene cannot be built at its values or at its defaults.
+pub fn long_period_gait(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+) -> Result<Result<Gait, NewtonError>, SceneError> {
+    Ok(nominal_gait(scene, setup_for, newton, homotopy)?.map(|(g, _)| g))
+}

@@ -1,0 +1,415 @@
+//! Periodic gaits: the Newton-Raphson fixed point of the stride function, eq. (24)-(26), and
+//! the stride Jacobian by perturbation, whose eigenvalues decide stability, eq. (27).
+//!
+//! The search is its own type, [`GaitSearch`]: a walker, its stride settings and the Newton
+//! settings, with the stride map, its Jacobian and the fixed-point iteration as methods. A
+//! search usually starts from the scene's [`GaitGuess`] ([`GaitSearch::find_from_guess`]).
+
+use crate::analysis::variational::VariationalError;
+use crate::engine::walker::Walker;
+use crate::stride::{
+    Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings,
+    StrideWorkspace,
+};
+use nalgebra::{Complex, DMatrix, DVector};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Settings of the fixed-point search.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct NewtonSettings {
+    /// Converged when `|Δv| <` this (∞-norm).
+    pub tolerance: f64,
+    /// Iteration budget.
+    pub max_iterations: usize,
+    /// Perturbation step of the finite-difference Jacobian.
+    pub perturbation: f64,
+    /// Central (true) or forward (false) differences.
+    pub central: bool,
+    /// The Jacobian that only steps Newton (not the one at the converged point, whose
+    /// eigenvalues are the gait's) by forward differences that reuse the nominal stride: `n`
+    /// strides instead of `2n`. Its `O(perturbation)` error only slows the chord iteration's
+    /// linear convergence by about that factor; the fixed point is where the residual
+    /// vanishes, as with central differences. False: the stepping Jacobian as `central` says.
+    pub forward_stepping: bool,
+    /// Step halvings allowed when a full Newton step lands where the stride fails or the
+    /// residual grows (0: the plain iteration of eq. 26).
+    pub max_halvings: usize,
+    /// Internal numerical differentiation: the perturbed strides of the Jacobian replay the
+    /// step sizes of the nominal stride ([`StepSchedule`]) instead of choosing their own, so
+    /// that the differences do not pick up the adaptive step selection's accept/reject flips.
+    pub frozen_steps: bool,
+    /// How the stride Jacobian is taken.
+    pub jacobian: JacobianMethod,
+}
+
+/// How the stride Jacobian is taken.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JacobianMethod {
+    /// Central differences of the stride map (2n strides).
+    #[default]
+    CentralDifferences,
+    /// The variational equations with saltation at every event (one stride with n
+    /// sensitivities by forward-mode automatic differentiation; [`crate::analysis::variational`]).
+    /// Strides it does not cover fall back to central differences, and the gait says so.
+    Variational,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-11,
+            max_iterations: 30,
+            perturbation: 1e-6,
+            central: true,
+            forward_stepping: true,
+            max_halvings: 8,
+            frozen_steps: false,
+            jacobian: JacobianMethod::CentralDifferences,
+        }
+    }
+}
+
+/// Why no fixed point was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NewtonError {
+    /// A stride failed during the search.
+    #[error("stride failed at Newton iteration {iteration}: {failure}")]
+    StrideFailed {
+        /// Iteration.
+        iteration: usize,
+        /// The failure.
+        failure: StrideFailure,
+    },
+    /// The budget ran out.
+    #[error("Newton did not converge in {iterations} iterations (last |Δv| = {last_step:e})")]
+    NotConverged {
+        /// Iterations used.
+        iterations: usize,
+        /// Last correction size.
+        last_step: f64,
+    },
+    /// `I − J` is singular.
+    #[error("I − J is singular at iteration {iteration}")]
+    Singular {
+        /// Iteration.
+        iteration: usize,
+    },
+}
+
+/// A periodic gait.
+#[derive(Clone, Debug)]
+pub struct Gait {
+    /// How the Jacobian (and so the eigenvalues) was taken.
+    pub jacobian_method: JacobianMethod,
+    /// The fixed point (stride-map vector).
+    pub fixed_point: DVector<f64>,
+    /// The stride Jacobian at the fixed point.
+    pub jacobian: DMatrix<f64>,
+    /// Its eigenvalues.
+    pub eigenvalues: Vec<Complex<f64>>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Strides the search integrated: one per iterate and trial step, and those of the
+    /// Jacobians (a variational Jacobian counts one).
+    pub strides: usize,
+    /// `|S(v) − v|` at the fixed point (∞-norm).
+    pub residual: f64,
+    /// The stride from the fixed point.
+    pub stride: StrideResult,
+}
+
+impl Gait {
+    /// Largest eigenvalue modulus.
+    pub fn max_abs_eigenvalue(&self) -> f64 {
+        self.eigenvalues
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max)
+    }
+    /// All eigenvalues strictly inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.max_abs_eigenvalue() < 1.0
+    }
+}
+
+/// A starting guess for a gait: the state just after heel strike (stance labelling), as a
+/// scene file's `guess` section gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaitGuess {
+    /// Coordinates [rad or m, by coordinate].
+    pub q: DVector<f64>,
+    /// Velocities [rad/s or m/s, by coordinate].
+    pub qd: DVector<f64>,
+}
+
+/// A gait search: the stride map of `walker` with `settings`, and Newton's method with
+/// `newton` on it.
+#[derive(Clone, Copy, Debug)]
+pub struct GaitSearch<'a> {
+    /// The walker.
+    pub walker: &'a Walker,
+    /// How each stride is integrated.
+    pub settings: &'a StrideSettings,
+    /// The fixed-point search and the Jacobian.
+    pub newton: &'a NewtonSettings,
+}
+
+impl<'a> GaitSearch<'a> {
+    /// A search for `walker`'s gait with these settings.
+    pub fn new(
+        walker: &'a Walker,
+        settings: &'a StrideSettings,
+        newton: &'a NewtonSettings,
+    ) -> Self {
+        Self {
+            walker,
+            settings,
+            newton,
+        }
+    }
+
+    /// Finds the gait from `guess` (packed into a stride-map vector).
+    ///
+    /// # Errors
+    /// As [`Self::find`].
+    pub fn find_from_guess(&self, guess: &GaitGuess) -> Result<Gait, NewtonError> {
+        self.find(&self.walker.pack(&guess.q, &guess.qd))
+    }
+
+    /// The stride function `S(v)` on packed stride-map vectors.
+    pub fn stride_map(
+        &self,
+        v: &DVector<f64>,
+    ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+        self.stride_map_in(&mut StrideWorkspace::new(self.walker), v)
+    }
+
+    /// [`Self::stride_map`] on `workspace` (of this search's walker).
+    fn stride_map_in(
+        &self,
+        workspace: &mut StrideWorkspace<'_>,
+        v: &DVector<f64>,
+    ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
+        let w = self.walker;
+        let (q, qd) = w.unpack(v);
+        let r = workspace.stride(&q, &qd, StrideRequest::new(self.settings))?;
+        Ok((w.pack(&r.q_next, &r.qd_next), r))
+    }
+
+    /// The stride Jacobian at `v` by `newton.jacobian`, with the method actually used (the
+    /// variational equations fall back to central differences where they do not apply).
+    ///
+    /// # Errors
+    /// A stride that fails.
+    pub fn stride_jacobian_by(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, JacobianMethod), StrideFailure> {
+        if self.newton.jacobian == JacobianMethod::Variational {
+            match crate::analysis::variational::stride_jacobian(self.walker, v, self.settings) {
+                Ok((j, _)) => return Ok((j, JacobianMethod::Variational)),
+                Err(VariationalError::Stride(f)) => return Err(f),
+                Err(_) => {}
+            }
+        }
+        Ok((
+            self.stride_jacobian(v, s_v)?,
+            JacobianMethod::CentralDifferences,
+        ))
+    }
+
+    /// The stride Jacobian at `v` by perturbation.
+    ///
+    /// # Errors
+    /// A stride that fails.
+    pub fn stride_jacobian(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+    ) -> Result<DMatrix<f64>, StrideFailure> {
+        let (w, settings) = (self.walker, self.newton);
+        let n = v.len();
+        let d = settings.perturbation;
+        let mut schedule = StepSchedule::default();
+        let nominal = if settings.frozen_steps {
+            let (q, qd) = w.unpack(v);
+            let request =
+                StrideRequest::new(self.settings).schedule(Schedule::Record(&mut schedule));
+            let r = StrideWorkspace::new(w).stride(&q, &qd, request)?;
+            Some(w.pack(&r.q_next, &r.qd_next))
+        } else {
+            None
+        };
+        let s_v = nominal.as_ref().unwrap_or(s_v);
+        let map = |ws: &mut StrideWorkspace<'_>,
+                   x: &DVector<f64>|
+         -> Result<DVector<f64>, StrideFailure> {
+            if settings.frozen_steps {
+                let (q, qd) = w.unpack(x);
+                let request =
+                    StrideRequest::new(self.settings).schedule(Schedule::Replay(&schedule));
+                let r = ws.stride(&q, &qd, request)?;
+                Ok(w.pack(&r.q_next, &r.qd_next))
+            } else {
+                Ok(self.stride_map_in(ws, x)?.0)
+            }
+        };
+        // The columns are independent strides: computed in parallel (rayon), each with the
+        // same arithmetic as a sequential loop, so the Jacobian is bit-identical to it. The
+        // first failure in column order is reported, as a sequential loop would.
+        let column =
+            |ws: &mut StrideWorkspace<'_>, k: usize| -> Result<DVector<f64>, StrideFailure> {
+                let mut vp = v.clone();
+                vp[k] += d;
+                let sp = map(ws, &vp)?;
+                Ok(if settings.central {
+                    let mut vm = v.clone();
+                    vm[k] -= d;
+                    let sm = map(ws, &vm)?;
+                    (sp - sm) / (2.0 * d)
+                } else {
+                    (sp - s_v) / d
+                })
+            };
+        let columns: Vec<Result<DVector<f64>, StrideFailure>> = (0..n)
+            .into_par_iter()
+            .map_init(|| StrideWorkspace::new(w), column)
+            .collect();
+        let mut j = DMatrix::zeros(n, n);
+        for (k, col) in columns.into_iter().enumerate() {
+            j.set_column(k, &col?);
+        }
+        Ok(j)
+    }
+
+    /// The Jacobian that steps Newton at `v` (whose stride is `s_v`), as
+    /// [`Self::stride_jacobian_by`] but by forward differences when `newton.forward_stepping`;
+    /// with the method used and whether its differences were central.
+    fn stepping_jacobian(
+        &self,
+        v: &DVector<f64>,
+        s_v: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, JacobianMethod, bool), StrideFailure> {
+        let central = self.newton.central && !self.newton.forward_stepping;
+        let newton = NewtonSettings {
+            central,
+            ..*self.newton
+        };
+        let (j, method) = GaitSearch {
+            newton: &newton,
+            ..*self
+        }
+        .stride_jacobian_by(v, s_v)?;
+        Ok((j, method, central))
+    }
+
+    /// Strides one Jacobian of an `n`-vector took by `method` (`central` differences or not).
+    fn jacobian_strides(&self, n: usize, method: JacobianMethod, central: bool) -> usize {
+        match method {
+            JacobianMethod::Variational => 1,
+            JacobianMethod::CentralDifferences => {
+                let nominal = usize::from(self.newton.frozen_steps);
+                n * if central { 2 } else { 1 } + nominal
+            }
+        }
+    }
+
+    /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
+    ///
+    /// # Errors
+    /// [`NewtonError`]: a stride fails, the budget runs out, or `I − J` is singular.
+    pub fn find(&self, v0: &DVector<f64>) -> Result<Gait, NewtonError> {
+        let settings = self.newton;
+        let mut v = v0.clone();
+        let n = v.len();
+        let mut last_step = f64::INFINITY;
+        // The Newton matrix is kept while the residual falls at least fourfold per iteration
+        // (a chord iteration); the eigenvalues always come from a Jacobian at the converged
+        // point.
+        let mut kept: Option<DMatrix<f64>> = None;
+        let mut last_residual = f64::INFINITY;
+        // The accepted trial's stride, reused as the next iteration's.
+        let mut carried: Option<(DVector<f64>, StrideResult)> = None;
+        let mut strides = 0;
+        for it in 0..=settings.max_iterations {
+            let fail = |failure| NewtonError::StrideFailed {
+                iteration: it,
+                failure,
+            };
+            let (s, stride) = match carried.take() {
+                Some(c) => c,
+                None => {
+                    strides += 1;
+                    self.stride_map(&v).map_err(fail)?
+                }
+            };
+            let r = &s - &v;
+            if last_step < settings.tolerance {
+                let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
+                strides += self.jacobian_strides(n, jacobian_method, self.newton.central);
+                let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
+                return Ok(Gait {
+                    jacobian_method,
+                    fixed_point: v,
+                    jacobian: j,
+                    eigenvalues,
+                    iterations: it,
+                    strides,
+                    residual: r.amax(),
+                    stride,
+                });
+            }
+            if it == settings.max_iterations {
+                break;
+            }
+            let r_norm_now = r.amax();
+            let j = match kept.take() {
+                Some(j) if r_norm_now <= 0.25 * last_residual => j,
+                _ => {
+                    let (j, method, central) = self.stepping_jacobian(&v, &s).map_err(fail)?;
+                    strides += self.jacobian_strides(n, method, central);
+                    j
+                }
+            };
+            last_residual = r_norm_now;
+            let a = DMatrix::identity(n, n) - &j;
+            let dv = a
+                .lu()
+                .solve(&r)
+                .ok_or(NewtonError::Singular { iteration: it })?;
+            // Damped step: halve while the stride from the new point fails or its residual
+            // grows; keep the last trial if the budget runs out (the next iteration reports).
+            let r_norm = r.amax();
+            let mut lambda = 1.0;
+            let mut accepted = settings.max_halvings == 0;
+            for _ in 0..settings.max_halvings {
+                let trial = &v + &dv * lambda;
+                strides += 1;
+                match self.stride_map(&trial) {
+                    Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
+                        carried = Some((st, sr));
+                        accepted = true;
+                        break;
+                    }
+                    _ => lambda *= 0.5,
+                }
+            }
+            // A step that no halving made acceptable is not a sign of convergence, however
+            // short it has become.
+            last_step = if accepted {
+                dv.amax() * lambda
+            } else {
+                f64::INFINITY
+            };
+            v += dv * lambda;
+            kept = Some(j);
+        }
+        Err(NewtonError::NotConverged {
+            iterations: settings.max_iterations,
+            last_step,
+        })
+    }
+}

@@ -1,0 +1,14 @@
+//! What is computed from strides: gaits (fixed points of the stride map) and their stability,
+//! exact stride Jacobians, homotopies and continuation of gaits through their bifurcations, the
+//! census of gaits, orbit diagrams, stability maps, tuning, and speed against error.
+
+pub mod accuracy;
+pub mod census;
+pub mod continuation;
+pub mod homotopy;
+pub mod limit_cycle;
+pub mod orbit_diagram;
+pub mod stability;
+pub mod stability_map;
+pub mod tune;
+pub mod variational;
