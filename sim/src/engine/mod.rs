@@ -5,7 +5,7 @@
 //!
 //! The fast evaluations (the planar tree with its closed forms, the 3D axis tree, the limit
 //! of vanishing masses) are the crate's own: a stride picks them
-//! ([`crate::stride::EvaluationPath`]) and the general engine stays their reference.
+//! ([`EvaluationPath`]) and the general engine stays their reference.
 //! [`PlanarTree`] and [`AxisTree`] are public so that they can be checked against it.
 
 pub mod actuator;
@@ -13,6 +13,7 @@ pub(crate) mod axis_tree;
 pub mod contact;
 pub mod control;
 pub mod dynamics;
+mod evaluation_path;
 pub mod events;
 pub mod hermite;
 pub(crate) mod hybrid;
@@ -27,6 +28,7 @@ pub(crate) mod singular_limit;
 pub mod walker;
 
 pub use axis_tree::AxisTree;
+pub use evaluation_path::EvaluationPath;
 pub use hybrid::phase::DriveValues;
 pub use math::rotation_about;
 pub use planar::PlanarTree;

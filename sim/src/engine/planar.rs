@@ -28,7 +28,7 @@ mod three_link;
 mod trig;
 mod two_link;
 
-pub use crate::stride::EvaluationPath;
+use crate::engine::EvaluationPath;
 pub(crate) use chain::Joints;
 pub use links::{LinkFrame, PlanarLinks, MAX_LINKS, MAX_PLANAR_COORDINATES};
 pub use trig::sin_cos;

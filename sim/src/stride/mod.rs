@@ -14,7 +14,7 @@
 //!   stride's end ([`Walker::heel_strike_impact`]);
 //! - `energy`: actuator work and damper dissipation;
 //! - `contact_figures`: [`ContactSummary`];
-//! - `evaluation_path`: [`EvaluationPath`], which evaluation a stride uses;
+//! - [`EvaluationPath`] (from [`crate::engine`]): which evaluation a stride uses;
 //! - `state`: `StrideState`, a state of a stride in one storage (dynamic or fixed-size);
 //! - `engine`: what the loop needs of a state's storage and its evaluation (`Engine`), and the
 //!   reference engine on `DVector` samples;
@@ -38,7 +38,6 @@
 mod contact_figures;
 mod energy;
 mod engine;
-mod evaluation_path;
 mod failure;
 mod fast;
 mod impacts;
@@ -53,8 +52,8 @@ pub mod walk;
 mod witnesses;
 mod workspace;
 
+pub use crate::engine::EvaluationPath;
 pub use contact_figures::ContactSummary;
-pub use evaluation_path::EvaluationPath;
 pub use failure::{FailureCause, FailureKind, StrideFailure};
 pub use impacts::HeelStrikeImpact;
 pub use phase::{linearised_limit, Drive, Phase};

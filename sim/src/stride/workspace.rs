@@ -12,7 +12,6 @@
 //! walk loop and the gait search keep one across their strides.
 
 use super::engine::DynamicEngine;
-use super::evaluation_path::EvaluationPath;
 use super::failure::{FailureCause, StrideFailure};
 use super::fast;
 use super::phase::Phase;
@@ -24,6 +23,7 @@ use super::settings::StrideSettings;
 use super::witnesses::{Watch, Witnesses};
 use crate::engine::integrators::{IntegratorChoice, Sample};
 use crate::engine::walker::Walker;
+use crate::engine::EvaluationPath;
 use nalgebra::DVector;
 
 /// What repeated strides of one walker reuse (see the module's documentation).
