@@ -334,6 +334,8 @@ impl<'a> GaitSearch<'a> {
         // The accepted trial's stride, reused as the next iteration's.
         let mut carried: Option<(DVector<f64>, StrideResult)> = None;
         let mut strides = 0;
+        // One workspace for Newton's own strides (residuals and line-search trials).
+        let mut workspace = StrideWorkspace::new(self.walker);
         for it in 0..=settings.max_iterations {
             let fail = |failure| NewtonError::StrideFailed {
                 iteration: it,
@@ -343,7 +345,7 @@ impl<'a> GaitSearch<'a> {
                 Some(c) => c,
                 None => {
                     strides += 1;
-                    self.stride_map(&v).map_err(fail)?
+                    self.stride_map_in(&mut workspace, &v).map_err(fail)?
                 }
             };
             let r = &s - &v;
@@ -388,7 +390,7 @@ impl<'a> GaitSearch<'a> {
             for _ in 0..settings.max_halvings {
                 let trial = &v + &dv * lambda;
                 strides += 1;
-                match self.stride_map(&trial) {
+                match self.stride_map_in(&mut workspace, &trial) {
                     Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
                         carried = Some((st, sr));
                         accepted = true;
