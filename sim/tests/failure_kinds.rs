@@ -197,20 +197,24 @@ impl sim::engine::control::AnkleController for Broken {
     fn heel_strike(&mut self, _: f64) {}
 }
 
-#[test]
-fn a_controlled_stride_on_a_walker_without_an_ankle_reflex_is_a_configuration_error() {
-    let (_, w) = common::walker("compass");
+/// A stride of `scene` from its gait's fixed point under the [`Broken`] controller: it fails.
+fn broken_controller_stride(scene: &str) -> sim::stride::StrideFailure {
+    let (_, w) = common::walker(scene);
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
     let mut ctl = Broken;
-    let e = w
-        .walker
+    w.walker
         .stride(
             &q,
             &qd,
             sim::stride::StrideRequest::new(&w.settings).controlled(&mut ctl, 0.0),
         )
-        .unwrap_err();
+        .unwrap_err()
+}
+
+#[test]
+fn a_controlled_stride_on_a_walker_without_an_ankle_reflex_is_a_configuration_error() {
+    let e = broken_controller_stride("compass");
     assert_eq!(e.kind, FailureKind::InvalidConfiguration, "{e}");
     assert_eq!(*e.cause, sim::stride::FailureCause::NoAnkleReflex);
     assert_eq!(
@@ -221,18 +225,7 @@ fn a_controlled_stride_on_a_walker_without_an_ankle_reflex_is_a_configuration_er
 
 #[test]
 fn a_controller_s_failure_is_its_own_typed_error_not_a_non_finite_state() {
-    let (_, w) = common::walker("wisse3d");
-    let g = common::gait(&w);
-    let (q, qd) = common::start_state(&w, &g);
-    let mut ctl = Broken;
-    let e = w
-        .walker
-        .stride(
-            &q,
-            &qd,
-            sim::stride::StrideRequest::new(&w.settings).controlled(&mut ctl, 0.0),
-        )
-        .unwrap_err();
+    let e = broken_controller_stride("wisse3d");
     assert_eq!(e.kind, FailureKind::ControlFailed, "{e}");
     assert_eq!(e.detail(), "controller: broken: the bus is down");
     let sim::stride::FailureCause::Control(c) = &*e.cause else {

@@ -79,6 +79,15 @@ pub enum EventError {
         /// Final bracket width \[s\].
         bracket_s: f64,
     },
+    /// An integrator that locates events on its dense output had none for the step (the
+    /// step asked about is not the last one it took).
+    #[error("no dense output of the step from {from_s} s to {to_s} s to locate the event on")]
+    NoDenseOutput {
+        /// The step's start \[s\].
+        from_s: f64,
+        /// The step's end \[s\].
+        to_s: f64,
+    },
 }
 
 /// Finds the crossing of `g` between samples `a` and `b` (with `g(a)`, `g(b)` of opposite

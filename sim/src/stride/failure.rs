@@ -287,9 +287,8 @@ impl FailureCause {
                 IntegrationError::StepUnderflow { .. } => FailureKind::StepUnderflow,
             },
             Self::Event(EventError::Integration(i)) => Self::Integration(i.clone()).kind(),
-            Self::Event(EventError::NotLocated { .. }) | Self::SeveralEventsHandedBack => {
-                FailureKind::EventNotLocated
-            }
+            Self::Event(EventError::NotLocated { .. } | EventError::NoDenseOutput { .. })
+            | Self::SeveralEventsHandedBack => FailureKind::EventNotLocated,
             Self::Impact(_) => FailureKind::ImpactSingular,
             Self::Relabel(_) => FailureKind::RelabelFailed,
             Self::Control(_)

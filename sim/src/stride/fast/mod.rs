@@ -268,9 +268,10 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
         let dense = self
             .integrator
             .dense_output(&mut self.sys, cur, next)
-            .ok_or(EventError::Integration(IntegrationError::Dynamics(
-                DynamicsError::NonFinite,
-            )))??;
+            .ok_or(EventError::NoDenseOutput {
+                from_s: cur.t_s,
+                to_s: next.t_s,
+            })??;
         let (guess, slope) = root_on_dense(
             |t| g(&dense.eval(t)),
             (cur.t_s, ga),
