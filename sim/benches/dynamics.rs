@@ -20,10 +20,10 @@ const SCENES: [&str; 5] = ["simplest", "compass", "kneed2d", "wisse2d", "wisse3d
 fn benches(c: &mut Criterion) {
     for name in SCENES {
         let setup = Scene::load(name).and_then(|s| s.setup()).unwrap();
-        let model = &setup.walker.model;
+        let model = setup.walker.model();
         let (q, qd) = (setup.guess.q.clone(), setup.guess.qd.clone());
         let mut active = vec![true; model.dof()];
-        for c in &setup.walker.initially_locked {
+        for c in setup.walker.initially_locked() {
             active[c.0] = false;
         }
         let mut group = c.benchmark_group(format!("dynamics/{name}"));

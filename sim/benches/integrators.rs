@@ -13,8 +13,8 @@ fn benches(c: &mut Criterion) {
     for name in ["compass", "wisse3d"] {
         let setup = Scene::load(name).and_then(|s| s.setup()).unwrap();
         let walker = &setup.walker;
-        let mut phase = Phase::new(&walker.model);
-        for c in &walker.initially_locked {
+        let mut phase = Phase::new(walker.model());
+        for c in walker.initially_locked() {
             phase.active[c.0] = false;
         }
         let start = Sample {

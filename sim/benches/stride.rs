@@ -104,7 +104,8 @@ fn benches(c: &mut Criterion) {
                         walker.stride(black_box(&q), black_box(&qd), request)
                     })
                 });
-                if sim::engine::PlanarTree::of(&walker.model).is_some_and(|t| t.has_closed_form()) {
+                if sim::engine::PlanarTree::of(walker.model()).is_some_and(|t| t.has_closed_form())
+                {
                     // The fixed-size stride on the planar link pass instead of the two-link
                     // closed form: what the closed form buys.
                     let mut link_pass = settings.clone();

@@ -92,7 +92,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     let setup = scene.setup()?;
     let walker = &setup.walker;
-    let model = &walker.model;
+    let model = walker.model();
     let g = model.gravity_floor_m_s2;
     let coords = Coordinates {
         slope_rad: g.x.atan2(-g.y),

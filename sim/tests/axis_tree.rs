@@ -131,7 +131,7 @@ fn the_3d_walkers_equations_of_motion_equal_the_general_engines() {
         "compass",
     ] {
         let setup = Scene::load(name).unwrap().setup().unwrap();
-        let (mf, qdd) = compare(&setup.walker.model, 60, 17);
+        let (mf, qdd) = compare(setup.walker.model(), 60, 17);
         println!("{name}: M̄, f̄ {mf:.2e}, q̈ {qdd:.2e}");
         assert!(mf <= 1e-13, "{name}: M̄, f̄ differ by {mf:e} relative");
         assert!(qdd <= 1e-11, "{name}: q̈ differs by {qdd:e} relative");
@@ -289,7 +289,7 @@ fn only_coordinate_axis_revolute_trees_of_finite_bodies_qualify() {
     assert!(AxisTree::of(&slider).is_none(), "a prismatic joint");
     let simplest = Scene::load("simplest").unwrap().setup().unwrap();
     assert!(
-        AxisTree::of(&simplest.walker.model).is_none(),
+        AxisTree::of(simplest.walker.model()).is_none(),
         "infinitesimal bodies"
     );
     let empty = Model::new(Vector3::new(0.0, -9.81, 0.0));
@@ -299,13 +299,13 @@ fn only_coordinate_axis_revolute_trees_of_finite_bodies_qualify() {
 #[test]
 fn the_3d_walker_evaluates_on_the_fast_path_unless_told_otherwise() {
     let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
-    let model = &setup.walker.model;
+    let model = setup.walker.model();
     assert!(Phase::with_path(model, EvaluationPath::Auto).is_axis_tree_fast_path());
     assert!(Phase::with_path(model, EvaluationPath::GeneralLoop).is_axis_tree_fast_path());
     assert!(!Phase::with_path(model, EvaluationPath::General).is_axis_tree_fast_path());
     // Planar walkers keep the planar fast path.
     let compass = Scene::load("compass").unwrap().setup().unwrap();
-    let phase = Phase::with_path(&compass.walker.model, EvaluationPath::Auto);
+    let phase = Phase::with_path(compass.walker.model(), EvaluationPath::Auto);
     assert!(phase.is_planar_fast_path() && !phase.is_axis_tree_fast_path());
 }
 
@@ -346,7 +346,7 @@ fn the_3d_walkers_gait_is_the_same_on_both_paths() {
 #[test]
 fn non_finite_states_are_errors_as_on_the_general_engine() {
     let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
-    let model = &setup.walker.model;
+    let model = setup.walker.model();
     let n = model.dof();
     let mut tree = AxisTree::of(model).unwrap();
     let mut general = Dynamics::new(model);

@@ -11,7 +11,7 @@ fn a_sampled_reflex_at_1_khz_walks_like_the_ideal_actuator() {
     let (_, w) = common::walker("wisse3d");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    let reflex = w.walker.ankle.clone().unwrap();
+    let reflex = w.walker.ankle().cloned().unwrap();
     let mut ctl = SampledReflex::new(1e-3, &reflex);
     let request = WalkRequest::new(&w.settings, 20).controlled(&mut ctl);
     let walk = sim::stride::walk::walk(&w.walker, &q, &qd, request);

@@ -67,7 +67,7 @@ fn walk_ticks(
     settings: &StrideSettings,
     steps: usize,
 ) -> (Vec<f64>, f64, bool) {
-    let reflex = w.walker.ankle.clone().unwrap();
+    let reflex = w.walker.ankle().cloned().unwrap();
     let period_s = 1e-3;
     let mut ctl = Recording::new(period_s, SampledReflex::new(period_s, &reflex));
     let request = WalkRequest::new(settings, steps).controlled(&mut ctl);
@@ -141,7 +141,7 @@ fn every_tick_runs_once_at_its_time_in_both_schemes_also_across_grazing_steps() 
 fn a_period_that_makes_no_ticks_is_refused_before_the_stride() {
     let (_, w) = common::walker("wisse3d");
     let (q, qd) = (w.guess.q.clone(), w.guess.qd.clone());
-    let reflex = w.walker.ankle.clone().unwrap();
+    let reflex = w.walker.ankle().cloned().unwrap();
     for period_s in [0.0, -1e-3, f64::NAN, f64::INFINITY, 1e-300] {
         for t_walk_start_s in [0.0, 12.5] {
             let mut ctl = Recording::new(period_s, SampledReflex::new(1e-3, &reflex));
@@ -163,7 +163,7 @@ fn a_period_far_too_short_for_the_stride_ends_in_the_step_budget() {
     // against the step budget in both schemes (in `HeldAcrossTicks` they run inside steps).
     let (_, mut w) = common::walker("wisse3d");
     let (q, qd) = (w.guess.q.clone(), w.guess.qd.clone());
-    let reflex = w.walker.ankle.clone().unwrap();
+    let reflex = w.walker.ankle().cloned().unwrap();
     w.settings.max_steps = 2_000;
     for stepping in [TickStepping::HeldAcrossTicks, TickStepping::EndAtEveryTick] {
         let settings = w.settings.with_tick_stepping(stepping);

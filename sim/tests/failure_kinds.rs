@@ -122,11 +122,13 @@ fn an_event_without_refinement_budget_is_not_located() {
 #[test]
 fn redundant_contact_constraints_make_the_impact_singular() {
     let (_, mut w) = common::walker("compass");
-    w.walker.heel_strike.constraints = vec![
-        ContactConstraint::X,
-        ContactConstraint::Y,
-        ContactConstraint::X,
-    ];
+    w.walker = w.walker.clone().with_changes(|_, rules| {
+        rules.heel_strike.constraints = vec![
+            ContactConstraint::X,
+            ContactConstraint::Y,
+            ContactConstraint::X,
+        ];
+    });
     let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::ImpactSingular);
 }
@@ -134,8 +136,11 @@ fn redundant_contact_constraints_make_the_impact_singular() {
 #[test]
 fn an_inconsistent_relabelling_is_an_error_not_a_wrong_state() {
     let (_, mut w) = common::walker("compass");
-    let (a, b) = (w.walker.relabel.pairs[0].0, w.walker.relabel.pairs[1].0);
-    w.walker.relabel.pairs = vec![(a, a), (b, b)];
+    let (a, b) = (w.walker.relabel().pairs[0].0, w.walker.relabel().pairs[1].0);
+    w.walker = w
+        .walker
+        .clone()
+        .with_changes(|_, rules| rules.relabel.pairs = vec![(a, a), (b, b)]);
     let e = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::RelabelFailed);
 }

@@ -29,16 +29,16 @@ fn noise(k: &mut u64) -> f64 {
 fn the_planar_scenes_qualify_and_the_3d_walker_does_not() {
     for name in PLANAR {
         let s = setup(name);
-        assert!(PlanarTree::of(&s.walker.model).is_some(), "{name}");
-        assert!(Phase::new(&s.walker.model).is_planar_fast_path(), "{name}");
+        assert!(PlanarTree::of(s.walker.model()).is_some(), "{name}");
+        assert!(Phase::new(s.walker.model()).is_planar_fast_path(), "{name}");
         assert!(
-            !Phase::with_path(&s.walker.model, EvaluationPath::General).is_planar_fast_path(),
+            !Phase::with_path(s.walker.model(), EvaluationPath::General).is_planar_fast_path(),
             "{name}"
         );
     }
     let s = setup("wisse3d");
-    assert!(PlanarTree::of(&s.walker.model).is_none());
-    assert!(!Phase::new(&s.walker.model).is_planar_fast_path());
+    assert!(PlanarTree::of(s.walker.model()).is_none());
+    assert!(!Phase::new(s.walker.model()).is_planar_fast_path());
 }
 
 #[test]
@@ -46,7 +46,7 @@ fn equations_of_motion_agree_with_the_general_engine() {
     let mut seed = 7u64;
     for name in PLANAR {
         let s = setup(name);
-        let model = &s.walker.model;
+        let model = s.walker.model();
         let n = model.dof();
         let mut fast = Phase::new(model);
         let mut general = Phase::with_path(model, EvaluationPath::General);
@@ -283,10 +283,10 @@ fn the_closed_forms_agree_with_the_link_pass_and_the_general_engine() {
         ("wisse2d", false),
     ] {
         let s = setup(name);
-        let tree = PlanarTree::of(&s.walker.model).unwrap();
+        let tree = PlanarTree::of(s.walker.model()).unwrap();
         assert_eq!(tree.has_closed_form(), closed, "{name}");
         assert!(!tree.link_pass_only().has_closed_form());
-        let path = PlanarTree::for_path(&s.walker.model, EvaluationPath::LinkPass).unwrap();
+        let path = PlanarTree::for_path(s.walker.model(), EvaluationPath::LinkPass).unwrap();
         assert!(!path.has_closed_form());
     }
     // The scenes as they are, then variants the scene files cannot express: distributed
@@ -310,7 +310,7 @@ fn the_closed_forms_agree_with_the_link_pass_and_the_general_engine() {
                 s.set("shank_com_from_knee_m", 0.3).unwrap();
             }
             let s = s.setup().unwrap();
-            let mut model = s.walker.model.clone();
+            let mut model = s.walker.model().clone();
             if variant % 2 == 1 {
                 for (i, link) in model.links.iter_mut().enumerate() {
                     let k = i as f64 + 1.0;

@@ -130,7 +130,7 @@ fn the_general_evaluation_equals_the_reference_arithmetic_on_random_states() {
     for name in ["wisse3d", "wisse2d", "kneed2d", "compass", "simplest"] {
         let (_, w) = common::walker(name);
         // The stance model and the impact model with its released root (prismatic joints).
-        for model in [&w.walker.model, &w.walker.impact_model] {
+        for model in [w.walker.model(), w.walker.impact_model()] {
             let n = model.dof();
             let mut dynamics = Dynamics::new(model);
             for _ in 0..50 {
@@ -174,7 +174,7 @@ fn the_partial_assembly_gives_the_full_assemblys_accelerations_to_the_bit() {
     let mut compared = 0;
     for name in ["wisse3d", "wisse2d", "kneed2d"] {
         let (_, w) = common::walker(name);
-        let model = &w.walker.model;
+        let model = w.walker.model();
         let n = model.dof();
         let (mut full, mut partial) = (Dynamics::new(model), Dynamics::new(model));
         for trial in 0..60 {

@@ -28,11 +28,11 @@ fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
         .unwrap();
     let clearance = c0.contact.mid_swing_clearance_m.unwrap();
     assert!(clearance < -1e-3, "{clearance}");
-    w.walker.model.points[w.walker.heel_strike.swing_foot.0]
-        .p_link_m
-        .y += -clearance - 5e-4;
-    w.walker.heel_strike.ignore_scuffing = false;
-    w.walker.heel_strike.min_ahead_m = 0.05;
+    w.walker = w.walker.clone().with_changes(|model, rules| {
+        model.points[rules.heel_strike.swing_foot.0].p_link_m.y += -clearance - 5e-4;
+        rules.heel_strike.ignore_scuffing = false;
+        rules.heel_strike.min_ahead_m = 0.05;
+    });
     let scuffs = |w: &sim::scene::Setup| matches!(common::stride(w, &q, &qd), Err(e) if e.kind == FailureKind::Scuffed);
     assert!(scuffs(&w), "the accurate integrator must see the graze");
     // Long fixed steps: the whole dip lies inside one step.
@@ -71,15 +71,15 @@ fn a_stiff_pelvic_spring_beyond_meijaards_limit_is_reported_not_integrated() {
         .unwrap()
         .parse()
         .unwrap();
-    let mut d = sim::engine::dynamics::Dynamics::new(&w.walker.model);
-    d.assemble(&w.walker.model, &w.guess.q, &w.guess.qd, None);
-    let free: Vec<usize> = (0..w.walker.model.dof())
-        .filter(|i| !w.walker.initially_locked.iter().any(|c| c.0 == *i))
+    let mut d = sim::engine::dynamics::Dynamics::new(w.walker.model());
+    d.assemble(w.walker.model(), &w.guess.q, &w.guess.qd, None);
+    let free: Vec<usize> = (0..w.walker.model().dof())
+        .filter(|i| !w.walker.initially_locked().iter().any(|c| c.0 == *i))
         .collect();
     let m = d.mass_matrix.select_rows(&free).select_columns(&free);
     let yaw = free
         .iter()
-        .position(|&i| i == w.walker.model.coord_index("pelvis_yaw").unwrap().0)
+        .position(|&i| i == w.walker.model().coord_index("pelvis_yaw").unwrap().0)
         .unwrap();
     let expected = (1.0e7 * m.try_inverse().unwrap()[(yaw, yaw)]).sqrt();
     assert!(
@@ -200,7 +200,10 @@ fn equations_of_motion_that_overflow_are_a_typed_failure() {
     let (_, mut w) = common::walker("compass");
     let g = common::gait(&w);
     let (q, qd) = common::start_state(&w, &g);
-    w.walker.model.gravity_floor_m_s2 *= 1e308;
+    w.walker = w
+        .walker
+        .clone()
+        .with_changes(|model, _| model.gravity_floor_m_s2 *= 1e308);
     let e = common::stride(&w, &q, &qd).unwrap_err();
     assert_eq!(e.kind, FailureKind::NonFiniteState, "{e}");
     assert!(!e.detail().contains("initial state"), "{e}");

@@ -70,17 +70,17 @@ fn compass_swing() -> (Setup, Sample) {
 fn energy_is_conserved_in_passive_swing_with_error_shrinking_at_each_order() {
     let (w, s0) = compass_swing();
     let t_end = 0.25; // inside single stance (heel strike is at ~0.73 s)
-    let e0 = energy(&w.walker.model, &s0);
-    let mut sys = Phase::new(&w.walker.model);
+    let e0 = energy(w.walker.model(), &s0);
+    let mut sys = Phase::new(w.walker.model());
     // The accuracy reference conserves energy to rounding.
     let r = reference(&mut sys, &s0, t_end);
-    assert!((energy(&w.walker.model, &r) - e0).abs() < 1e-11);
+    assert!((energy(w.walker.model(), &r) - e0).abs() < 1e-11);
     let steps = [50, 100, 200, 400];
     let rk4: Vec<f64> = steps
         .iter()
         .map(|&n| {
             (energy(
-                &w.walker.model,
+                w.walker.model(),
                 &integrate(&IntegratorChoice::Rk4 { h_s: 0.0 }, &mut sys, &s0, t_end, n),
             ) - e0)
                 .abs()
@@ -98,7 +98,7 @@ fn energy_is_conserved_in_passive_swing_with_error_shrinking_at_each_order() {
                 h_s: 0.0,
                 check_every: 0,
             };
-            (energy(&w.walker.model, &integrate(&ch, &mut sys, &s0, t_end, n)) - e0).abs()
+            (energy(w.walker.model(), &integrate(&ch, &mut sys, &s0, t_end, n)) - e0).abs()
         })
         .collect();
     for p in orders(&mj) {
@@ -120,7 +120,7 @@ fn energy_is_conserved_in_passive_swing_with_error_shrinking_at_each_order() {
         while s.t_s < t_end - 1e-15 {
             s = integ.advance(&mut sys, &s, t_end - s.t_s).unwrap();
         }
-        let e = (energy(&w.walker.model, &s) - e0).abs();
+        let e = (energy(w.walker.model(), &s) - e0).abs();
         assert!(e < last && e < 100.0 * rtol, "dopri5 rtol {rtol}: {e}");
         last = e;
     }
@@ -197,18 +197,18 @@ fn angular_momentum_about_the_new_contact_is_conserved_across_heel_strike() {
     for name in ["compass", "kneed2d"] {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
-        let active: Vec<bool> = (0..w.walker.model.dof())
-            .map(|i| !w.walker.knees.iter().any(|k| k.coordinate.0 == i))
+        let active: Vec<bool> = (0..w.walker.model().dof())
+            .map(|i| !w.walker.knees().iter().any(|k| k.coordinate.0 == i))
             .collect();
         let imp = w
             .walker
             .heel_strike_impact(&g.stride.pre_impact, &active)
             .unwrap();
-        let mut d = Dynamics::new(&w.walker.impact_model);
-        d.assemble(&w.walker.impact_model, &imp.q, &imp.qd_minus, None);
-        let before = d.angular_momentum_about(&w.walker.impact_model, &imp.p_contact_m);
-        d.assemble(&w.walker.impact_model, &imp.q, &imp.qd_plus, None);
-        let after = d.angular_momentum_about(&w.walker.impact_model, &imp.p_contact_m);
+        let mut d = Dynamics::new(w.walker.impact_model());
+        d.assemble(w.walker.impact_model(), &imp.q, &imp.qd_minus, None);
+        let before = d.angular_momentum_about(w.walker.impact_model(), &imp.p_contact_m);
+        d.assemble(w.walker.impact_model(), &imp.q, &imp.qd_plus, None);
+        let after = d.angular_momentum_about(w.walker.impact_model(), &imp.p_contact_m);
         assert!(
             (before - after).norm() < 1e-12 * (1.0 + before.norm()),
             "{name}: {before} vs {after}"
@@ -216,10 +216,10 @@ fn angular_momentum_about_the_new_contact_is_conserved_across_heel_strike() {
         // And the impact is dissipative and the new contact is at rest.
         assert!(imp.energy_loss_j > 0.0);
         // Angular momentum about the old contact is NOT conserved (the check could fail).
-        d.assemble(&w.walker.impact_model, &imp.q, &imp.qd_minus, None);
-        let b0 = d.angular_momentum_about(&w.walker.impact_model, &Vector3::zeros());
-        d.assemble(&w.walker.impact_model, &imp.q, &imp.qd_plus, None);
-        let a0 = d.angular_momentum_about(&w.walker.impact_model, &Vector3::zeros());
+        d.assemble(w.walker.impact_model(), &imp.q, &imp.qd_minus, None);
+        let b0 = d.angular_momentum_about(w.walker.impact_model(), &Vector3::zeros());
+        d.assemble(w.walker.impact_model(), &imp.q, &imp.qd_plus, None);
+        let a0 = d.angular_momentum_about(w.walker.impact_model(), &Vector3::zeros());
         assert!((b0 - a0).norm() > 1e-3, "{name}");
     }
 }
@@ -339,18 +339,18 @@ fn relabelling_twice_returns_the_configuration() {
         let (_, w) = common::walker(name);
         let g = common::gait(&w);
         let mut q0 = g.stride.pre_impact.q.clone();
-        for c in &w.walker.initially_locked {
+        for c in w.walker.initially_locked() {
             q0[c.0] = 0.0;
         }
-        let zero = DVector::zeros(w.walker.model.dof());
+        let zero = DVector::zeros(w.walker.model().dof());
         let relabel_once = |q: &DVector<f64>| {
-            let mut kin = sim::engine::kinematics::Kinematics::new(&w.walker.model);
-            kin.update(&w.walker.model, q, &zero);
-            let foot = kin.point_position(&w.walker.model, w.walker.heel_strike.swing_foot);
+            let mut kin = sim::engine::kinematics::Kinematics::new(w.walker.model());
+            kin.update(w.walker.model(), q, &zero);
+            let foot = kin.point_position(w.walker.model(), w.walker.heel_strike().swing_foot);
             let states = LinkStates::from_kinematics(&kin, 0, &foot);
             w.walker
-                .relabel
-                .solve(&w.walker.model, &states, q)
+                .relabel()
+                .solve(w.walker.model(), &states, q)
                 .unwrap()
                 .q
         };
@@ -360,7 +360,7 @@ fn relabelling_twice_returns_the_configuration() {
             "{name}: relabelling must change the labels"
         );
         let twice = relabel_once(&once);
-        for c in &w.walker.relabel.cyclic {
+        for c in &w.walker.relabel().cyclic {
             q0[c.0] = 0.0;
         }
         assert!((&twice - &q0).amax() < 1e-10, "{name}: {twice} vs {q0}");

@@ -349,10 +349,11 @@ fn the_references_examples_load() {
         .collect();
     assert_eq!(blocks.len(), 2, "a scene and a variant of a built-in one");
     let scene = Scene::parse("docs/scenes.md", &blocks[0]).unwrap();
-    assert_eq!(scene.setup().unwrap().walker.model.dof(), 2);
+    assert_eq!(scene.setup().unwrap().walker.model().dof(), 2);
     let variant = Scene::parse("docs/scenes.md", &blocks[1]).unwrap();
     assert_eq!(variant.values["slope_rad"], 0.04);
-    let model = variant.build().unwrap().model;
+    let built = variant.build().unwrap();
+    let model = built.model();
     let swing = model.link_index("swing_leg").unwrap();
     assert_eq!(model.links[swing.0].joint_force.damping, 0.3);
 }

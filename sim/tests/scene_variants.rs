@@ -50,15 +50,16 @@ fn a_variant_adding_a_damper_gives_the_model_of_the_base_file_with_it() {
     );
     let written = written.unwrap();
     let (a, b) = (variant.setup().unwrap(), written.setup().unwrap());
-    assert_eq!(a.walker.model, b.walker.model);
+    assert_eq!(a.walker.model(), b.walker.model());
     assert_eq!(format!("{a:?}"), format!("{b:?}"));
     let force =
-        &a.walker.model.links[a.walker.model.link_index("swing_leg").unwrap().0].joint_force;
+        &a.walker.model().links[a.walker.model().link_index("swing_leg").unwrap().0].joint_force;
     assert_eq!((force.damping, force.stiffness), (0.3, 2.0));
     // The damper follows its parameter.
     let mut changed = variant.clone();
     changed.set("hip_damping_n_m_s_rad", 0.7).unwrap();
-    let model = changed.build().unwrap().model;
+    let built = changed.build().unwrap();
+    let model = built.model();
     assert_eq!(
         model.links[model.link_index("swing_leg").unwrap().0]
             .joint_force
@@ -88,10 +89,10 @@ fn overriding_a_default_changes_the_default_in_the_parameter_table() {
         let q = default(&base, "slope_rad");
         assert_eq!((p.unit, p.doc, p.min, p.max), (q.unit, q.doc, q.min, q.max));
         assert_eq!(scene.values["slope_rad"], 0.04);
-        assert_eq!(scene.setup().unwrap().walker.model, {
+        assert_eq!(scene.setup().unwrap().walker.model(), {
             let mut s = Scene::load("compass").unwrap();
             s.set("slope_rad", 0.04).unwrap();
-            s.build().unwrap().model
+            s.build().unwrap().model()
         });
     }
 }

@@ -63,11 +63,11 @@ fn the_paper_scenes_use_every_table_one_value() {
             assert_eq!(v[param], table_one, "{name}: {param}");
         }
         assert_eq!(v["leg_inertia_about_joint"], 1.0, "{name}");
-        let ankle = common::walker(name).1.walker.ankle.unwrap();
+        let ankle = common::walker(name).1.walker.ankle().cloned().unwrap();
         assert_eq!((ankle.engage_rad, ankle.final_rad), (-0.08, 0.2), "{name}");
     }
     let (_, w) = common::walker("wisse3d");
-    let m = &w.walker.model;
+    let m = w.walker.model();
     let link = |n: &str| m.links.iter().find(|l| l.name == n).unwrap();
     let close = |a: f64, b: f64, what: &str| assert!((a - b).abs() < 1e-15, "{what}: {a} vs {b}");
     let vec = |a: nalgebra::Vector3<f64>, b: [f64; 3], what: &str| {
@@ -157,7 +157,7 @@ fn leg_inertia_about_the_joint_axle_is_parallel_axis_shifted_to_the_centre_of_ma
         let (mut scene, _) = common::walker("wisse3d");
         scene.set("leg_inertia_about_joint", about_joint).unwrap();
         let w = scene.setup().unwrap();
-        let m = &w.walker.model;
+        let m = w.walker.model();
         let of = |link: &str| {
             let i = m.links.iter().position(|l| l.name == link).unwrap();
             let j = m.links[i].body.inertia_com_kg_m2;
@@ -199,7 +199,7 @@ fn the_six_multipliers_nearest_the_circle_of_the_3d_walker_are_3d_modes() {
         &g.jacobian,
         &g.eigenvalues,
         &w.walker.map_names(),
-        &w.walker.three_d_freedoms,
+        w.walker.three_d_freedoms(),
     );
     assert_eq!(m.len(), g.eigenvalues.len());
     // All inside the circle: nearest to it is largest in modulus.
@@ -226,7 +226,7 @@ fn the_centre_of_mass_reading_at_table_one_is_unstable_in_a_3d_mode() {
         &g.jacobian,
         &g.eigenvalues,
         &w.walker.map_names(),
-        &w.walker.three_d_freedoms,
+        w.walker.three_d_freedoms(),
     );
     let worst = m.iter().max_by(|a, b| a.abs.total_cmp(&b.abs)).unwrap();
     assert!(worst.three_d, "{worst:?}");
@@ -270,7 +270,7 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
 fn stance_yaw_per_step(w: &sim::scene::Setup, walk: &sim::stride::walk::Walk) -> Vec<f64> {
     let yaw = w
         .walker
-        .model
+        .model()
         .coordinates
         .iter()
         .position(|c| c.name == "stance_foot_yaw")
@@ -367,7 +367,7 @@ fn speed_and_cost_of_transport_are_near_the_paper_and_energy_balances() {
             "progress leaves out the sideways zigzag"
         );
         let speed = length / s.duration_s;
-        let cot = s.actuator_work_j / (w.walker.model.total_mass_kg() * length);
+        let cot = s.actuator_work_j / (w.walker.model().total_mass_kg() * length);
         assert!((0.4..0.7).contains(&speed), "{name}: speed {speed}");
         assert!((0.1..0.2).contains(&cot), "{name}: cost of transport {cot}");
         // Over a periodic stride on level ground the actuator's work is what impacts and the

@@ -52,11 +52,7 @@ pub fn setup() -> &'static Setup {
 /// the scene's extension profile is the firmware's default one (taut −0.08 rad, extended
 /// 0.2 rad, 0.27 s; checked here, and by the `sil` crate's `scene_profile` test).
 pub fn matched() -> SilConfig {
-    let reflex = setup()
-        .walker
-        .ankle
-        .clone()
-        .expect("wisse3d has actuated ankles");
+    let reflex = setup().walker.ankle().expect("wisse3d has actuated ankles");
     for (scene, id) in [
         (reflex.engage_rad, protocol::ParamId::TautAngle),
         (reflex.final_rad, protocol::ParamId::ExtendedAngle),

@@ -89,7 +89,7 @@ pub fn eigenvalues(scene: &Scene, walker: &Walker, gait: &Gait) -> Plot {
         &gait.jacobian,
         &gait.eigenvalues,
         &walker.map_names(),
-        &walker.three_d_freedoms,
+        walker.three_d_freedoms(),
     );
     let (three_d, plain): (Vec<_>, Vec<_>) = m.iter().partition(|e| e.three_d);
     let point = |e: &&sim::analysis::stability::EigenMode| (e.eigenvalue[0], e.eigenvalue[1]);
@@ -299,10 +299,10 @@ pub fn joint_angles(
         _ => 1.0,
     };
     let samples = dense(samples, CURVE_POINTS / duration_s);
-    let coords = &walker.model.coordinates;
+    let coords = &walker.model().coordinates;
     let revolute = coords.iter().all(|c| {
         walker
-            .model
+            .model()
             .links
             .get(c.link.0)
             .is_none_or(|l| matches!(l.joint, JointKind::Revolute { .. }))

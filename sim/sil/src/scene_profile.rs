@@ -72,7 +72,7 @@ mod tests {
     fn the_wisse3d_scene_profile_is_the_firmware_default_profile() {
         let scene = sim::scene::Scene::load("wisse3d").unwrap();
         let walker = scene.build().unwrap();
-        let reflex = walker.ankle.as_ref().unwrap();
+        let reflex = walker.ankle().unwrap();
         for (scene_name, scene_value, id) in [
             ("ankle_engage_rad", reflex.engage_rad, ParamId::TautAngle),
             ("ankle_final_rad", reflex.final_rad, ParamId::ExtendedAngle),
@@ -113,7 +113,7 @@ mod tests {
     #[test]
     fn a_difference_or_a_missing_report_is_named() {
         let walker = sim::scene::Scene::load("wisse3d").unwrap().build().unwrap();
-        let mut reflex = walker.ankle.clone().unwrap();
+        let mut reflex = walker.ankle().cloned().unwrap();
         (reflex.engage_rad, reflex.final_rad, reflex.duration_s) = (-0.08, 0.2, 0.27);
         let same = BTreeMap::from([
             (Side::Left, node(-0.08, 0.2, 0.27)),

@@ -201,7 +201,7 @@ pub fn study_with_progress(
         on_setting();
     }
     Ok(AccuracyStudy {
-        scene: w.name.clone(),
+        scene: w.name().to_string(),
         reference,
         reference_step_period_s: t_ref,
         points,

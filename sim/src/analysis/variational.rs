@@ -213,14 +213,15 @@ fn variational<const N: usize>(
     v: &DVector<f64>,
     settings: &StrideSettings,
 ) -> Result<(DMatrix<f64>, StrideResult), VariationalError> {
-    if walker.model.has_infinitesimal_bodies() || walker.impact_model.has_infinitesimal_bodies() {
+    if walker.model().has_infinitesimal_bodies() || walker.impact_model().has_infinitesimal_bodies()
+    {
         return Err(VariationalError::Unsupported(
             "infinitesimal bodies (their vanishing-mass limit is solved in f64 only)".into(),
         ));
     }
     let (q0, qd0) = walker.unpack(v);
     let nominal = walker.stride(&q0, &qd0, StrideRequest::new(settings))?;
-    let n = walker.model.dof();
+    let n = walker.model().dof();
     let m = v.len();
     let coords = walker.map_coordinates();
     let half = coords.len();
@@ -234,7 +235,7 @@ fn variational<const N: usize>(
         active: vec![true; n],
         drive: None,
     };
-    for c in &walker.initially_locked {
+    for c in walker.initially_locked() {
         spec.active[c.0] = false;
     }
     let (mut start, mut start_sens) = (0.0, vec![0.0; m]);
@@ -248,8 +249,8 @@ fn variational<const N: usize>(
         | IntegratorChoice::Dopri5 { rtol, h_max_s, .. } => (rtol, h_max_s),
         _ => (1e-12, 0.05),
     };
-    let mut dy_f: DynamicsOf<f64> = DynamicsOf::new(&walker.model);
-    let mut dy_d: DynamicsOf<DualSVec64<N>> = DynamicsOf::new(&walker.model);
+    let mut dy_f: DynamicsOf<f64> = DynamicsOf::new(walker.model());
+    let mut dy_d: DynamicsOf<DualSVec64<N>> = DynamicsOf::new(walker.model());
     for (event, (before, after)) in nominal.events.iter().zip(&nominal.event_states) {
         // The flow up to the event.
         phi = propagate::<N>(
@@ -265,7 +266,7 @@ fn variational<const N: usize>(
         )?;
         let t = before.t_s;
         let field = |spec: &PhaseSpec, start: f64, s: &Sample, dy: &mut DynamicsOf<f64>| {
-            accelerations(&walker.model, dy, spec, t, start, &s.q, &s.qd)
+            accelerations(walker.model(), dy, spec, t, start, &s.q, &s.qd)
                 .map(|a| DVector::from_fn(2 * n, |i, _| if i < n { s.qd[i] } else { a[i - n] }))
                 .map_err(num)
         };
@@ -293,8 +294,8 @@ fn variational<const N: usize>(
             };
         let name = event.name.as_str();
         if name == "heel_strike" {
-            let foot = walker.model.points[walker.heel_strike.swing_foot.0].clone();
-            let model = &walker.model;
+            let foot = walker.model().points[walker.heel_strike().swing_foot.0].clone();
+            let model = walker.model();
             let height = move |x: &DVector<DualSVec64<N>>| -> DualSVec64<N> {
                 let mut kin: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(model);
                 let q = x.rows(0, n).into_owned();
@@ -313,9 +314,9 @@ fn variational<const N: usize>(
         let (c, value, impact_active, new_spec) =
             if let Some(knee) = name.strip_prefix("knee_lock:") {
                 let k = walker
-                    .knees
+                    .knees()
                     .iter()
-                    .find(|k| walker.model.coordinates[k.coordinate.0].name == knee)
+                    .find(|k| walker.model().coordinates[k.coordinate.0].name == knee)
                     .ok_or_else(|| num(format!("unknown knee {knee}")))?;
                 let c = k.coordinate.0;
                 let mut s = spec.clone();
@@ -323,8 +324,7 @@ fn variational<const N: usize>(
                 (c, k.stop_rad, spec.active.clone(), s)
             } else if name == "string_engaged" {
                 let r = walker
-                    .ankle
-                    .as_ref()
+                    .ankle()
                     .ok_or_else(|| num("engagement without an ankle reflex"))?;
                 let (a, toe) = (r.ankle.0, r.toe_pitch.0);
                 let mut act = spec.active.clone();
@@ -348,7 +348,7 @@ fn variational<const N: usize>(
                 let target = DVector::zeros(1);
                 let qd_plus = solve_finite(
                     dy,
-                    &walker.model,
+                    walker.model(),
                     q,
                     qd,
                     &impact_active,
@@ -417,16 +417,16 @@ fn propagate<const N: usize>(
     rtol: f64,
     h_max: f64,
 ) -> Result<DMatrix<f64>, VariationalError> {
-    let n = walker.model.dof();
+    let n = walker.model().dof();
     let m = phi.ncols();
     let mut sys = Augmented::<N> {
-        model: &walker.model,
+        model: walker.model(),
         spec: spec.clone(),
         start,
         start_sens: start_sens.to_vec(),
         n,
         m,
-        dy: DynamicsOf::new(&walker.model),
+        dy: DynamicsOf::new(walker.model()),
     };
     let mut q = DVector::zeros(n + n * m);
     let mut qd = DVector::zeros(n + n * m);
@@ -479,21 +479,21 @@ fn terminal_jacobian<const N: usize>(
     before: &Sample,
     y: &DMatrix<f64>,
 ) -> Result<DMatrix<f64>, VariationalError> {
-    let n = walker.model.dof();
+    let n = walker.model().dof();
     // The f64 relabelling, for the converged new pose.
     let hs = walker.heel_strike_impact(before, active).map_err(num)?;
-    let nr = walker.heel_strike.release.len();
-    let mi = &walker.impact_model;
+    let nr = walker.heel_strike().release.len();
+    let mi = walker.impact_model();
     let mut kin: KinematicsOf<f64> = KinematicsOf::new(mi);
     kin.update(mi, &hs.q, &hs.qd_plus);
     let states = LinkStates::from_kinematics(&kin, nr, &hs.p_contact_m);
     let solved = walker
-        .relabel
-        .solve(&walker.model, &states, &walker.relabel_reference_q)
-        .or_else(|_| walker.relabel.solve(&walker.model, &states, &before.q))
+        .relabel()
+        .solve(walker.model(), &states, walker.relabel_reference_q())
+        .or_else(|_| walker.relabel().solve(walker.model(), &states, &before.q))
         .map_err(num)?;
     let mut q_new = solved.q.clone();
-    for (c, x) in walker.relabel.cyclic.iter().zip(&solved.cyclic_values) {
+    for (c, x) in walker.relabel().cyclic.iter().zip(&solved.cyclic_values) {
         q_new[c.0] = *x;
     }
     let x_minus = stacked(before);
@@ -522,9 +522,9 @@ fn terminal_map<const N: usize>(
     qd: &DVector<DualSVec64<N>>,
     q_new: &DVector<f64>,
 ) -> Result<DVector<DualSVec64<N>>, VariationalError> {
-    let hs = &walker.heel_strike;
+    let hs = walker.heel_strike();
     let nr = hs.release.len();
-    let mi = &walker.impact_model;
+    let mi = walker.impact_model();
     let rows = heel_strike_rows(mi, hs, q, qd, active);
     let target = &rows.g * &rows.qd * konst::<DualSVec64<N>>(-hs.restitution);
     let mut dy: DynamicsOf<DualSVec64<N>> = DynamicsOf::new(mi);
@@ -542,8 +542,8 @@ fn terminal_map<const N: usize>(
     let mut kin: KinematicsOf<DualSVec64<N>> = KinematicsOf::new(mi);
     kin.update(mi, &rows.q, &qd_plus);
     // The old links' states relative to the new contact, mirrored if the scene mirrors.
-    let rel = &walker.relabel;
-    let model = &walker.model;
+    let rel = walker.relabel();
+    let model = walker.model();
     let old = LinkStatesOf::from_kinematics(&kin, nr, &rows.p_contact_m);
     let targets = RelabelTargets::new(rel, model, &old);
     // Positions: one Gauss-Newton step from the converged pose (implicit function

@@ -10,6 +10,7 @@
 
 pub mod actuator;
 pub(crate) mod axis_tree;
+pub(crate) mod compiled;
 pub mod contact;
 pub mod control;
 pub mod dynamics;

@@ -24,13 +24,14 @@ use nalgebra::{DVector, SMatrix, SVector};
 
 mod chain;
 mod links;
+mod points;
 mod three_link;
 mod trig;
 mod two_link;
 
 use crate::engine::EvaluationPath;
-pub(crate) use chain::Joints;
 pub use links::{LinkFrame, PlanarLinks, MAX_LINKS, MAX_PLANAR_COORDINATES};
+pub(crate) use points::PlanarPoints;
 pub use trig::sin_cos;
 
 /// A small planar tree, ready for fast evaluations: built once from a [`Model`] that qualifies.

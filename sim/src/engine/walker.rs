@@ -1,10 +1,14 @@
 //! A hybrid walker: a model plus its contact, impact, event and relabelling rules (the rules
-//! themselves, over the model only, are in `crate::engine::hybrid`).
+//! themselves, over the model only, are in `crate::engine::hybrid`), and what it derives from
+//! them once (`crate::engine::compiled`). Built by [`Walker::new`] and read-only after: a
+//! changed walker is a new one ([`Walker::into_parts`], then [`Walker::new`]).
 
+use crate::engine::compiled::{CompiledWalker, PathStructures};
 use crate::engine::events::Direction;
 pub use crate::engine::hybrid::heel_strike::{ContactConstraint, HeelStrikeRule};
 use crate::engine::model::{CoordIndex, Model, PointIndex};
 use crate::engine::relabel::Relabel;
+use crate::engine::EvaluationPath;
 use nalgebra::DVector;
 
 /// A knee with a hyperextension stop that locks after its inelastic impact.
@@ -27,36 +31,21 @@ pub struct FallRule {
     pub min_hip_height_m: f64,
 }
 
-/// A complete hybrid walker.
+/// A complete hybrid walker (read-only: see the module's documentation).
 #[derive(Clone, Debug)]
 pub struct Walker {
-    /// The scene name.
-    pub name: String,
-    /// The single-stance model.
-    pub model: Model,
-    /// The same model with the stance contact released (for impacts).
-    pub impact_model: Model,
-    /// Heel strike.
-    pub heel_strike: HeelStrikeRule,
-    /// Knee locks (empty for straight legs).
-    pub knees: Vec<KneeLock>,
-    /// Falls.
-    pub fall: FallRule,
-    /// Relabelling after heel strike.
-    pub relabel: Relabel,
-    /// The stance ankle's stretch reflex, if the walker has one.
-    pub ankle: Option<crate::engine::actuator::AnkleReflex>,
-    /// Coordinates locked (at zero) at the start of every stride, e.g. the toe pitch of a flat
-    /// stance foot. They are left out of the stride map.
-    pub initially_locked: Vec<CoordIndex>,
-    /// Coordinates only the 3D model has (for eigenvalue reports).
-    pub three_d_freedoms: Vec<String>,
-    /// The relabelling's reference pose: the Newton solve that finds the new stance
-    /// coordinates after heel strike starts from it (and, failing that, from the pre-impact
-    /// pose). Any pose near the walker's stance just after heel strike will do; the scene sets
-    /// it to the coordinates of its gait guess. It does not change the solution, only whether
-    /// and how fast the solve finds it.
-    pub relabel_reference_q: DVector<f64>,
+    name: String,
+    model: Model,
+    impact_model: Model,
+    heel_strike: HeelStrikeRule,
+    knees: Vec<KneeLock>,
+    fall: FallRule,
+    relabel: Relabel,
+    ankle: Option<crate::engine::actuator::AnkleReflex>,
+    initially_locked: Vec<CoordIndex>,
+    three_d_freedoms: Vec<String>,
+    relabel_reference_q: DVector<f64>,
+    compiled: CompiledWalker,
 }
 
 /// A walker's rules besides its model: what [`Walker::new`] builds a walker from.
@@ -108,7 +97,97 @@ impl Walker {
             initially_locked,
             three_d_freedoms,
             relabel_reference_q,
+            compiled: CompiledWalker::default(),
         }
+    }
+
+    /// The walker's name, model and rules, as [`Walker::new`] takes them (to build a changed
+    /// walker from).
+    pub fn into_parts(self) -> (String, Model, WalkerRules) {
+        let rules = WalkerRules {
+            heel_strike: self.heel_strike,
+            knees: self.knees,
+            fall: self.fall,
+            relabel: self.relabel,
+            ankle: self.ankle,
+            three_d_freedoms: self.three_d_freedoms,
+            relabel_reference_q: self.relabel_reference_q,
+        };
+        (self.name, self.model, rules)
+    }
+
+    /// This walker with its model and rules changed by `change`: a new walker
+    /// ([`Walker::new`] of the changed parts), its derived structures built again.
+    pub fn with_changes(self, change: impl FnOnce(&mut Model, &mut WalkerRules)) -> Self {
+        let (name, mut model, mut rules) = self.into_parts();
+        change(&mut model, &mut rules);
+        Self::new(name, model, rules)
+    }
+
+    /// The scene name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The single-stance model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The same model with the stance contact released (for impacts).
+    pub fn impact_model(&self) -> &Model {
+        &self.impact_model
+    }
+
+    /// Heel strike.
+    pub fn heel_strike(&self) -> &HeelStrikeRule {
+        &self.heel_strike
+    }
+
+    /// Knee locks (empty for straight legs).
+    pub fn knees(&self) -> &[KneeLock] {
+        &self.knees
+    }
+
+    /// Falls.
+    pub fn fall(&self) -> &FallRule {
+        &self.fall
+    }
+
+    /// Relabelling after heel strike.
+    pub fn relabel(&self) -> &Relabel {
+        &self.relabel
+    }
+
+    /// The stance ankle's stretch reflex, if the walker has one.
+    pub fn ankle(&self) -> Option<&crate::engine::actuator::AnkleReflex> {
+        self.ankle.as_ref()
+    }
+
+    /// Coordinates locked (at zero) at the start of every stride, e.g. the toe pitch of a flat
+    /// stance foot. They are left out of the stride map.
+    pub fn initially_locked(&self) -> &[CoordIndex] {
+        &self.initially_locked
+    }
+
+    /// Coordinates only the 3D model has (for eigenvalue reports).
+    pub fn three_d_freedoms(&self) -> &[String] {
+        &self.three_d_freedoms
+    }
+
+    /// The relabelling's reference pose: the Newton solve that finds the new stance
+    /// coordinates after heel strike starts from it (and, failing that, from the pre-impact
+    /// pose). Any pose near the walker's stance just after heel strike will do; the scene sets
+    /// it to the coordinates of its gait guess. It does not change the solution, only whether
+    /// and how fast the solve finds it.
+    pub fn relabel_reference_q(&self) -> &DVector<f64> {
+        &self.relabel_reference_q
+    }
+
+    /// What the walker derives from its model for `path`, built at the first call.
+    pub(crate) fn compiled(&self, path: EvaluationPath) -> &PathStructures {
+        self.compiled
+            .path(&self.model, &self.heel_strike, self.fall.hip, path)
     }
 
     /// The coordinates that enter the stride map (all but the cyclic ones).

@@ -136,7 +136,7 @@ mod tests {
     #[test]
     fn table_one_push_is_cut_by_heel_strike() {
         let (scene, setup, gait) = table_one_gait();
-        let reflex = setup.walker.ankle.as_ref().unwrap();
+        let reflex = setup.walker.ankle().unwrap();
         let x = AnkleExtension::of(reflex, &gait.stride).unwrap();
         // The profile from the scene's parameters (Table I: -0.08 to 0.2 rad).
         let (from, to, d) = (
@@ -179,7 +179,7 @@ mod tests {
     #[test]
     fn a_short_profile_completes_before_heel_strike() {
         let (_, setup, gait) = table_one_gait();
-        let mut reflex = setup.walker.ankle.clone().unwrap();
+        let mut reflex = setup.walker.ankle().cloned().unwrap();
         // The same stride read with a profile shorter than the push: complete, at the end.
         let t0 = gait
             .stride
@@ -196,7 +196,7 @@ mod tests {
     #[test]
     fn a_stride_without_release_is_refused() {
         let (_, setup, mut gait) = table_one_gait();
-        let reflex = setup.walker.ankle.as_ref().unwrap();
+        let reflex = setup.walker.ankle().unwrap();
         gait.stride.events.pop();
         gait.stride.event_states.pop();
         assert_eq!(

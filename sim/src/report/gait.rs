@@ -193,10 +193,10 @@ impl GaitReport {
 impl FoundGait {
     fn new(scene: &Scene, walker: &Walker, g: &Gait, contact: Option<&ContactSummary>) -> Self {
         let n = gait_numbers(walker, g);
-        let mass = walker.model.total_mass_kg();
-        let g_m_s2 = walker.model.gravity_floor_m_s2.norm();
+        let mass = walker.model().total_mass_kg();
+        let g_m_s2 = walker.model().gravity_floor_m_s2.norm();
         let s = &g.stride;
-        let actuator = walker.ankle.as_ref().map(|_| {
+        let actuator = walker.ankle().map(|_| {
             let cost = s.actuator_work_j / (mass * n.progress_m);
             ActuatorFigures {
                 actuator_work_j_per_step: s.actuator_work_j,
@@ -230,11 +230,11 @@ impl FoundGait {
                 &g.jacobian,
                 &g.eigenvalues,
                 &walker.map_names(),
-                &walker.three_d_freedoms,
+                walker.three_d_freedoms(),
             ),
             actuator,
             ankle_extension: walker
-                .ankle
+                .ankle()
                 .as_ref()
                 .and_then(|r| AnkleExtension::of(r, s).ok()),
             contact: contact.map(ContactFigures::from),

@@ -35,7 +35,7 @@ impl IdealGaitRecord {
     /// The figures of `gait`, found by `walker`.
     pub fn of(walker: &Walker, gait: &Gait) -> Self {
         let n = gait_numbers(walker, gait);
-        let cost = gait.stride.actuator_work_j / (walker.model.total_mass_kg() * n.progress_m);
+        let cost = gait.stride.actuator_work_j / (walker.model().total_mass_kg() * n.progress_m);
         Self {
             step_period_s: n.step_period_s,
             step_length_m: n.step_length_m,

@@ -91,7 +91,7 @@ pub fn forward_progress_m(walker: &Walker, gait: &Gait) -> f64 {
     let next = crate::stride::walk::FloorFrame::default().next(
         &c,
         gait.stride.heading_change_rad,
-        walker.relabel.mirror,
+        walker.relabel().mirror,
     );
     (c + next.r * c).norm() / 2.0
 }

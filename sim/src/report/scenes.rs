@@ -78,7 +78,7 @@ impl SceneEntry {
         let coordinates: Vec<String> = scene
             .setup()?
             .walker
-            .model
+            .model()
             .coordinates
             .iter()
             .map(|c| c.name.clone())

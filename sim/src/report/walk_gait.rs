@@ -67,7 +67,7 @@ impl WalkGaitRecord {
             let (dx, dz) = (b[0] - a[0], b[2] - a[2]);
             ((dx * dx + dz * dz).sqrt() / k as f64, Some(dz.atan2(dx)))
         };
-        let cost = work / (walker.model.total_mass_kg() * progress);
+        let cost = work / (walker.model().total_mass_kg() * progress);
         Some(Self {
             steps_averaged: n,
             step_period_s: period,

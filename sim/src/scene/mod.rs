@@ -323,7 +323,7 @@ impl Scene {
         for o in &conv.outputs {
             self.opt(&o.offset, &format!("convention output `{}`.offset", o.name))?;
             for (name, c) in &o.coefficients {
-                if walker.model.coord_index(name).is_none() {
+                if walker.model().coord_index(name).is_none() {
                     return Err(SceneError::Invalid(format!(
                         "convention output `{}`: unknown coordinate `{name}`",
                         o.name
@@ -356,7 +356,7 @@ impl Scene {
             let mut v = self.opt(&o.offset, &o.name)?;
             let mut vd = 0.0;
             for (name, c) in &o.coefficients {
-                let i: CoordIndex = walker.model.coord_index(name).ok_or_else(|| {
+                let i: CoordIndex = walker.model().coord_index(name).ok_or_else(|| {
                     SceneError::Invalid(format!("convention output `{}`: unknown `{name}`", o.name))
                 })?;
                 v += c * q[i.0];

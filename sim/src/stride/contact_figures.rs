@@ -35,7 +35,7 @@ impl ContactSummary {
         let mut s2 = s.clone();
         phase.snap(&mut s2);
         wit.update(&s2);
-        let load = crate::engine::contact::ContactLoad::from_motion(&walker.model, &wit.kin, &qdd);
+        let load = crate::engine::contact::ContactLoad::from_motion(walker.model(), &wit.kin, &qdd);
         let cop = load.lateral_cop_m(&wit.heading());
         if self.lateral_cop_trace.is_empty() {
             self.min_normal_force_n = f64::INFINITY;

@@ -73,10 +73,10 @@ impl Walker {
         c: usize,
         value: f64,
     ) -> Result<Locked, StrideFailure> {
-        let g = unit_row(self.model.dof(), c);
-        let mut dynamics = Dynamics::new(&self.model);
-        let before = energy(&mut dynamics, &self.model, at);
-        let imp = resolve(&mut dynamics, &self.model, &at.q, &at.qd, active, &g, 0.0)
+        let g = unit_row(self.model().dof(), c);
+        let mut dynamics = Dynamics::new(self.model());
+        let before = energy(&mut dynamics, self.model(), at);
+        let imp = resolve(&mut dynamics, self.model(), &at.q, &at.qd, active, &g, 0.0)
             .map_err(|e| StrideFailure::new(at.t_s, e))?;
         // A drive holding the ankle through the impact takes an impulse and does work on it
         // (impulse × its rate, which the impact does not change): the actuator's work, not part
@@ -90,7 +90,7 @@ impl Walker {
         };
         let (q, qd) = locked_state(&at.q, imp.qd_plus, c, value, 0.0);
         let after = Sample { t_s: at.t_s, q, qd };
-        let loss_j = before - energy(&mut dynamics, &self.model, &after) + drive_work_j;
+        let loss_j = before - energy(&mut dynamics, self.model(), &after) + drive_work_j;
         Ok(Locked {
             after,
             loss_j,
@@ -112,13 +112,21 @@ impl Walker {
         let (a, toe) = (reflex.ankle.0, reflex.toe_pitch.0);
         let mut act = active.to_vec();
         act[toe] = true;
-        let g = unit_row(self.model.dof(), a);
+        let g = unit_row(self.model().dof(), a);
         let (p_rad, v_rad_s, _) = drive.eval(at.t_s);
-        let mut dynamics = Dynamics::new(&self.model);
-        let before = energy(&mut dynamics, &self.model, at);
+        let mut dynamics = Dynamics::new(self.model());
+        let before = energy(&mut dynamics, self.model(), at);
         let target = DVector::from_element(1, v_rad_s);
-        let imp = resolve_to(&mut dynamics, &self.model, &at.q, &at.qd, &act, &g, &target)
-            .map_err(|e| StrideFailure::new(at.t_s, e))?;
+        let imp = resolve_to(
+            &mut dynamics,
+            self.model(),
+            &at.q,
+            &at.qd,
+            &act,
+            &g,
+            &target,
+        )
+        .map_err(|e| StrideFailure::new(at.t_s, e))?;
         // The string's impulse on the ankle, with its far end moving at the drive's rate, is
         // work the actuator does (zero for the ideal drive, which starts at rest).
         let drive_work_j = imp.impulse[0] * v_rad_s;
@@ -132,7 +140,7 @@ impl Walker {
             ));
         }
         let after = Sample { t_s: at.t_s, q, qd };
-        let dissipated_j = before - energy(&mut dynamics, &self.model, &after);
+        let dissipated_j = before - energy(&mut dynamics, self.model(), &after);
         act[a] = false;
         Ok(Engaged {
             after,
@@ -149,8 +157,8 @@ impl Walker {
         at: &Sample,
         active: &[bool],
     ) -> Result<HeelStrikeImpact, ImpactError> {
-        let hs = &self.heel_strike;
-        let m = &self.impact_model;
+        let hs = &self.heel_strike();
+        let m = &self.impact_model();
         let HeelStrikeRows {
             q,
             qd,
@@ -198,9 +206,9 @@ impl Walker {
         mut energy_loss: f64,
     ) -> Result<StrideResult, StrideFailure> {
         let t = at.t_s;
-        let hs = &self.heel_strike;
+        let hs = &self.heel_strike();
         let nr = hs.release.len();
-        let m = &self.impact_model;
+        let m = &self.impact_model();
         let HeelStrikeImpact {
             q,
             qd_plus,
@@ -224,9 +232,9 @@ impl Walker {
         }
         let states = LinkStates::from_kinematics(&kin, nr, &p_foot);
         let solved = self
-            .relabel
-            .solve(&self.model, &states, &self.relabel_reference_q)
-            .or_else(|_| self.relabel.solve(&self.model, &states, &at.q))
+            .relabel()
+            .solve(self.model(), &states, self.relabel_reference_q())
+            .or_else(|_| self.relabel().solve(self.model(), &states, &at.q))
             .map_err(|e| StrideFailure::new(t, e))?;
         Ok(StrideResult {
             q_next: solved.q,

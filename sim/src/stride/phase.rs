@@ -3,12 +3,14 @@
 
 use crate::engine::actuator::AnkleProfile;
 use crate::engine::axis_tree::AxisTree;
+use crate::engine::compiled::PathStructures;
 use crate::engine::control::ActuatorSegment;
 use crate::engine::dynamics::{Dynamics, DynamicsError};
 use crate::engine::hybrid::phase::DriveValues;
 use crate::engine::integrators::{Sample, SecondOrderSystem, StabilityLimit};
 use crate::engine::model::{CoordIndex, Model};
 use crate::engine::planar::PlanarTree;
+use crate::engine::walker::Walker;
 use crate::stride::EvaluationPath;
 use nalgebra::{DMatrix, DVector};
 
@@ -223,16 +225,22 @@ impl<'a> Phase<'a> {
         Self::with_path(model, EvaluationPath::Auto)
     }
 
-    /// All coordinates active, evaluated along `path`.
+    /// All coordinates active, evaluated along `path` (the trees built here).
     pub fn with_path(model: &'a Model, path: EvaluationPath) -> Self {
-        let planar = PlanarTree::for_path(model, path);
-        let axis_tree = match (&planar, path) {
-            (
-                None,
-                EvaluationPath::Auto | EvaluationPath::GeneralLoop | EvaluationPath::LinkPass,
-            ) => AxisTree::of(model),
-            _ => None,
-        };
+        Self::on_trees(model, PathStructures::trees(model, path))
+    }
+
+    /// All coordinates active, evaluated along `path` on copies of the trees `walker`
+    /// compiled once.
+    pub(crate) fn of_walker(walker: &'a Walker, path: EvaluationPath) -> Self {
+        Self::on_trees(walker.model(), walker.compiled(path).clone())
+    }
+
+    /// All coordinates active, evaluated on `trees`.
+    fn on_trees(model: &'a Model, trees: PathStructures) -> Self {
+        let PathStructures {
+            planar, axis_tree, ..
+        } = trees;
         Self {
             model,
             dynamics: Dynamics::new(model),
@@ -554,7 +562,7 @@ mod tests {
         let setup = Scene::load("wisse3d").unwrap().setup().unwrap();
         let gait = setup.find_gait(&NewtonSettings::default()).unwrap();
         let walker = &setup.walker;
-        let ankle = walker.ankle.as_ref().unwrap().ankle;
+        let ankle = walker.ankle().unwrap().ankle;
         let (q, qd) = walker.unpack(&gait.fixed_point);
         let seg = |t0_s: f64, p0_rad: f64, v0_rad_s: f64, v1_rad_s: f64| ActuatorSegment {
             t0_s,
@@ -570,7 +578,7 @@ mod tests {
             seg(0.1, q[ankle.0], 1.5, 3.0),
         );
         let phase_with = |s: ActuatorSegment| {
-            let mut p = Phase::new(&walker.model);
+            let mut p = Phase::new(walker.model());
             p.active[ankle.0] = false;
             p.prescribed = Some((ankle, Drive::Segment(s)));
             p

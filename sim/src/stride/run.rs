@@ -123,7 +123,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             schedule: ScheduleCursor::new(schedule),
             evaluations: 0,
             steps: 0,
-            power: Power::new(&walker.model),
+            power: Power::new(walker.model()),
             contact: ContactSummary::default(),
             wit,
             w_cached: None,
@@ -248,7 +248,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             cur: &mut self.cur,
         };
         if self.ticks.control_tick(plant, self.w_cached)? == TickEffect::Released {
-            self.power.close(&self.walker.model, &self.cur);
+            self.power.close(self.walker.model(), &self.cur);
             self.events.push(StrideEvent {
                 name: "string_released".into(),
                 t_stride_s: self.cur.t_s(),
@@ -395,7 +395,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         w_cur: &WitnessValues,
         w_next: &WitnessValues,
     ) -> bool {
-        let hs = &self.walker.heel_strike;
+        let hs = self.walker.heel_strike();
         triggered == [Watch::Heel]
             && hs.ignore_scuffing
             && self.power.undamped()
@@ -407,7 +407,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     /// The string's limit the engagement witness compares with.
     fn string_limit(&self) -> StringLimit {
         match (
-            &self.walker.ankle,
+            &self.walker.ankle(),
             self.ticks.controlled(),
             self.ticks.segment(),
         ) {
@@ -487,7 +487,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             located.push((watch, locate(self, watch)?));
         }
         located.sort_by(|a, b| a.1.t_s().total_cmp(&b.1.t_s()));
-        let hs = &self.walker.heel_strike;
+        let hs = self.walker.heel_strike();
         if located.len() > 1
             && located[0].0 == Watch::Heel
             && hs.ignore_scuffing
@@ -514,7 +514,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 }
                 // The string is slack: the heel lands, an inelastic impact that stops the
                 // foot's pitch about its toe; the foot is flat again, the ankle free.
-                let Some(r) = &w.ankle else {
+                let Some(r) = &w.ankle() else {
                     return Ok(Applied::Skipped);
                 };
                 let toe = r.toe_pitch.0;
@@ -530,7 +530,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                 Ok(Applied::Impact("heel_down".into()))
             }
             Watch::Engage => {
-                let Some(r) = &w.ankle else {
+                let Some(r) = &w.ankle() else {
                     return Ok(Applied::Skipped);
                 };
                 // The string's far end: fixed (ideal reflex) or moving with the actuator.
@@ -547,28 +547,28 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
                     self.engine.set_active(c, free);
                 }
                 self.engine.set_prescribed(Some((r.ankle, drive)));
-                self.power.open(&w.model, &self.cur);
+                self.power.open(w.model(), &self.cur);
                 Ok(Applied::Impact("string_engaged".into()))
             }
             Watch::Knee(k) => {
-                let c = w.knees[k].coordinate.0;
-                self.power.close(&w.model, at);
+                let c = w.knees()[k].coordinate.0;
+                self.power.close(w.model(), at);
                 let l = w.lock_coordinate(
                     (self.engine.active(), self.engine.prescribed()),
                     &at.to_sample(),
                     c,
-                    w.knees[k].stop_rad,
+                    w.knees()[k].stop_rad,
                 )?;
                 self.engine.set_active(c, false);
                 self.cur = self.state_after_impact(l.after, "knee lock")?;
                 self.power.work_j += l.drive_work_j;
                 self.energy_loss_j += l.loss_j;
                 if self.engine.prescribed().is_some() {
-                    self.power.open(&w.model, &self.cur);
+                    self.power.open(w.model(), &self.cur);
                 }
                 Ok(Applied::Impact(format!(
                     "knee_lock:{}",
-                    w.model.coordinates[c].name
+                    w.model().coordinates[c].name
                 )))
             }
             Watch::Heel => self.heel_strike(at),
@@ -592,8 +592,8 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     fn heel_strike(&mut self, at: &E::State) -> Result<Applied, StrideFailure> {
         let w = self.walker;
         let ahead = self.wit.eval(at).foot_ahead_m;
-        if ahead < w.heel_strike.min_ahead_m {
-            if w.heel_strike.ignore_scuffing {
+        if ahead < w.heel_strike().min_ahead_m {
+            if w.heel_strike().ignore_scuffing {
                 return Ok(Applied::Ignored);
             }
             return Err(StrideFailure::new(
@@ -604,18 +604,18 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             ));
         }
         if let Some(knee) = w
-            .knees
+            .knees()
             .iter()
             .find(|k| self.engine.active()[k.coordinate.0])
         {
             return Err(StrideFailure::new(
                 at.t_s(),
                 FailureCause::KneeFreeAtHeelStrike {
-                    knee: w.model.coordinates[knee.coordinate.0].name.clone(),
+                    knee: w.model().coordinates[knee.coordinate.0].name.clone(),
                 },
             ));
         }
-        self.power.close(&w.model, at);
+        self.power.close(w.model(), at);
         self.ticks.heel_strike(at.t_s());
         self.events.push(StrideEvent {
             name: "heel_strike".into(),

@@ -227,7 +227,7 @@ pub fn walk(
     let (mut q, mut qd) = (q0.clone(), qd0.clone());
     let v0 = walker.pack(q0, qd0);
     let names = walker.map_names();
-    let mut kin = Kinematics::new(&walker.model);
+    let mut kin = Kinematics::new(walker.model());
     let mut out = Walk {
         steps_completed: 0,
         steps: Vec::new(),
@@ -235,7 +235,7 @@ pub fn walk(
         path: Vec::new(),
     };
     let mut t0 = 0.0;
-    let hip = &walker.model.points[walker.fall.hip.0];
+    let hip = &walker.model().points[walker.fall().hip.0];
     let mut samples = Vec::new();
     let mut workspace = StrideWorkspace::new(walker);
     for step in 0..steps {
@@ -266,7 +266,7 @@ pub fn walk(
                 break;
             }
             Ok(r) => {
-                kin.update(&walker.model, &r.pre_impact.q, &r.pre_impact.qd);
+                kin.update(walker.model(), &r.pre_impact.q, &r.pre_impact.qd);
                 let p_hip = frame.apply(&kin.position_of(hip.link, &hip.p_link_m));
                 let v = walker.pack(&r.q_next, &r.qd_next);
                 let summary = StepSummary {
@@ -291,7 +291,7 @@ pub fn walk(
                 if let Some(keep) = keep_steps {
                     trim_to_kept(&mut out.steps, keep);
                 }
-                frame = frame.next(&r.step_m, r.heading_change_rad, walker.relabel.mirror);
+                frame = frame.next(&r.step_m, r.heading_change_rad, walker.relabel().mirror);
                 t0 += r.duration_s;
                 q = r.q_next;
                 qd = r.qd_next;
@@ -315,8 +315,8 @@ fn path_sample(
     t0: f64,
     s: &Sample,
 ) -> PathSample {
-    kin.update(&walker.model, &s.q, &s.qd);
-    let hip = &walker.model.points[walker.fall.hip.0];
+    kin.update(walker.model(), &s.q, &s.qd);
+    let hip = &walker.model().points[walker.fall().hip.0];
     PathSample {
         step,
         t_walk_s: t0 + s.t_s,

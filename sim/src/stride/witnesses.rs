@@ -136,25 +136,25 @@ impl<'a> Witnesses<'a> {
     pub(super) fn new(walker: &'a Walker) -> Self {
         Self {
             walker,
-            kin: Kinematics::new(&walker.model),
+            kin: Kinematics::new(walker.model()),
         }
     }
 
     pub(super) fn update(&mut self, s: &Sample) {
-        self.kin.update(&self.walker.model, &s.q, &s.qd);
+        self.kin.update(self.walker.model(), &s.q, &s.qd);
     }
 
     pub(super) fn eval(&mut self, s: &Sample) -> WitnessValues {
         self.update(s);
-        let m = &self.walker.model;
-        let foot = &m.points[self.walker.heel_strike.swing_foot.0];
+        let m = self.walker.model();
+        let foot = &m.points[self.walker.heel_strike().swing_foot.0];
         let p_foot = self.kin.position_of(foot.link, &foot.p_link_m);
-        let hip = &m.points[self.walker.fall.hip.0];
+        let hip = &m.points[self.walker.fall().hip.0];
         let p_hip = self.kin.position_of(hip.link, &hip.p_link_m);
         let p_contact = self
             .kin
-            .point_position(m, self.walker.heel_strike.stance_contact);
-        let contact_link = m.points[self.walker.heel_strike.stance_contact.0].link;
+            .point_position(m, self.walker.heel_strike().stance_contact);
+        let contact_link = m.points[self.walker.heel_strike().stance_contact.0].link;
         let heading = self.heading();
         WitnessValues {
             t_s: s.t_s,
@@ -164,7 +164,7 @@ impl<'a> Witnesses<'a> {
             foot_ahead_rate_m_s: (self.kin.velocity_of(foot.link, &p_foot)
                 - self.kin.velocity_of(contact_link, &p_contact))
             .dot(&heading),
-            hip_height_margin_m: p_hip.y - self.walker.fall.min_hip_height_m,
+            hip_height_margin_m: p_hip.y - self.walker.fall().min_hip_height_m,
             hip_ahead_m: (p_hip - p_contact).dot(&heading),
             hip_forward_velocity_m_s: self.kin.velocity_of(hip.link, &p_hip).dot(&heading),
         }
@@ -172,8 +172,8 @@ impl<'a> Witnesses<'a> {
 
     /// The walking direction: the stance contact link's forward axis, level with the floor.
     pub(super) fn heading(&self) -> Vector3<f64> {
-        let m = &self.walker.model;
-        let link = m.points[self.walker.heel_strike.stance_contact.0].link;
+        let m = self.walker.model();
+        let link = m.points[self.walker.heel_strike().stance_contact.0].link;
         let mut d = self.kin.r_floor_link[link.0] * Vector3::x();
         d.y = 0.0;
         let n = d.norm();
@@ -197,14 +197,14 @@ pub(super) fn value<S: StrideState>(
     let w = walker;
     match watch {
         Watch::Heel => wit.eval(s).foot_height_m,
-        Watch::Knee(k) => s.q(w.knees[k].coordinate.0) - w.knees[k].stop_rad,
+        Watch::Knee(k) => s.q(w.knees()[k].coordinate.0) - w.knees()[k].stop_rad,
         Watch::HipLow => wit.eval(s).hip_height_margin_m,
         Watch::HipBack => wit.eval(s).hip_forward_velocity_m_s,
         Watch::Engage => {
-            let a = w.ankle.as_ref().map_or(0, |r| r.ankle.0);
+            let a = w.ankle().as_ref().map_or(0, |r| r.ankle.0);
             s.q(a) - limit.at(s.t_s()).unwrap_or(0.0)
         }
-        Watch::HeelDrop => s.q(w.ankle.as_ref().map_or(0, |r| r.toe_pitch.0)),
+        Watch::HeelDrop => s.q(w.ankle().as_ref().map_or(0, |r| r.toe_pitch.0)),
     }
 }
 
@@ -224,7 +224,7 @@ pub(super) fn triggered<S: StrideState>(
     if Direction::Falling.triggered(w_cur.foot_height_m, w_next.foot_height_m) {
         triggered.push(Watch::Heel);
     }
-    for (k, knee) in w.knees.iter().enumerate() {
+    for (k, knee) in w.knees().iter().enumerate() {
         let c = knee.coordinate.0;
         if active[c]
             && knee
@@ -245,7 +245,7 @@ pub(super) fn triggered<S: StrideState>(
     {
         triggered.push(Watch::HipBack);
     }
-    if let Some(r) = &w.ankle {
+    if let Some(r) = &w.ankle() {
         let (a, toe) = (r.ankle.0, r.toe_pitch.0);
         let flat = !active[toe] && !driven;
         if let (true, Some(l0), Some(l1)) = (flat, limit.at(cur.t_s()), limit.at(next.t_s())) {

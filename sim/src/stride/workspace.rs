@@ -1,14 +1,13 @@
-//! [`StrideWorkspace`]: what repeated strides of one walker reuse — the structures derived
-//! from the model for the stride's evaluation path (the planar tree and the witnesses'
-//! geometry of the fixed-size engine; the reference engine's phase, with its planar tree,
-//! axis tree and dynamics workspace; the witnesses' kinematics), compiled at the first stride
-//! that needs them, and the loop's scratch storage; and the stride's entry points
+//! [`StrideWorkspace`]: what repeated strides of one walker reuse, besides what the walker
+//! itself compiled once from its model (the trees and the witnesses' planar points,
+//! `crate::engine::compiled`) — the reference engine's phase (its copies of the trees, whose
+//! assemblies it writes, and the general dynamics workspace), the witnesses' kinematics, and
+//! the loop's scratch storage; and the stride's entry points
 //! ([`Walker::stride`], [`StrideWorkspace::stride`]), which pick the engine a stride runs on
 //! (the fixed-size one where it covers the stride, else the reference) and run the one loop
 //! (`stride::run`) on it.
 //!
-//! The workspace borrows its walker: the model cannot change while the workspace lives, so
-//! what it compiled stays the model's. [`Walker::stride`] makes one for a single stride; the
+//! The workspace borrows its walker, which is read-only: what it holds stays the model's. [`Walker::stride`] makes one for a single stride; the
 //! walk loop and the gait search keep one across their strides.
 
 use super::engine::DynamicEngine;
@@ -29,9 +28,6 @@ use nalgebra::DVector;
 /// What repeated strides of one walker reuse (see the module's documentation).
 pub struct StrideWorkspace<'w> {
     walker: &'w Walker,
-    /// The fixed-size engine's compiled structures, for the path they were compiled for
-    /// (`None` inside: the walker does not qualify on that path).
-    fixed: Option<(EvaluationPath, Option<fast::Compiled>)>,
     /// The reference engine of the last stride that ran on it, with the integrator and the
     /// path it was built for.
     reference: Option<(IntegratorChoice, EvaluationPath, DynamicEngine<'w>)>,
@@ -42,11 +38,10 @@ pub struct StrideWorkspace<'w> {
 }
 
 impl<'w> StrideWorkspace<'w> {
-    /// An empty workspace for strides of `walker` (compiled at its first stride).
+    /// An empty workspace for strides of `walker` (filled at its first stride).
     pub fn new(walker: &'w Walker) -> Self {
         Self {
             walker,
-            fixed: None,
             reference: None,
             witnesses: None,
             triggered: Vec::new(),
@@ -56,14 +51,6 @@ impl<'w> StrideWorkspace<'w> {
     /// The walker this workspace runs strides of.
     pub fn walker(&self) -> &'w Walker {
         self.walker
-    }
-
-    /// The fixed-size engine's structures on `path`, compiled on first use.
-    pub(super) fn fixed(&mut self, path: EvaluationPath) -> Option<&fast::Compiled> {
-        if !matches!(&self.fixed, Some((p, _)) if *p == path) {
-            self.fixed = Some((path, fast::Compiled::of(self.walker, path)));
-        }
-        self.fixed.as_ref().and_then(|(_, c)| c.as_ref())
     }
 
     /// The reference engine for `settings`: the last stride's, restarted (all coordinates
@@ -79,7 +66,7 @@ impl<'w> StrideWorkspace<'w> {
             }
             _ => DynamicEngine {
                 integrator: settings.integrator.build(),
-                phase: Phase::with_path(&self.walker.model, settings.evaluation),
+                phase: Phase::of_walker(self.walker, settings.evaluation),
             },
         }
     }
@@ -110,9 +97,9 @@ impl Walker {
 }
 
 impl StrideWorkspace<'_> {
-    /// [`Walker::stride`] of this workspace's walker, on this workspace: what the model gives
-    /// the stride's evaluation path is compiled at the first stride (again only when a
-    /// request asks for another path or integrator), the evaluators' storage reused.
+    /// [`Walker::stride`] of this workspace's walker, on this workspace: the reference
+    /// engine's storage is made at the first stride that runs on it (again only when a request
+    /// asks for another path or integrator) and reused after.
     ///
     /// # Errors
     /// As [`Walker::stride`].
@@ -130,7 +117,7 @@ impl StrideWorkspace<'_> {
             control,
             sink,
         } = request;
-        if control.is_some() && walker.ankle.is_none() {
+        if control.is_some() && walker.ankle().is_none() {
             return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
         }
         let mut own = Vec::new();
@@ -141,7 +128,8 @@ impl StrideWorkspace<'_> {
         };
         if fast::covers(walker, settings, options, control.is_some()) {
             let mut triggered = std::mem::take(&mut self.triggered);
-            if let Some(fixed) = self.fixed(settings.evaluation) {
+            let compiled = walker.compiled(settings.evaluation);
+            if let (Some(tree), Some(points)) = (&compiled.planar, &compiled.planar_points) {
                 let recorded = trajectory.len();
                 let fast_schedule = match &mut schedule {
                     Schedule::Free => Schedule::Free,
@@ -156,7 +144,7 @@ impl StrideWorkspace<'_> {
                     trajectory,
                     triggered: &mut triggered,
                 };
-                let done = fast::stride(start, fixed, q0, qd0);
+                let done = fast::stride(start, tree, points, q0, qd0);
                 self.triggered = triggered;
                 match done {
                     Some(mut r) => {
@@ -178,7 +166,7 @@ impl StrideWorkspace<'_> {
         };
         let mut engine = self.reference_engine(settings);
         engine.integrator.reset();
-        for c in &walker.initially_locked {
+        for c in walker.initially_locked() {
             engine.phase.active[c.0] = false;
         }
         let wit = self

@@ -257,7 +257,7 @@ mod tests {
     use super::*;
 
     fn figure(scene: &Scene) -> Result<Figure, SceneError> {
-        Figure::of(scene, &scene.setup()?.walker.model)
+        Figure::of(scene, scene.setup()?.walker.model())
     }
 
     fn names(f: &Figure) -> Vec<&str> {

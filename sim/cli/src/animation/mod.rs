@@ -127,7 +127,7 @@ impl Animation<'_> {
 
     /// The page.
     pub fn html(&self) -> Result<String, AnimationError> {
-        let figure = geometry::Figure::of(self.scene, &self.walker.model)?;
+        let figure = geometry::Figure::of(self.scene, self.walker.model())?;
         let mut instants: Vec<f64> = self.events.iter().map(|e| e.t_s).collect();
         instants.sort_by(f64::total_cmp);
         let track = track::sample(
@@ -138,7 +138,7 @@ impl Animation<'_> {
             &instants,
         )
         .ok_or(AnimationError::NothingRecorded)?;
-        let g = self.walker.model.gravity_floor_m_s2;
+        let g = self.walker.model().gravity_floor_m_s2;
         let title = self.title();
         let data = PageData {
             format: 1,

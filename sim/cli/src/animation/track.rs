@@ -73,12 +73,12 @@ fn frames(
     fps: f64,
     instants_s: &[f64],
 ) -> Vec<Frame> {
-    let mut kin = Kinematics::new(&walker.model);
-    let hip = &walker.model.points[walker.fall.hip.0];
+    let mut kin = Kinematics::new(walker.model());
+    let hip = &walker.model().points[walker.fall().hip.0];
     let mut frames: Vec<Frame> = Vec::new();
     let mut pose = |q: &DVector<f64>, floor: &FloorFrame, t_walk_s: f64, step: usize| {
         let qd = DVector::zeros(q.len());
-        kin.update(&walker.model, q, &qd);
+        kin.update(walker.model(), q, &qd);
         let points_m = figure
             .points
             .iter()
@@ -221,7 +221,7 @@ mod tests {
             &qd,
             WalkRequest::new(&setup.settings, steps).recording(true),
         );
-        let figure = Figure::of(&scene, &setup.walker.model).unwrap();
+        let figure = Figure::of(&scene, setup.walker.model()).unwrap();
         let instants: Vec<f64> = super::super::timeline::walk_events(&w)
             .iter()
             .map(|e| e.t_s)
@@ -231,7 +231,7 @@ mod tests {
     }
 
     fn key(figure: &Figure, walker: &Walker, point: &str) -> usize {
-        let p = &walker.model.points[walker.model.point_index(point).unwrap().0];
+        let p = &walker.model().points[walker.model().point_index(point).unwrap().0];
         figure
             .points
             .iter()

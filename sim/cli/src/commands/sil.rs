@@ -151,7 +151,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         settings: mut stride_settings,
         ..
     } = common.setup(&scene)?;
-    let Some(reflex) = walker.ankle.clone() else {
+    let Some(reflex) = walker.ankle().cloned() else {
         return Err(InputError::Other(format!(
             "scene `{}` has no actuated ankles (ankle_reflex)",
             scene.name()

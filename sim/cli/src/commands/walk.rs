@@ -189,7 +189,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         print_json(&report)?;
     } else {
         let gait = WalkGaitRecord::of(walker, &walk, GAIT_STEPS)
-            .map(|g| GaitFigures::of_walk(&g, walker.ankle.is_some()));
+            .map(|g| GaitFigures::of_walk(&g, walker.ankle().is_some()));
         output::text(|out| print_text(out, &report, steps, gait.as_ref()))?;
     }
     Ok(walk_exit_code(&walk))
@@ -273,7 +273,7 @@ fn write_csv(
 ) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(file);
     let coords: Vec<&str> = walker
-        .model
+        .model()
         .coordinates
         .iter()
         .map(|c| c.name.as_str())

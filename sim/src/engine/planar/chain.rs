@@ -3,7 +3,7 @@
 //! chain (each joint's link below the previous joint's) the bodies lumped per joint at
 //! `q = 0` with the joints' springs and dampers ([`SerialChain`]). The closed forms
 //! (`two_link.rs`, `three_link.rs`) and the fixed-size stride's witnesses
-//! (`stride/fast/witness.rs`) read them.
+//! (`points.rs`) read them.
 
 use super::links::{LinkFrame, PlanarLinks, MAX_LINKS, MAX_PLANAR_COORDINATES};
 use nalgebra::SVector;

@@ -34,7 +34,7 @@ pub(super) struct Relabelled {
 
 /// Whether the walker's heel strike is one this module covers.
 fn covered(walker: &Walker) -> bool {
-    let hs = &walker.heel_strike;
+    let hs = walker.heel_strike();
     let axis = |k: &JointKind, x: f64, y: f64| matches!(k, JointKind::Prismatic { axis_parent } if axis_parent.x == x && axis_parent.y == y && axis_parent.z == 0.0);
     let release_xy =
         hs.release.len() == 2 && axis(&hs.release[0], 1.0, 0.0) && axis(&hs.release[1], 0.0, 1.0);
@@ -47,7 +47,7 @@ fn covered(walker: &Walker) -> bool {
                 | ContactConstraint::Yaw
         )
     });
-    let r = &walker.relabel;
+    let r = walker.relabel();
     release_xy && rows && !r.mirror && r.cyclic.is_empty()
 }
 
@@ -108,8 +108,8 @@ pub(super) fn heel_strike<const N: usize>(
     if !covered(walker) {
         return None;
     }
-    let hs = &walker.heel_strike;
-    let model = &walker.model;
+    let hs = walker.heel_strike();
+    let model = walker.model();
     let (foot_link, foot_p, foot_z) = point_of(model, hs.swing_foot)?;
     let (sc_link, sc_p, _) = point_of(model, hs.stance_contact)?;
     let fr = tree.links().frames(&at.q, &at.qd);
@@ -234,8 +234,8 @@ fn relabel<const N: usize>(
     v0: [f64; 2],
     p_foot: [f64; 2],
 ) -> Option<(DVector<f64>, DVector<f64>)> {
-    let r = &walker.relabel;
-    let model = &walker.model;
+    let r = walker.relabel();
+    let model = walker.model();
     let angle_old = link_angles(tree, &at.q);
     let mut angle_new = [0.0; MAX_LINKS + 1];
     let mut rate_new = [0.0; MAX_LINKS + 1];

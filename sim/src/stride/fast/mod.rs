@@ -31,7 +31,7 @@ use crate::engine::dynamics::{Dynamics, DynamicsError};
 use crate::engine::events::{refine, root_on_dense, EventError, EventTolerance};
 use crate::engine::integrators::{IntegrationError, IntegratorChoice, Sample};
 use crate::engine::model::{CoordIndex, Model};
-use crate::engine::planar::{PlanarTree, MAX_PLANAR_COORDINATES};
+use crate::engine::planar::{PlanarPoints, PlanarTree};
 use crate::engine::walker::Walker;
 use dop853::{FixedDop853, FixedSystem, State};
 use heel_strike::heel_strike;
@@ -40,7 +40,8 @@ use planar_witnesses::PlanarWitnesses;
 
 /// Whether the fixed-size engine covers a stride of `walker` with these settings and options
 /// (and no controller), as far as they go: the walker's model must also qualify
-/// ([`Compiled::of`]).
+/// (its planar points on a tree of 1 to `MAX_PLANAR_COORDINATES` coordinates, compiled
+/// once per walker).
 pub(super) fn covers(
     walker: &Walker,
     settings: &StrideSettings,
@@ -53,34 +54,8 @@ pub(super) fn covers(
     ) && matches!(settings.integrator, IntegratorChoice::Dop853 { .. })
         && settings.event_tolerance.dense_output
         && !controlled
-        && walker.ankle.is_none()
+        && walker.ankle().is_none()
         && !options.contact
-}
-
-/// What the fixed-size engine derives from a walker's model, once per workspace: the planar
-/// tree and the points the witnesses follow.
-pub(super) struct Compiled {
-    tree: PlanarTree,
-    witnesses: PlanarWitnesses,
-}
-
-impl Compiled {
-    /// The structures of `walker` on `path`: `None` when its model is not a planar tree of 1
-    /// to [`MAX_PLANAR_COORDINATES`] coordinates on that path, or its witnesses' points are
-    /// not on the tree.
-    pub(super) fn of(walker: &Walker, path: EvaluationPath) -> Option<Self> {
-        let tree = PlanarTree::for_path(&walker.model, path)?;
-        let witnesses = match tree.dof() {
-            1 => PlanarWitnesses::new::<1>(walker, &tree),
-            2 => PlanarWitnesses::new::<2>(walker, &tree),
-            3 => PlanarWitnesses::new::<3>(walker, &tree),
-            4 => PlanarWitnesses::new::<4>(walker, &tree),
-            5 => PlanarWitnesses::new::<5>(walker, &tree),
-            6 => PlanarWitnesses::new::<6>(walker, &tree),
-            _ => None,
-        }?;
-        Some(Self { tree, witnesses })
-    }
 }
 
 impl Walker {
@@ -94,21 +69,24 @@ impl Walker {
         options: StrideOptions,
     ) -> bool {
         covers(self, settings, options, false)
-            && PlanarTree::for_path(&self.model, settings.evaluation)
-                .is_some_and(|t| (1..=MAX_PLANAR_COORDINATES).contains(&t.dof()))
+            && self.compiled(settings.evaluation).planar_points.is_some()
     }
 }
 
-/// Runs the stride from `q0`, `qd0` on fixed-size states, with the walker's `compiled`
-/// structures: the stride's result, or `None` when the stride is handed back to the reference
+/// Runs the stride from `q0`, `qd0` on fixed-size states, on the walker's planar `tree` and
+/// `points` (compiled once per walker): the stride's result, or `None` when the stride is handed back to the reference
 /// engine (samples it recorded are then dropped by the caller).
 pub(super) fn stride(
     start: Start<'_, '_, '_>,
-    compiled: &Compiled,
+    tree: &PlanarTree,
+    points: &PlanarPoints,
     q0: &DVector<f64>,
     qd0: &DVector<f64>,
 ) -> Option<StrideResult> {
-    let (tree, wit) = (&compiled.tree, compiled.witnesses);
+    let wit = PlanarWitnesses {
+        points,
+        min_hip_height_m: start.walker.fall().min_hip_height_m,
+    };
     match tree.dof() {
         1 => stride_n::<1>(start, tree, wit, q0, qd0),
         2 => stride_n::<2>(start, tree, wit, q0, qd0),
@@ -124,7 +102,7 @@ pub(super) fn stride(
 fn stride_n<const N: usize>(
     start: Start<'_, '_, '_>,
     tree: &PlanarTree,
-    wit: PlanarWitnesses,
+    wit: PlanarWitnesses<'_>,
     q0: &DVector<f64>,
     qd0: &DVector<f64>,
 ) -> Option<StrideResult> {
@@ -139,7 +117,7 @@ fn stride_n<const N: usize>(
     };
     let cur = state::<N>(0.0, q0, qd0)?;
     let mut active = [true; N];
-    for c in &walker.initially_locked {
+    for c in walker.initially_locked() {
         *active.get_mut(c.0)? = false;
     }
     let engine = FixedEngine {
@@ -148,7 +126,7 @@ fn stride_n<const N: usize>(
         integrator: FixedDop853::new(rtol, atol, h_max_s),
         sys: FastPhase {
             tree,
-            model: &walker.model,
+            model: walker.model(),
             active,
             limit: None,
         },
@@ -238,10 +216,10 @@ struct FixedEngine<'w, const N: usize> {
     sys: FastPhase<'w, N>,
 }
 
-impl<const N: usize> Engine for FixedEngine<'_, N> {
+impl<'w, const N: usize> Engine for FixedEngine<'w, N> {
     type State = State<N>;
     type Interpolant = NoInterpolant;
-    type Witness = PlanarWitnesses;
+    type Witness = PlanarWitnesses<'w>;
     const HANDS_BACK: bool = true;
 
     #[inline]
@@ -347,7 +325,7 @@ impl<const N: usize> Engine for FixedEngine<'_, N> {
         &mut self,
         _summary: &mut ContactSummary,
         _walker: &Walker,
-        _wit: &mut PlanarWitnesses,
+        _wit: &mut PlanarWitnesses<'w>,
         _s: &State<N>,
     ) -> Result<(), DynamicsError> {
         Ok(())

@@ -148,7 +148,7 @@ fn sense<E: Engine>(
 ) -> Result<AnkleSensing, StrideFailure> {
     let swing_foot_on_floor =
         swing_foot_on_floor.unwrap_or_else(|| wit.eval(s).foot_height_m <= ON_FLOOR_M);
-    let (a, engaged) = match &walker.ankle {
+    let (a, engaged) = match &walker.ankle() {
         Some(r) => (r.ankle.0, engine.prescribed().is_some()),
         None => (0, false),
     };
