@@ -10,6 +10,7 @@ use crate::engine::model::{CoordIndex, Model, PointIndex};
 use crate::engine::relabel::Relabel;
 use crate::engine::EvaluationPath;
 use nalgebra::DVector;
+use std::sync::Arc;
 
 /// A knee with a hyperextension stop that locks after its inelastic impact.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,7 +46,9 @@ pub struct Walker {
     initially_locked: Vec<CoordIndex>,
     three_d_freedoms: Vec<String>,
     relabel_reference_q: DVector<f64>,
-    compiled: CompiledWalker,
+    /// Shared by the walker's clones (the same model and rules): kept out of the walker's
+    /// own size, which moves by value.
+    compiled: Arc<CompiledWalker>,
 }
 
 /// A walker's rules besides its model: what [`Walker::new`] builds a walker from.
@@ -97,7 +100,7 @@ impl Walker {
             initially_locked,
             three_d_freedoms,
             relabel_reference_q,
-            compiled: CompiledWalker::default(),
+            compiled: Arc::default(),
         }
     }
 
