@@ -33,7 +33,9 @@ use crate::engine::hybrid::phase::DriveValues;
 use crate::engine::hybrid::profile::extension;
 use crate::engine::hybrid::relabel::{pose_jacobian, pose_residual, row_count, RelabelTargets};
 use crate::engine::hybrid::{konst, EngineScalar};
-use crate::engine::integrators::{Dop853, Integrator, IntegratorChoice, Sample, SecondOrderSystem};
+use crate::engine::integrators::{
+    Dop853, Integrator, IntegratorChoice, Sample, SecondOrderSystem, SystemChange,
+};
 use crate::engine::kinematics::KinematicsOf;
 use crate::engine::model::Model;
 use crate::engine::relabel::{LinkStates, LinkStatesOf};
@@ -459,7 +461,7 @@ fn propagate<const N: usize>(
             .advance(&mut sys, &cur, stop - cur.t_s)
             .map_err(num)?;
         if next.t_s >= drive_end - 1e-12 && cur.t_s < drive_end - 1e-12 {
-            integrator.system_changed();
+            integrator.system_changed(SystemChange::Equations);
         }
         cur = next;
         if (t_end - cur.t_s).abs() < 1e-13 {

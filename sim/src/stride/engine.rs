@@ -18,7 +18,7 @@ use super::state::StrideState;
 use super::witnesses::{WitnessEvaluator, Witnesses};
 use crate::engine::dynamics::DynamicsError;
 use crate::engine::events::{locate, EventError, EventTolerance};
-use crate::engine::integrators::{DenseOutput, IntegrationError, Integrator, Sample};
+use crate::engine::integrators::{DenseOutput, IntegrationError, Integrator, Sample, SystemChange};
 use crate::engine::model::CoordIndex;
 use crate::engine::walker::Walker;
 
@@ -85,8 +85,8 @@ pub(super) trait Engine {
     fn evaluations(&self) -> usize;
     /// A new phase after an impact: the integrator restarts.
     fn reset(&mut self);
-    /// The equations changed without the state changing.
-    fn system_changed(&mut self);
+    /// The equations changed without the state changing, as `change` says.
+    fn system_changed(&mut self, change: SystemChange);
 
     /// Which coordinates are free.
     fn active(&self) -> &[bool];
@@ -98,8 +98,14 @@ pub(super) trait Engine {
     fn set_prescribed(&mut self, p: Option<(CoordIndex, Drive)>);
     /// Puts the driven coordinate of `s` exactly on its drive.
     fn snap(&self, s: &mut Self::State);
-    /// The driven coordinate's actuator force and rate at `s`.
-    fn actuator_torque(&mut self, s: &Self::State) -> Result<(f64, f64), DynamicsError>;
+    /// The driven coordinate's actuator force and rate at `s`; `at_step_end`: the loop states
+    /// that `s` is the end of the last step taken (where an integrator whose last stage is
+    /// evaluated there left an assembly to read).
+    fn actuator_torque(
+        &mut self,
+        s: &Self::State,
+        at_step_end: bool,
+    ) -> Result<(f64, f64), DynamicsError>;
     /// Adds the contact figures of the accepted state `s`.
     fn add_contact(
         &mut self,
@@ -177,8 +183,8 @@ impl<'w> Engine for DynamicEngine<'w> {
         self.integrator.reset();
     }
 
-    fn system_changed(&mut self) {
-        self.integrator.system_changed();
+    fn system_changed(&mut self, change: SystemChange) {
+        self.integrator.system_changed(change);
     }
 
     fn active(&self) -> &[bool] {
@@ -201,8 +207,17 @@ impl<'w> Engine for DynamicEngine<'w> {
         self.phase.snap(s);
     }
 
-    fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
-        self.phase.actuator_torque(s)
+    fn actuator_torque(
+        &mut self,
+        s: &Sample,
+        at_step_end: bool,
+    ) -> Result<(f64, f64), DynamicsError> {
+        let assembled = if at_step_end {
+            self.integrator.end_stage_epoch()
+        } else {
+            None
+        };
+        self.phase.actuator_torque(s, assembled)
     }
 
     fn add_contact(

@@ -48,58 +48,51 @@ pub struct Phase<'a> {
     /// Scratch for a driven evaluation: `q`, `q̇` with the drive's angle and rate put in, and
     /// the prescribed accelerations (zero but the driven coordinate's).
     driven: (DVector<f64>, DVector<f64>, DVector<f64>),
-    /// Where the evaluation's workspace (the 3D fast path's tree, or else the general engine's)
-    /// was last assembled by this phase's partial evaluations (not valid after anything else
-    /// used it).
-    assembled_at: AssemblyKey,
+    /// Which evaluation made the workspace's assembly ([`Assembly`]).
+    assembly: Assembly,
 }
 
-/// The state (`q`, `q̇` as evaluated: the drive's angle and rate put in) and free set of the
-/// workspace's last assembly. Another evaluation there (the first stage after a tick's new
-/// segment, at the state where the step before it ended; the string's torque at that tick)
-/// solves on that assembly instead of assembling again: `M̄`, `f̄` depend on `q`, `q̇`
-/// only, not on the drive's acceleration, so the result is the same to the bit. Compared
-/// bit for bit.
-#[derive(Clone, Debug)]
-struct AssemblyKey {
-    valid: bool,
-    q: DVector<f64>,
-    qd: DVector<f64>,
+/// Which use of the evaluation's workspace (the 3D fast path's tree, or else the general
+/// engine's) made its assembly, stated, never found by comparing states: every evaluation, and
+/// anything else that writes the workspace, is numbered (the epoch); an evaluation that
+/// assembles records its epoch and its free set. A caller that knows it is at the state of
+/// that evaluation — an integrator at the end of a step whose last stage was that evaluation
+/// (first same as last), after a tick whose drive continues the last one's angle and rate to
+/// the bit — names the epoch, and the phase solves on that assembly instead of assembling
+/// again (`M̄`, `f̄` depend on `q`, `q̇` only, not on the drive's acceleration: the same
+/// result to the bit) if nothing used the workspace since.
+#[derive(Clone, Debug, Default)]
+struct Assembly {
+    /// Uses of the workspace so far.
+    epoch: u64,
+    /// The epoch of the evaluation that made the workspace's assembly, if the last use left
+    /// one to solve on.
+    made_at: Option<u64>,
+    /// The free set of that assembly.
     active: Vec<bool>,
-    /// How many evaluations (accelerations or the actuator torque) solved on the assembly
-    /// instead of assembling again (what the tests read to know the cache was taken).
+    /// How many evaluations (accelerations or the actuator torque) solved on an assembly
+    /// instead of assembling again (what the tests read to know the stage was skipped).
     reuses: u64,
 }
 
-impl AssemblyKey {
-    fn new(n: usize) -> Self {
-        Self {
-            valid: false,
-            q: DVector::zeros(n),
-            qd: DVector::zeros(n),
-            active: vec![false; n],
-            reuses: 0,
-        }
+impl Assembly {
+    /// A new use of the workspace that leaves no assembly to solve on (yet).
+    fn next_use(&mut self) {
+        self.epoch += 1;
+        self.made_at = None;
     }
 
-    fn is(&self, q: &DVector<f64>, qd: &DVector<f64>, active: &[bool]) -> bool {
-        let same = |a: &DVector<f64>, b: &DVector<f64>| {
-            a.len() == b.len()
-                && a.iter()
-                    .zip(b.iter())
-                    .all(|(x, y)| x.to_bits() == y.to_bits())
-        };
-        self.valid && self.active == active && same(&self.q, q) && same(&self.qd, qd)
+    /// The assembly of evaluation `epoch` with free set `active`, if it is the workspace's
+    /// last use.
+    fn is_of(&self, epoch: u64, active: &[bool]) -> bool {
+        self.made_at == Some(epoch) && self.epoch == epoch && self.active == active
     }
 
-    fn set(&mut self, q: &DVector<f64>, qd: &DVector<f64>, active: &[bool]) {
-        self.valid = self.q.len() == q.len() && self.qd.len() == qd.len();
-        if self.valid {
-            self.q.copy_from(q);
-            self.qd.copy_from(qd);
-            self.active.clear();
-            self.active.extend_from_slice(active);
-        }
+    /// The current use assembled with free set `active`.
+    fn made(&mut self, active: &[bool]) {
+        self.made_at = Some(self.epoch);
+        self.active.clear();
+        self.active.extend_from_slice(active);
     }
 }
 
@@ -121,8 +114,8 @@ fn put_drive(
     qdd_p[drive.coordinate] = drive.acceleration_rad_s2;
 }
 
-/// An evaluation that keeps its last assembly, to solve on it again: the general engine's
-/// workspace or the 3D fast path's tree.
+/// An evaluation that keeps its assembly (to solve on it again: `Phase::solve_on_assembly_of`):
+/// the general engine's workspace or the 3D fast path's tree.
 trait Assembler {
     /// `q̈` by a (partial) assembly at (`q`, `q̇`) and its solve; `driven`, a coordinate whose
     /// row the assembly computes too, where the evaluation can.
@@ -137,14 +130,6 @@ trait Assembler {
         driven: Option<usize>,
         out: &mut DVector<f64>,
     ) -> Result<(), DynamicsError>;
-
-    /// `q̈` by a solve on the last assembly; `Ok(false)` when it lacks a row the solve reads.
-    fn solve_on_assembly(
-        &mut self,
-        active: &[bool],
-        qdd_prescribed: Option<&DVector<f64>>,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, DynamicsError>;
 }
 
 impl Assembler for Dynamics {
@@ -159,15 +144,6 @@ impl Assembler for Dynamics {
         out: &mut DVector<f64>,
     ) -> Result<(), DynamicsError> {
         self.accelerations_of_free_into(model, q, qd, active, qdd_prescribed, out)
-    }
-
-    fn solve_on_assembly(
-        &mut self,
-        active: &[bool],
-        qdd_prescribed: Option<&DVector<f64>>,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, DynamicsError> {
-        self.accelerations_on_assembly_into(active, qdd_prescribed, out)
     }
 }
 
@@ -184,24 +160,14 @@ impl Assembler for AxisTree {
     ) -> Result<(), DynamicsError> {
         self.accelerations_into(q, qd, active, qdd_prescribed, driven, out)
     }
-
-    fn solve_on_assembly(
-        &mut self,
-        active: &[bool],
-        qdd_prescribed: Option<&DVector<f64>>,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, DynamicsError> {
-        self.accelerations_on_assembly_into(active, qdd_prescribed, out)
-    }
 }
 
-/// `q̈` by `assembler`'s partial assembly at (`q`, `q̇`), or by a solve on its last assembly
-/// when `key` says it was made there; `key` follows.
+/// `q̈` by `assembler`'s partial assembly at (`q`, `q̇`), recorded in `assembly`.
 #[allow(clippy::too_many_arguments)]
 fn accelerations_of_free<A: Assembler>(
     model: &Model,
     assembler: &mut A,
-    key: &mut AssemblyKey,
+    assembly: &mut Assembly,
     q: &DVector<f64>,
     qd: &DVector<f64>,
     active: &[bool],
@@ -209,13 +175,9 @@ fn accelerations_of_free<A: Assembler>(
     driven: Option<usize>,
     out: &mut DVector<f64>,
 ) -> Result<(), DynamicsError> {
-    if key.is(q, qd, active) && assembler.solve_on_assembly(active, qdd_prescribed, out)? {
-        key.reuses += 1;
-        return Ok(());
-    }
-    key.valid = false;
+    assembly.next_use();
     assembler.assemble_and_solve(model, q, qd, active, qdd_prescribed, driven, out)?;
-    key.set(q, qd, active);
+    assembly.made(active);
     Ok(())
 }
 
@@ -253,7 +215,7 @@ impl<'a> Phase<'a> {
                 DVector::zeros(model.dof()),
                 DVector::zeros(model.dof()),
             ),
-            assembled_at: AssemblyKey::new(model.dof()),
+            assembly: Assembly::default(),
         }
     }
 
@@ -262,7 +224,7 @@ impl<'a> Phase<'a> {
     pub(crate) fn restart(&mut self) {
         self.active.iter_mut().for_each(|a| *a = true);
         self.prescribed = None;
-        self.assembled_at.valid = false;
+        self.assembly.next_use();
     }
 
     /// Puts the prescribed coordinate of `s` exactly on its profile.
@@ -275,12 +237,19 @@ impl<'a> Phase<'a> {
     }
 
     /// The generalised force [N·m] the prescribed coordinate's actuator exerts at `s`, and the
-    /// coordinate's rate: their product is the actuator power.
-    pub fn actuator_torque(&mut self, s: &Sample) -> Result<(f64, f64), DynamicsError> {
+    /// coordinate's rate: their product is the actuator power. `assembled`: the epoch of the
+    /// evaluation made at `s` (as evaluated, the drive's angle and rate put in), when the
+    /// caller knows one (the last stage of the step that ended at `s`): the torque is then
+    /// solved on its assembly.
+    pub fn actuator_torque(
+        &mut self,
+        s: &Sample,
+        assembled: Option<u64>,
+    ) -> Result<(f64, f64), DynamicsError> {
         let Some((c, _)) = self.prescribed else {
             return Ok((0.0, 0.0));
         };
-        if let Some(tau) = self.torque_on_assembly(s)? {
+        if let Some(tau) = self.torque_on_assembly(s, assembled)? {
             return Ok((tau, s.qd[c.0]));
         }
         if self.axis_tree.is_some() {
@@ -302,54 +271,69 @@ impl<'a> Phase<'a> {
         Ok((tau, s.qd[c.0]))
     }
 
-    /// The actuator torque at `s` from the workspace's assembly, when it was made at `s` (as
-    /// evaluated, the drive's angle and rate put in) and computed the driven coordinate's row:
-    /// the step that ended at `s` evaluated its last stage there. The same arithmetic as the
-    /// general path (its `q̈` the same to the bit; the row's entries the assembly skipped are
-    /// those of locked coordinates, whose `q̈` is zero). `None` otherwise.
-    fn torque_on_assembly(&mut self, s: &Sample) -> Result<Option<f64>, DynamicsError> {
-        let Some(drive) = self.drive_at(s.t_s) else {
+    /// The actuator torque at `s` from the assembly of evaluation `epoch` (made at `s`), when
+    /// that is the workspace's last use and it computed the driven coordinate's row. The same
+    /// arithmetic as the general path (its `q̈` the same to the bit; the row's entries the
+    /// assembly skipped are those of locked coordinates, whose `q̈` is zero). `None`
+    /// otherwise.
+    fn torque_on_assembly(
+        &mut self,
+        s: &Sample,
+        epoch: Option<u64>,
+    ) -> Result<Option<f64>, DynamicsError> {
+        let (Some(epoch), Some((c, _))) = (epoch, self.prescribed) else {
             return Ok(None);
         };
-        let c = drive.coordinate;
-        if self.planar.is_some() {
-            return Ok(None);
-        }
-        if self.axis_tree.is_none() && !self.dynamics.assembled_row(c) {
-            return Ok(None);
-        }
-        if self.driven.0.len() != s.q.len() || self.driven.1.len() != s.qd.len() {
-            return Ok(None);
-        }
-        put_drive(&mut self.driven, &s.q, &s.qd, &drive);
-        let (dq, dqd, qdd_p) = &self.driven;
-        if !self.assembled_at.is(dq, dqd, &self.active) {
+        if self.axis_tree.is_none() && !self.dynamics.assembled_row(c.0) {
             return Ok(None);
         }
         let mut qdd = DVector::zeros(s.q.len());
-        let tau = match self.axis_tree.as_mut() {
-            Some(t) => {
-                if !t.accelerations_on_assembly_into(&self.active, Some(qdd_p), &mut qdd)? {
-                    return Ok(None);
-                }
-                t.actuator_force(c, &qdd)
-            }
+        if !self.solve_on_assembly_of(epoch, s.t_s, &mut qdd)? {
+            return Ok(None);
+        }
+        Ok(match self.axis_tree.as_ref() {
+            Some(t) => t.actuator_force(c.0, &qdd),
             None => {
-                if !self.dynamics.accelerations_on_assembly_into(
-                    &self.active,
-                    Some(qdd_p),
-                    &mut qdd,
-                )? {
-                    return Ok(None);
-                }
                 let m = &self.dynamics.mass_matrix;
-                Some((m.row(c) * &qdd)[(0, 0)] - self.dynamics.force[c])
+                Some((m.row(c.0) * &qdd)[(0, 0)] - self.dynamics.force[c.0])
+            }
+        })
+    }
+
+    /// `q̈` into `out` by a solve on the assembly of evaluation `epoch`, with the drive's
+    /// prescribed acceleration at `t` [s]: `false` (nothing written) unless that assembly is
+    /// the workspace's last use, with the current free set (the planar path keeps none).
+    fn solve_on_assembly_of(
+        &mut self,
+        epoch: u64,
+        t: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        if self.planar.is_some()
+            || !self.assembly.is_of(epoch, &self.active)
+            || self.driven.2.len() != out.len()
+        {
+            return Ok(false);
+        }
+        let qdd_p = match self.drive_at(t) {
+            None => None,
+            Some(d) => {
+                let qdd_p = &mut self.driven.2;
+                qdd_p.as_mut_slice().fill(0.0);
+                qdd_p[d.coordinate] = d.acceleration_rad_s2;
+                Some(&self.driven.2)
             }
         };
-        if tau.is_some() {
-            self.assembled_at.reuses += 1;
+        let solved = match self.axis_tree.as_mut() {
+            Some(tree) => tree.accelerations_on_assembly_into(&self.active, qdd_p, out)?,
+            None => self
+                .dynamics
+                .accelerations_on_assembly_into(&self.active, qdd_p, out)?,
+        };
+        if solved {
+            self.assembly.reuses += 1;
         }
-        Ok(tau)
+        Ok(solved)
     }
 
     /// Whether this phase evaluates along the planar fast path.
@@ -383,7 +367,7 @@ impl<'a> Phase<'a> {
         qd: &DVector<f64>,
     ) -> Result<DVector<f64>, DynamicsError> {
         let drive = self.drive_at(t);
-        self.assembled_at.valid = false;
+        self.assembly.next_use();
         crate::engine::hybrid::phase::accelerations(
             self.model,
             &mut self.dynamics,
@@ -405,7 +389,7 @@ impl SecondOrderSystem for Phase<'_> {
         match &self.planar {
             Some(p) => {
                 let drive = self.drive_at(t);
-                self.assembled_at.valid = false;
+                self.assembly.next_use();
                 p.accelerations(&mut self.dynamics, &self.active, drive.as_ref(), q, qd)
             }
             // (`accelerations_into` takes the fast path for these lengths, not this method.)
@@ -428,7 +412,7 @@ impl SecondOrderSystem for Phase<'_> {
         match &self.planar {
             Some(p) if out.len() == q.len() => {
                 let drive = self.drive_at(t);
-                self.assembled_at.valid = false;
+                self.assembly.next_use();
                 p.accelerations_into(&mut self.dynamics, &self.active, drive.as_ref(), q, qd, out)
             }
             // The 3D fast path's or the general engine's solve straight into `out` (the latter
@@ -447,7 +431,7 @@ impl SecondOrderSystem for Phase<'_> {
                     }
                 };
                 let driven = drive.map(|d| d.coordinate);
-                let key = &mut self.assembled_at;
+                let key = &mut self.assembly;
                 match self.axis_tree.as_mut() {
                     Some(tree) => accelerations_of_free(
                         self.model,
@@ -480,13 +464,26 @@ impl SecondOrderSystem for Phase<'_> {
         }
     }
 
+    fn evaluation_epoch(&self) -> u64 {
+        self.assembly.epoch
+    }
+
+    fn accelerations_again_into(
+        &mut self,
+        epoch: u64,
+        t_s: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        self.solve_on_assembly_of(epoch, t_s, out)
+    }
+
     fn stability_limit(
         &mut self,
         _t: f64,
         q: &DVector<f64>,
         qd: &DVector<f64>,
     ) -> Option<StabilityLimit> {
-        self.assembled_at.valid = false;
+        self.assembly.next_use();
         linearised_limit(self.model, &mut self.dynamics, q, qd, &self.active)
     }
 }
@@ -594,16 +591,14 @@ mod tests {
         phase
             .accelerations_into(0.1, &at.q, &at.qd, &mut qdd)
             .unwrap();
-        assert!(phase.assembled_at.is(
-            &phase.driven.0.clone(),
-            &phase.driven.1.clone(),
-            &phase.active
-        ));
-        let reuses = phase.assembled_at.reuses;
-        let torque = phase.actuator_torque(&at).unwrap();
+        // The evaluation assembled, and names its assembly by its epoch.
+        let epoch = phase.evaluation_epoch();
+        assert!(phase.assembly.is_of(epoch, &phase.active));
+        let reuses = phase.assembly.reuses;
+        let torque = phase.actuator_torque(&at, Some(epoch)).unwrap();
         // The torque was solved on the assembly, not by a fresh evaluation.
-        assert_eq!(phase.assembled_at.reuses, reuses + 1);
-        let fresh = phase_with(old).actuator_torque(&at).unwrap();
+        assert_eq!(phase.assembly.reuses, reuses + 1);
+        let fresh = phase_with(old).actuator_torque(&at, None).unwrap();
         assert_eq!(torque.0.to_bits(), fresh.0.to_bits());
         assert_eq!(torque.1.to_bits(), fresh.1.to_bits());
         // Another drive acceleration at the same angle and rate (the new segment's rate at its
@@ -622,11 +617,11 @@ mod tests {
         };
         phase.prescribed = Some((ankle, Drive::Segment(other)));
         let mut reused = DVector::zeros(q.len());
-        phase
-            .accelerations_into(0.1, &at.q, &at.qd, &mut reused)
-            .unwrap();
+        assert!(phase
+            .accelerations_again_into(epoch, 0.1, &mut reused)
+            .unwrap());
         // The accelerations were solved on the assembly, not by a fresh evaluation.
-        assert_eq!(phase.assembled_at.reuses, reuses + 2);
+        assert_eq!(phase.assembly.reuses, reuses + 2);
         let mut again = DVector::zeros(q.len());
         phase_with(other)
             .accelerations_into(0.1, &at.q, &at.qd, &mut again)
@@ -636,5 +631,14 @@ mod tests {
             .zip(again.iter())
             .all(|(a, b)| a.to_bits() == b.to_bits()));
         assert_ne!(reused, qdd);
+        // After another use of the workspace, that epoch's assembly is not offered again.
+        phase
+            .accelerations_into(0.1, &at.q, &at.qd, &mut again)
+            .unwrap();
+        assert!(!phase
+            .accelerations_again_into(epoch, 0.1, &mut again)
+            .unwrap());
+        assert!(phase.actuator_torque(&at, Some(epoch)).is_ok());
+        assert_eq!(phase.assembly.reuses, reuses + 2);
     }
 }

@@ -17,7 +17,7 @@ use super::schedule::{Schedule, ScheduleCursor};
 use super::settings::StrideSettings;
 use super::state::StrideState;
 use super::witnesses::{self, StringLimit, Watch, WitnessEvaluator, WitnessValues};
-use crate::engine::integrators::Sample;
+use crate::engine::integrators::{Sample, SystemChange};
 use crate::engine::walker::Walker;
 use ticks::{Plant, TickEffect, Ticks};
 
@@ -77,6 +77,9 @@ pub(super) struct Run<'w, 'r, 't, E: Engine> {
     triggered: &'t mut Vec<Watch>,
     /// The last accepted state.
     cur: E::State,
+    /// `cur` is the end of the last step the integrator took (not a state located or
+    /// interpolated inside it, nor one after an impact).
+    cur_at_step_end: bool,
     events: Vec<StrideEvent>,
     event_states: Vec<(Sample, Sample)>,
     energy_loss_j: f64,
@@ -129,6 +132,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             w_cached: None,
             triggered,
             cur,
+            cur_at_step_end: false,
             events: Vec::new(),
             event_states: Vec::new(),
             energy_loss_j: 0.0,
@@ -199,10 +203,10 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             *self.triggered = triggered;
             let Some((watch, mut at)) = (match located? {
                 Located::None => {
-                    let next = self
-                        .held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?
-                        .unwrap_or(next);
-                    self.accept(next, drive_end_s)?;
+                    let held = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?;
+                    let at_step_end = held.is_none();
+                    self.accept(held.unwrap_or(next), drive_end_s)?;
+                    self.cur_at_step_end = at_step_end;
                     continue;
                 }
                 Located::IgnoredScuff => {
@@ -246,6 +250,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             engine: &mut self.engine,
             wit: &mut self.wit,
             cur: &mut self.cur,
+            at_step_end: self.cur_at_step_end,
         };
         if self.ticks.control_tick(plant, self.w_cached)? == TickEffect::Released {
             self.power.close(self.walker.model(), &self.cur);
@@ -273,6 +278,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             engine: &mut self.engine,
             wit: &mut self.wit,
             cur: &mut self.cur,
+            at_step_end: false,
         };
         self.ticks.held_ticks(plant, dense, ends, end_s)
     }
@@ -429,7 +435,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         self.schedule.stepped(next.t_s() - self.cur.t_s());
         if next.t_s() >= drive_end_s - 1e-12 {
             // A new smooth phase: the schedule and the integrator's memory restart.
-            self.engine.system_changed();
+            self.engine.system_changed(SystemChange::Equations);
             self.schedule.next_phase();
         }
         self.record(next);
@@ -446,6 +452,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
     /// `s` becomes the current state (and is recorded when asked).
     fn record(&mut self, s: E::State) {
         self.cur = s;
+        self.cur_at_step_end = false;
         if self.options.record {
             self.trajectory.push(self.cur.to_sample());
         }

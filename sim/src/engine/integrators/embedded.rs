@@ -4,7 +4,10 @@
 //! coefficients, its controller constants and its error estimate.
 
 use super::dense::{DenseCoefficients, DenseOutput};
-use super::{adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits};
+use super::{
+    adaptive_step, IntegrationError, Integrator, Sample, SecondOrderSystem, StepLimits,
+    SystemChange,
+};
 use nalgebra::DVector;
 use std::fmt::Debug;
 use std::marker::PhantomData;
@@ -14,6 +17,9 @@ use std::marker::PhantomData;
 #[derive(Clone, Debug, Default)]
 struct Kept {
     valid: bool,
+    /// Only the driven coordinate's prescribed acceleration changed since `a` was evaluated
+    /// ([`SystemChange::DriveAcceleration`]): `a` is solved again, not copied.
+    stale: bool,
     t_s: f64,
     q: DVector<f64>,
     v: DVector<f64>,
@@ -27,6 +33,7 @@ impl Kept {
 
     fn set(&mut self, t_s: f64, q: &DVector<f64>, v: &DVector<f64>, a: &DVector<f64>) {
         self.valid = true;
+        self.stale = false;
         self.t_s = t_s;
         copy_into(&mut self.q, q);
         copy_into(&mut self.v, v);
@@ -172,6 +179,11 @@ pub struct EmbeddedRk<P: EmbeddedPair> {
     kept: Kept,
     /// The last trial step's final stage is valid for `kept` (FSAL pairs).
     last_stage: bool,
+    /// The system's epoch of the last trial step's final stage (FSAL pairs).
+    last_stage_epoch: u64,
+    /// The system's epoch of the accepted step's final stage, kept in `kept` (FSAL pairs):
+    /// [`Integrator::end_stage_epoch`].
+    end_stage_epoch: Option<u64>,
     /// The last trial step, kept for its dense output (pairs with a continuous extension).
     last_step: LastStep,
     /// Stage buffers, reused from step to step.
@@ -190,6 +202,8 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             h_min_s: 1e-14,
             kept: Kept::default(),
             last_stage: false,
+            last_stage_epoch: 0,
+            end_stage_epoch: None,
             last_step: LastStep::default(),
             stages: Stages::default(),
             pair: PhantomData,
@@ -211,9 +225,22 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
     ) -> Result<(), IntegrationError> {
         self.stages.kq[0].copy_from(&s.qd);
         if self.kept.matches(s) {
-            self.stages.kv[0].copy_from(&self.kept.a);
-            return Ok(());
+            if !self.kept.stale {
+                self.stages.kv[0].copy_from(&self.kept.a);
+                return Ok(());
+            }
+            // A tick changed only the drive's acceleration at the end of the last step: the
+            // derivative there solved again on the system's assembly of that step's last stage.
+            self.kept.valid = false;
+            if let Some(epoch) = self.end_stage_epoch.take() {
+                self.evaluations += 1;
+                if sys.accelerations_again_into(epoch, s.t_s, &mut self.stages.kv[0])? {
+                    return Ok(());
+                }
+                self.evaluations -= 1;
+            }
         }
+        self.end_stage_epoch = None;
         self.evaluations += 1;
         sys.accelerations_into(s.t_s, &s.q, &s.qd, &mut self.stages.kv[0])?;
         if !P::FSAL {
@@ -296,8 +323,10 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
                 let last = P::C.len() - 1;
                 self.kept
                     .set(next.t_s, &next.q, &next.qd, &self.stages.kv[last]);
+                self.end_stage_epoch = Some(self.last_stage_epoch);
             } else {
                 self.kept.valid = false;
+                self.end_stage_epoch = None;
             }
             self.last_stage = false;
         }
@@ -320,6 +349,7 @@ impl<P: EmbeddedPair> EmbeddedRk<P> {
             self.evaluations += 1;
             self.stages.evaluate(sys, i, s.t_s + P::C[i] * h)?;
         }
+        self.last_stage_epoch = sys.evaluation_epoch();
         let mut q_new = s.q.clone();
         let mut v_new = s.qd.clone();
         let (kq, kv) = (&self.stages.kq, &self.stages.kv);
@@ -360,11 +390,23 @@ impl<P: EmbeddedPair> Integrator for EmbeddedRk<P> {
         self.evaluations = 0;
         self.h_next_s = 0.0;
         self.kept.valid = false;
+        self.end_stage_epoch = None;
         self.last_step.valid = false;
     }
-    fn system_changed(&mut self) {
-        self.kept.valid = false;
+    fn system_changed(&mut self, change: SystemChange) {
+        match change {
+            SystemChange::DriveAcceleration if self.end_stage_epoch.is_some() => {
+                self.kept.stale = true;
+            }
+            _ => {
+                self.kept.valid = false;
+                self.end_stage_epoch = None;
+            }
+        }
         self.last_step.valid = false;
+    }
+    fn end_stage_epoch(&self) -> Option<u64> {
+        self.end_stage_epoch
     }
     fn dense_output(
         &mut self,

@@ -25,7 +25,7 @@ pub(crate) use dop853::{combined_error, component_error};
 pub use dop853::{Dop853, Dop853Pair};
 pub use dopri5::{Dopri5, Dopri5Pair};
 pub use embedded::{EmbeddedPair, EmbeddedRk, Tolerances};
-pub use integrator::Integrator;
+pub use integrator::{Integrator, SystemChange};
 pub use meijaard::Meijaard;
 pub use rk4::Rk4;
 pub use system::{IntegrationError, Sample, SecondOrderSystem, StabilityLimit};

@@ -33,6 +33,26 @@ pub trait SecondOrderSystem {
         Ok(())
     }
 
+    /// How many evaluations (and other uses of its workspace) the system has made: an epoch
+    /// that names its last evaluation. `0` for a system that keeps no assembly.
+    fn evaluation_epoch(&self) -> u64 {
+        0
+    }
+
+    /// Accelerations at time `t_s` into `out` by a solve on the assembly of evaluation
+    /// `epoch`, when the caller states that this is that evaluation's state with only the
+    /// driven coordinate's prescribed acceleration changed since (its angle and rate the same
+    /// to the bit), and the system has not been used since: `Ok(true)`, the same result to the
+    /// bit as an evaluation. `Ok(false)`: not available, evaluate instead.
+    fn accelerations_again_into(
+        &mut self,
+        _epoch: u64,
+        _t_s: f64,
+        _out: &mut DVector<f64>,
+    ) -> Result<bool, DynamicsError> {
+        Ok(false)
+    }
+
     /// Largest undamped eigenfrequency `λ_max` [rad/s] and its relative damping `β` of the
     /// linearised system at `q`, `q̇` (for eq. 12). `None` if the system cannot tell.
     fn stability_limit(

@@ -29,7 +29,7 @@ use super::state::StrideState;
 use super::EvaluationPath;
 use crate::engine::dynamics::{Dynamics, DynamicsError};
 use crate::engine::events::{refine, root_on_dense, EventError, EventTolerance};
-use crate::engine::integrators::{IntegrationError, IntegratorChoice, Sample};
+use crate::engine::integrators::{IntegrationError, IntegratorChoice, Sample, SystemChange};
 use crate::engine::model::{CoordIndex, Model};
 use crate::engine::planar::{PlanarPoints, PlanarTree};
 use crate::engine::walker::Walker;
@@ -292,7 +292,7 @@ impl<'w, const N: usize> Engine for FixedEngine<'w, N> {
     }
 
     /// Nothing to forget: without a drive the equations change only at impacts.
-    fn system_changed(&mut self) {}
+    fn system_changed(&mut self, _change: SystemChange) {}
 
     #[inline]
     fn active(&self) -> &[bool] {
@@ -316,7 +316,11 @@ impl<'w, const N: usize> Engine for FixedEngine<'w, N> {
     #[inline]
     fn snap(&self, _s: &mut State<N>) {}
 
-    fn actuator_torque(&mut self, _s: &State<N>) -> Result<(f64, f64), DynamicsError> {
+    fn actuator_torque(
+        &mut self,
+        _s: &State<N>,
+        _at_step_end: bool,
+    ) -> Result<(f64, f64), DynamicsError> {
         Ok((0.0, 0.0))
     }
 

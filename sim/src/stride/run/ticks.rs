@@ -21,6 +21,7 @@
 
 use crate::engine::control::{ActuatorSegment, AnkleSensing, TickStepping};
 use crate::engine::hermite::{self, Knot};
+use crate::engine::integrators::SystemChange;
 use crate::engine::walker::Walker;
 use crate::stride::engine::{Engine, Interpolant};
 use crate::stride::failure::{FailureCause, StrideFailure};
@@ -90,6 +91,16 @@ fn clear_of_floor(from: &WitnessValues, to: &WitnessValues, t_s: f64) -> bool {
     height_m > CLEAR_OF_FLOOR_M
 }
 
+/// Whether the drive `next` takes over from `ended` at stride time `t_s` with the same angle
+/// and rate to the bit (only its acceleration may differ): the state as evaluated is then the
+/// same on both sides of the tick, and the next step's first stage is solved on the assembly of
+/// the last stage of the step that ended there ([`SystemChange::DriveAcceleration`]).
+fn drive_continues(ended: &ActuatorSegment, next: &ActuatorSegment, t_s: f64) -> bool {
+    let (a0, v0, _) = ended.eval(t_s);
+    let (a1, v1, _) = next.eval(t_s);
+    a0.to_bits() == a1.to_bits() && v0.to_bits() == v1.to_bits()
+}
+
 /// The largest rounding difference [rad, rad/s] between the ending segment's angle and rate
 /// at the tick (its `x = (t − t0)/h` only near 1 in stride time) and its end knot that
 /// [`continue_at_tick`] absorbs.
@@ -101,8 +112,8 @@ const KNOT_ROUNDING: f64 = 1e-12;
 /// `next` starts at `t_s` from `ended`'s angle and rate at `t_s` exactly (they differ from
 /// the knot by rounding only: the two segments' clocks are shifted to stride time by
 /// rounding). The plant's angle and rate are then the same bits on both sides of the tick, so
-/// the next step's first stage is evaluated on the assembly of the last stage of the step that
-/// ended there (`Phase`'s assembly key). Any other pair is returned unchanged.
+/// the next step's first stage is solved on the assembly of the last stage of the step that
+/// ended there ([`drive_continues`]). Any other pair is returned unchanged.
 fn continue_at_tick(
     ended: Option<&ActuatorSegment>,
     next: ActuatorSegment,
@@ -143,7 +154,7 @@ fn sense<E: Engine>(
     wit: &mut E::Witness,
     engine: &mut E,
     t_walk_start_s: f64,
-    s: &E::State,
+    (s, at_step_end): (&E::State, bool),
     swing_foot_on_floor: Option<bool>,
 ) -> Result<AnkleSensing, StrideFailure> {
     let swing_foot_on_floor =
@@ -161,7 +172,7 @@ fn sense<E: Engine>(
         string_engaged: engaged,
         string_torque_n_m: if engaged {
             engine
-                .actuator_torque(s)
+                .actuator_torque(s, at_step_end)
                 .map_err(|e| StrideFailure::new(s.t_s(), e))?
                 .0
         } else {
@@ -188,6 +199,9 @@ pub(super) struct Plant<'a, E: Engine> {
     pub(super) engine: &'a mut E,
     pub(super) wit: &'a mut E::Witness,
     pub(super) cur: &'a mut E::State,
+    /// `cur` is the end of the last step taken (the loop states it; see
+    /// [`Engine::actuator_torque`]).
+    pub(super) at_step_end: bool,
 }
 
 /// What a tick at the current state did to the string, for the stride loop to write down.
@@ -367,7 +381,7 @@ impl<'r> Ticks<'r> {
                     plant.wit,
                     plant.engine,
                     t0,
-                    plant.cur,
+                    (plant.cur, plant.at_step_end),
                     on_floor,
                 )?;
                 self.tick_controller(&sensing)?
@@ -406,17 +420,21 @@ impl<'r> Ticks<'r> {
         mut seg: ActuatorSegment,
     ) -> TickEffect {
         let mut effect = TickEffect::Quiet;
-        if let Some((coord, Drive::Segment(_))) = engine.prescribed() {
+        let mut change = SystemChange::Equations;
+        if let Some((coord, Drive::Segment(ended))) = engine.prescribed() {
             if seg.released {
                 // The string goes slack during the push (an emergency stop, a fault): no
                 // impulse, the ankle is free again, and the foot keeps pivoting about its toe
                 // until the heel comes back down or the stride ends.
                 engine.set_prescribed(None);
                 engine.set_active(coord.0, true);
-                engine.system_changed();
+                engine.system_changed(SystemChange::Equations);
                 effect = TickEffect::Released;
             } else {
                 seg = continue_at_tick(self.segment.as_ref(), seg, cur.t_s());
+                if drive_continues(&ended, &seg, cur.t_s()) {
+                    change = SystemChange::DriveAcceleration;
+                }
                 engine.set_prescribed(Some((coord, Drive::Segment(seg))));
                 engine.snap(cur);
             }
@@ -425,7 +443,7 @@ impl<'r> Ticks<'r> {
         // free the tick only moves the engagement witness, and the integrator keeps its last
         // stage (first same as last).
         if engine.prescribed().is_some() {
-            engine.system_changed();
+            engine.system_changed(change);
         }
         self.segment = Some(seg);
         self.end_at_next_tick = false;
@@ -487,7 +505,14 @@ impl<'r> Ticks<'r> {
             let mut s = dense.eval(self.next_tick_s);
             plant.engine.snap(&mut s);
             let clear = clear_of_floor(ends.0, ends.1, s.t_s()).then_some(false);
-            let sensing = sense(plant.walker, plant.wit, plant.engine, t0, &s, clear)?;
+            let sensing = sense(
+                plant.walker,
+                plant.wit,
+                plant.engine,
+                t0,
+                (&s, false),
+                clear,
+            )?;
             let seg = self.tick_controller(&sensing)?;
             match self.segment {
                 Some(held) if held.same_held_input(&seg) => {
