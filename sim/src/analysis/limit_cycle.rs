@@ -118,6 +118,10 @@ pub struct Gait {
     pub residual: f64,
     /// The stride from the fixed point.
     pub stride: StrideResult,
+    /// The fixed-point search's settings that produced it.
+    pub newton: NewtonSettings,
+    /// The stride settings it was integrated with.
+    pub stride_settings: StrideSettings,
 }
 
 impl Gait {
@@ -362,6 +366,8 @@ impl<'a> GaitSearch<'a> {
                     strides,
                     residual: r.amax(),
                     stride,
+                    newton: *self.newton,
+                    stride_settings: self.settings.clone(),
                 });
             }
             if it == settings.max_iterations {
