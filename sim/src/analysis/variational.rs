@@ -310,37 +310,12 @@ fn variational<const N: usize>(
             let j = terminal_jacobian::<N>(walker, &spec.active, before, &y)?;
             return Ok((j, nominal));
         }
-        // Both remaining events are a coordinate reaching a value and an inelastic impact
-        // that stops it there: the knee at its stop; the ankle at the taut angle (the
-        // ideal drive starts at rest there, its far end not moving), the toe set free.
-        let (c, value, impact_active, new_spec) =
-            if let Some(knee) = name.strip_prefix("knee_lock:") {
-                let k = walker
-                    .knees()
-                    .iter()
-                    .find(|k| walker.model().coordinates[k.coordinate.0].name == knee)
-                    .ok_or_else(|| num(format!("unknown knee {knee}")))?;
-                let c = k.coordinate.0;
-                let mut s = spec.clone();
-                s.active[c] = false;
-                (c, k.stop_rad, spec.active.clone(), s)
-            } else if name == "string_engaged" {
-                let r = walker
-                    .ankle()
-                    .ok_or_else(|| num("engagement without an ankle reflex"))?;
-                let (a, toe) = (r.ankle.0, r.toe_pitch.0);
-                let mut act = spec.active.clone();
-                act[toe] = true;
-                let mut after_active = act.clone();
-                after_active[a] = false;
-                let s = PhaseSpec {
-                    active: after_active,
-                    drive: Some((a, r.extension_from(t))),
-                };
-                (a, r.engage_rad, act, s)
-            } else {
-                return Err(VariationalError::Unsupported(format!("event `{name}`")));
-            };
+        let StoppingEvent {
+            coordinate: c,
+            value,
+            impact_active,
+            after: new_spec,
+        } = stopping_event(walker, &spec, name, t)?;
         let tau = tau_of(&|x: &DVector<DualSVec64<N>>| x[c] - konst::<DualSVec64<N>>(value))?;
         let y = &phi + &f_minus * DMatrix::from_row_slice(1, m, &tau);
         let jump = jump_derivative(
@@ -380,6 +355,66 @@ fn variational<const N: usize>(
         from = after.clone();
     }
     Err(num("the stride ended without a heel strike"))
+}
+
+/// An event other than heel strike: a coordinate reaching a value and an inelastic impact that
+/// stops it there.
+struct StoppingEvent {
+    /// The coordinate.
+    coordinate: usize,
+    /// The value it reaches [rad].
+    value: f64,
+    /// The free coordinates of the impact.
+    impact_active: Vec<bool>,
+    /// The phase after it.
+    after: PhaseSpec,
+}
+
+/// The stopping event `name` of `walker` at stride time `t` [s] in phase `spec`: the knee at
+/// its stop; the ankle at the taut angle (the ideal drive starts at rest there, its far end
+/// not moving), the toe set free.
+fn stopping_event(
+    walker: &Walker,
+    spec: &PhaseSpec,
+    name: &str,
+    t: f64,
+) -> Result<StoppingEvent, VariationalError> {
+    if let Some(knee) = name.strip_prefix("knee_lock:") {
+        let k = walker
+            .knees()
+            .iter()
+            .find(|k| walker.model().coordinates[k.coordinate.0].name == knee)
+            .ok_or_else(|| num(format!("unknown knee {knee}")))?;
+        let c = k.coordinate.0;
+        let mut after = spec.clone();
+        after.active[c] = false;
+        Ok(StoppingEvent {
+            coordinate: c,
+            value: k.stop_rad,
+            impact_active: spec.active.clone(),
+            after,
+        })
+    } else if name == "string_engaged" {
+        let r = walker
+            .ankle()
+            .ok_or_else(|| num("engagement without an ankle reflex"))?;
+        let (a, toe) = (r.ankle.0, r.toe_pitch.0);
+        let mut impact_active = spec.active.clone();
+        impact_active[toe] = true;
+        let mut after_active = impact_active.clone();
+        after_active[a] = false;
+        Ok(StoppingEvent {
+            coordinate: a,
+            value: r.engage_rad,
+            impact_active,
+            after: PhaseSpec {
+                active: after_active,
+                drive: Some((a, r.extension_from(t))),
+            },
+        })
+    } else {
+        Err(VariationalError::Unsupported(format!("event `{name}`")))
+    }
 }
 
 /// `DΔ · Y` for a jump `Δ(q, q̇)` evaluated in dual numbers at `x⁻` along the columns of
