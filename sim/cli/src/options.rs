@@ -22,8 +22,8 @@ pub struct Common {
     /// Integrator: meijaard, rk4, dopri5 or dop853 (default: the scene's).
     #[arg(long)]
     pub integrator: Option<String>,
-    /// Fixed step for meijaard/rk4 \[s\].
-    #[arg(long)]
+    /// Fixed step for meijaard/rk4, in seconds.
+    #[arg(long, help = "Fixed step for meijaard/rk4 [s]")]
     pub step_s: Option<f64>,
     /// Relative and absolute tolerance for dopri5 and dop853.
     #[arg(long)]

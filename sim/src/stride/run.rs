@@ -80,6 +80,9 @@ pub(super) struct Run<'w, 'r, 't, E: Engine> {
     /// `cur` is the end of the last step the integrator took (not a state located or
     /// interpolated inside it, nor one after an impact).
     cur_at_step_end: bool,
+    /// The step's end the grazing check returned is the end of the integrator's last step
+    /// (no probe was taken inside the step, or its probe was adopted).
+    next_at_step_end: bool,
     events: Vec<StrideEvent>,
     event_states: Vec<(Sample, Sample)>,
     energy_loss_j: f64,
@@ -133,6 +136,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             triggered,
             cur,
             cur_at_step_end: false,
+            next_at_step_end: false,
             events: Vec::new(),
             event_states: Vec::new(),
             energy_loss_j: 0.0,
@@ -204,7 +208,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             let Some((watch, mut at)) = (match located? {
                 Located::None => {
                     let held = self.held_ticks(dense.as_ref(), (&w_cur, &w_next), next.t_s())?;
-                    let at_step_end = held.is_none();
+                    let at_step_end = held.is_none() && self.next_at_step_end;
                     self.accept(held.unwrap_or(next), drive_end_s)?;
                     self.cur_at_step_end = at_step_end;
                     continue;
@@ -357,7 +361,10 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
         };
         let mut w_next = self.wit.eval(&next);
         let samples = self.settings.event_tolerance.grazing_samples;
+        self.next_at_step_end = true;
         if let Some(t) = w_cur.grazing_sample_time(&w_next, samples) {
+            // The probe is the integrator's last step now: `next` is its end only if adopted.
+            self.next_at_step_end = false;
             let mut s = self
                 .engine
                 .step_exact(cur, t - cur.t_s())
@@ -367,6 +374,7 @@ impl<'w, 'r, 't, E: Engine> Run<'w, 'r, 't, E> {
             if ws.foot_height_m <= 0.0 {
                 next = s;
                 w_next = ws;
+                self.next_at_step_end = true;
             }
         }
         self.w_cached = Some(w_next);
