@@ -243,7 +243,10 @@ impl GaitSource {
 /// the defaults' gait followed to the requested values ([`follow`]) — the branch of the
 /// scene's nominal gait, which for the simplest walker is Garcia's long-period gait, wherever
 /// that branch reaches, not only near the guess. Two or three Newton searches in the usual
-/// case; every period-1 gait is [`crate::analysis::census::census`]'s job. With where it came from.
+/// case; every period-1 gait is [`crate::analysis::census::census`]'s job. With where it came
+/// from. The one rule for "the gait of this scene at these values": every command and study
+/// calls it (a study over many values keeps one [`GaitRule`], which finds the defaults' gait
+/// once).
 ///
 /// # Errors
 /// The scene cannot be built at its values or at its defaults.
@@ -253,29 +256,111 @@ pub fn nominal_gait(
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
 ) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
-    let setup = setup_for(scene)?;
-    if is_at_defaults(scene) {
-        return Ok(setup.find_gait(newton).map(|g| (g, GaitSource::Defaults)));
+    GaitRule::new(setup_for, newton, homotopy).gait(scene)
+}
+
+/// A scene at its defaults and its gait there (Newton from its guess).
+type DefaultsGait = (Scene, Result<Gait, NewtonError>);
+
+/// [`nominal_gait`] for many values of one scene: the defaults' gait is found once, at the
+/// first value off the defaults, and kept (for every scene whose defaults are the same scene;
+/// another scene's are found afresh). The same gaits as [`nominal_gait`], to the bit.
+pub struct GaitRule<'a> {
+    setup_for: &'a SetupFor<'a>,
+    newton: &'a NewtonSettings,
+    homotopy: &'a HomotopySettings,
+    defaults: std::sync::OnceLock<Result<DefaultsGait, SceneError>>,
+}
+
+impl<'a> GaitRule<'a> {
+    /// The rule with these solver settings.
+    pub fn new(
+        setup_for: &'a SetupFor<'a>,
+        newton: &'a NewtonSettings,
+        homotopy: &'a HomotopySettings,
+    ) -> Self {
+        Self {
+            setup_for,
+            newton,
+            homotopy,
+            defaults: std::sync::OnceLock::new(),
+        }
     }
-    let defaults = at_defaults(scene)?;
-    let default_setup = setup_for(&defaults)?;
-    let (from_guess, followed) = rayon::join(
-        || setup.find_gait(newton),
-        || match default_setup.find_gait(newton) {
-            Ok(g) => follow(&defaults, scene, setup_for, &g, newton, homotopy).0,
-            Err(e) => Err(e),
-        },
-    );
-    Ok(match (from_guess, followed) {
-        (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
-            (b, GaitSource::ContinuedFromDefaults)
-        } else {
-            (a, GaitSource::Guess)
-        }),
-        (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
-        (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
-        (Err(e), Err(_)) => Err(e),
-    })
+
+    /// The scene's gait at its values, and where it came from ([`nominal_gait`]).
+    ///
+    /// # Errors
+    /// The scene cannot be built at its values or at its defaults.
+    pub fn gait(
+        &self,
+        scene: &Scene,
+    ) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
+        let setup = (self.setup_for)(scene)?;
+        if is_at_defaults(scene) {
+            return Ok(setup
+                .find_gait(self.newton)
+                .map(|g| (g, GaitSource::Defaults)));
+        }
+        let defaults = at_defaults(scene)?;
+        let (from_guess, followed) = rayon::join(
+            || setup.find_gait(self.newton),
+            || -> Result<Result<Gait, NewtonError>, SceneError> {
+                let found;
+                let (defaults, gait) = match self.kept_defaults(&defaults)? {
+                    Some(kept) => (&kept.0, &kept.1),
+                    None => {
+                        found = self.defaults_gait(defaults.clone())?;
+                        (&found.0, &found.1)
+                    }
+                };
+                Ok(match gait {
+                    Ok(g) => {
+                        follow(
+                            defaults,
+                            scene,
+                            self.setup_for,
+                            g,
+                            self.newton,
+                            self.homotopy,
+                        )
+                        .0
+                    }
+                    Err(e) => Err(e.clone()),
+                })
+            },
+        );
+        let followed = followed?;
+        Ok(match (from_guess, followed) {
+            (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
+                (b, GaitSource::ContinuedFromDefaults)
+            } else {
+                (a, GaitSource::Guess)
+            }),
+            (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
+            (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
+            (Err(e), Err(_)) => Err(e),
+        })
+    }
+
+    /// The kept defaults' gait when `defaults` is the scene it was found for (found now at
+    /// the first call); `None` when it is another scene's.
+    fn kept_defaults(&self, defaults: &Scene) -> Result<Option<&DefaultsGait>, SceneError> {
+        let kept = self
+            .defaults
+            .get_or_init(|| self.defaults_gait(defaults.clone()))
+            .as_ref()
+            .map_err(Clone::clone)?;
+        Ok((kept.0.name() == defaults.name()
+            && kept.0.file == defaults.file
+            && kept.0.values == defaults.values)
+            .then_some(kept))
+    }
+
+    /// The gait of `defaults` (Newton from its guess).
+    fn defaults_gait(&self, defaults: Scene) -> Result<DefaultsGait, SceneError> {
+        let gait = (self.setup_for)(&defaults)?.find_gait(self.newton);
+        Ok((defaults, gait))
+    }
 }
 
 /// [`nominal_gait`] without its source: "the long-period gait" of `walker gait`, the sweep's

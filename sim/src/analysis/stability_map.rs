@@ -1,24 +1,21 @@
-//! The stability map: the largest |eigenvalue| of the stride Jacobian of the long-period
-//! gait over a grid of two parameters — a designer's first picture of a walker.
+//! The stability map: the largest |eigenvalue| of the stride Jacobian of the scene's gait over
+//! a grid of two parameters — a designer's first picture of a walker.
 //!
-//! Each row (one value of the y parameter) is filled by natural-parameter continuation along x
-//! ([`crate::analysis::continuation::along`]): a cell starts Newton from the secant predictor of the
-//! row's last two gaits (the last one alone after the first), and accepts the result unless
-//! the corrector moved it by more than [`HomotopySettings::max_correction`] or its step period
-//! differs from the last gait's by more than [`HomotopySettings::max_period_change`] (a jump
-//! to another branch). The first cell of a row, a cell after one without a gait, and a cell
-//! whose continuation failed or jumped are **seeded** by [`crate::analysis::homotopy::long_period_gait`]
-//! (Newton from the scene's guess and the defaults' gait followed to the cell), so a row
-//! re-enters the long-period branch where it reappears. A cell has no gait when both fail.
+//! Every cell's gait is the one `walker gait` reports at the cell's values: the scene's
+//! nominal gait ([`crate::analysis::homotopy::nominal_gait`], the one rule every command and
+//! study shares — Newton from the scene's guess at the cell and the defaults' gait followed to
+//! the cell, the longer-period of the two), with where it came from ([`GaitSource`]). A cell
+//! never reports another gait than `walker gait` would at the same values: it does not follow
+//! its neighbours along a row (which can land on another branch past a fold; a study that
+//! follows a branch on purpose is `walker sweep`). A cell has no gait when both searches fail.
 //!
-//! Rows are independent and run in parallel (rayon); the results do not depend on the
-//! number of threads. Budget per cell: one continuation search of at most
-//! [`HomotopySettings::max_corrector_iterations`] Newton iterations, and when seeded two
+//! Cells are independent and run in parallel (rayon); the results do not depend on the number
+//! of threads. Budget per cell: that of [`crate::analysis::homotopy::nominal_gait`] — two
 //! searches with the caller's Newton budget and at most [`HomotopySettings::max_solves`]
-//! corrector searches along the path from the defaults.
+//! corrector searches along the path from the defaults, whose gait is found once for the map
+//! ([`GaitRule`]).
 
-use crate::analysis::continuation::along;
-use crate::analysis::homotopy::{HomotopySettings, SetupFor};
+use crate::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings, SetupFor};
 use crate::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
@@ -44,8 +41,8 @@ pub struct MapCell {
     pub step_period_s: f64,
     /// The fixed point (stride-map vector).
     pub fixed_point: DVector<f64>,
-    /// Found by seeding rather than by continuation along the row.
-    pub seeded: bool,
+    /// Where the gait came from (as `walker gait`'s `gait_source`).
+    pub source: GaitSource,
 }
 
 /// The map: one row per y value, one cell per x value; `Err` where no gait was found.
@@ -56,13 +53,13 @@ pub struct StabilityMap {
 }
 
 impl MapCell {
-    fn of(g: &Gait, seeded: bool) -> Self {
+    fn of(g: &Gait, source: GaitSource) -> Self {
         Self {
             max_abs_eigenvalue: g.max_abs_eigenvalue(),
             stable: g.stable(),
             step_period_s: g.stride.duration_s,
             fixed_point: g.fixed_point.clone(),
-            seeded,
+            source,
         }
     }
 }
@@ -90,22 +87,24 @@ pub fn stability_map(
     {
         check.set(&axis.name, *v)?;
     }
-    let rows: Vec<Result<Vec<Result<MapCell, NewtonError>>, SceneError>> = y
-        .values
-        .par_iter()
-        .map(|&yv| {
+    let rule = GaitRule::new(setup_for, newton, homotopy);
+    let nx = x.values.len();
+    let cells: Vec<Result<Result<MapCell, NewtonError>, SceneError>> = (0..nx * y.values.len())
+        .into_par_iter()
+        .map(|k| {
             let mut at = scene.clone();
-            at.set(&y.name, yv)?;
-            let cells = along(
-                &at, &x.name, &x.values, setup_for, newton, homotopy, progress,
-            )?;
-            Ok(cells
-                .into_iter()
-                .map(|c| c.map(|(g, seeded)| MapCell::of(&g, seeded)))
-                .collect())
+            at.set(&x.name, x.values[k % nx])?;
+            at.set(&y.name, y.values[k / nx])?;
+            let cell = rule.gait(&at)?.map(|(g, source)| MapCell::of(&g, source));
+            progress();
+            Ok(cell)
         })
         .collect();
-    Ok(StabilityMap {
-        rows: rows.into_iter().collect::<Result<_, _>>()?,
-    })
+    let cells = cells.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let mut rows: Vec<Vec<Result<MapCell, NewtonError>>> = Vec::with_capacity(y.values.len());
+    let mut cells = cells.into_iter();
+    for _ in &y.values {
+        rows.push(cells.by_ref().take(nx).collect());
+    }
+    Ok(StabilityMap { rows })
 }

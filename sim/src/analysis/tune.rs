@@ -1,11 +1,13 @@
 //! Searching parameters near a design for a more stable gait: Nelder-Mead on the largest
-//! |eigenvalue| of the stride Jacobian, within stated bounds, warm-starting every gait search
-//! from the best fixed point found so far (the paper notes such searches are slow; they are
-//! fine at these sizes).
+//! |eigenvalue| of the stride Jacobian, within stated bounds. Every point's gait is the one
+//! `walker gait` reports at its values ([`GaitRule`], the one rule: Newton from the scene's
+//! guess and the defaults' gait followed there, the longer-period of the two), never one
+//! warm-started from another point (which can land on another branch); each point says where
+//! its gait came from.
 
-use crate::analysis::limit_cycle::{GaitSearch, NewtonSettings};
+use crate::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings, SetupFor};
+use crate::analysis::limit_cycle::NewtonSettings;
 use crate::scene::{Scene, SceneError};
-use nalgebra::DVector;
 use serde::Serialize;
 
 /// A parameter the search may change, with its bounds.
@@ -26,6 +28,11 @@ pub struct TunePoint {
     pub values: Vec<f64>,
     /// Largest |eigenvalue|, or `None` where no gait was found.
     pub max_abs_eigenvalue: Option<f64>,
+    /// Where the gait came from, as `walker gait`'s `gait_source` at these values (`None`: no
+    /// gait).
+    pub gait_source: Option<GaitSource>,
+    /// The gait's step period \[s\] (`None`: no gait).
+    pub step_period_s: Option<f64>,
 }
 
 /// The outcome of a search.
@@ -42,26 +49,41 @@ pub struct TuneResult {
 /// Objective value for a failed gait search.
 const NO_GAIT: f64 = 10.0;
 
-/// Minimises max |λ| over `params` from the scene's current values, with at most `evaluations`
-/// gait searches.
-pub fn tune(
-    scene: &Scene,
-    params: &[TunedParameter],
-    evaluations: usize,
-    settings: &NewtonSettings,
-) -> Result<TuneResult, SceneError> {
-    tune_with_progress(scene, params, evaluations, settings, &|| {})
+/// How a search runs: what it varies, its budget, and the gait rule's solver settings.
+pub struct TuneSettings<'a> {
+    /// What the search may change, with its bounds.
+    pub params: &'a [TunedParameter],
+    /// Most gait evaluations.
+    pub evaluations: usize,
+    /// Builds the setup at each point (the caller's solver overrides).
+    pub setup_for: &'a SetupFor<'a>,
+    /// The fixed-point search.
+    pub newton: &'a NewtonSettings,
+    /// How the defaults' gait is followed to a point.
+    pub homotopy: &'a HomotopySettings,
 }
 
-/// As [`tune`], calling `on_evaluation` after each gait search (at most `evaluations`; for a
-/// progress bar).
+/// Minimises max |λ| over `settings.params` from the scene's current values, with at most
+/// `settings.evaluations` gait evaluations.
+///
+/// # Errors
+/// An unknown parameter, a bound out of the scene's range, a scene that cannot be built.
+pub fn tune(scene: &Scene, settings: &TuneSettings<'_>) -> Result<TuneResult, SceneError> {
+    tune_with_progress(scene, settings, &|| {})
+}
+
+/// As [`tune`], calling `on_evaluation` after each gait evaluation (at most `evaluations`; for
+/// a progress bar).
+///
+/// # Errors
+/// As [`tune`].
 pub fn tune_with_progress(
     scene: &Scene,
-    params: &[TunedParameter],
-    evaluations: usize,
-    settings: &NewtonSettings,
+    settings: &TuneSettings<'_>,
     on_evaluation: &dyn Fn(),
 ) -> Result<TuneResult, SceneError> {
+    let (params, evaluations) = (settings.params, settings.evaluations);
+    let rule = GaitRule::new(settings.setup_for, settings.newton, settings.homotopy);
     let mut scene = scene.clone();
     let n = params.len();
     let start: Vec<f64> = params
@@ -73,7 +95,6 @@ pub fn tune_with_progress(
         scene.set(&p.name, p.min)?;
         scene.set(&p.name, p.max)?;
     }
-    let mut warm: Option<DVector<f64>> = None;
     let mut history: Vec<TunePoint> = Vec::new();
     let mut eval = |x: &[f64], history: &mut Vec<TunePoint>| -> Result<f64, SceneError> {
         // The budget holds per gait search: a simplex step may want several searches, and
@@ -89,22 +110,13 @@ pub fn tune_with_progress(
         for (v, p) in clamped.iter().zip(params) {
             scene.set(&p.name, *v)?;
         }
-        let setup = scene.setup()?;
-        let search = GaitSearch::new(&setup.walker, &setup.settings, settings);
-        let gait = match &warm {
-            Some(v) => search.find(v),
-            None => search.find_from_guess(&setup.guess),
-        };
-        let value = match &gait {
-            Ok(g) => {
-                warm = Some(g.fixed_point.clone());
-                Some(g.max_abs_eigenvalue())
-            }
-            Err(_) => None,
-        };
+        let gait = rule.gait(&scene)?.ok();
+        let value = gait.as_ref().map(|(g, _)| g.max_abs_eigenvalue());
         history.push(TunePoint {
             values: clamped,
             max_abs_eigenvalue: value,
+            gait_source: gait.as_ref().map(|(_, source)| *source),
+            step_period_s: gait.as_ref().map(|(g, _)| g.stride.duration_s),
         });
         on_evaluation();
         Ok(value.unwrap_or(NO_GAIT))
@@ -186,6 +198,8 @@ pub fn tune_with_progress(
         .unwrap_or(TunePoint {
             values: start,
             max_abs_eigenvalue: None,
+            gait_source: None,
+            step_period_s: None,
         });
     Ok(TuneResult {
         parameters: params.to_vec(),

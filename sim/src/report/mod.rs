@@ -27,6 +27,7 @@ mod ideal_gait;
 mod orbit_diagram;
 mod scenes;
 mod stability_map;
+mod start;
 mod sweep;
 mod walk;
 mod walk_gait;
@@ -40,6 +41,7 @@ pub use ideal_gait::IdealGaitRecord;
 pub use orbit_diagram::{FellRecord, OrbitDiagramReport, OrbitPointRecord};
 pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
 pub use stability_map::{AxisRecord, StabilityMapReport};
+pub use start::{StartKind, StartRecord};
 pub use sweep::{
     BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, SweepPointRecord,
     SweepReport, SwitchFailureRecord, UnlocatedRecord,

@@ -1,6 +1,7 @@
 //! The `walker stability-map` report: the largest |eigenvalue| of the long-period gait over
 //! a grid of two parameters, `null` where there is no gait.
 
+use crate::analysis::homotopy::GaitSource;
 use crate::analysis::stability_map::{Axis, StabilityMap};
 use serde::Serialize;
 
@@ -22,6 +23,9 @@ pub struct StabilityMapReport {
     pub step_period_s: Vec<Vec<Option<f64>>>,
     /// Why there is no gait (`null` where there is one).
     pub no_gait_reason: Vec<Vec<Option<String>>>,
+    /// Where each cell's gait came from, as `walker gait`'s `gait_source` at the cell's values
+    /// (`null`: no gait).
+    pub gait_source: Vec<Vec<Option<GaitSource>>>,
 }
 
 /// An axis of the grid.
@@ -73,6 +77,15 @@ impl StabilityMapReport {
                 .map(|r| {
                     r.iter()
                         .map(|c| c.as_ref().err().map(ToString::to_string))
+                        .collect()
+                })
+                .collect(),
+            gait_source: map
+                .rows
+                .iter()
+                .map(|r| {
+                    r.iter()
+                        .map(|c| c.as_ref().ok().map(|c| c.source))
                         .collect()
                 })
                 .collect(),

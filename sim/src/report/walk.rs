@@ -1,5 +1,6 @@
 //! The `walker walk` report: the steps of a walk and its first failure.
 
+use super::StartRecord;
 use crate::scene::Scene;
 use crate::stride::walk::{StepSummary, Walk, WalkFailure};
 use serde::Serialize;
@@ -18,6 +19,8 @@ pub struct WalkReport {
     pub failure: Option<WalkFailure>,
     /// Summaries of the steps completed.
     pub steps: Vec<StepSummary>,
+    /// What the walk started from (`null` when the caller did not say).
+    pub start: Option<StartRecord>,
 }
 
 impl WalkReport {
@@ -29,6 +32,7 @@ impl WalkReport {
             steps_completed: walk.steps_completed,
             failure: walk.failure.clone(),
             steps: walk.steps.clone(),
+            start: None,
         }
     }
 }

@@ -15,7 +15,7 @@ pub enum Num {
 }
 
 /// A whole scene file.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// Name and description.
@@ -107,7 +107,7 @@ impl ShapeDef {
 }
 
 /// Scene header.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SceneHeader {
     /// Name used on the command line.
@@ -120,7 +120,7 @@ pub struct SceneHeader {
 }
 
 /// One parameter.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ParameterDef {
     /// Default value.
@@ -141,7 +141,7 @@ pub struct ParameterDef {
 }
 
 /// Gravity and slope.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct WorldDef {
     /// Gravitational acceleration [m/s²].
@@ -151,7 +151,7 @@ pub struct WorldDef {
 }
 
 /// A link: a joint and the body it carries.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LinkDef {
     /// Name (also the coordinate's name).
@@ -190,7 +190,7 @@ pub struct LinkDef {
 }
 
 /// A marker point.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PointDef {
     /// Name.
@@ -202,7 +202,7 @@ pub struct PointDef {
 }
 
 /// Heel strike.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct HeelStrikeDef {
     /// Swing-foot point.
@@ -225,7 +225,7 @@ pub struct HeelStrikeDef {
 }
 
 /// A knee stop.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct KneeDef {
     /// Knee coordinate (link name).
@@ -237,7 +237,7 @@ pub struct KneeDef {
 }
 
 /// Falls.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FallDef {
     /// Hip point.
@@ -247,7 +247,7 @@ pub struct FallDef {
 }
 
 /// Relabelling.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RelabelDef {
     /// `[new, old]` link pairs whose orientations agree.
@@ -264,7 +264,7 @@ pub struct RelabelDef {
 }
 
 /// Integrator defaults.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorDef {
     /// `meijaard`, `rk4`, `dopri5` or `dop853`.
@@ -305,7 +305,7 @@ impl Default for IntegratorDef {
 }
 
 /// Gait guess, by coordinate name.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct GuessDef {
     /// Positions.
@@ -315,7 +315,7 @@ pub struct GuessDef {
 }
 
 /// Outputs in a publication's convention: each is a linear combination of coordinates.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ConventionDef {
     /// Velocities are multiplied by this \[s\] (e.g. `sqrt(l/g)` for dimensionless time).
@@ -326,7 +326,7 @@ pub struct ConventionDef {
 }
 
 /// One derived output.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct OutputDef {
     /// Name of the position output; the rate is `<name>_dot`.
@@ -339,7 +339,7 @@ pub struct OutputDef {
 }
 
 /// The ankle stretch reflex.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AnkleReflexDef {
     /// Ankle coordinate.

@@ -27,7 +27,7 @@ use toml::{Table, Value};
 
 /// A scene file's `[variant]` table. Unknown keys are rejected (a typo such as `wled` would
 /// otherwise leave the base walker unchanged).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct VariantDef {
     /// The built-in scene this one derives from.
@@ -48,7 +48,7 @@ pub struct VariantDef {
 }
 
 /// A spring and damper on a joint (`[variant.joint.<link>]`): the same keys as a link's.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct JointForceDef {
     /// Joint spring stiffness \[N·m/rad\] (N/m on a prismatic joint).

@@ -14,9 +14,10 @@ use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
+use sim::analysis::homotopy::{nominal_gait, GaitSource, HomotopySettings};
 use sim::analysis::limit_cycle::Gait;
 use sim::engine::integrators::IntegratorChoice;
-use sim::report::{IdealGaitRecord, WalkGaitRecord};
+use sim::report::{IdealGaitRecord, StartRecord, WalkGaitRecord};
 use sim::scene::Setup;
 use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
 use std::collections::BTreeMap;
@@ -42,8 +43,13 @@ pub struct SilArgs {
     /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
-    /// Host emergency stop to every ankle at this walk time \[s\] (finite, not negative).
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    /// Host emergency stop to every ankle at this walk time, in seconds (finite, not negative).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        allow_negative_numbers = true,
+        help = "Host emergency stop to every ankle at this walk time [s] (finite, not negative)"
+    )]
     pub estop_at: Option<f64>,
     /// Write the bus traffic as a candump log.
     #[arg(long, value_name = "FILE")]
@@ -51,10 +57,15 @@ pub struct SilArgs {
     /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
     #[arg(long, value_name = "ADDR")]
     pub socketcand: Option<String>,
-    /// With `--socketcand`: before the walk starts, wait up to this long \[s\] for a client
-    /// (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk starts
-    /// anyway and says so on standard error.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    /// With `--socketcand`: before the walk starts, wait up to this long, in seconds, for a
+    /// client (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk
+    /// starts anyway and says so on standard error.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        allow_negative_numbers = true,
+        help = "With `--socketcand`: before the walk starts, wait up to this long [s] for a client (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk starts anyway and says so on standard error"
+    )]
     pub wait_client: Option<f64>,
     /// Slow the simulation to this multiple of real time (e.g. 1 for a live monitor; 0.001 to
     /// 1000); by default it runs as fast as it can.
@@ -111,6 +122,9 @@ struct SilWalkReport<'a, Bus: Serialize> {
     steps_before_emergency_stop: usize,
     /// The ideal-actuator gait.
     ideal_gait: IdealGaitRecord,
+    /// What the walk started from: the ideal-actuator gait, as `walker gait` finds it
+    /// (`gait_source`, its step period).
+    start: StartRecord,
     /// Faults the nodes raised or cleared.
     node_faults: &'a [sil::FaultRecord],
     /// The left and the right node; `nodes.<side>.parameters`: the extension profile's
@@ -159,7 +173,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         .into());
     };
     let (config, firmware_params_written) = sil_config(actuator_choice, &args)?;
-    let Some((ideal_setup, ideal)) = ideal_gait(&scene, common)? else {
+    let Some((ideal_setup, ideal, source)) = ideal_gait(&scene, common)? else {
         return Ok(ExitCode::from(1));
     };
     if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
@@ -201,6 +215,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         walker: &walker,
         integrator: &stride_settings.integrator,
         ideal: IdealGaitRecord::of(&ideal_setup.walker, &ideal),
+        start: StartRecord::gait(scene.name(), &ideal, source),
         walk: &walk,
         keep_steps: args.keep_steps,
         firmware: &firmware,
@@ -244,12 +259,22 @@ fn check_options(
 
 /// The ideal-actuator gait with the scene's own (accurate) integrator (the walk with the
 /// firmware uses `sil::SIL_INTEGRATOR`, DOPRI5 at 1e-6, at most one step per 1 ms control
-/// tick, unless an integrator is given on the command line); `None`, said on standard error,
-/// when there is none to start from.
-fn ideal_gait(scene: &sim::scene::Scene, common: &Common) -> Result<Option<(Setup, Gait)>> {
+/// tick, unless an integrator is given on the command line), by the one gait rule (what
+/// `walker gait` reports at these values), with where it came from; `None`, said on standard
+/// error, when there is none to start from.
+fn ideal_gait(
+    scene: &sim::scene::Scene,
+    common: &Common,
+) -> Result<Option<(Setup, Gait, GaitSource)>> {
     let ideal_setup = scene.setup()?;
-    match ideal_setup.find_gait(&common.newton()) {
-        Ok(g) => Ok(Some((ideal_setup, g))),
+    let own_integrator = |s: &sim::scene::Scene| s.setup();
+    match nominal_gait(
+        scene,
+        &own_integrator,
+        &common.newton(),
+        &HomotopySettings::default(),
+    )? {
+        Ok((g, source)) => Ok(Some((ideal_setup, g, source))),
         Err(e) => {
             output::note(format_args!(
                 "error: no ideal-actuator gait to start from: {e}"
@@ -434,6 +459,7 @@ struct WalkRun<'a> {
     walker: &'a sim::engine::walker::Walker,
     integrator: &'a IntegratorChoice,
     ideal: IdealGaitRecord,
+    start: StartRecord,
     walk: &'a Walk,
     keep_steps: Option<usize>,
     firmware: &'a sil::SilReport,
@@ -469,6 +495,7 @@ impl<'a> WalkRun<'a> {
             emergency_stop_sent_s,
             steps_before_emergency_stop: actuated_steps.len(),
             ideal_gait: self.ideal,
+            start: self.start,
             node_faults: &self.firmware.faults,
             nodes: &self.firmware.nodes,
             firmware_params_written: self.firmware_params_written,
@@ -552,6 +579,7 @@ fn print_text<Bus: Serialize>(
         "ideal actuator's gait (max |λ| = {:.6}):",
         shown(r.ideal_gait.max_abs_eigenvalue)
     )?;
+    writeln!(out, "    start: {}", r.start.describe())?;
     GaitFigures::of_ideal(&r.ideal_gait).write(out, "    ")?;
     for (side, n) in r.nodes {
         let p = &n.parameters;

@@ -8,7 +8,8 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::tune::{tune_with_progress, TuneResult, TunedParameter};
+use sim::analysis::homotopy::HomotopySettings;
+use sim::analysis::tune::{tune_with_progress, TuneResult, TuneSettings, TunedParameter};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -68,9 +69,15 @@ pub fn run(args: TuneArgs) -> Result<ExitCode> {
         "tune (gait searches)",
         !common.json,
     );
-    let result = tune_with_progress(&scene, &params, evaluations, &common.newton(), &|| {
-        progress.tick()
-    })?;
+    let (setup_for, newton) = (common.setup_for(), common.newton());
+    let settings = TuneSettings {
+        params: &params,
+        evaluations,
+        setup_for: &setup_for,
+        newton: &newton,
+        homotopy: &HomotopySettings::default(),
+    };
+    let result = tune_with_progress(&scene, &settings, &|| progress.tick())?;
     progress.finish();
     if common.json {
         print_json(&result)?;
@@ -89,9 +96,21 @@ fn print_text(out: &mut dyn Write, result: &TuneResult) -> std::io::Result<()> {
             p.name, v, p.min, p.max
         )?;
     }
-    match result.best.max_abs_eigenvalue {
-        Some(m) => writeln!(out, "best max |λ| = {m:.6}"),
-        None => writeln!(out, "no gait found"),
+    match (
+        result.best.max_abs_eigenvalue,
+        result.best.gait_source,
+        result.best.step_period_s,
+    ) {
+        (Some(m), Some(source), Some(period_s)) => {
+            writeln!(out, "best max |λ| = {m:.6}")?;
+            writeln!(
+                out,
+                "gait: {} (step period {period_s:.4} s), as `walker gait` finds at these values",
+                source.describe()
+            )
+        }
+        (Some(m), _, _) => writeln!(out, "best max |λ| = {m:.6}"),
+        _ => writeln!(out, "no gait found"),
     }
 }
 

@@ -15,8 +15,9 @@ use crate::output::{self, PathError};
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
+use sim::analysis::homotopy::{nominal_gait, GaitRule, HomotopySettings};
 use sim::engine::walker::Walker;
-use sim::report::{WalkGaitRecord, WalkReport};
+use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::stride::walk::WalkRequest;
 use std::io::Write;
@@ -95,39 +96,42 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         None => None,
     };
     let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
-    let start_from_scene = match (start_from_scene, start.as_str()) {
-        (None, "gait") => match &scene.file.walk_start_scene {
-            Some(other) if setup.find_gait(&common.newton()).is_err() => {
-                output::note(format_args!(
-                    "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
-                    scene.name()
-                ));
-                Some(other.clone())
+    let (newton, setup_for) = (common.newton(), common.setup_for());
+    let homotopy = HomotopySettings::default();
+    let rule = GaitRule::new(&setup_for, &newton, &homotopy);
+    let from_other = |other: &str| start::from_other_scene(other, &scene, walker, &rule);
+    let started = match (start_from_scene, start.as_str()) {
+        (Some(other), _) => from_other(&other)?,
+        (None, "guess") => Some((v0, StartRecord::guess(scene.name()))),
+        (None, "gait") => match rule.gait(&scene)? {
+            Ok((g, source)) => {
+                let record = StartRecord::gait(scene.name(), &g, source);
+                Some((g.fixed_point, record))
             }
-            _ => None,
-        },
-        (s, _) => s,
-    };
-    let mut v = match (start_from_scene, start.as_str()) {
-        (Some(other), _) => match start::from_other_scene(&other, &scene, walker, &common)? {
-            Some(v) => v,
-            None => return Ok(ExitCode::from(1)),
-        },
-        (None, "guess") => v0,
-        (None, "gait") => match setup.find_gait(&common.newton()) {
-            Ok(g) => g.fixed_point,
-            Err(e) => {
-                output::note(format_args!(
-                    "error: no gait to start from: {e} (use --start guess)"
-                ));
-                return Ok(ExitCode::from(1));
-            }
+            Err(e) => match &scene.file.walk_start_scene {
+                Some(other) => {
+                    output::note(format_args!(
+                        "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
+                        scene.name()
+                    ));
+                    from_other(other)?
+                }
+                None => {
+                    output::note(format_args!(
+                        "error: no gait to start from: {e} (use --start guess)"
+                    ));
+                    None
+                }
+            },
         },
         (None, other) => {
             return Err(
                 InputError::Other(format!("--start `{other}`: expected gait or guess")).into(),
             )
         }
+    };
+    let Some((mut v, start_record)) = started else {
+        return Ok(ExitCode::from(1));
     };
     let names = walker.map_names();
     if let Some(path) = &start_state {
@@ -155,9 +159,8 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             let oset = os.setup()?;
             let ow = &oset.walker;
             let v0 = ow.pack(&oset.guess.q, &oset.guess.qd);
-            let start = oset
-                .find_gait(&common.newton())
-                .map(|g| g.fixed_point)
+            let start = nominal_gait(&os, &setup_for, &newton, &homotopy)?
+                .map(|(g, _)| g.fixed_point)
                 .unwrap_or(v0);
             let (oq, oqd) = ow.unpack(&start);
             let request = WalkRequest::new(&oset.settings, steps).recording(true);
@@ -184,7 +187,8 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             emergency_stop_sent_s: None,
         })?;
     }
-    let report = WalkReport::new(&scene, &walk);
+    let mut report = WalkReport::new(&scene, &walk);
+    report.start = Some(start_record);
     if common.json {
         print_json(&report)?;
     } else {
@@ -221,6 +225,9 @@ fn print_text(
         "scene {}: {} of {steps} steps",
         r.scene, r.steps_completed
     )?;
+    if let Some(start) = &r.start {
+        writeln!(out, "start: {}", start.describe())?;
+    }
     writeln!(
         out,
         "{:>5} {:>10} {:>10} {:>10} {:>12}",

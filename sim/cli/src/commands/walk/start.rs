@@ -1,23 +1,25 @@
 //! The start state of `walker walk`: another scene's gait, a start-state file, perturbations.
 
 use crate::input_error::InputError;
-use crate::options::Common;
 use crate::output;
 use anyhow::Result;
 use nalgebra::DVector;
 use serde_json::Value;
+use sim::analysis::homotopy::GaitRule;
 use sim::engine::walker::Walker;
+use sim::report::StartRecord;
 use sim::scene::Scene;
 use std::io::Read;
 
-/// The gait of scene `other` (with this scene's shared parameter values), mapped onto this
-/// walker's stride-map entries by name. `None` (after a message) if it has no gait.
+/// The gait of scene `other` (with this scene's shared parameter values) by the one gait
+/// rule, mapped onto this walker's stride-map entries by name, with where it came from.
+/// `None` (after a message) if it has no gait.
 pub fn from_other_scene(
     other: &str,
     scene: &Scene,
     walker: &Walker,
-    common: &Common,
-) -> Result<Option<DVector<f64>>> {
+    rule: &GaitRule<'_>,
+) -> Result<Option<(DVector<f64>, StartRecord)>> {
     let mut other_scene = Scene::load(other)?;
     for (k, val) in &scene.values {
         if other_scene.file.parameters.contains_key(k) {
@@ -26,7 +28,7 @@ pub fn from_other_scene(
     }
     let oset = other_scene.setup()?;
     let ow = &oset.walker;
-    let og = match oset.find_gait(&common.newton()) {
+    let (og, source) = match rule.gait(&other_scene)? {
         Ok(g) => g,
         Err(e) => {
             output::note(format_args!(
@@ -43,7 +45,10 @@ pub fn from_other_scene(
             v[i] = og.fixed_point[j];
         }
     }
-    Ok(Some(v))
+    Ok(Some((
+        v,
+        StartRecord::gait(other_scene.name(), &og, source),
+    )))
 }
 
 /// The entries a start-state file sets, as (stride-map index, value); every problem with the
