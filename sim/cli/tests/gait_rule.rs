@@ -148,7 +148,11 @@ fn the_issue_s_reproductions_agree_and_find_a_gait() {
         assert_eq!(tune, gait, "{scene} {p1:?}");
         assert_eq!(walk, Some((g.1, g.2.clone())), "{scene} {p1:?}");
         if scene == "simplest" {
-            assert!((g.1 - 3.912).abs() < 1e-3, "Garcia's long-period gait: {}", g.1);
+            assert!(
+                (g.1 - 3.912).abs() < 1e-3,
+                "Garcia's long-period gait: {}",
+                g.1
+            );
         }
     }
 }
