@@ -74,14 +74,24 @@ impl AngleCalibration {
     }
 
     /// The reading that gives `angle_rad` (inverse of [`Self::angle_rad`], rounded to a count);
-    /// used by simulated encoders to quantise like the real sensor.
+    /// used by simulated encoders to quantise like the real sensor. Any angle gives a reading:
+    /// the rounded counts are reduced to one revolution before any integer arithmetic (`fmod`
+    /// of an integer-valued float is exact), so a huge angle (a glitch of 1e6 rad, ±∞) can
+    /// neither saturate nor wrap an integer; a NaN reads as the zero.
     pub fn counts(&self, angle_rad: f32) -> u16 {
-        let per_rad = ENCODER_COUNTS_PER_REV as f32 / core::f32::consts::TAU;
-        let mut d = libm::roundf(angle_rad * per_rad) as i32;
+        let n = ENCODER_COUNTS_PER_REV as f32;
+        let per_rad = n / core::f32::consts::TAU;
+        let within_rev = libm::fmodf(libm::roundf(angle_rad * per_rad), n);
+        // |within_rev| < n = 16384 (or NaN, which casts to 0): exact as an i32.
+        let mut d = if within_rev.is_finite() {
+            within_rev as i32
+        } else {
+            0
+        };
         if self.reversed {
             d = -d;
         }
-        (self.zero_counts as i32 + d).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
+        (i32::from(self.zero_counts) + d).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
     }
 }
 
@@ -245,6 +255,55 @@ mod tests {
             counts,
             angle_rad: cal.angle_rad(counts),
         })
+    }
+
+    #[test]
+    fn any_angle_gives_a_reading_without_integer_overflow() {
+        // Extremes a glitch or a broken model can hand the simulated encoder: no overflow (a
+        // debug build panics on one), a reading in range, and angles a whole number of
+        // revolutions apart (exact in f32 counts) read the same.
+        for reversed in [false, true] {
+            for zero_counts in [0u16, 1, 4000, 16383, u16::MAX] {
+                let cal = AngleCalibration {
+                    zero_counts,
+                    reversed,
+                };
+                for a in [
+                    0.0f32,
+                    -0.0,
+                    1e6,
+                    -1e6,
+                    1e30,
+                    -1e30,
+                    f32::MAX,
+                    f32::MIN,
+                    f32::INFINITY,
+                    f32::NEG_INFINITY,
+                    f32::NAN,
+                    f32::MIN_POSITIVE,
+                ] {
+                    assert!(cal.counts(a) < ENCODER_COUNTS_PER_REV, "{a}");
+                }
+                assert_eq!(cal.counts(f32::NAN), cal.counts(0.0));
+                let per_count = core::f32::consts::TAU / ENCODER_COUNTS_PER_REV as f32;
+                // 2²³ counts from zero: 512 revolutions, every count exact in f32.
+                for c in [0.0f32, 1.0, 123.0, 8191.0] {
+                    let far = (c + 512.0 * ENCODER_COUNTS_PER_REV as f32) * per_count;
+                    let near = c * per_count;
+                    let diff = (i32::from(cal.counts(far)) - i32::from(cal.counts(near)))
+                        .rem_euclid(ENCODER_COUNTS_PER_REV as i32);
+                    // The angles round to counts one ulp apart at most.
+                    assert!(
+                        diff <= 1 || diff >= ENCODER_COUNTS_PER_REV as i32 - 1,
+                        "{c}: {diff}"
+                    );
+                }
+                // A glitch of 1e6 rad moves the reading (1e6 rad is not a whole number of
+                // revolutions; the old saturating cast read every huge angle as one count).
+                let c0 = cal.counts(0.1);
+                assert_ne!(cal.counts(0.1 + 1e6), c0);
+            }
+        }
     }
 
     #[test]
