@@ -505,3 +505,47 @@ fn a_fixed_step_too_small_for_the_stride_budget_is_refused() {
         );
     }
 }
+
+#[test]
+fn scene_files_that_are_huge_devices_or_fifos_are_refused_before_they_are_read() {
+    // A link to /dev/zero grew to 4 GB; a 100 MB scene took 20 s and 5.2 GB; a FIFO blocked
+    // forever. Every path that reads a scene file (`--scene`, `--start-from-scene`,
+    // `--plot-with`, `walker scenes PATH`) goes through the one bounded read.
+    let dir = scratch("scene-files");
+    let zero = dir.join("zero.toml");
+    let _ = std::fs::remove_file(&zero);
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    let fifo = dir.join("fifo.toml");
+    let _ = std::fs::remove_file(&fifo);
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let huge = dir.join("huge.toml");
+    std::fs::write(&huge, "#".repeat(2 << 20)).unwrap();
+    let (zero, fifo, huge) = (
+        zero.to_str().unwrap(),
+        fifo.to_str().unwrap(),
+        huge.to_str().unwrap(),
+    );
+    for (path, why) in [
+        (zero, "not a regular file"),
+        (fifo, "not a regular file"),
+        (huge, "larger than 1048576 bytes"),
+    ] {
+        assert_refused(&["gait", "--scene", path], 2, &[path, why]);
+        assert_refused(&["scenes", path], 2, &[why]);
+        assert_refused(
+            &[
+                "walk",
+                "--scene",
+                "compass",
+                "--steps",
+                "1",
+                "--start-from-scene",
+                path,
+            ],
+            2,
+            &[why],
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -7,6 +7,7 @@ mod build;
 mod error;
 pub mod expr;
 pub mod file;
+pub mod text_file;
 mod usage;
 pub mod variant;
 
@@ -86,14 +87,24 @@ pub struct Scene {
     unused: BTreeSet<String>,
 }
 
+/// Largest scene file read \[bytes\] (the built-in scenes are a few kilobytes): a larger one,
+/// or a path to a device or FIFO, is refused before it is read.
+pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
+
 impl Scene {
-    /// Loads a built-in scene by name, or a scene file by path.
+    /// Loads a built-in scene by name, or a scene file by path (a regular file of at most
+    /// [`MAX_SCENE_FILE_BYTES`]).
     pub fn load(name_or_path: &str) -> Result<Self, SceneError> {
         if let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
             return Self::parse(name_or_path, text);
         }
         if name_or_path.ends_with(".toml") {
-            let text = std::fs::read_to_string(name_or_path).map_err(|e| SceneError::File {
+            let text = text_file::read_text_file(
+                std::path::Path::new(name_or_path),
+                MAX_SCENE_FILE_BYTES,
+                "a scene file",
+            )
+            .map_err(|e| SceneError::File {
                 path: name_or_path.to_string(),
                 message: e.to_string(),
             })?;

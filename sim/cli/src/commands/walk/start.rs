@@ -8,8 +8,8 @@ use serde_json::Value;
 use sim::analysis::homotopy::GaitRule;
 use sim::engine::walker::Walker;
 use sim::report::StartRecord;
+use sim::scene::text_file::read_text_file;
 use sim::scene::Scene;
-use std::io::Read;
 
 /// The gait of scene `other` (with this scene's shared parameter values) by the one gait
 /// rule, mapped onto this walker's stride-map entries by name, with where it came from.
@@ -58,17 +58,10 @@ pub fn read_start_state(
     names: &[String],
 ) -> Result<Vec<(usize, f64)>, InputError> {
     let bad = |why: String| InputError::Other(format!("--start-state `{}`: {why}", path.display()));
-    // At most `MAX_START_STATE_BYTES` are read: a path to a huge file (or `/dev/zero`) is
-    // refused instead of filling memory.
-    let mut text = String::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_START_STATE_BYTES + 1).read_to_string(&mut text))
+    // A regular file of at most `MAX_START_STATE_BYTES`: a path to a huge file, `/dev/zero` or
+    // a FIFO is refused instead of filling memory or blocking.
+    let text = read_text_file(path, MAX_START_STATE_BYTES, "a start state")
         .map_err(|e| bad(e.to_string()))?;
-    if text.len() as u64 > MAX_START_STATE_BYTES {
-        return Err(bad(format!(
-            "larger than {MAX_START_STATE_BYTES} bytes; a start state is a few kilobytes"
-        )));
-    }
     parse_start_state(&text, names).map_err(bad)
 }
 
