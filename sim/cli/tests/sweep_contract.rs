@@ -194,3 +194,45 @@ fn the_command_lines_integrator_applies_at_every_value() {
     assert!((rk4 - scene).abs() > 1e-9, "{rk4} vs {scene}");
     assert!((rk4 - scene).abs() < 1e-6, "{rk4} vs {scene}");
 }
+
+#[test]
+fn a_sweep_that_cannot_start_or_runs_out_of_budget_exits_1_naming_the_unanswered_range() {
+    // No gait on steep uphill slopes: the sweep cannot start at its first 32 values; it
+    // used to exit 0.
+    let out = walker(&[
+        "sweep", "--scene", "simplest", "--param", "slope", "--from", "-0.5", "--to", "-0.4",
+        "--points", "50",
+    ]);
+    let err = common::stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("values of slope from -0.5 to") && err.contains("unanswered: no gait"),
+        "{err}"
+    );
+    // The compass's branch to a slope of 0.5 runs out of its point budget: said, exit 1.
+    let out = walker(&[
+        "sweep", "--scene", "compass", "--param", "slope", "--from", "0.01", "--to", "0.5",
+        "--points", "2000",
+    ]);
+    let err = common::stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("unanswered") && err.contains("budget"),
+        "{err}"
+    );
+    // The text's rows are in parameter order, whatever the branches' order.
+    let text = String::from_utf8_lossy(&out.stdout);
+    let values: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map_while(|l| l.split_whitespace().next()?.parse().ok())
+        .collect();
+    assert!(values.len() > 10, "{text}");
+    assert!(values.windows(2).all(|w| w[0] <= w[1]), "{values:?}");
+    // A sweep that answers every value exits 0.
+    let out = walker(&[
+        "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.009", "--to", "0.012",
+        "--points", "4",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", common::stderr(&out));
+}

@@ -117,7 +117,83 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     } else {
         output::text(|out| print_text(out, &report))?;
     }
-    Ok(ExitCode::SUCCESS)
+    let unanswered = unanswered_ranges(&report);
+    for u in &unanswered {
+        output::note(format_args!("sweep: {}", u.describe(param.as_str())));
+    }
+    let started = report
+        .points
+        .iter()
+        .any(|p| matches!(p, SweepPointRecord::Converged(_)));
+    let out_of_budget = report.branch_ends.iter().any(|e| e.kind == "budget");
+    Ok(if !started || out_of_budget {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// A run of grid values the sweep did not answer, in parameter order, for one kind of reason
+/// (the reason's words before its first colon), with the first value's reason in full.
+struct Unanswered {
+    count: usize,
+    from: f64,
+    to: f64,
+    kind: String,
+    reason: String,
+}
+
+impl Unanswered {
+    fn describe(&self, param: &str) -> String {
+        if self.count == 1 {
+            format!("{param} = {} unanswered: {}", self.from, self.reason)
+        } else {
+            format!(
+                "{} values of {param} from {} to {} unanswered: {} (at {}: {})",
+                self.count, self.from, self.to, self.kind, self.from, self.reason
+            )
+        }
+    }
+}
+
+/// The values without a gait on branch 0 (no start, a corrector that failed, values past its
+/// end), grouped into runs of one reason in parameter order.
+fn unanswered_ranges(r: &SweepReport) -> Vec<Unanswered> {
+    let mut failed: Vec<(f64, &str)> = r
+        .points
+        .iter()
+        .filter_map(|p| match p {
+            SweepPointRecord::Failed(e) if e.branch == 0 => Some((e.value, e.reason.as_str())),
+            _ => None,
+        })
+        .collect();
+    failed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut runs: Vec<Unanswered> = Vec::new();
+    for (value, reason) in failed {
+        let kind = reason.split(':').next().unwrap_or(reason);
+        match runs.last_mut() {
+            Some(run) if run.kind == kind => {
+                run.count += 1;
+                run.to = value;
+            }
+            _ => runs.push(Unanswered {
+                count: 1,
+                from: value,
+                to: value,
+                kind: kind.to_string(),
+                reason: reason.to_string(),
+            }),
+        }
+    }
+    runs
+}
+
+/// A row's parameter value.
+fn row_value(p: &SweepPointRecord) -> f64 {
+    match p {
+        SweepPointRecord::Converged(g) => g.value,
+        SweepPointRecord::Failed(e) => e.value,
+    }
 }
 
 fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
@@ -127,7 +203,10 @@ fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
         "{:>14} {:>7} {:>7} {:>10} {:>8}",
         param, "branch", "period", "max|λ|", "stable"
     )?;
-    for p in &r.points {
+    // Rows in parameter order (the JSON keeps the branches' order).
+    let mut rows: Vec<&SweepPointRecord> = r.points.iter().collect();
+    rows.sort_by(|a, b| row_value(a).total_cmp(&row_value(b)));
+    for p in rows {
         match p {
             SweepPointRecord::Converged(g) => writeln!(
                 out,
