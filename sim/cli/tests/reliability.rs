@@ -549,3 +549,54 @@ fn scene_files_that_are_huge_devices_or_fifos_are_refused_before_they_are_read()
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn flags_a_command_would_ignore_are_refused() {
+    // Each was once accepted and ignored in silence.
+    assert_refused(
+        &["gait", "--scene", "compass", "--step-s", "0.001"],
+        2,
+        &["--step-s", "dop853"],
+    );
+    assert_refused(
+        &[
+            "gait",
+            "--scene",
+            "compass",
+            "--integrator",
+            "rk4",
+            "--rtol",
+            "1e-8",
+        ],
+        2,
+        &["--rtol", "rk4"],
+    );
+    assert_refused(
+        &[
+            "walk",
+            "--scene",
+            "compass",
+            "--steps",
+            "1",
+            "--plot-with",
+            "simplest",
+        ],
+        2,
+        &["--plot-with", "--plot"],
+    );
+    assert_refused(
+        &[
+            "walk",
+            "--scene",
+            "compass",
+            "--steps",
+            "1",
+            "--start",
+            "guess",
+            "--start-from-scene",
+            "simplest",
+        ],
+        2,
+        &["--start-from-scene", "--start guess"],
+    );
+}

@@ -80,6 +80,20 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         animate,
     } = args;
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
+    // Flags the walk would ignore are refused, not dropped in silence.
+    if plot_with.is_some() && plot.is_none() {
+        return Err(InputError::Other(
+            "--plot-with draws into the --plot figure: give --plot DIR too".to_owned(),
+        )
+        .into());
+    }
+    if start_from_scene.is_some() && start != "gait" {
+        return Err(InputError::Other(format!(
+            "--start-from-scene starts from another scene's gait: it cannot be combined with \
+             --start {start}"
+        ))
+        .into());
+    }
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
     let walker = &setup.walker;
