@@ -7,6 +7,7 @@ use crate::analysis::limit_cycle::GaitGuess;
 use crate::engine::actuator::AnkleReflex;
 use crate::engine::events::EventTolerance;
 use crate::engine::integrators::IntegratorChoice;
+use crate::engine::kinematics::Kinematics;
 use crate::engine::model::{
     BodyInertia, CoordIndex, JointForce, JointKind, LinkIndex, Model, PointIndex,
 };
@@ -45,6 +46,12 @@ impl Scene {
     pub(super) fn model(&self) -> Result<(Model, f64), SceneError> {
         let f = &self.file;
         let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
+        if g <= 0.0 {
+            return Err(SceneError::Invalid(format!(
+                "world.gravity_m_s2 must be positive (its direction is down the slope's normal), \
+                 got {g}"
+            )));
+        }
         let slope = self.num(&f.world.slope_rad, "world.slope_rad")?;
         let mut model = Model::new(Model::gravity_on_slope(g, slope));
         for l in &f.links {
@@ -123,13 +130,38 @@ impl Scene {
             .iter()
             .map(|r| released_joint(r))
             .collect::<Result<Vec<_>, _>>()?;
+        if constraints.is_empty() {
+            return Err(SceneError::Invalid(
+                "heel_strike.constraints is empty: the new stance contact needs at least one \
+                 constrained direction"
+                    .to_owned(),
+            ));
+        }
+        for (list, names) in [("constraints", &hs.constraints), ("release", &hs.release)] {
+            if let Some(twice) = names
+                .iter()
+                .enumerate()
+                .find(|(i, n)| names[..*i].contains(n))
+                .map(|(_, n)| n)
+            {
+                return Err(SceneError::Invalid(format!(
+                    "heel_strike.{list} names `{twice}` twice"
+                )));
+            }
+        }
+        let restitution = self.opt(&hs.restitution, "heel_strike.restitution")?;
+        if !(0.0..=1.0).contains(&restitution) {
+            return Err(SceneError::Invalid(format!(
+                "heel_strike.restitution must lie in [0, 1] (0 plastic, 1 elastic), got {restitution}"
+            )));
+        }
         let rule = HeelStrikeRule {
             swing_foot,
             swing_foot_link: names.0.points[swing_foot.0].link,
             min_ahead_m: self.opt(&hs.min_ahead_m, "heel_strike.min_ahead_m")?,
             ignore_scuffing: hs.ignore_scuffing,
             constraints,
-            restitution: self.opt(&hs.restitution, "heel_strike.restitution")?,
+            restitution,
             release,
             stance_contact: names.point(&hs.stance_contact)?,
         };
@@ -306,6 +338,27 @@ fn released_joint(r: &str) -> Result<JointKind, SceneError> {
     })
 }
 
+/// The fall rule can fire: the hip at the guess stands above `fall.min_hip_height_m` (a walker
+/// that starts below it would never be seen to fall).
+fn check_fall_height(
+    model: &Model,
+    fall: &FallRule,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) -> Result<(), SceneError> {
+    let mut kin = Kinematics::new(model);
+    kin.update(model, q, qd);
+    let hip_m = kin.point_position(model, fall.hip).y;
+    if hip_m <= fall.min_hip_height_m {
+        return Err(SceneError::Invalid(format!(
+            "fall.min_hip_height_m = {} is not below the hip's height at the guess ({hip_m:.4} m): \
+             no fall could be seen",
+            fall.min_hip_height_m
+        )));
+    }
+    Ok(())
+}
+
 impl Scene {
     /// Builds the walker (the physics only; [`Self::setup`] for its settings and gait guess).
     pub fn build(&self) -> Result<Walker, SceneError> {
@@ -327,6 +380,12 @@ impl Scene {
         let (integrator, max_stride_time_s) = self.integrator()?;
         let (guess_q, guess_qd) = self.guess(&names)?;
         let ankle = self.ankle_reflex(&names)?;
+        for c in &f.three_d_freedoms {
+            names.coord(c).map_err(|_| {
+                SceneError::Invalid(format!("three_d_freedoms: unknown coordinate `{c}`"))
+            })?;
+        }
+        check_fall_height(&model, &fall, &guess_q, &guess_qd)?;
         let walker = Walker::new(
             self.name(),
             model,

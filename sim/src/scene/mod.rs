@@ -151,7 +151,44 @@ impl Scene {
             }
             scene.check_range(k, p.default)?;
         }
+        scene.check_names()?;
         Ok(scene)
+    }
+
+    /// Names the file must keep apart: every parameter name and alias names one parameter;
+    /// convention outputs are named once; `walk_start_scene` is a built-in scene or a `.toml`
+    /// path.
+    fn check_names(&self) -> Result<(), SceneError> {
+        let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
+        for (name, p) in &self.file.parameters {
+            for key in std::iter::once(name).chain(&p.aliases) {
+                if let Some(other) = owner.insert(key, name) {
+                    if other != name {
+                        return Err(SceneError::Invalid(format!(
+                            "parameter `{name}`: `{key}` already names parameter `{other}`"
+                        )));
+                    }
+                }
+            }
+        }
+        if let Some(conv) = &self.file.convention {
+            for (i, o) in conv.outputs.iter().enumerate() {
+                if conv.outputs[..i].iter().any(|e| e.name == o.name) {
+                    return Err(SceneError::Invalid(format!(
+                        "convention output `{}` is named twice",
+                        o.name
+                    )));
+                }
+            }
+        }
+        if let Some(other) = &self.file.walk_start_scene {
+            if !other.ends_with(".toml") && !BUILTIN.iter().any(|(n, _)| n == other) {
+                return Err(SceneError::Invalid(format!(
+                    "walk_start_scene `{other}` is not a built-in scene (nor a .toml path)"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Parses text to a TOML table, resolving `[variant] base = ...` (at most 4 deep).
