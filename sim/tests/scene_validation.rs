@@ -89,3 +89,13 @@ fn impossible_statements_are_refused_at_load_naming_the_key() {
     let e = top("walk_start_scene = \"compas\"");
     assert!(e.contains("walk_start_scene `compas`"), "{e}");
 }
+
+#[test]
+fn a_parameter_range_upside_down_is_refused() {
+    // It once said "allowed range [0.5, -0.5]" at the first `--set`.
+    let from = "min = -0.5\nmax = 0.5\naliases = [\"slope\"]";
+    assert_eq!(COMPASS.matches(from).count(), 1);
+    let text = COMPASS.replace(from, "min = 0.5\nmax = -0.5\naliases = [\"slope\"]");
+    let e = Scene::parse("changed.toml", &text).unwrap_err().to_string();
+    assert!(e.contains("min 0.5 is above max -0.5"), "{e}");
+}

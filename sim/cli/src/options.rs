@@ -23,10 +23,14 @@ pub struct Common {
     #[arg(long)]
     pub integrator: Option<String>,
     /// Fixed step for meijaard/rk4, in seconds.
-    #[arg(long, help = "Fixed step for meijaard/rk4 [s]")]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        help = "Fixed step for meijaard/rk4 [s]"
+    )]
     pub step_s: Option<f64>,
     /// Relative and absolute tolerance for dopri5 and dop853.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
     /// Newton tolerance on |Δv|.
     #[arg(long, default_value_t = 1e-11)]
@@ -87,13 +91,19 @@ impl Common {
     fn configure(&self, settings: &mut StrideSettings) -> Result<(), InputError> {
         let positive = |name: &str, v: Option<f64>| match v {
             Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
-                "--{name} must be a positive number, got {x}"
+                "--{name} must be a positive number, got {}",
+                sim::scene::short_number(x)
             ))),
             _ => Ok(()),
         };
         positive("step-s", self.step_s)?;
         positive("rtol", self.rtol)?;
         positive("newton-tol", Some(self.newton_tol))?;
+        if self.newton_max_iter == 0 {
+            return Err(InputError::Other(
+                "--newton-max-iter must be at least 1 (Newton iterations allowed)".to_owned(),
+            ));
+        }
         positive("perturbation", Some(self.perturbation))?;
         if !matches!(self.jacobian.as_str(), "central" | "variational") {
             return Err(InputError::Other(format!(

@@ -55,7 +55,28 @@ pub fn text(print: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result
 /// written there is nowhere left to say so: the line is dropped instead of panicking as
 /// `eprintln!` does.
 pub fn note(line: std::fmt::Arguments<'_>) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
+    let _ = writeln!(std::io::stderr().lock(), "{}", sanitized(&line.to_string()));
+}
+
+/// `text` with every control character but newline and tab escaped (`\u{1b}`): a message that
+/// quotes a user's file or flag (a TOML error echoes the offending line) never sends terminal
+/// escape sequences to the terminal.
+pub fn sanitized(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text
+        .chars()
+        .any(|c| c.is_control() && c != '\n' && c != '\t')
+    {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() && c != '\n' && c != '\t' {
+            out.push_str(&c.escape_unicode().to_string());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// Creates the folder `dir` that option `flag` names (and its parents).

@@ -600,3 +600,43 @@ fn flags_a_command_would_ignore_are_refused() {
         &["--start-from-scene", "--start guess"],
     );
 }
+
+#[test]
+fn messages_are_clear_short_and_never_carry_terminal_escapes() {
+    // A TOML error quoting a line with an escape sequence reached the terminal raw.
+    let dir = scratch("messages");
+    let scene = dir.join("escape.toml");
+    std::fs::write(
+        &scene,
+        "[scene]\nname = \"x\u{1b}]0;title\u{7}\"\nbad = \u{1b}[31m\n",
+    )
+    .unwrap();
+    let out = walker(&["gait", "--scene", scene.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(!err.contains('\u{1b}') && !err.contains('\u{7}'), "{err:?}");
+    assert!(err.contains("\\u{1b}"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    // A tiny value in short scientific form, not 300 digits.
+    assert_refused(
+        &["gait", "--scene", "compass", "--set", "leg_length_m=1e-300"],
+        2,
+        &["= 1e-300 m is outside its allowed range [1e-6, inf]"],
+    );
+    // Negative tolerances reach the check (clap once took `-1e-8` for a flag).
+    assert_refused(
+        &["gait", "--scene", "compass", "--rtol", "-1e-8"],
+        2,
+        &["--rtol must be a positive number, got -1e-8"],
+    );
+    assert_refused(
+        &["gait", "--scene", "compass", "--newton-max-iter", "0"],
+        2,
+        &["--newton-max-iter must be at least 1"],
+    );
+    assert_refused(
+        &["tune", "--scene", "compass", "--vary", "slope=0.06:0.04"],
+        2,
+        &["min 0.06 must be below max 0.04"],
+    );
+}

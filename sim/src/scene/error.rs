@@ -43,7 +43,13 @@ pub enum SceneError {
         value: String,
     },
     /// A parameter outside its physical range.
-    #[error("parameter `{name}` = {value}{} is outside its allowed range [{min}, {max}]", unit_suffix(.unit))]
+    #[error(
+        "parameter `{name}` = {}{} is outside its allowed range [{}, {}]",
+        short_number(*.value),
+        unit_suffix(.unit),
+        short_number(*.min),
+        short_number(*.max)
+    )]
     OutOfRange {
         /// Parameter.
         name: String,
@@ -158,5 +164,16 @@ fn unit_suffix(unit: &str) -> String {
     match unit {
         "" | "1" => String::new(),
         u => format!(" {u}"),
+    }
+}
+
+/// `x` for a message: as Rust prints it between 1e-4 and 1e15 (and 0, ±∞), else in short
+/// scientific form (`1e-300`, not three hundred digits).
+pub fn short_number(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

@@ -11,7 +11,7 @@ pub mod text_file;
 mod usage;
 pub mod variant;
 
-pub use error::{SceneError, VariantError};
+pub use error::{short_number, SceneError, VariantError};
 
 use crate::analysis::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::engine::events::Direction;
@@ -146,6 +146,15 @@ impl Scene {
                 if v.is_some_and(f64::is_nan) {
                     return Err(SceneError::Invalid(format!(
                         "parameter `{k}`: {bound} is NaN"
+                    )));
+                }
+            }
+            if let (Some(min), Some(max)) = (p.min, p.max) {
+                if min > max {
+                    return Err(SceneError::Invalid(format!(
+                        "parameter `{k}`: min {} is above max {}",
+                        error::short_number(min),
+                        error::short_number(max)
                     )));
                 }
             }

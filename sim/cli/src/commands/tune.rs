@@ -123,8 +123,15 @@ fn parse_vary(v: &str) -> Result<TunedParameter, InputError> {
         lo.trim().parse().map_err(|_| bad())?,
         hi.trim().parse().map_err(|_| bad())?,
     );
-    if !(min.is_finite() && max.is_finite() && min < max) {
-        return Err(bad());
+    if !(min.is_finite() && max.is_finite()) {
+        return Err(InputError::Other(format!(
+            "--vary `{v}`: the bounds must be finite numbers"
+        )));
+    }
+    if min >= max {
+        return Err(InputError::Other(format!(
+            "--vary `{v}`: min {min} must be below max {max} (name=min:max)"
+        )));
     }
     Ok(TunedParameter {
         name: name.trim().to_string(),
