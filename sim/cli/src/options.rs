@@ -56,6 +56,9 @@ impl Common {
     /// The scene with the `--set` parameters applied.
     pub fn scene(&self) -> Result<Scene, InputError> {
         let mut scene = Scene::load(&self.scene)?;
+        // Each parameter once: a second `--set` of one parameter (by name or alias) was
+        // dropped in silence, the last one winning.
+        let mut given: Vec<(String, &str)> = Vec::new();
         for s in &self.set {
             scene.set_text(s).map_err(|e| match e {
                 SceneError::NotAnAssignment { text } => {
@@ -63,6 +66,15 @@ impl Common {
                 }
                 other => other.into(),
             })?;
+            let key = s.split_once('=').map_or(s.as_str(), |(k, _)| k.trim());
+            let name = scene.parameter_name(key)?;
+            if let Some((_, first)) = given.iter().find(|(n, _)| *n == name) {
+                return Err(InputError::Other(format!(
+                    "`--set {s}`: parameter `{name}` is already set by `--set {first}` (each \
+                     parameter once)"
+                )));
+            }
+            given.push((name, s));
         }
         Ok(scene)
     }

@@ -640,3 +640,36 @@ fn messages_are_clear_short_and_never_carry_terminal_escapes() {
         &["min 0.06 must be below max 0.04"],
     );
 }
+
+#[test]
+fn a_parameter_or_a_perturbation_given_twice_is_refused() {
+    // The last `--set` won and repeated `--perturb`s were added, in silence.
+    assert_refused(
+        &[
+            "gait",
+            "--scene",
+            "compass",
+            "--set",
+            "slope=0.04",
+            "--set",
+            "slope_rad=0.05",
+        ],
+        2,
+        &["parameter `slope_rad` is already set by `--set slope=0.04`"],
+    );
+    assert_refused(
+        &[
+            "walk",
+            "--scene",
+            "compass",
+            "--steps",
+            "1",
+            "--perturb",
+            "stance_leg=0.01",
+            "--perturb",
+            "stance_leg=0.01",
+        ],
+        2,
+        &["`stance_leg` is already perturbed"],
+    );
+}

@@ -153,8 +153,18 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             v[i] = x;
         }
     }
+    let mut perturbed: Vec<usize> = Vec::with_capacity(perturb.len());
     for p in &perturb {
         let (i, d) = start::parse_perturbation(p, &names)?;
+        if perturbed.contains(&i) {
+            // Two perturbations of one entry were added in silence.
+            return Err(InputError::Other(format!(
+                "--perturb `{p}`: `{}` is already perturbed (each entry once)",
+                names[i]
+            ))
+            .into());
+        }
+        perturbed.push(i);
         v[i] += d;
     }
     let (q, qd) = walker.unpack(&v);
