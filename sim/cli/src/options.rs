@@ -60,14 +60,12 @@ impl Common {
         // dropped in silence, the last one winning.
         let mut given: Vec<(String, &str)> = Vec::new();
         for s in &self.set {
-            scene.set_text(s).map_err(|e| match e {
+            let name = scene.set_text(s).map_err(|e| match e {
                 SceneError::NotAnAssignment { text } => {
                     InputError::Other(format!("`--set {text}`: expected key=value"))
                 }
                 other => other.into(),
             })?;
-            let key = s.split_once('=').map_or(s.as_str(), |(k, _)| k.trim());
-            let name = scene.parameter_name(key)?;
             if let Some((_, first)) = given.iter().find(|(n, _)| *n == name) {
                 return Err(InputError::Other(format!(
                     "`--set {s}`: parameter `{name}` is already set by `--set {first}` (each \

@@ -318,8 +318,8 @@ impl Scene {
         Ok(())
     }
 
-    /// Sets a parameter from `key=value` text.
-    pub fn set_text(&mut self, assignment: &str) -> Result<(), SceneError> {
+    /// Sets a parameter from `key=value` text; returns its canonical name.
+    pub fn set_text(&mut self, assignment: &str) -> Result<String, SceneError> {
         let (k, v) = assignment
             .split_once('=')
             .ok_or_else(|| SceneError::NotAnAssignment {
@@ -332,7 +332,8 @@ impl Scene {
             name: name.clone(),
             value: v.to_string(),
         })?;
-        self.set(&name, value)
+        self.set(&name, value)?;
+        Ok(name)
     }
 
     /// Evaluates a number or expression with the current parameter values.

@@ -15,7 +15,7 @@ use crate::output::{self, PathError};
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::homotopy::{nominal_gait, GaitRule, HomotopySettings};
+use sim::analysis::homotopy::{GaitRule, HomotopySettings};
 use sim::engine::walker::Walker;
 use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
@@ -183,9 +183,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             let oset = os.setup()?;
             let ow = &oset.walker;
             let v0 = ow.pack(&oset.guess.q, &oset.guess.qd);
-            let start = nominal_gait(&os, &setup_for, &newton, &homotopy)?
-                .map(|(g, _)| g.fixed_point)
-                .unwrap_or(v0);
+            let start = rule.gait(&os)?.map(|(g, _)| g.fixed_point).unwrap_or(v0);
             let (oq, oqd) = ow.unpack(&start);
             let request = WalkRequest::new(&oset.settings, steps).recording(true);
             let other_walk = sim::stride::walk::walk(ow, &oq, &oqd, request);
