@@ -256,7 +256,13 @@ impl std::str::FromStr for FaultSpec {
         let prob = spec.optional("prob", "a probability between 0 and 1", |v| {
             v.parse::<f64>().ok().filter(|p| (0.0..=1.0).contains(p))
         })?;
-        let count = spec.optional("count", "a non-negative integer", |v| v.parse::<u32>().ok())?;
+        // count=0 would hit nothing (the fault silently did nothing); past u32 is no count a
+        // run can reach.
+        let count = spec.optional(
+            "count",
+            "a whole number of frames from 1 to 4294967295",
+            |v| v.parse::<u32>().ok().filter(|&c| c > 0),
+        )?;
         let from_ns = spec.optional("from_ms", ms, parse_ms_to_ns)?.unwrap_or(0);
         let until_ns = spec.optional("until_ms", ms, parse_ms_to_ns)?;
         if until_ns.is_some_and(|u| u <= from_ns) {
@@ -444,6 +450,17 @@ mod tests {
         );
         let e = p("delay:ms=-3").unwrap_err();
         assert!(e.to_string().contains("`-3`"));
+        for (bad, why) in [
+            ("drop:id=0x072,count=0", "count=0 hits nothing"),
+            ("drop:id=0x072,count=18446744073709551615", "past u32"),
+            ("corrupt:id=0x072,count=-1", "negative"),
+        ] {
+            let e = p(bad).unwrap_err().to_string();
+            assert!(
+                e.contains("count") && e.contains("from 1 to 4294967295"),
+                "{bad} ({why}): {e}"
+            );
+        }
         let e = p("busoff:node=left,count=3").unwrap_err();
         assert!(
             matches!(&e, FaultParseError::UnknownKey { key, .. } if key == "count"),
@@ -477,7 +494,7 @@ mod tests {
     fn arb_hit() -> impl Strategy<Value = Hit> {
         (
             proptest::option::of((0u32..=1000).prop_map(|p| f64::from(p) / 1000.0)),
-            proptest::option::of(any::<u32>()),
+            proptest::option::of(1..=u32::MAX),
         )
             .prop_map(|(prob, count)| Hit { prob, count })
     }

@@ -10,6 +10,13 @@
 //! client: < echo >                server: < echo >
 //! ```
 //!
+//! **Read-only unless told otherwise.** A monitor needs no write access, and a frame sent into
+//! the simulated bus is a command to the walker (a spoofed heel strike or an
+//! `EmergencyStop_ALL` makes it fall): `send` is answered `< error read-only bus ... >` and
+//! counted in [`ServerStats::sends_refused`] unless [`ServerConfig::allow_send`] is set (the
+//! `--socketcand-allow-send` flag of `walker sil` and `canbus-demo`: the server is then a
+//! control channel for any local process).
+//!
 //! Frames are queued per client in a bounded queue (frames that do not fit are counted in
 //! [`ServerStats::frames_dropped`], never blocking the simulation); frames sent by clients are
 //! queued in a bounded inbound queue that the simulation drains with
@@ -19,12 +26,20 @@
 //! frames are not sent (socketcand's rawmode has no form python-can parses).
 //!
 //! Bounds, whatever the clients do:
-//! * at most [`ServerConfig::max_clients`] clients at once; more are answered
+//! * at most [`ServerConfig::max_clients`] clients at once. A client that has not opened a bus
+//!   and entered rawmode within [`ServerConfig::open_timeout`] is dropped
+//!   ([`ServerStats::clients_idle`]); when the server is full, a new connection takes the place
+//!   of the oldest client not yet in rawmode (also counted there), so idle connections never
+//!   lock a monitor out. Only when every client is in rawmode is a new one answered
 //!   `< error too many clients ... >`, closed and counted in [`ServerStats::clients_refused`];
 //! * per client, memory for at most [`ServerConfig::client_queue_frames`] queued frames (taken
 //!   as needed, not up front), 64 KiB of output and 64 KiB of unparsed input; a client whose
 //!   output makes no progress for [`ServerConfig::write_timeout`] is disconnected
-//!   ([`ServerStats::clients_stalled`]); [`ServerConfig::memory_bound_bytes`] sums it up;
+//!   ([`ServerStats::clients_stalled`]), and so is one whose frame queue stays full (every
+//!   frame published for it lost) for as long. The kernel's send buffer of each client socket
+//!   is set to [`ServerConfig::socket_send_buffer_bytes`], so a client that stops reading
+//!   stalls the output after at most that much (plus its own receive buffer) instead of the
+//!   4 MiB the kernel's autotuning allows; [`ServerConfig::memory_bound_bytes`] sums it up;
 //! * sockets are non-blocking: no thread ever waits on a client, finished clients are joined
 //!   and forgotten at once, and [`SocketcandServer::shutdown`] (also run on drop) returns within
 //!   a few polls of 10 ms.
@@ -59,9 +74,18 @@ pub struct ServerConfig {
     pub rawmode_grace: Duration,
     /// Added to simulated time in frame timestamps [ns since the Unix epoch]. Default 0.
     pub origin_ns: u64,
-    /// A client whose pending output makes no progress for this long (it does not read) is
-    /// disconnected. Default 5 s.
+    /// A client whose pending output makes no progress for this long (it does not read), or
+    /// whose frame queue stays full this long, is disconnected. Default 5 s.
     pub write_timeout: Duration,
+    /// A client that has not entered rawmode (`< open CHANNEL >`, `< rawmode >`) this long
+    /// after connecting is disconnected. Default 3 s.
+    pub open_timeout: Duration,
+    /// Frames from clients (`< send ... >`) are put on the bus; otherwise they are refused
+    /// and the server is read-only. Default false.
+    pub allow_send: bool,
+    /// The kernel send buffer of each client socket (`SO_SNDBUF`) [bytes]: how much a client
+    /// that stopped reading can be sent before its output stalls. Default 32 KiB.
+    pub socket_send_buffer_bytes: usize,
 }
 
 impl Default for ServerConfig {
@@ -74,6 +98,9 @@ impl Default for ServerConfig {
             rawmode_grace: Duration::from_millis(200),
             origin_ns: 0,
             write_timeout: Duration::from_secs(5),
+            open_timeout: Duration::from_secs(3),
+            allow_send: false,
+            socket_send_buffer_bytes: 32 * 1024,
         }
     }
 }
@@ -148,6 +175,11 @@ pub struct ServerStats {
     pub clients_stalled: u64,
     /// Frames from clients dropped because the inbound queue was full.
     pub inbound_dropped: u64,
+    /// Clients disconnected because they had not entered rawmode within
+    /// [`ServerConfig::open_timeout`], or to make room for a new client.
+    pub clients_idle: u64,
+    /// `send` commands refused because the server is read-only.
+    pub sends_refused: u64,
 }
 
 #[derive(Default)]
@@ -160,6 +192,8 @@ struct Counters {
     clients_refused: AtomicU64,
     clients_stalled: AtomicU64,
     inbound_dropped: AtomicU64,
+    clients_idle: AtomicU64,
+    sends_refused: AtomicU64,
 }
 
 fn bump(c: &AtomicU64) {
@@ -175,6 +209,11 @@ struct ClientState {
     queue: Mutex<VecDeque<(Frame, u64)>>,
     /// Output not yet written (frames taken from the queue, answers).
     out_pending: AtomicBool,
+    /// Told to leave (its place was given to a new client).
+    evicted: AtomicBool,
+    /// When its queue was last found full by [`SocketcandServer::publish`] with no room made
+    /// since (`None` while frames fit).
+    full_since: Mutex<Option<Instant>>,
 }
 
 struct Client {
@@ -267,10 +306,13 @@ impl SocketcandServer {
                 continue;
             }
             let mut q = lock(&c.state.queue);
+            let mut full_since = lock(&c.state.full_since);
             if q.len() < self.shared.config.client_queue_frames {
                 q.push_back((*frame, t));
+                *full_since = None;
             } else {
                 bump(&self.shared.counters.frames_dropped);
+                full_since.get_or_insert_with(Instant::now);
             }
         }
         Ok(())
@@ -359,6 +401,8 @@ impl SocketcandServer {
             clients_refused: get(&c.clients_refused),
             clients_stalled: get(&c.clients_stalled),
             inbound_dropped: get(&c.inbound_dropped),
+            clients_idle: get(&c.clients_idle),
+            sends_refused: get(&c.sends_refused),
         }
     }
 
@@ -413,6 +457,23 @@ fn refuse(mut stream: TcpStream, why: &str, shared: &Shared) {
 fn admit(stream: TcpStream, shared: &Arc<Shared>) {
     let mut clients = lock(&shared.clients);
     let max = shared.config.max_clients;
+    if clients.len() >= max {
+        // The oldest client not yet in rawmode (and not already leaving) gives up its place.
+        if let Some(pos) = clients.iter().position(|c| {
+            !c.state.rawmode.load(Ordering::Acquire) && !c.state.evicted.load(Ordering::Acquire)
+        }) {
+            if let Some(old) = clients.get(pos) {
+                old.state.evicted.store(true, Ordering::Release);
+                bump(&shared.counters.clients_idle);
+            }
+            let old = clients.remove(pos);
+            // Its thread sees the flag within a poll and closes; the acceptor's reap would
+            // join it, but it is no longer listed: join it here, off the lock.
+            drop(clients);
+            let _ = old.thread.join();
+            clients = lock(&shared.clients);
+        }
+    }
     if clients.len() >= max {
         drop(clients);
         refuse(
@@ -622,6 +683,14 @@ impl<'a> Session<'a> {
                 self.me.rawmode.store(true, Ordering::Release);
                 Some("< ok >".into())
             }
+            (Phase::Raw { .. }, ["send", ..]) if !shared.config.allow_send => {
+                bump(&shared.counters.sends_refused);
+                Some(
+                    "< error read-only bus: frames from clients are refused (the server was \
+                     started without --socketcand-allow-send) >"
+                        .into(),
+                )
+            }
             (Phase::Raw { .. }, ["send", rest @ ..]) => match parse_send(rest) {
                 Ok(f) => {
                     let mut q = lock(&shared.inbound);
@@ -667,13 +736,34 @@ fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
         return;
     }
     let _ = stream.set_nodelay(true);
+    // Bounds what the kernel holds for a client that stopped reading (autotuning lets it grow
+    // to 4 MiB, which hid a stalled client for minutes).
+    let _ = socket2::SockRef::from(&stream)
+        .set_send_buffer_size(shared.config.socket_send_buffer_bytes);
     let mut s = Session::new(shared, me);
     s.push_out("< hi >");
     let mut chunk = [0u8; READ_CHUNK_BYTES];
-    let mut last_progress = Instant::now();
+    let connected_at = Instant::now();
+    let mut last_progress = connected_at;
     while !shared.stop.load(Ordering::Acquire) {
         let now = Instant::now();
         let mut busy = false;
+        if me.evicted.load(Ordering::Acquire) {
+            return;
+        }
+        if !matches!(s.phase, Phase::Raw { .. })
+            && now.duration_since(connected_at) > shared.config.open_timeout
+        {
+            bump(&shared.counters.clients_idle);
+            let _ = stream.write(b"< error no bus opened in rawmode in time >");
+            return;
+        }
+        let stuck_full = lock(&me.full_since)
+            .is_some_and(|t| now.duration_since(t) > shared.config.write_timeout);
+        if stuck_full {
+            bump(&shared.counters.clients_stalled);
+            return;
+        }
         s.take_frames(now);
         if s.pending() > 0 {
             match stream.write(s.out.as_bytes().get(s.out_pos..).unwrap_or(&[])) {
@@ -727,11 +817,7 @@ mod tests {
             inbound: Mutex::new(VecDeque::new()),
             counters: Counters::default(),
         };
-        let me = ClientState {
-            rawmode: AtomicBool::new(false),
-            queue: Mutex::new(VecDeque::new()),
-            out_pending: AtomicBool::new(false),
-        };
+        let me = ClientState::default();
         let mut s = Session::new(&shared, &me);
         s.push_out("< hi >");
         for _ in 0..200_000 {
@@ -766,6 +852,7 @@ mod tests {
             "127.0.0.1:0",
             ServerConfig {
                 rawmode_grace: Duration::from_millis(20),
+                allow_send: true,
                 ..ServerConfig::default()
             },
         )

@@ -32,6 +32,8 @@ fn python_monitor_decodes_the_live_demo_over_socketcand() {
             "127.0.0.1:0",
             "--wait-client",
             "60",
+            // the monitor sends an emergency stop
+            "--socketcand-allow-send",
         ])
         .arg("--candump")
         .arg(&demo_log)

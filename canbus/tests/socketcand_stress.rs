@@ -39,6 +39,8 @@ const MIB: u64 = 1024 * 1024;
 fn config() -> ServerConfig {
     ServerConfig {
         rawmode_grace: Duration::from_millis(1),
+        // the garbage test ends by sending a frame that must arrive
+        allow_send: true,
         ..ServerConfig::default()
     }
 }
@@ -215,8 +217,8 @@ fn garbage_input_is_bounded_and_the_server_keeps_serving() {
     assert!(got.contains("< frame 072 0.000001 07000000 >"), "{got}");
 }
 
-/// Beyond `max_clients`, connections are refused with a clear answer; a slot frees as soon as
-/// a client leaves.
+/// Beyond `max_clients` clients in rawmode, connections are refused with a clear answer; a
+/// slot frees as soon as a client leaves.
 #[test]
 fn clients_beyond_the_cap_are_refused_clearly() {
     let _guard = one_at_a_time();
@@ -232,7 +234,11 @@ fn clients_beyond_the_cap_are_refused_clearly() {
     let mut kept = Vec::new();
     for _ in 0..4 {
         let mut c = TcpStream::connect(addr).unwrap();
-        assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+        c.write_all(b"< open vcan0 >< rawmode >").unwrap();
+        assert!(
+            read_until(&mut c, "< hi >< ok >< ok >", Duration::from_secs(5))
+                .contains("< hi >< ok >< ok >")
+        );
         kept.push(c);
     }
     for _ in 0..200 {

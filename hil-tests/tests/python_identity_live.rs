@@ -37,6 +37,8 @@ fn python_monitor_reads_identity_and_fault_history_from_the_firmware() {
     };
     let config = SilConfig {
         socketcand: Some("127.0.0.1:0".into()),
+        // the monitor sends GetIdentity and GetFaultHistory
+        socketcand_allow_send: true,
         ..SilConfig::default()
     }
     .with_sensor_fault(SensorFault::Glitch {

@@ -43,6 +43,10 @@ struct Cli {
     /// (0 to 86400).
     #[arg(long, value_name = "SECONDS")]
     wait_client: Option<f64>,
+    /// With --socketcand: put frames the clients send on the bus as the host's (a control
+    /// channel for any local process). Without it the server is read-only and refuses them.
+    #[arg(long)]
+    socketcand_allow_send: bool,
     /// Write a candump log of the bus (frames, error frames, bus-off).
     #[arg(long, value_name = "FILE")]
     candump: Option<PathBuf>,
@@ -83,6 +87,11 @@ fn input(msg: String) -> anyhow::Error {
 
 /// Slowest and fastest --speed other than 0.
 const SPEED_RANGE: (f64, f64) = (1e-3, 1e6);
+/// Bit rates accepted [bit/s]: classic CAN's range (ISO 11898-2 high speed up to 1 Mbit/s;
+/// 10 kbit/s is the slowest rate CiA 301 lists). At 1 bit/s a single frame outlasts any run
+/// and the load read 0.00 %.
+const BITRATE_RANGE_BPS: (u32, u32) = (10_000, 1_000_000);
+
 /// How long the end of a run waits for socketcand clients to read what is queued.
 const FLUSH_TIMEOUT: Duration = Duration::from_millis(500);
 
@@ -160,6 +169,22 @@ fn check(cli: &Cli) -> Result<Checked> {
             SPEED_RANGE.0, SPEED_RANGE.1
         )));
     }
+    if cli.socketcand.is_none() {
+        for (given, flag) in [
+            (cli.wait_client.is_some(), "--wait-client"),
+            (cli.socketcand_allow_send, "--socketcand-allow-send"),
+        ] {
+            if given {
+                return Err(input(format!("{flag} needs --socketcand ADDR")));
+            }
+        }
+    }
+    if !(BITRATE_RANGE_BPS.0..=BITRATE_RANGE_BPS.1).contains(&cli.bitrate) {
+        return Err(input(format!(
+            "--bitrate {}: expected a classic CAN bit rate from {} to {} bit/s",
+            cli.bitrate, BITRATE_RANGE_BPS.0, BITRATE_RANGE_BPS.1
+        )));
+    }
     let wait_client = match cli.wait_client {
         None => None,
         Some(w) => Some(wait_client_timeout(w).map_err(input)?),
@@ -224,11 +249,20 @@ fn run(cli: &Cli) -> Result<()> {
                 ServerConfig {
                     channel: cli.channel.clone(),
                     origin_ns,
+                    allow_send: cli.socketcand_allow_send,
                     ..ServerConfig::default()
                 },
             )
             .map_err(|e| input(format!("--socketcand {addr}: {e}")))?;
             eprintln!("socketcand: listening on {}", s.local_addr());
+            eprintln!(
+                "socketcand: {}",
+                if cli.socketcand_allow_send {
+                    "clients may send frames onto the bus (--socketcand-allow-send)"
+                } else {
+                    "read-only (frames from clients are refused; --socketcand-allow-send to accept them)"
+                }
+            );
             if let Some(w) = wait_client {
                 if !s.wait_for_client(w) {
                     bail!(

@@ -599,6 +599,31 @@ fn flags_a_command_would_ignore_are_refused() {
         2,
         &["--start-from-scene", "--start guess"],
     );
+    assert_refused(
+        &[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "1",
+            "--socketcand-allow-send",
+        ],
+        2,
+        &["--socketcand-allow-send", "needs --socketcand"],
+    );
+    assert_refused(
+        &[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "1",
+            "--fault",
+            "drop:id=0x022,count=0",
+        ],
+        2,
+        &["count", "from 1 to 4294967295"],
+    );
 }
 
 #[test]
@@ -638,6 +663,20 @@ fn messages_are_clear_short_and_never_carry_terminal_escapes() {
         &["tune", "--scene", "compass", "--vary", "slope=0.06:0.04"],
         2,
         &["min 0.06 must be below max 0.04"],
+    );
+    // A firmware parameter far out of range as given, not as its f32 (`= inf`).
+    assert_refused(
+        &[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "1",
+            "--firmware-param",
+            "taut_angle_rad=1e300",
+        ],
+        2,
+        &["taut_angle_rad = 1e300 is outside its range"],
     );
 }
 

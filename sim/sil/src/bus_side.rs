@@ -68,7 +68,8 @@ impl BusSide {
     }
 
     /// Write every bus event to a candump log at `candump`, and serve the bus over
-    /// socketcand on `socketcand`, each if given.
+    /// socketcand on `socketcand`, each if given; the server takes frames from its clients
+    /// only with `allow_send`.
     ///
     /// # Errors
     /// [`SilError::Candump`] when the log cannot be created, [`SilError::Socketcand`] when
@@ -77,13 +78,20 @@ impl BusSide {
         &mut self,
         candump: Option<&Path>,
         socketcand: Option<&str>,
+        allow_send: bool,
     ) -> Result<(), SilError> {
         if let Some(path) = candump {
             let file = BufWriter::new(File::create(path)?);
             self.candump = Some(CandumpWriter::new(file, "vcan0", 0));
         }
         if let Some(addr) = socketcand {
-            self.server = Some(SocketcandServer::bind(addr, ServerConfig::default())?);
+            self.server = Some(SocketcandServer::bind(
+                addr,
+                ServerConfig {
+                    allow_send,
+                    ..ServerConfig::default()
+                },
+            )?);
         }
         Ok(())
     }
@@ -212,6 +220,10 @@ impl BusSide {
                 frames_sent: st.frames_sent,
                 frames_dropped: st.frames_dropped,
                 frames_received: st.frames_received,
+                sends_refused: st.sends_refused,
+                clients_dropped_idle: st.clients_idle,
+                clients_dropped_stalled: st.clients_stalled,
+                clients_refused: st.clients_refused,
             }
         })
     }

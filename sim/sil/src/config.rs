@@ -152,6 +152,9 @@ pub struct SilConfig {
     pub candump: Option<PathBuf>,
     /// Serve the bus over socketcand on this loopback address (`127.0.0.1:PORT`).
     pub socketcand: Option<String>,
+    /// The socketcand server puts frames its clients send on the bus as the host's (a control
+    /// channel); otherwise it is read-only and refuses them. Default false.
+    pub socketcand_allow_send: bool,
 }
 
 impl Default for SilConfig {
@@ -177,6 +180,7 @@ impl Default for SilConfig {
             history_capacity: 10_000,
             candump: None,
             socketcand: None,
+            socketcand_allow_send: false,
         }
     }
 }
@@ -239,7 +243,7 @@ impl SilConfig {
                 let (min, max) = param.id.range_si();
                 FirmwareParamError::OutOfRange {
                     name: crate::firmware_param::param_name(param.id),
-                    value: param.value_si,
+                    value: f64::from(param.value_si),
                     min,
                     max,
                     unit: param.id.unit(),

@@ -59,12 +59,16 @@ pub enum FirmwareParamError {
         text: String,
     },
     /// Outside the parameter's range (the node would answer `OutOfRange`).
-    #[error("{name} = {value} is outside its range {min} to {max} {unit}")]
+    #[error(
+        "{name} = {} is outside its range {min} to {max} {unit}",
+        sim::scene::short_number(*value)
+    )]
     OutOfRange {
         /// The parameter's name.
         name: &'static str,
-        /// The value given.
-        value: f32,
+        /// The value given (as parsed, before any narrowing to the wire's `f32`: `1e300` is
+        /// shown as `1e300`, not `inf`).
+        value: f64,
         /// Smallest allowed value.
         min: f32,
         /// Largest allowed value.
@@ -117,7 +121,7 @@ impl FirmwareParam {
             .map(|value_si| FirmwareParam { id, value_si })
             .map_err(|_| FirmwareParamError::OutOfRange {
                 name: param_name(id),
-                value: value_si,
+                value: f64::from(value_si),
                 min,
                 max,
                 unit: id.unit(),
@@ -153,14 +157,25 @@ impl FromStr for FirmwareParam {
             .find(|(_, n)| *n == name)
             .copied()
             .ok_or_else(|| FirmwareParamError::UnknownName(name.to_owned()))?;
-        let value: f32 = text
+        let value: f64 = text
             .trim()
             .parse()
             .map_err(|_| FirmwareParamError::NotANumber {
                 name,
                 text: text.to_owned(),
             })?;
-        FirmwareParam::new(id, value)
+        let (min, max) = id.range_si();
+        if !(value >= f64::from(min) && value <= f64::from(max)) {
+            return Err(FirmwareParamError::OutOfRange {
+                name,
+                value,
+                min,
+                max,
+                unit: id.unit(),
+            });
+        }
+        // In range, so the narrowing is finite; the range check again on the f32.
+        FirmwareParam::new(id, value as f32)
     }
 }
 

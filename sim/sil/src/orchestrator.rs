@@ -43,7 +43,11 @@ impl FirmwareInTheLoop {
         let left = Ankle::new(Side::Left, bus.attach_ankle(Side::Left), &config)?;
         let right = Ankle::new(Side::Right, bus.attach_ankle(Side::Right), &config)?;
         bus.add_faults(&config.bus_faults)?;
-        bus.open_outputs(config.candump.as_deref(), config.socketcand.as_deref())?;
+        bus.open_outputs(
+            config.candump.as_deref(),
+            config.socketcand.as_deref(),
+            config.socketcand_allow_send,
+        )?;
         Ok(FirmwareInTheLoop {
             clock,
             host: Host::new(&config),

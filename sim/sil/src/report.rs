@@ -236,6 +236,14 @@ pub struct SocketcandReport {
     pub frames_dropped: u64,
     /// Frames received from clients.
     pub frames_received: u64,
+    /// Frames clients tried to send to a read-only server (no `--socketcand-allow-send`).
+    pub sends_refused: u64,
+    /// Clients dropped for not opening the bus in rawmode in time (or to make room).
+    pub clients_dropped_idle: u64,
+    /// Clients dropped because they stopped reading.
+    pub clients_dropped_stalled: u64,
+    /// Connections refused (every place taken by a client in rawmode).
+    pub clients_refused: u64,
 }
 
 /// The whole run.

@@ -527,6 +527,7 @@ fn a_socketcand_client_sees_the_frames_and_its_emergency_stop_reaches_the_nodes(
 
     let config = SilConfig {
         socketcand: Some("127.0.0.1:0".into()),
+        socketcand_allow_send: true,
         ..SilConfig::default()
     };
     let mut c = sil(config);

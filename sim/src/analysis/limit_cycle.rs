@@ -83,7 +83,10 @@ pub enum NewtonError {
         failure: StrideFailure,
     },
     /// The budget ran out.
-    #[error("Newton did not converge in {iterations} iterations (last |Δv| = {last_step:e})")]
+    #[error(
+        "Newton did not converge in {iterations} iterations ({})",
+        last_correction_words(*last_step)
+    )]
     NotConverged {
         /// Iterations used.
         iterations: usize,
@@ -96,6 +99,16 @@ pub enum NewtonError {
         /// Iteration.
         iteration: usize,
     },
+}
+
+/// The last Newton correction, in words: its size, or that it was not a number (a stride map
+/// that diverged gives an infinite or NaN correction, once shown as `last |Δv| = inf`).
+fn last_correction_words(last_step: f64) -> String {
+    if last_step.is_finite() {
+        format!("last |Δv| = {last_step:e}")
+    } else {
+        "the last correction was not finite: the stride map diverged from the start given".into()
+    }
 }
 
 /// A periodic gait.
@@ -419,5 +432,30 @@ impl<'a> GaitSearch<'a> {
             iterations: settings.max_iterations,
             last_step,
         })
+    }
+}
+
+#[cfg(test)]
+mod message_tests {
+    use super::*;
+
+    /// `last |Δv| = inf` said nothing a user could act on.
+    #[test]
+    fn a_correction_that_is_not_finite_is_named_as_such() {
+        for bad in [f64::INFINITY, f64::NAN] {
+            let e = NewtonError::NotConverged {
+                iterations: 3,
+                last_step: bad,
+            }
+            .to_string();
+            assert!(!e.contains("inf") && !e.contains("NaN"), "{e}");
+            assert!(e.contains("not finite"), "{e}");
+        }
+        let e = NewtonError::NotConverged {
+            iterations: 3,
+            last_step: 2.5e-3,
+        }
+        .to_string();
+        assert!(e.ends_with("(last |Δv| = 2.5e-3)"), "{e}");
     }
 }

@@ -57,6 +57,11 @@ pub struct SilArgs {
     /// Serve the bus live over the socketcand protocol on this address (127.0.0.1:PORT).
     #[arg(long, value_name = "ADDR")]
     pub socketcand: Option<String>,
+    /// With `--socketcand`: put frames the server's clients send on the bus as the host's (a
+    /// control channel for any local process: a sent `EmergencyStop_ALL` stops the walker).
+    /// Without it the server is read-only and refuses them.
+    #[arg(long)]
+    pub socketcand_allow_send: bool,
     /// With `--socketcand`: before the walk starts, wait up to this long, in seconds, for a
     /// client (e.g. the bus monitor) to connect in rawmode (0 to 86400); if none does, the walk
     /// starts anyway and says so on standard error.
@@ -341,6 +346,11 @@ fn sil_config(
             .with_sensor_fault_str(f)
             .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
     }
+    if args.socketcand_allow_send && args.socketcand.is_none() {
+        return Err(InputError::Other(
+            "--socketcand-allow-send needs --socketcand ADDR".to_owned(),
+        ));
+    }
     if let Some(addr) = &args.socketcand {
         let parsed: std::net::SocketAddr = addr
             .parse()
@@ -353,6 +363,7 @@ fn sil_config(
     }
     config.candump = args.candump.clone();
     config.socketcand = args.socketcand.clone();
+    config.socketcand_allow_send = args.socketcand_allow_send;
     Ok((config, firmware_params_written))
 }
 
@@ -365,13 +376,19 @@ fn start_firmware(
     estop_at: Option<f64>,
     wait_client: Option<std::time::Duration>,
 ) -> Result<sil::FirmwareInTheLoop, InputError> {
+    let allows_send = config.socketcand_allow_send;
     let mut ctl = sil::FirmwareInTheLoop::new(config).map_err(|e| candump_error(candump, e))?;
     if let Some(t) = estop_at {
         ctl.emergency_stop_at(t);
     }
     if let Some(addr) = ctl.socketcand_addr() {
         output::note(format_args!(
-            "socketcand: serving the bus on {addr} (channel vcan0)"
+            "socketcand: serving the bus on {addr} (channel vcan0, {})",
+            if allows_send {
+                "clients may send frames: --socketcand-allow-send"
+            } else {
+                "read-only"
+            }
         ));
     }
     if let Some(timeout) = wait_client {
