@@ -6,6 +6,8 @@ Run: scripts/python-venv && .venv/bin/python -m pytest python/
 
 import json
 import logging
+import math
+import os
 import pathlib
 import socket
 import sys
@@ -256,3 +258,397 @@ def test_the_monitor_ends_when_the_server_closes_and_reads_split_frames_quietly(
     assert "closed the connection" in err
     assert "incomplete message" not in err
     assert not [r for r in caplog.records if "incomplete message" in r.getMessage()]
+
+
+# --- bounded on every input (issue 25): live frames, the bus, files, the DBC checks -------
+
+def _hb(db, t, node="LEFT_ANKLE"):
+    """A heartbeat frame of `node` at `t` in socketcand's text."""
+    m = db.get_message_by_name(f"Heartbeat_{node}")
+    data = m.encode({s.name: 0 for s in m.signals}, strict=False)
+    return b"< frame %03X %.6f %s >" % (m.frame_id, t, data.hex().upper().encode())
+
+
+class FakeSocketcand:
+    """A socketcand server on 127.0.0.1 for one client: `< hi >` (or `greeting`), `< ok >`
+    (or `open_reply`) to `< open ... >`, `< ok >` to `< rawmode >`, then `payload` (bytes, or
+    a callable given the connection), then it closes (with a reset if `reset`). Every socket
+    operation has a timeout; `close()` joins the thread."""
+
+    def __init__(self, payload=b"", greeting=b"< hi >", open_reply=b"< ok >", reset=False):
+        self.listener = socket.socket()
+        self.listener.bind(("127.0.0.1", 0))
+        self.listener.listen(1)
+        self.listener.settimeout(5)
+        self.port = self.listener.getsockname()[1]
+        self.received = b""
+        self.args = (payload, greeting, open_reply, reset)
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self):
+        payload, greeting, open_reply, reset = self.args
+        try:
+            conn, _ = self.listener.accept()
+        except OSError:
+            return
+        conn.settimeout(5)
+        try:
+            if greeting:
+                conn.sendall(greeting)
+            else:
+                time.sleep(0.6)
+                return
+            self.received += conn.recv(256)
+            conn.sendall(open_reply)
+            if open_reply != b"< ok >":
+                time.sleep(0.2)
+                return
+            self.received += conn.recv(256)
+            conn.sendall(b"< ok >")
+            if callable(payload):
+                payload(conn)
+            else:
+                conn.sendall(payload)
+            time.sleep(0.1)
+            if reset:
+                conn.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\1\0\0\0\0\0\0\0")
+        except OSError:
+            pass
+        finally:
+            conn.close()
+
+    def close(self):
+        self.thread.join(10)
+        self.listener.close()
+        assert not self.thread.is_alive()
+
+
+def _live(port, *extra):
+    return ["--interface", "socketcand", "--host", "127.0.0.1", "--port", str(port),
+            "--channel", "vcan0", "--json", "--duration", "10", *extra]
+
+
+@pytest.mark.parametrize("bad, reason", [
+    (b"< frame XYZ 1.0 00 >", "identifier `XYZ`"),
+    (b"< frame 123 abc 00 >", "timestamp `abc`"),
+    (b"< frame 123 1.0 0 >", "odd number of hex digits"),
+    (b"< frame 123 1.0 \xff\xfe >", "byte 0xFF is not printable ASCII"),
+    (b"< frame 123 1.0 001122334455667788 >", "longer than 8 bytes"),  # 9 bytes
+    (b"< frame 1FFFFFFFF 1.0 00 >", "not 3 or 8 hex digits"),  # 33 bits
+    (b"< frame 3FFFFFFF 1.0 00 >", "exceeds 29 bits"),
+    (b"< frame 800 1.0 00 >", "exceeds 0x7FF"),
+    (b"< frame 123 nan 00 >", "timestamp `nan`"),
+    (b"< frame 123 >", "expected `< frame ID"),
+    (b"< frame 123 1.0 00 11 >", "expected `< frame ID"),
+    (b"< error could not send >", "the server reports an error"),
+    (b"< >", "an empty element"),
+    (b"unframed bytes", "bytes outside"),
+    (b"< frame 123 1.0 00", "a `<` came first"),
+    (b"< frame " + b"7" * 5000 + b" >", "no `>` within 256 bytes"),
+])
+def test_each_malformed_live_frame_is_counted_and_quoted_never_a_traceback(
+        db, capsys, bad, reason):
+    """python-can's interface raised CanError on these (and kept the frame, raising again on
+    every read) or took them (9 bytes, 33-bit identifiers): now each is one malformed frame,
+    quoted, and the good frames on either side are decoded once."""
+    server = FakeSocketcand(_hb(db, 100.0) + bad + _hb(db, 100.05))
+    rc = wm.main(_live(server.port))
+    server.close()
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert rc == 0
+    assert s["messages"]["Heartbeat_LEFT_ANKLE"]["count"] == 2 and s["frames"] == 2
+    assert s["malformed_frames"] == 1, s["bad_frames"]
+    assert [b["frame"] for b in s["bad_frames"]] == [2]
+    assert reason in s["bad_frames"][0]["reason"]
+    assert len(s["bad_frames"][0]["text"]) <= wm.candump_grammar.QUOTE_BYTES + 3
+    assert "bad frame #2" in err and reason in err
+    assert "Traceback" not in err and "closed the connection" in err
+
+
+def test_a_peer_streaming_unframed_bytes_costs_bounded_output(db, capsys):
+    """python-can logged `Bad data ...` with its whole buffer for every 1 kB read (837 MB of
+    stderr in 10 s): now the run of stray bytes is one malformed frame."""
+    junk = b"no socketcand here " * 1000
+
+    def stream(conn):
+        for _ in range(800):  # 15 MB
+            conn.sendall(junk)
+        conn.sendall(_hb(db, 1.0))
+
+    server = FakeSocketcand(stream)
+    t0 = time.monotonic()
+    rc = wm.main(_live(server.port))
+    server.close()
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert rc == 0 and time.monotonic() - t0 < 8
+    assert s["malformed_frames"] == 1 and s["frames"] == 1
+    assert s["bad_frames"][0]["text"].endswith("...")
+    assert len(err) < 2000 and len(out) < 16_000
+
+
+def test_the_socketcand_stream_is_cut_the_same_in_any_pieces():
+    import random
+    text = (b"< hi >< frame 022 1.000000 01 > junk <" + b"x" * 600 + b"> tail < ok >"
+            + b"< frame 0 < frame 123 2.5 > \xff" + b"y" * 300 + b"< frame 7FF 3.0 00 ><")
+    whole = wm.SocketcandStream()
+    expected = whole.feed(text) + whole.finish()
+
+    def canon(items):
+        return [(k, r[0]) if k == "element" else (k, r[0].head, r[0].length, r[1])
+                for k, *r in items]
+
+    rnd = random.Random(3)
+    for _ in range(200):
+        st, got, pos = wm.SocketcandStream(), [], 0
+        while pos < len(text):
+            step = rnd.randint(1, 40)
+            got += st.feed(text[pos:pos + step])
+            pos += step
+        got += st.finish()
+        assert canon(got) == canon(expected)
+    kinds = [k for k, *_ in expected]
+    assert kinds.count("element") == 5 and kinds.count("bad") == 6
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--interface", "nosuch"], ["--interface 'nosuch' is not a python-can interface"]),
+    (["--interface", "socketcan", "--channel", "can7"], ["can7", "cannot open the bus"]),
+    (["--interface", "socketcand", "--channel", "a b"], ["--channel", "not a channel name"]),
+])
+def test_a_wrong_interface_or_channel_exits_2_with_a_message(capsys, flags, words):
+    with pytest.raises(SystemExit) as e:
+        wm.main(flags)
+    err = capsys.readouterr().err
+    assert e.value.code == 2
+    assert all(w in err for w in words), err
+    assert "Traceback" not in err
+
+
+def test_a_channel_the_server_refuses_exits_2_with_its_reason(capsys):
+    server = FakeSocketcand(open_reply=b"< error could not open bus can7 >")
+    with pytest.raises(SystemExit) as e:
+        wm.main(["--interface", "socketcand", "--port", str(server.port), "--channel", "can7"])
+    server.close()
+    err = capsys.readouterr().err
+    assert e.value.code == 2
+    assert "refused" in err and "could not open bus can7" in err
+    assert server.received.startswith(b"< open can7 >")
+
+
+def test_no_server_or_a_silent_one_exits_2_in_bounded_time(capsys, monkeypatch):
+    free = socket.socket()
+    free.bind(("127.0.0.1", 0))
+    port = free.getsockname()[1]
+    free.close()  # nothing listens: python-can retried for 10 s, logging each try
+    t0 = time.monotonic()
+    with pytest.raises(SystemExit) as e:
+        wm.main(_live(port))
+    assert e.value.code == 2 and time.monotonic() - t0 < 3
+    assert "cannot connect" in capsys.readouterr().err
+    monkeypatch.setattr(wm, "HANDSHAKE_TIMEOUT_S", 0.3)
+    server = FakeSocketcand(greeting=None)  # accepts, never says hi
+    with pytest.raises(SystemExit) as e:
+        wm.main(_live(server.port))
+    server.close()
+    assert e.value.code == 2
+    assert "no answer (a greeting) within 0.3 s" in capsys.readouterr().err
+
+
+def test_a_connection_reset_mid_run_exits_1_with_the_summary(db, capsys):
+    server = FakeSocketcand(_hb(db, 1.0) + _hb(db, 1.05), reset=True)
+    rc = wm.main(_live(server.port))
+    server.close()
+    out, err = capsys.readouterr()
+    assert rc == 1
+    assert json.loads(out)["frames"] == 2  # the summary of what was seen
+    assert "walker_monitor: socketcand server" in err and "Traceback" not in err
+
+
+def test_python_can_log_floods_are_rate_limited():
+    logger = logging.getLogger("can.interfaces.socketcand.socketcand")
+    wm.guard_library_logs()
+    seen = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            seen.append(record.getMessage())
+
+    h = Keep()
+    logger.addHandler(h)
+    before = wm.LOG_GUARD.suppressed
+    try:
+        t0 = time.monotonic()
+        for _ in range(100_000):
+            logger.warning("Bad data: No opening < found => discarding entire buffer '%s'",
+                           "\x1b[2J" + "x" * 1024)
+        elapsed = time.monotonic() - t0
+    finally:
+        logger.removeHandler(h)
+    assert len(seen) <= wm.LOG_BURST + 1 + elapsed / wm.LOG_INTERVAL_S
+    assert wm.LOG_GUARD.suppressed - before >= 100_000 - len(seen)
+    assert all(len(m) <= wm.LOG_RECORD_CHARS + 3 and "\x1b" not in m for m in seen)
+
+
+@pytest.mark.parametrize("flag", ["--log", "--dbc"])
+@pytest.mark.parametrize("kind", ["fifo", "/dev/zero", "directory"])
+def test_a_log_or_dbc_that_is_no_regular_file_exits_2_at_once(tmp_path, capsys, flag, kind):
+    """A FIFO blocked the monitor forever (waiting for a writer), /dev/zero looped forever."""
+    if kind == "fifo":
+        path = tmp_path / "fifo"
+        os.mkfifo(path)
+    elif kind == "directory":
+        path = tmp_path
+    else:
+        path = pathlib.Path(kind)
+        if not path.exists():
+            pytest.skip("no /dev/zero")
+    argv = ["--log", str(FIX / "demo-nominal.log"), flag, str(path)]
+    result = []
+
+    def run():
+        try:
+            wm.main(argv)
+        except SystemExit as e:
+            result.append(e.code)
+
+    t = threading.Thread(target=run, daemon=True)
+    t.start()
+    t.join(10)
+    assert not t.is_alive(), "the monitor blocked"
+    assert result == [2]
+    assert "not a regular file" in capsys.readouterr().err
+
+
+def test_a_dbc_over_its_size_limit_or_not_the_walker_protocol_exits_2(tmp_path, capsys):
+    big = tmp_path / "big.dbc"
+    with open(big, "wb") as f:
+        f.truncate(wm.MAX_DBC_BYTES + 1)
+    other = tmp_path / "other.dbc"
+    other.write_text('VERSION ""\nNS_ :\nBS_:\nBU_: A\nBO_ 100 M: 1 A\n'
+                     ' SG_ s : 0|8@1+ (1,0) [0|255] "" Vector__XXX\n')
+    for path, words in ((big, f"limit of {wm.MAX_DBC_BYTES} bytes"),
+                        (other, "not the walker protocol")):
+        with pytest.raises(SystemExit) as e:
+            wm.main(["--log", str(FIX / "demo-nominal.log"), "--dbc", str(path)])
+        assert e.value.code == 2
+        assert words in capsys.readouterr().err
+
+
+def test_a_log_of_zeros_without_a_newline_is_one_bad_line_in_bounded_memory(tmp_path, capsys):
+    """64 MiB of zeros (a sparse file): cut at 256 bytes, skipped in 64 KiB pieces, one
+    malformed line; measured 0.9 s and 0.2 MB traced for 256 MiB."""
+    import tracemalloc
+    zeros = tmp_path / "zeros.log"
+    with open(zeros, "wb") as f:
+        f.truncate(64 << 20)
+    tracemalloc.start()
+    t0 = time.monotonic()
+    try:
+        rc = wm.main(["--log", str(zeros), "--json"])
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert rc == 0 and time.monotonic() - t0 < 10
+    assert peak < 4 << 20, peak
+    assert (s["malformed_lines"], s["frames"]) == (1, 0)
+    assert s["bad_lines"][0]["reason"] == f"line of {64 << 20} bytes is longer than 256 bytes"
+    assert s["bad_lines"][0]["text"].startswith("\\x00\\x00")
+    assert len(err) < 1000
+
+
+def test_frames_are_checked_against_the_dbc_length_and_identifier_width(db):
+    mon = wm.Monitor(db)
+    hb = db.get_message_by_name("Heartbeat_LEFT_ANKLE")
+    data = hb.encode({s.name: 0 for s in hb.signals}, strict=False)
+
+    def feed(**kw):
+        args = dict(timestamp=1.0, arbitration_id=hb.frame_id, is_extended_id=False,
+                    data=data, channel="vcan0")
+        args.update(kw)
+        mon.feed(can.Message(**args))
+
+    feed()
+    feed(data=data + b"\0")  # longer than the DBC's: cantools decoded it in silence
+    feed(data=data[:-1])
+    feed(data=bytes(9))  # no classic CAN frame
+    feed(arbitration_id=0x1_FFFF_FFFF, is_extended_id=True)  # 33 bits
+    feed(arbitration_id=0x800)
+    feed(is_fd=True)
+    feed(timestamp=math.nan)
+    s = mon.summary()
+    assert s["messages"]["Heartbeat_LEFT_ANKLE"]["count"] == 1
+    assert s["faults"]["wrong_length"] == {"Heartbeat_LEFT_ANKLE": 2}
+    assert s["faults"]["undecodable"] == 2
+    assert s["malformed_frames"] == 5 and s["frames"] == 3
+    reasons = [b["reason"] for b in s["bad_frames"]]
+    assert reasons == ["9 data bytes, more than 8", "identifier 0x1FFFFFFFF exceeds 29 bits",
+                       "identifier 0x800 exceeds 11 bits (a standard frame)",
+                       "CAN FD frames are not supported", "timestamp nan is not a finite number"]
+    assert any("another length than the DBC's" in w for w in s["warnings"])
+
+
+def _log(tmp_path, lines):
+    p = tmp_path / "t.log"
+    p.write_text("".join(l + "\n" for l in lines))
+    return str(p)
+
+
+def test_frames_on_other_channels_are_counted_not_decoded(tmp_path, capsys):
+    lines = [f"({1 + i * 0.01:.6f}) {'vcan1' if i % 3 == 0 else 'vcan0'} 062#0000000000000000"
+             for i in range(30)]
+    path = _log(tmp_path, lines)
+    assert wm.main(["--log", path, "--json"]) == 0
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert s["channel"] == "vcan1"  # the first frame's
+    assert (s["frames"], s["faults"]["other_channels"]) == (10, {"vcan0": 20})
+    assert "20 frames on other channels than vcan1 not decoded" in err
+    assert wm.main(["--log", path, "--json", "--channel", "vcan0"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert (s["frames"], s["faults"]["other_channels"]) == (20, {"vcan1": 10})
+
+
+def test_backwards_timestamps_are_reported(tmp_path, capsys):
+    lines = [f"({t:.6f}) vcan0 062#0000000000000000" for t in (1.0, 1.1, 1.2, 0.9, 1.3)]
+    assert wm.main(["--log", _log(tmp_path, lines), "--json"]) == 0
+    out, err = capsys.readouterr()
+    f = json.loads(out)["faults"]
+    assert f["backwards_timestamps"] == 1
+    assert f["largest_step_back_s"] == pytest.approx(0.3)
+    assert "1 frames with a timestamp earlier than a frame before them" in err
+
+
+def test_an_impossible_bus_load_is_reported_a_full_bus_is_not(db, tmp_path, capsys):
+    hb = db.get_message_by_name("Heartbeat_LEFT_ANKLE")
+    data = hb.encode({s.name: 0 for s in hb.signals}, strict=False)
+    step = wm.frame_bits(hb.frame_id, data) / 500_000  # one frame's time on the wire
+    line = "({:.6f}) vcan0 %03X#%s" % (hb.frame_id, data.hex().upper())
+    # back to back for 2 s: 100 %, possible
+    full = [line.format(1 + (i + 1) * step) for i in range(int(2 / step))]
+    assert wm.main(["--log", _log(tmp_path, full), "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["bus_load"] == pytest.approx(1.0, abs=0.01)
+    assert not s["faults"]["impossible_load"] and s["warnings"] == []
+    # timestamps 1 µs apart: 17,000 % passed without a word
+    fast = [line.format(1 + i * 1e-6) for i in range(2000)]
+    assert wm.main(["--log", _log(tmp_path, fast), "--json"]) == 0
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert s["bus_load"] > 100 and s["faults"]["impossible_load"]
+    assert "impossible bus load" in err
+
+
+def test_the_rust_logs_raise_no_warning():
+    for name in ("demo-nominal", "demo-faults"):
+        db = cantools.database.load_file(str(wm.DEFAULT_DBC), strict=True)
+        mon = wm.Monitor(db)
+        for m in wm.read_log(str(FIX / f"{name}.log"), []):
+            mon.feed(m)
+        s = mon.summary()
+        assert s["warnings"] == [] and not s["faults"]["impossible_load"], name
+        assert s["bus_load_window_peak"] < 1.0
