@@ -19,6 +19,7 @@ mod limits;
 mod options;
 mod output;
 mod param_range;
+mod path_csv;
 mod plot;
 mod progress;
 #[cfg(test)]

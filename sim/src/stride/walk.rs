@@ -125,10 +125,17 @@ pub struct PathSample {
 }
 
 /// What a walk keeps.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WalkOptions {
-    /// Record the path (every integration sample).
+    /// Record the path in [`Walk::path`]: every integration sample, or with
+    /// [`WalkOptions::path_interval_s`] fewer.
     pub record: bool,
+    /// Keep in [`Walk::path`] at most one sample per this much walk time \[s\], plus every
+    /// step's first and last sample (the impacts stay sharp); `None`: every integration
+    /// sample. The recorded path then grows with the walk's duration, not with the
+    /// integrator's step (a fixed step of 2e-5 s kept 50,000 samples a second). The samples
+    /// given to [`WalkRequest::on_sample`] are never thinned.
+    pub path_interval_s: Option<f64>,
     /// Keep only the summaries of the last this many steps in [`Walk::steps`] (`None`: all).
     /// A long walk (a soak) then runs in bounded memory; [`Walk::steps_completed`] still
     /// counts every step and the per-step callback of [`WalkRequest::on_step`] sees each.
@@ -161,6 +168,9 @@ pub struct WalkRequest<'a> {
     pub controller: Option<&'a mut dyn AnkleController>,
     /// Called with each step's summary as it completes.
     pub on_step: Option<&'a mut dyn FnMut(&StepSummary)>,
+    /// Called with every integration sample, in the floor frame, as its stride completes
+    /// (streaming: the walk keeps none of them unless recording).
+    pub on_sample: Option<&'a mut dyn FnMut(&PathSample)>,
 }
 
 impl<'a> WalkRequest<'a> {
@@ -172,6 +182,7 @@ impl<'a> WalkRequest<'a> {
             options: WalkOptions::default(),
             controller: None,
             on_step: None,
+            on_sample: None,
         }
     }
 
@@ -182,6 +193,25 @@ impl<'a> WalkRequest<'a> {
             ..self.options
         };
         Self { options, ..self }
+    }
+
+    /// Recording at most one sample per `interval_s` of walk time (and every step's first
+    /// and last): see [`WalkOptions::path_interval_s`].
+    pub fn path_interval(self, interval_s: f64) -> Self {
+        let options = WalkOptions {
+            path_interval_s: Some(interval_s),
+            ..self.options
+        };
+        Self { options, ..self }
+    }
+
+    /// With `on_sample` called with every integration sample (see
+    /// [`WalkRequest::on_sample`]).
+    pub fn on_sample(self, on_sample: &'a mut dyn FnMut(&PathSample)) -> Self {
+        Self {
+            on_sample: Some(on_sample),
+            ..self
+        }
     }
 
     /// With these options.
@@ -221,8 +251,12 @@ pub fn walk(
         options,
         mut controller,
         mut on_step,
+        mut on_sample,
     } = request;
     let (record, keep_steps) = (options.record, options.keep_steps);
+    let path_interval_s = options.path_interval_s;
+    let sampling = record || on_sample.is_some();
+    let mut last_kept_s = f64::NEG_INFINITY;
     let mut frame = FloorFrame::default();
     let (mut q, mut qd) = (q0.clone(), qd0.clone());
     let v0 = walker.pack(q0, qd0);
@@ -241,7 +275,7 @@ pub fn walk(
     for step in 0..steps {
         samples.clear();
         let options = StrideOptions {
-            record,
+            record: sampling,
             contact: false,
         };
         let mut request = StrideRequest::new(settings)
@@ -251,9 +285,24 @@ pub fn walk(
             request = request.controlled(c, t0);
         }
         let result = workspace.stride(&q, &qd, request);
-        for s in &samples {
-            out.path
-                .push(path_sample(walker, &mut kin, &frame, step, t0, s));
+        let last = samples.len().saturating_sub(1);
+        for (i, s) in samples.iter().enumerate() {
+            let t_walk_s = t0 + s.t_s;
+            let kept = record
+                && (i == 0
+                    || i == last
+                    || path_interval_s.is_none_or(|dt| t_walk_s - last_kept_s >= dt));
+            if !kept && on_sample.is_none() {
+                continue;
+            }
+            let p = path_sample(walker, &mut kin, &frame, step, t0, s);
+            if let Some(f) = on_sample.as_deref_mut() {
+                f(&p);
+            }
+            if kept {
+                last_kept_s = t_walk_s;
+                out.path.push(p);
+            }
         }
         match result {
             Err(f) => {

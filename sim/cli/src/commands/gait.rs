@@ -78,7 +78,9 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
         (Some(file), Ok(g)) => {
             // Strides of the limit cycle: a walk from its fixed point.
             let (q, qd) = walker.unpack(&g.fixed_point);
-            let request = WalkRequest::new(&setup.settings, ANIMATED_STRIDES).recording(true);
+            let request = WalkRequest::new(&setup.settings, ANIMATED_STRIDES)
+                .recording(true)
+                .path_interval(crate::animation::PATH_SAMPLE_INTERVAL_S);
             let walk = sim::stride::walk::walk(walker, &q, &qd, request);
             file.write(&Animation {
                 scene: &scene,

@@ -432,6 +432,7 @@ fn walk_with_firmware(
     // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
     let options = sim::stride::walk::WalkOptions {
         record: plan.record,
+        path_interval_s: Some(crate::animation::PATH_SAMPLE_INTERVAL_S),
         keep_steps: plan.keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
     };
     let progress = Progress::after(

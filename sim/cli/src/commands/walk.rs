@@ -12,11 +12,11 @@ use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
+use crate::path_csv::PathCsv;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::homotopy::{GaitRule, HomotopySettings};
-use sim::engine::walker::Walker;
 use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::stride::walk::WalkRequest;
@@ -170,11 +170,27 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     let (q, qd) = walker.unpack(&v);
     let progress = Progress::after(PROGRESS_DELAY, steps, "walk (steps)", !common.json);
     let mut tick = |_: &sim::stride::walk::StepSummary| progress.tick();
-    let request = WalkRequest::new(&setup.settings, steps)
-        .recording(out.is_some() || plot.is_some() || animation.is_some())
+    // The CSV is written as the strides complete (every integrator sample); the figure and
+    // the page keep the path thinned to their resolution: memory follows neither the walk's
+    // length (for --out) nor the integrator's step.
+    let mut csv = csv.map(|(path, file)| (path, PathCsv::new(file, walker)));
+    let mut row = |s: &sim::stride::walk::PathSample| {
+        if let Some((_, c)) = csv.as_mut() {
+            c.row(s);
+        }
+    };
+    let mut request = WalkRequest::new(&setup.settings, steps)
+        .recording(plot.is_some() || animation.is_some())
+        .path_interval(animation::PATH_SAMPLE_INTERVAL_S)
         .on_step(&mut tick);
+    if out.is_some() {
+        request = request.on_sample(&mut row);
+    }
     let walk = sim::stride::walk::walk(walker, &q, &qd, request);
     progress.finish();
+    if let Some((path, c)) = csv {
+        c.finish().map_err(|e| PathError::new("--out", path, e))?;
+    }
     if let Some(dir) = &plot {
         let mut walks = vec![(scene.clone(), walk.clone())];
         if let Some(other) = &plot_with {
@@ -185,7 +201,9 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             let v0 = ow.pack(&oset.guess.q, &oset.guess.qd);
             let start = rule.gait(&os)?.map(|(g, _)| g.fixed_point).unwrap_or(v0);
             let (oq, oqd) = ow.unpack(&start);
-            let request = WalkRequest::new(&oset.settings, steps).recording(true);
+            let request = WalkRequest::new(&oset.settings, steps)
+                .recording(true)
+                .path_interval(animation::PATH_SAMPLE_INTERVAL_S);
             let other_walk = sim::stride::walk::walk(ow, &oq, &oqd, request);
             walks.push((os, other_walk));
         }
@@ -194,9 +212,6 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         let size = (860.0, 480.0);
         let fig = figures::floor_paths(&refs, size);
         export::write_figure("--plot", dir, "floor_path", &fig.to_svg(size.0, size.1))?;
-    }
-    if let Some((path, file)) = csv {
-        write_csv(file, walker, &walk).map_err(|e| PathError::new("--out", path, e))?;
     }
     if let Some(file) = animation {
         file.write(&Animation {
@@ -291,41 +306,4 @@ pub fn failure_text(f: &sim::stride::walk::WalkFailure) -> String {
         f.t_walk_s,
         f.detail
     )
-}
-
-/// The walk's trajectory as CSV: step, time, coordinates, rates and the hip-axle centre in the
-/// floor frame, one row per integrator sample.
-fn write_csv(
-    file: std::fs::File,
-    walker: &Walker,
-    walk: &sim::stride::walk::Walk,
-) -> std::io::Result<()> {
-    let mut f = std::io::BufWriter::new(file);
-    let coords: Vec<&str> = walker
-        .model()
-        .coordinates
-        .iter()
-        .map(|c| c.name.as_str())
-        .collect();
-    write!(f, "step,time_s")?;
-    for c in &coords {
-        write!(f, ",{c}")?;
-    }
-    for c in &coords {
-        write!(f, ",{c}_dot")?;
-    }
-    writeln!(f, ",hip_x_m,hip_y_m,hip_z_m")?;
-    for s in &walk.path {
-        write!(f, "{},{}", s.step, s.t_walk_s)?;
-        for v in s.q.iter().chain(s.qd.iter()) {
-            write!(f, ",{v}")?;
-        }
-        writeln!(
-            f,
-            ",{},{},{}",
-            s.hip_floor_m.x, s.hip_floor_m.y, s.hip_floor_m.z
-        )?;
-    }
-    f.flush()?;
-    Ok(())
 }
