@@ -352,42 +352,93 @@ fn quote(bytes: &[u8]) -> String {
     q
 }
 
-/// Read every record; bad lines are reported (their text cut to [`QUOTE_BYTES`]), the others
-/// kept. Blank lines are skipped. Lines are read in bounded pieces: a line longer than
-/// [`MAX_LINE_BYTES`] is reported without being held, and bytes that are not UTF-8 make their
-/// line bad, not the read.
+/// A candump log read as a stream: one record or one bad line at a time, never holding more
+/// than [`MAX_LINE_BYTES`] + 1 bytes of the input, so memory does not grow with the log
+/// (`read_log` collects it for logs known to be small: fixtures, tests). Blank lines are
+/// skipped; a line longer than [`MAX_LINE_BYTES`] is reported without being held, and bytes
+/// that are not UTF-8 make their line bad, not the read. After a reader error it ends.
+pub struct LogReader<R> {
+    reader: R,
+    line_no: usize,
+    failed: bool,
+}
+
+impl<R: BufRead> LogReader<R> {
+    /// A stream over `reader`.
+    pub fn new(reader: R) -> Self {
+        Self {
+            reader,
+            line_no: 0,
+            failed: false,
+        }
+    }
+
+    /// Lines read so far (blank ones included).
+    pub fn lines_read(&self) -> usize {
+        self.line_no
+    }
+}
+
+impl<R: BufRead> Iterator for LogReader<R> {
+    /// A record, or why a line is not one; [`ReadError`] when the reader fails (then the
+    /// stream ends).
+    type Item = Result<Result<LogRecord, LineError>, ReadError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        // each pass reads one line: bounded by the input
+        loop {
+            let raw = match next_line(&mut self.reader) {
+                Ok(Some(raw)) => raw,
+                Ok(None) => return None,
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(ReadError::Io(e)));
+                }
+            };
+            self.line_no += 1;
+            let (bytes, result) = match raw {
+                RawLine::TooLong(head, len) => (
+                    head,
+                    Err(format!(
+                        "line of {len} bytes is longer than {MAX_LINE_BYTES} bytes"
+                    )),
+                ),
+                RawLine::Fits(bytes) => {
+                    let result = match std::str::from_utf8(&bytes) {
+                        Err(_) => Err("bytes that are not ASCII".to_string()),
+                        Ok(t) if t.trim_matches(|c| is_blank(c) || c == '\r').is_empty() => {
+                            continue
+                        }
+                        Ok(t) => parse_line(t),
+                    };
+                    (bytes, result)
+                }
+            };
+            return Some(Ok(result.map_err(|reason| LineError {
+                line_no: self.line_no,
+                line: quote(&bytes),
+                reason,
+            })));
+        }
+    }
+}
+
+/// Read every record of a log known to be small (fixtures, tests): a [`LogReader`] collected,
+/// so memory grows with the log; stream with [`LogReader`] otherwise. Bad lines are reported
+/// (their text cut to [`QUOTE_BYTES`]), the others kept.
 ///
 /// # Errors
 /// [`ReadError::Io`] when the reader fails (not for bad lines).
-pub fn read_log<R: BufRead>(mut reader: R) -> Result<(Vec<LogRecord>, Vec<LineError>), ReadError> {
+pub fn read_log<R: BufRead>(reader: R) -> Result<(Vec<LogRecord>, Vec<LineError>), ReadError> {
     let mut records = Vec::new();
     let mut errors = Vec::new();
-    let mut line_no = 0usize;
-    while let Some(raw) = next_line(&mut reader)? {
-        line_no += 1;
-        let (bytes, result) = match raw {
-            RawLine::TooLong(head, len) => (
-                head,
-                Err(format!(
-                    "line of {len} bytes is longer than {MAX_LINE_BYTES} bytes"
-                )),
-            ),
-            RawLine::Fits(bytes) => {
-                let result = match std::str::from_utf8(&bytes) {
-                    Err(_) => Err("bytes that are not ASCII".to_string()),
-                    Ok(t) if t.trim_matches(|c| is_blank(c) || c == '\r').is_empty() => continue,
-                    Ok(t) => parse_line(t),
-                };
-                (bytes, result)
-            }
-        };
-        match result {
+    for item in LogReader::new(reader) {
+        match item? {
             Ok(r) => records.push(r),
-            Err(reason) => errors.push(LineError {
-                line_no,
-                line: quote(&bytes),
-                reason,
-            }),
+            Err(e) => errors.push(e),
         }
     }
     Ok((records, errors))
@@ -521,6 +572,52 @@ impl<W: Write> CandumpWriter<W> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A log read as a stream holds no more than a line: an endless log of records (and one
+    /// of bad lines) yields entry after entry, where collecting it would never end.
+    #[test]
+    fn an_endless_log_streams_entry_by_entry() {
+        let line = b"(1.000000) vcan0 123#0011\n";
+        let endless = Endless { line, pos: 0 };
+        let mut reader = LogReader::new(std::io::BufReader::new(endless));
+        for _ in 0..200_000 {
+            let r = reader.next().unwrap().unwrap().unwrap();
+            assert_eq!(r.channel, "vcan0");
+        }
+        assert_eq!(reader.lines_read(), 200_000);
+        let bad = Endless {
+            line: b"garbage\n",
+            pos: 0,
+        };
+        let mut reader = LogReader::new(std::io::BufReader::new(bad));
+        for n in 1..=200_000 {
+            let e = reader.next().unwrap().unwrap().unwrap_err();
+            assert_eq!(e.line_no, n);
+        }
+        // no newline ever: one over-long line per read, never the whole input held (the
+        // reader ends when the input does; here a bounded one of 8 MiB of zeros)
+        let zeros = std::io::Read::take(std::io::repeat(0), 8 << 20);
+        let mut reader = LogReader::new(std::io::BufReader::new(zeros));
+        let e = reader.next().unwrap().unwrap().unwrap_err();
+        assert!(e.reason.contains("longer than 256 bytes"), "{e}");
+        assert!(reader.next().is_none());
+    }
+
+    /// `line`, repeated for ever.
+    struct Endless {
+        line: &'static [u8],
+        pos: usize,
+    }
+
+    impl std::io::Read for Endless {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            for b in buf.iter_mut() {
+                *b = self.line[self.pos];
+                self.pos = (self.pos + 1) % self.line.len();
+            }
+            Ok(buf.len())
+        }
+    }
     use proptest::prelude::*;
 
     #[test]
