@@ -136,6 +136,7 @@ fn failure_clause(kind: FailureKind) -> String {
         FailureKind::InvalidControlPeriod => "the controller's period is not usable".into(),
         FailureKind::ControlFailed => "the controller could not run a tick".into(),
         FailureKind::InvalidConfiguration => "the scene does not fit the request".into(),
+        FailureKind::SearchBudgetExhausted => "the search used its budget of strides".into(),
     }
 }
 

@@ -24,6 +24,7 @@ mod plot;
 mod progress;
 #[cfg(test)]
 mod readme_commands;
+mod search_progress;
 mod svg_text;
 mod sweep_figures;
 

@@ -38,6 +38,11 @@ pub struct Common {
     /// Newton iteration budget.
     #[arg(long, default_value_t = 30)]
     pub newton_max_iter: usize,
+    /// Strides one gait search may take, over all its Newton searches and the path from the
+    /// scene's defaults; past them it stops and says so (exit 1). On a terminal a search
+    /// that lasts over a second shows these strides as its progress.
+    #[arg(long, value_name = "STRIDES", default_value_t = sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET)]
+    pub max_strides: usize,
     /// Perturbation step of the stride Jacobian.
     #[arg(long, default_value_t = 1e-6)]
     pub perturbation: f64,
@@ -109,6 +114,11 @@ impl Common {
         positive("step-s", self.step_s)?;
         positive("rtol", self.rtol)?;
         positive("newton-tol", Some(self.newton_tol))?;
+        if self.max_strides == 0 {
+            return Err(InputError::Other(
+                "--max-strides must be at least 1 (strides one gait search may take)".to_owned(),
+            ));
+        }
         if self.newton_max_iter == 0 {
             return Err(InputError::Other(
                 "--newton-max-iter must be at least 1 (Newton iterations allowed)".to_owned(),
@@ -155,6 +165,15 @@ impl Common {
         settings
             .validate()
             .map_err(|e| InputError::Other(e.to_string()))
+    }
+
+    /// How a gait is followed from the scene's defaults, with the gait's budget of strides
+    /// (`--max-strides`).
+    pub fn homotopy(&self) -> sim::analysis::homotopy::HomotopySettings {
+        sim::analysis::homotopy::HomotopySettings {
+            gait_stride_budget: self.max_strides,
+            ..Default::default()
+        }
     }
 
     /// The gait search's settings.

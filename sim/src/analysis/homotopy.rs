@@ -14,7 +14,9 @@
 
 use crate::analysis::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
 use crate::scene::{Scene, SceneError, Setup};
+use crate::stride::{SearchBudget, SharedBudget};
 use nalgebra::DVector;
+use std::sync::Arc;
 
 /// Builds the [`Setup`] of a scene at given parameter values: `Scene::setup` and whatever
 /// solver settings the caller overrides (the CLI's `--integrator`, `--rtol`, `--step-s`).
@@ -43,6 +45,10 @@ pub struct HomotopySettings {
     /// predictor Newton converges in a few; more means the step is too long, and halving it
     /// is cheaper than iterating on (a failing search of the 3D walker costs seconds).
     pub max_corrector_iterations: usize,
+    /// Strides one gait of [`GaitRule`] (and so [`nominal_gait`]) may take over all its
+    /// searches: Newton from the guess, the defaults' gait (a budget of its own), the path.
+    /// Default [`DEFAULT_GAIT_STRIDE_BUDGET`]; `walker ... --max-strides`.
+    pub gait_stride_budget: usize,
 }
 
 impl HomotopySettings {
@@ -64,6 +70,7 @@ impl Default for HomotopySettings {
             max_period_change: 0.1,
             max_solves: 24,
             max_corrector_iterations: 12,
+            gait_stride_budget: DEFAULT_GAIT_STRIDE_BUDGET,
         }
     }
 }
@@ -203,6 +210,7 @@ pub fn follow(
                 path.push(s, &g);
                 step = (step * 2.0).min(1.0);
             }
+            Some(Err(e)) if e.budget_spent() => return (Err(e), solves),
             Some(Err(e)) => {
                 last_error = e;
                 step *= 0.5;
@@ -265,11 +273,31 @@ type DefaultsGait = (Scene, Result<Gait, NewtonError>);
 /// [`nominal_gait`] for many values of one scene: the defaults' gait is found once, at the
 /// first value off the defaults, and kept (for every scene whose defaults are the same scene;
 /// another scene's are found afresh). The same gaits as [`nominal_gait`], to the bit.
+///
+/// Every gait it finds has a budget of strides ([`HomotopySettings::gait_stride_budget`]) for
+/// all its searches (Newton from the guess, the defaults' gait
+/// when it is found, the path from the defaults); a search that spends it ends with
+/// [`NewtonError::budget_spent`]. [`GaitRule::with_budget`] shares one budget among every gait
+/// of the rule instead, for a command that finds one gait and shows its progress.
 pub struct GaitRule<'a> {
     setup_for: &'a SetupFor<'a>,
     newton: &'a NewtonSettings,
     homotopy: &'a HomotopySettings,
     defaults: std::sync::OnceLock<Result<DefaultsGait, SceneError>>,
+    budget: RuleBudget,
+}
+
+/// The strides one gait of [`GaitRule`] may take by default: about a minute of wisse3d
+/// strides, hundreds of times what its gait takes (a few hundred), and a stop for a search
+/// that would run for hours on a large model.
+pub const DEFAULT_GAIT_STRIDE_BUDGET: usize = 100_000;
+
+/// Whose budget a gait of [`GaitRule`] spends.
+enum RuleBudget {
+    /// A fresh budget of this many strides for each gait.
+    PerGait(usize),
+    /// One budget for every gait of the rule.
+    Shared(Arc<SearchBudget>),
 }
 
 impl<'a> GaitRule<'a> {
@@ -284,6 +312,15 @@ impl<'a> GaitRule<'a> {
             newton,
             homotopy,
             defaults: std::sync::OnceLock::new(),
+            budget: RuleBudget::PerGait(homotopy.gait_stride_budget),
+        }
+    }
+
+    /// Every gait of the rule spends `budget` (whose count shows the searches' progress).
+    pub fn with_budget(self, budget: Arc<SearchBudget>) -> Self {
+        Self {
+            budget: RuleBudget::Shared(budget),
+            ..self
         }
     }
 
@@ -295,7 +332,39 @@ impl<'a> GaitRule<'a> {
         &self,
         scene: &Scene,
     ) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
-        let setup = (self.setup_for)(scene)?;
+        let fresh = || {
+            SharedBudget(Some(match &self.budget {
+                RuleBudget::PerGait(n) => Arc::new(SearchBudget::new(*n)),
+                RuleBudget::Shared(b) => Arc::clone(b),
+            }))
+        };
+        // The defaults' gait, kept for every later gait, has a budget of its own: it is spent
+        // only when that search alone needs more, never by the search beside it.
+        let (budget, defaults_budget) = (fresh(), fresh());
+        let spending = |budget: &SharedBudget, sc: &Scene| -> Result<Setup, SceneError> {
+            let mut setup = (self.setup_for)(sc)?;
+            setup.settings.search_budget = budget.clone();
+            Ok(setup)
+        };
+        let budgeted = |sc: &Scene| spending(&budget, sc);
+        let defaults_budgeted = |sc: &Scene| spending(&defaults_budget, sc);
+        let found = self.gait_within(scene, &budgeted, &defaults_budgeted)?;
+        // The gait's settings go on to other strides: without this search's budget.
+        Ok(found.map(|(mut g, source)| {
+            g.stride_settings.search_budget = SharedBudget::default();
+            (g, source)
+        }))
+    }
+
+    /// [`Self::gait`] with setups built by `setup_for` (which spend the gait's budget), the
+    /// defaults' gait by `defaults_setup_for`.
+    fn gait_within(
+        &self,
+        scene: &Scene,
+        setup_for: &SetupFor<'_>,
+        defaults_setup_for: &SetupFor<'_>,
+    ) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
+        let setup = setup_for(scene)?;
         if is_at_defaults(scene) {
             return Ok(setup
                 .find_gait(self.newton)
@@ -306,25 +375,15 @@ impl<'a> GaitRule<'a> {
             || setup.find_gait(self.newton),
             || -> Result<Result<Gait, NewtonError>, SceneError> {
                 let found;
-                let (defaults, gait) = match self.kept_defaults(&defaults)? {
+                let (defaults, gait) = match self.kept_defaults(&defaults, defaults_setup_for)? {
                     Some(kept) => (&kept.0, &kept.1),
                     None => {
-                        found = self.defaults_gait(defaults.clone())?;
+                        found = self.defaults_gait(defaults.clone(), defaults_setup_for)?;
                         (&found.0, &found.1)
                     }
                 };
                 Ok(match gait {
-                    Ok(g) => {
-                        follow(
-                            defaults,
-                            scene,
-                            self.setup_for,
-                            g,
-                            self.newton,
-                            self.homotopy,
-                        )
-                        .0
-                    }
+                    Ok(g) => follow(defaults, scene, setup_for, g, self.newton, self.homotopy).0,
                     Err(e) => Err(e.clone()),
                 })
             },
@@ -338,16 +397,22 @@ impl<'a> GaitRule<'a> {
             }),
             (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
             (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
+            // a spent budget is said, whichever search spent it
+            (Err(e), Err(f)) if f.budget_spent() && !e.budget_spent() => Err(f),
             (Err(e), Err(_)) => Err(e),
         })
     }
 
     /// The kept defaults' gait when `defaults` is the scene it was found for (found now at
     /// the first call); `None` when it is another scene's.
-    fn kept_defaults(&self, defaults: &Scene) -> Result<Option<&DefaultsGait>, SceneError> {
+    fn kept_defaults(
+        &self,
+        defaults: &Scene,
+        setup_for: &SetupFor<'_>,
+    ) -> Result<Option<&DefaultsGait>, SceneError> {
         let kept = self
             .defaults
-            .get_or_init(|| self.defaults_gait(defaults.clone()))
+            .get_or_init(|| self.defaults_gait(defaults.clone(), setup_for))
             .as_ref()
             .map_err(Clone::clone)?;
         Ok((kept.0.name() == defaults.name()
@@ -357,8 +422,15 @@ impl<'a> GaitRule<'a> {
     }
 
     /// The gait of `defaults` (Newton from its guess).
-    fn defaults_gait(&self, defaults: Scene) -> Result<DefaultsGait, SceneError> {
-        let gait = (self.setup_for)(&defaults)?.find_gait(self.newton);
+    fn defaults_gait(
+        &self,
+        defaults: Scene,
+        setup_for: &SetupFor<'_>,
+    ) -> Result<DefaultsGait, SceneError> {
+        let gait = setup_for(&defaults)?.find_gait(self.newton).map(|mut g| {
+            g.stride_settings.search_budget = SharedBudget::default();
+            g
+        });
         Ok((defaults, gait))
     }
 }

@@ -8,8 +8,8 @@
 use crate::analysis::variational::VariationalError;
 use crate::engine::walker::Walker;
 use crate::stride::{
-    Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult, StrideSettings,
-    StrideWorkspace,
+    FailureCause, FailureKind, Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult,
+    StrideSettings, StrideWorkspace,
 };
 use nalgebra::{Complex, DMatrix, DVector};
 use rayon::prelude::*;
@@ -75,7 +75,7 @@ impl Default for NewtonSettings {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NewtonError {
     /// A stride failed during the search.
-    #[error("stride failed at Newton iteration {iteration}: {failure}")]
+    #[error("{}", stride_failed_words(*iteration, failure))]
     StrideFailed {
         /// Iteration.
         iteration: usize,
@@ -99,6 +99,27 @@ pub enum NewtonError {
         /// Iteration.
         iteration: usize,
     },
+}
+
+impl NewtonError {
+    /// The search stopped because its budget of strides was spent
+    /// ([`crate::stride::SearchBudget`]), not because of the walker.
+    pub fn budget_spent(&self) -> bool {
+        matches!(self, Self::StrideFailed { failure, .. }
+            if failure.kind == FailureKind::SearchBudgetExhausted)
+    }
+}
+
+/// A stride that failed in a Newton search, in words; a spent search budget is no stride's
+/// failure and is said as such.
+fn stride_failed_words(iteration: usize, failure: &StrideFailure) -> String {
+    match &*failure.cause {
+        FailureCause::SearchBudget { limit_strides } => format!(
+            "the search used its budget of {limit_strides} strides at Newton iteration \
+             {iteration} (--max-strides allows more)"
+        ),
+        _ => format!("stride failed at Newton iteration {iteration}: {failure}"),
+    }
 }
 
 /// The last Newton correction, in words: its size, or that it was not a number (a stride map
@@ -414,6 +435,10 @@ impl<'a> GaitSearch<'a> {
                         carried = Some((st, sr));
                         accepted = true;
                         break;
+                    }
+                    // the search's budget is spent: no halving can help
+                    Err(f) if f.kind == FailureKind::SearchBudgetExhausted => {
+                        return Err(fail(f));
                     }
                     _ => lambda *= 0.5,
                 }

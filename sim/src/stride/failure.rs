@@ -56,6 +56,9 @@ pub enum FailureKind {
     /// The request does not fit the walker (a controlled stride on a walker without an ankle
     /// reflex): a configuration error, found before the stride starts.
     InvalidConfiguration,
+    /// The search the stride belongs to has used its budget of strides
+    /// ([`super::SearchBudget`]): not run.
+    SearchBudgetExhausted,
 }
 
 /// A failed stride. Serialised as `{kind, time_s, detail}` (`detail`: the cause's text).
@@ -117,6 +120,12 @@ pub enum FailureCause {
     /// `ankle_reflex` section): a request that does not fit the walker.
     #[error("a controlled stride needs a scene with an ankle_reflex section")]
     NoAnkleReflex,
+    /// The search's budget of strides is spent: the stride was not run.
+    #[error("the search's budget of {limit_strides} strides is spent (--max-strides)")]
+    SearchBudget {
+        /// The budget \[strides\].
+        limit_strides: usize,
+    },
     /// The stride's start state is not finite.
     #[error("initial state")]
     NonFiniteInitialState,
@@ -277,6 +286,7 @@ impl FailureCause {
     pub fn kind(&self) -> FailureKind {
         match self {
             Self::NoAnkleReflex => FailureKind::InvalidConfiguration,
+            Self::SearchBudget { .. } => FailureKind::SearchBudgetExhausted,
             Self::NonFiniteInitialState
             | Self::NonFiniteState
             | Self::NonFiniteAfterImpact { .. }

@@ -35,6 +35,7 @@
 //! [`Walker::stride`]: crate::engine::walker::Walker::stride
 //! [`Walker::heel_strike_impact`]: crate::engine::walker::Walker::heel_strike_impact
 
+mod budget;
 mod contact_figures;
 mod energy;
 mod engine;
@@ -53,6 +54,7 @@ mod witnesses;
 mod workspace;
 
 pub use crate::engine::EvaluationPath;
+pub use budget::{SearchBudget, SharedBudget};
 pub use contact_figures::ContactSummary;
 pub use failure::{FailureCause, FailureKind, StrideFailure};
 pub use impacts::HeelStrikeImpact;

@@ -36,6 +36,11 @@ pub struct StrideSettings {
     /// How a controlled stride's steps meet the control ticks. Default:
     /// [`TickStepping::HeldAcrossTicks`]; `EndAtEveryTick` is the reference.
     pub tick_stepping: TickStepping,
+    /// A budget of strides shared with the other strides of a search (see
+    /// [`super::SearchBudget`]); each stride takes one. Default: none. Not serialised, not
+    /// compared.
+    #[serde(skip)]
+    pub search_budget: super::SharedBudget,
 }
 
 impl Default for StrideSettings {
@@ -52,6 +57,7 @@ impl Default for StrideSettings {
             max_evaluations: Self::DEFAULT_MAX_EVALUATIONS,
             evaluation: EvaluationPath::Auto,
             tick_stepping: TickStepping::default(),
+            search_budget: super::SharedBudget::default(),
         }
     }
 }

@@ -120,6 +120,9 @@ impl StrideWorkspace<'_> {
         if control.is_some() && walker.ankle().is_none() {
             return Err(StrideFailure::new(0.0, FailureCause::NoAnkleReflex));
         }
+        settings.search_budget.take().map_err(|limit_strides| {
+            StrideFailure::new(0.0, FailureCause::SearchBudget { limit_strides })
+        })?;
         let mut own = Vec::new();
         let keep_in_result = sink.is_none();
         let trajectory = match sink {

@@ -12,7 +12,6 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::homotopy::HomotopySettings;
 use sim::analysis::orbit_diagram::linspace;
 use sim::analysis::stability_map::{stability_map, Axis};
 use sim::report::StabilityMapReport;
@@ -88,7 +87,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
         output::create_dir("--plot", dir)?;
     }
     let progress = Progress::new(cells, "stability map", !common.json);
-    let homotopy = HomotopySettings::default();
+    let homotopy = common.homotopy();
     let map = stability_map(
         &scene,
         &common.setup_for(),

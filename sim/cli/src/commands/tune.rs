@@ -8,7 +8,6 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::homotopy::HomotopySettings;
 use sim::analysis::tune::{tune_with_progress, TuneResult, TuneSettings, TunedParameter};
 use std::io::Write;
 use std::process::ExitCode;
@@ -75,7 +74,7 @@ pub fn run(args: TuneArgs) -> Result<ExitCode> {
         evaluations,
         setup_for: &setup_for,
         newton: &newton,
-        homotopy: &HomotopySettings::default(),
+        homotopy: &common.homotopy(),
     };
     let result = tune_with_progress(&scene, &settings, &|| progress.tick())?;
     progress.finish();

@@ -14,14 +14,17 @@ use crate::options::Common;
 use crate::output::{self, PathError};
 use crate::path_csv::PathCsv;
 use crate::progress::Progress;
+use crate::search_progress::SearchProgress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::homotopy::{GaitRule, HomotopySettings};
+use sim::analysis::homotopy::GaitRule;
 use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::stride::walk::WalkRequest;
+use sim::stride::SearchBudget;
 use std::io::Write;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 /// Options of `walker walk`.
 #[derive(Args)]
@@ -111,8 +114,10 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     };
     let v0 = walker.pack(&setup.guess.q, &setup.guess.qd);
     let (newton, setup_for) = (common.newton(), common.setup_for());
-    let homotopy = HomotopySettings::default();
-    let rule = GaitRule::new(&setup_for, &newton, &homotopy);
+    let homotopy = common.homotopy();
+    let budget = Arc::new(SearchBudget::new(common.max_strides));
+    let rule = GaitRule::new(&setup_for, &newton, &homotopy).with_budget(Arc::clone(&budget));
+    let search_progress = SearchProgress::watch(&budget, "gait search", !common.json);
     let from_other = |other: &str| start::from_other_scene(other, &scene, walker, &rule);
     let started = match (start_from_scene, start.as_str()) {
         (Some(other), _) => from_other(&other)?,
@@ -144,6 +149,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
             )
         }
     };
+    drop(search_progress);
     let Some((mut v, start_record)) = started else {
         return Ok(ExitCode::from(1));
     };
