@@ -1,6 +1,7 @@
 //! `canbus-demo` on bad input (exit code 2, a message naming the option, never a panic), on
 //! a far timestamp origin (no wrapped timestamps), and with a socketcand client that never
-//! reads (the process still exits promptly at the end of the run).
+//! reads (the process still exits at the end of the run instead of hanging; every wait is a
+//! deadline that only turns a hang into a failure, never a timing assertion).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
 use std::io::{BufReader, Read, Write};
@@ -183,8 +184,11 @@ fn a_client_that_never_reads_does_not_keep_the_demo_alive() {
     let mut client = TcpStream::connect(addr).unwrap();
     client.write_all(b"< open vcan0 >< rawmode >").unwrap();
     let t0 = Instant::now();
-    // the demo runs 3000 simulated seconds as fast as it can (measured: about 2 s), far more
-    // than the socket buffers hold
+    // The demo runs 3000 simulated seconds as fast as it can (measured: about 2 s), far more
+    // than the socket buffers hold. The deadline only turns a hang (the bug: for ever) into a
+    // failure; how long the exit takes is printed, not asserted (a loaded machine may take
+    // seconds). That shutdown does not wait on the stalled client's write timeout is
+    // `socketcand_stress.rs`'s `a_client_that_never_reads_loses_frames_and_does_not_hold_shutdown`.
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
             break s;
@@ -209,13 +213,8 @@ fn a_client_that_never_reads_does_not_keep_the_demo_alive() {
     assert!(sc["frames_dropped"].as_u64().unwrap() > 0, "{sc}");
     assert_eq!(sc["flushed"], false, "{sc}");
     let wall_s = j["wall_s"].as_f64().unwrap();
+    // After the run: the rawmode grace (0.2 s) before it, the flush and the shutdown after
+    // it; measured: about 0.35 s.
     eprintln!("exited {elapsed_s:.3} s after the client connected, the run took {wall_s:.3} s");
-    // after the run: the rawmode grace (0.2 s) before it, the flush and the shutdown after
-    // it; measured: about 0.35 s
-    assert!(
-        elapsed_s - wall_s < 1.2,
-        "exited {:.3} s after a run of {wall_s:.3} s",
-        elapsed_s
-    );
     drop(client);
 }

@@ -1,12 +1,15 @@
 //! The socketcand server under abuse, over real TCP on 127.0.0.1: hundreds of connections,
 //! garbage input, more clients than allowed, a client that never reads. Memory (VmRSS of this
-//! process) and shutdown time are bounded generously; the measured values are in comments.
+//! process) is bounded generously; the measured values are in comments.
 //!
-//! The tests take a lock so that they run one at a time: each measures the process's memory.
+//! Every wait is a deadline ([`DEADLINE`]) that only turns a hang into a failure; what is
+//! asserted is what the server did (counters, answers, a closed connection or listener), never
+//! how long it took, so a loaded machine cannot fail them. The tests take a lock so that they
+//! run one at a time: each measures the process's memory.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
 use std::io::{ErrorKind, Read, Write};
-use std::net::TcpStream;
+use std::net::{SocketAddr, TcpStream};
 use std::sync::{mpsc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -36,6 +39,11 @@ fn vm_rss_bytes() -> u64 {
 
 const MIB: u64 = 1024 * 1024;
 
+/// How long any wait may take before the test fails instead of hanging: far beyond what any
+/// of them takes (milliseconds), far below the 600 s write timeout a shutdown that waited on a
+/// stalled client would take.
+const DEADLINE: Duration = Duration::from_secs(60);
+
 fn config() -> ServerConfig {
     ServerConfig {
         rawmode_grace: Duration::from_millis(1),
@@ -45,12 +53,12 @@ fn config() -> ServerConfig {
     }
 }
 
-/// Read until `want` is in the text or `budget` passes.
-fn read_until(s: &mut TcpStream, want: &str, budget: Duration) -> String {
+/// Read until `want` is in the text, the connection closes or [`DEADLINE`] passes.
+fn read_until(s: &mut TcpStream, want: &str) -> String {
     s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
     let mut got = String::new();
     let mut b = [0u8; 4096];
-    let end = Instant::now() + budget;
+    let end = Instant::now() + DEADLINE;
     while !got.contains(want) && Instant::now() < end {
         match s.read(&mut b) {
             Ok(0) => break,
@@ -62,8 +70,9 @@ fn read_until(s: &mut TcpStream, want: &str, budget: Duration) -> String {
     got
 }
 
-fn wait_until(budget: Duration, mut done: impl FnMut() -> bool) -> bool {
-    let end = Instant::now() + budget;
+/// Whether `done` comes true before [`DEADLINE`].
+fn wait_until(mut done: impl FnMut() -> bool) -> bool {
+    let end = Instant::now() + DEADLINE;
     while Instant::now() < end {
         if done() {
             return true;
@@ -73,15 +82,50 @@ fn wait_until(budget: Duration, mut done: impl FnMut() -> bool) -> bool {
     done()
 }
 
-/// Shut the server down on another thread; how long it took, or `None` if not within 10 s.
-fn timed_shutdown(mut server: SocketcandServer) -> Option<Duration> {
+/// Shut the server down on another thread; panics if it has not returned by [`DEADLINE`].
+/// Prints how long it took (a measurement, not asserted).
+fn shut_down(mut server: SocketcandServer) {
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         let t = Instant::now();
         server.shutdown();
         let _ = tx.send(t.elapsed());
     });
-    rx.recv_timeout(Duration::from_secs(10)).ok()
+    let took = rx
+        .recv_timeout(DEADLINE)
+        .unwrap_or_else(|_| panic!("shutdown has not returned after {DEADLINE:?}"));
+    eprintln!("shutdown took {took:?}");
+}
+
+/// A client in rawmode whose receive buffer is fixed at 64 KiB (the kernel doubles it; a set
+/// size is not autotuned): with the server's bounded send buffer and its 64 KiB of pending
+/// output the connection holds a few hundred KiB, about 7,000 frames, far fewer than a
+/// client's queue (65,536), so once frames are dropped its output has stalled for good.
+fn client_that_never_reads(addr: SocketAddr) -> TcpStream {
+    let s = socket2::Socket::new(socket2::Domain::IPV4, socket2::Type::STREAM, None).unwrap();
+    s.set_recv_buffer_size(64 * 1024).unwrap();
+    s.connect(&addr.into()).unwrap();
+    let mut c: TcpStream = s.into();
+    c.write_all(b"< open vcan0 >< rawmode >").unwrap();
+    c
+}
+
+/// Reads what the server sent until it closes the connection; whether it did by
+/// [`DEADLINE`], and how many bytes came.
+fn read_to_close(c: &mut TcpStream) -> (bool, usize) {
+    c.set_read_timeout(Some(Duration::from_millis(50))).unwrap();
+    let mut b = [0u8; 65536];
+    let mut total = 0;
+    let end = Instant::now() + DEADLINE;
+    while Instant::now() < end {
+        match c.read(&mut b) {
+            Ok(0) => return (true, total),
+            Ok(n) => total += n,
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(_) => return (true, total),
+        }
+    }
+    (false, total)
 }
 
 fn frame(i: u32) -> Frame {
@@ -98,12 +142,12 @@ fn hundreds_of_connections_leave_no_memory_behind() {
     let cycle = |i: u32| {
         // The clients before have closed, but the server notices within its poll: wait for a
         // free slot, so that no connection is refused on a slow machine.
-        assert!(wait_until(Duration::from_secs(5), || server
-            .connected_clients()
-            < ServerConfig::default().max_clients));
+        assert!(wait_until(
+            || server.connected_clients() < ServerConfig::default().max_clients
+        ));
         let mut c = TcpStream::connect(addr).unwrap();
         c.set_write_timeout(Some(Duration::from_secs(10))).unwrap();
-        assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+        assert!(read_until(&mut c, "< hi >").contains("< hi >"));
         if i.is_multiple_of(3) {
             // garbage, then gone
             c.write_all(b"<<< \xff\xfe nonsense >>> < send zz >")
@@ -111,31 +155,27 @@ fn hundreds_of_connections_leave_no_memory_behind() {
             return;
         }
         c.write_all(b"< open vcan0 >< rawmode >").unwrap();
-        let got = read_until(&mut c, "< ok >< ok >", Duration::from_secs(5));
+        let got = read_until(&mut c, "< ok >< ok >");
         assert!(got.contains("< ok >< ok >"), "{got}");
-        assert!(wait_until(Duration::from_secs(5), || server
-            .rawmode_clients()
-            > 0));
+        assert!(wait_until(|| server.rawmode_clients() > 0));
         for k in 0..50 {
             server.publish(&frame(k), u64::from(i) * 1_000_000).unwrap();
         }
         if i.is_multiple_of(2) {
-            let got = read_until(&mut c, "< frame", Duration::from_secs(5));
+            let got = read_until(&mut c, "< frame");
             assert!(got.contains("< frame 072"), "{got}");
         }
     };
     for i in 0..20 {
         cycle(i);
     }
-    assert!(wait_until(Duration::from_secs(5), || server
-        .connected_clients()
-        == 0));
+    assert!(wait_until(|| server.connected_clients() == 0));
     let rss0 = vm_rss_bytes();
     for i in 0..300 {
         cycle(i);
     }
     assert!(
-        wait_until(Duration::from_secs(5), || server.connected_clients() == 0),
+        wait_until(|| server.connected_clients() == 0),
         "{} clients still held",
         server.connected_clients()
     );
@@ -146,10 +186,12 @@ fn hundreds_of_connections_leave_no_memory_behind() {
     let st = server.stats();
     assert_eq!(st.clients_accepted, 320);
     assert!(st.bad_commands >= 100, "{st:?}");
-    // measured: about 2 ms
-    let took = timed_shutdown(server).expect("shutdown returns");
-    eprintln!("shutdown took {took:?}");
-    assert!(took < Duration::from_secs(1), "{took:?}");
+    // Shutdown returns (measured: about 2 ms) and closes the listener.
+    shut_down(server);
+    assert!(
+        TcpStream::connect(addr).is_err(),
+        "still listening on {addr}"
+    );
 }
 
 /// Garbage of every kind is answered or discarded within bounds, and a well-behaved client is
@@ -194,9 +236,7 @@ fn garbage_input_is_bounded_and_the_server_keeps_serving() {
         let answered = reader.join().unwrap();
         assert!(answered >= "< hi >".len());
     }
-    assert!(wait_until(Duration::from_secs(5), || server
-        .connected_clients()
-        == 0));
+    assert!(wait_until(|| server.connected_clients() == 0));
     let st = server.stats();
     assert!(st.bad_commands > 1000, "{st:?}");
     assert_eq!(st.frames_received, 0);
@@ -208,12 +248,10 @@ fn garbage_input_is_bounded_and_the_server_keeps_serving() {
     let mut c = TcpStream::connect(addr).unwrap();
     c.write_all(b"< open vcan0 >< rawmode >< send 123 2 AB CD >")
         .unwrap();
-    assert!(read_until(&mut c, "< ok >< ok >", Duration::from_secs(5)).contains("< ok >< ok >"));
-    assert!(wait_until(Duration::from_secs(5), || !server
-        .take_inbound()
-        .is_empty()));
+    assert!(read_until(&mut c, "< ok >< ok >").contains("< ok >< ok >"));
+    assert!(wait_until(|| !server.take_inbound().is_empty()));
     server.publish(&frame(7), 1_000).unwrap();
-    let got = read_until(&mut c, "< frame", Duration::from_secs(5));
+    let got = read_until(&mut c, "< frame");
     assert!(got.contains("< frame 072 0.000001 07000000 >"), "{got}");
 }
 
@@ -235,15 +273,12 @@ fn clients_beyond_the_cap_are_refused_clearly() {
     for _ in 0..4 {
         let mut c = TcpStream::connect(addr).unwrap();
         c.write_all(b"< open vcan0 >< rawmode >").unwrap();
-        assert!(
-            read_until(&mut c, "< hi >< ok >< ok >", Duration::from_secs(5))
-                .contains("< hi >< ok >< ok >")
-        );
+        assert!(read_until(&mut c, "< hi >< ok >< ok >").contains("< hi >< ok >< ok >"));
         kept.push(c);
     }
     for _ in 0..200 {
         let mut c = TcpStream::connect(addr).unwrap();
-        let got = read_until(&mut c, ">", Duration::from_secs(5));
+        let got = read_until(&mut c, ">");
         assert!(
             got.contains("< error too many clients (4 connected, the limit) >"),
             "{got}"
@@ -252,32 +287,29 @@ fn clients_beyond_the_cap_are_refused_clearly() {
     assert_eq!(server.stats().clients_refused, 200);
     assert_eq!(server.connected_clients(), 4);
     drop(kept.pop());
-    assert!(wait_until(Duration::from_secs(5), || server
-        .connected_clients()
-        == 3));
+    assert!(wait_until(|| server.connected_clients() == 3));
     let mut c = TcpStream::connect(addr).unwrap();
-    assert!(read_until(&mut c, "< hi >", Duration::from_secs(5)).contains("< hi >"));
+    assert!(read_until(&mut c, "< hi >").contains("< hi >"));
 }
 
-/// Publish frames until the client's socket buffers are full (nothing written for 300 ms).
-fn publish_until_stalled(server: &SocketcandServer) {
-    let end = Instant::now() + Duration::from_secs(30);
-    let mut last = (server.stats().frames_sent, Instant::now());
+/// Publish frames until the server drops some (a client's queue is full) and has sent some.
+/// With [`client_that_never_reads`] the queue then holds far more than the connection can ever
+/// take: its output has stalled for good, whatever the machine's load.
+fn publish_until_dropping(server: &SocketcandServer) {
+    let end = Instant::now() + DEADLINE;
     let mut i = 0u32;
     while Instant::now() < end {
         for _ in 0..2000 {
             server.publish(&frame(i), u64::from(i) * 1000).unwrap();
             i = i.wrapping_add(1);
         }
-        std::thread::sleep(Duration::from_millis(2));
-        let sent = server.stats().frames_sent;
-        if sent != last.0 {
-            last = (sent, Instant::now());
-        } else if last.1.elapsed() > Duration::from_millis(300) {
+        let st = server.stats();
+        if st.frames_dropped > 0 && st.frames_sent > 0 {
             return;
         }
+        std::thread::sleep(Duration::from_millis(2));
     }
-    panic!("the client's output never stalled: {:?}", server.stats());
+    panic!("no frame dropped: {:?}", server.stats());
 }
 
 /// A client in rawmode that never reads used to block its thread in `write_all` for ever, and
@@ -294,29 +326,27 @@ fn a_client_that_never_reads_loses_frames_and_does_not_hold_shutdown() {
     let bound = cfg.memory_bound_bytes() as u64;
     let server = SocketcandServer::bind("127.0.0.1:0", cfg).unwrap();
     let rss0 = vm_rss_bytes();
-    let c = {
-        let mut c = TcpStream::connect(server.local_addr()).unwrap();
-        c.write_all(b"< open vcan0 >< rawmode >").unwrap();
-        c
-    };
-    assert!(wait_until(Duration::from_secs(5), || server
-        .rawmode_clients()
-        == 1));
-    publish_until_stalled(&server);
+    let mut c = client_that_never_reads(server.local_addr());
+    assert!(wait_until(|| server.rawmode_clients() == 1));
+    publish_until_dropping(&server);
     let st = server.stats();
     assert!(st.frames_dropped > 0, "{st:?}");
     assert!(st.frames_sent > 0, "{st:?}");
     assert_eq!(server.connected_clients(), 1);
+    // The queue holds far more than the connection can take: a flush cannot complete.
     assert!(!server.flush(Duration::from_secs(5)));
     // measured: about 2 MiB (mostly the full 65,536-frame queue); the documented bound, 30 MiB
     let grown = vm_rss_bytes().saturating_sub(rss0);
     eprintln!("VmRSS grew by {} KiB", grown / 1024);
     assert!(grown < bound, "VmRSS grew by {grown} B, bound {bound} B");
-    // measured: about 10 ms
-    let took = timed_shutdown(server).expect("shutdown returns within 10 s");
-    eprintln!("shutdown took {took:?}");
-    assert!(took < Duration::from_secs(1), "{took:?}");
-    drop(c);
+    // Shutdown returns (measured: about 10 ms; waiting on the client would take its 600 s
+    // write timeout, ten times the deadline) and closes the client's connection: the client
+    // reads what was sent, then the end.
+    shut_down(server);
+    let (closed, bytes) = read_to_close(&mut c);
+    eprintln!("the client read {bytes} bytes, then the connection closed: {closed}");
+    assert!(closed, "the connection is still open after {bytes} bytes");
+    assert!(bytes > 0);
 }
 
 /// A client whose output makes no progress for `write_timeout` is disconnected and counted.
@@ -331,14 +361,9 @@ fn a_stalled_client_is_disconnected_after_the_write_timeout() {
         },
     )
     .unwrap();
-    let mut c = TcpStream::connect(server.local_addr()).unwrap();
-    c.write_all(b"< open vcan0 >< rawmode >").unwrap();
-    assert!(wait_until(Duration::from_secs(5), || server
-        .rawmode_clients()
-        == 1));
-    publish_until_stalled(&server);
-    assert!(wait_until(Duration::from_secs(5), || server
-        .connected_clients()
-        == 0));
+    let _c = client_that_never_reads(server.local_addr());
+    assert!(wait_until(|| server.rawmode_clients() == 1));
+    publish_until_dropping(&server);
+    assert!(wait_until(|| server.connected_clients() == 0));
     assert_eq!(server.stats().clients_stalled, 1);
 }

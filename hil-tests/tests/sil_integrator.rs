@@ -2,9 +2,12 @@
 //! output holds: the default `TickStepping::HeldAcrossTicks`) against DOPRI5 at 1e-12 with
 //! every step ending at a tick (`TickStepping::EndAtEveryTick`, the reference) on the same
 //! firmware-in-the-loop walk: the first step of `wisse3d` from its limit cycle with both ankle
-//! nodes' firmware. The bounds are those `SIL_INTEGRATOR`'s documentation claims, so they can
-//! fail. The same integrator with every step ending at a tick (the scheme before
-//! `HeldAcrossTicks`) meets the same bounds, and the two schemes agree with each other.
+//! nodes' firmware. The bounds ([`AGAINST_REFERENCE`]) are about ten times the differences
+//! measured (docs/sil.md), tighter than the ones `SIL_INTEGRATOR`'s documentation claims
+//! (1.5e-7 kinematic, 5e-7 impact loss, 2.7e-5 work and cost of transport), so those hold
+//! too. The same integrator with every step ending at a tick (the scheme before
+//! `HeldAcrossTicks`) meets the same bounds, and the two schemes agree with each other within
+//! [`HELD_AGAINST_EVERY_TICK`], again about ten times what they differ by.
 //!
 //! One step, not more: the firmware senses through a quantised encoder (0.38 mrad) at 1 ms
 //! ticks, so the closed loop amplifies any difference between two walks (a reading one count
@@ -26,6 +29,16 @@ use sim::stride::walk::Walk;
 
 const STEPS: usize = 1;
 
+/// Relative bounds against DOPRI5 at 1e-12, in the order of [`Figures::named`]: step period
+/// (measured 5.7e-10 stepping across held ticks, 6.0e-10 ending every step at a tick), speed
+/// (1.4e-8), step length (1.5e-8), cost of transport (2.4e-7), actuator work (2.2e-7), impact
+/// loss (3.3e-9 and 6.7e-9).
+const AGAINST_REFERENCE: [f64; 6] = [5e-9, 1.5e-7, 1.5e-7, 2.5e-6, 2.5e-6, 5e-8];
+
+/// Relative bounds between the two tick-stepping schemes, same order: measured 2.4e-11,
+/// 8.7e-11, 1.1e-10, 2.5e-10, 3.6e-10, 3.4e-9.
+const HELD_AGAINST_EVERY_TICK: [f64; 6] = [3e-10, 1e-9, 1e-9, 3e-9, 4e-9, 3e-8];
+
 struct Figures {
     period_s: f64,
     speed_m_s: f64,
@@ -34,6 +47,20 @@ struct Figures {
     work_j: f64,
     impact_loss_j: f64,
     evaluations: usize,
+}
+
+impl Figures {
+    /// The compared figures, named, in the order of the bounds.
+    fn named(&self) -> [(&'static str, f64); 6] {
+        [
+            ("step period", self.period_s),
+            ("speed", self.speed_m_s),
+            ("step length", self.step_length_m),
+            ("cost of transport", self.cost_of_transport),
+            ("actuator work per step", self.work_j),
+            ("impact loss per step", self.impact_loss_j),
+        ]
+    }
 }
 
 /// DOPRI5 at 1e-12, every step ending at a tick.
@@ -82,7 +109,7 @@ fn walk_with(integrator: IntegratorChoice, stepping: TickStepping) -> (Walk, Fig
 fn the_sil_integrator_gives_the_first_step_of_dopri5_at_1e_12() {
     let (_, sil) = walk_with(SIL_INTEGRATOR, TickStepping::default());
     assert_eq!(TickStepping::default(), TickStepping::HeldAcrossTicks);
-    assert_within_bounds("SIL", &sil, &reference());
+    assert_within_bounds("SIL", &sil, &reference(), &AGAINST_REFERENCE);
 }
 
 #[test]
@@ -94,7 +121,7 @@ fn stepping_across_held_ticks_agrees_with_ending_every_step_at_a_tick() {
     let (held_walk, held) = walk_with(SIL_INTEGRATOR, TickStepping::HeldAcrossTicks);
     let (tick_walk, every_tick) = walk_with(SIL_INTEGRATOR, TickStepping::EndAtEveryTick);
     // The scheme before: within the same bounds of the reference.
-    assert_within_bounds("every tick", &every_tick, &reference());
+    assert_within_bounds("every tick", &every_tick, &reference(), &AGAINST_REFERENCE);
     // The same events, in the same order, at times that agree to the integration error.
     let events = |w: &Walk| -> Vec<(String, f64)> {
         w.steps
@@ -108,8 +135,13 @@ fn stepping_across_held_ticks_agrees_with_ending_every_step_at_a_tick() {
         assert_eq!(na, nb);
         assert!((ta - tb).abs() < 1e-6, "{na}: {ta} vs {tb}");
     }
-    // The two schemes agree with each other as each does with the reference.
-    assert_within_bounds("held against every tick", &held, &every_tick);
+    // The two schemes agree with each other far better than each does with the reference.
+    assert_within_bounds(
+        "held against every tick",
+        &held,
+        &every_tick,
+        &HELD_AGAINST_EVERY_TICK,
+    );
     // Fewer than half the evaluations (counted, not timed): the firmware holds the string
     // slack over about three quarters of the stride.
     eprintln!(
@@ -124,42 +156,21 @@ fn stepping_across_held_ticks_agrees_with_ending_every_step_at_a_tick() {
     );
 }
 
-/// `sil` against `reference` within the bounds `SIL_INTEGRATOR`'s documentation states.
-fn assert_within_bounds(what: &str, sil: &Figures, reference: &Figures) {
+/// `sil` against `reference` within `bounds` (relative, in the order of [`Figures::named`]).
+fn assert_within_bounds(what: &str, sil: &Figures, reference: &Figures, bounds: &[f64; 6]) {
     let rel = |a: f64, b: f64| ((a - b) / b).abs();
-    let figures = [
-        ("step period", sil.period_s, reference.period_s, 1.5e-7),
-        ("speed", sil.speed_m_s, reference.speed_m_s, 1.5e-7),
-        (
-            "step length",
-            sil.step_length_m,
-            reference.step_length_m,
-            1.5e-7,
-        ),
-        (
-            "cost of transport",
-            sil.cost_of_transport,
-            reference.cost_of_transport,
-            2.7e-5,
-        ),
-        (
-            "actuator work per step",
-            sil.work_j,
-            reference.work_j,
-            2.8e-5,
-        ),
-        (
-            "impact loss per step",
-            sil.impact_loss_j,
-            reference.impact_loss_j,
-            5e-7,
-        ),
-    ];
     eprintln!(
         "{what}: evaluations {} reference {}",
         sil.evaluations, reference.evaluations
     );
-    for (name, a, b, bound) in figures {
+    let figures: Vec<(&str, f64, f64, f64)> = sil
+        .named()
+        .iter()
+        .zip(reference.named())
+        .zip(bounds)
+        .map(|(((name, a), (_, b)), bound)| (*name, *a, b, *bound))
+        .collect();
+    for &(name, a, b, bound) in &figures {
         eprintln!(
             "{what}: {name}: {a:.12e} reference {b:.12e} relative {:.2e} (bound {bound:.1e})",
             rel(a, b)

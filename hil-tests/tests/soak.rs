@@ -1,21 +1,28 @@
-//! Soak: 10,000 steps of the `wisse3d` walker with both ankle nodes' firmware in the loop, in
-//! bounded memory and without drift of the bus statistics.
+//! Soak: the `wisse3d` walker with both ankle nodes' firmware in the loop, in bounded memory
+//! and without drift of the bus statistics. Two runs of the same checks ([`Soak`]):
 //!
-//! Minutes even in a release build, so ignored; run it with
-//! `cargo test --release -p hil-tests --test soak -- --ignored --nocapture`.
-//! Every 1,000 steps it samples the process's resident memory (VmRSS, VmHWM from
+//! * [`SHORT`], 1,000 steps in windows of 100, histories of 50 entries: seconds in a release
+//!   build, so it runs with every `cargo test --release` (and `scripts/test-all`);
+//! * [`LONG`], 10,000 steps in windows of 1,000, histories of 1,000 entries: minutes even in a
+//!   release build, so ignored; run it on its own with
+//!   `cargo test --release -p hil-tests --test soak -- --ignored --nocapture` (not with
+//!   `--include-ignored`: the two would share the process whose memory each measures).
+//!
+//! Every window it samples the process's resident memory (VmRSS, VmHWM from
 //! `/proc/self/status`; the test fails when that file cannot be read, so that the memory check
 //! cannot pass vacuously) and the bus statistics, prints a table, and checks:
 //!
 //! * the walk completes with no node fault and no bus error;
-//! * the controller's histories are bounded at [`HISTORY_CAPACITY`] entries, so that every one
-//!   of them is full well before step 2,000 (the phase history at step 250, the landings at
-//!   step 1,000), and the resident memory grows by less than [`RSS_GROWTH_BOUND_KB`] from step
-//!   2,000 to 10,000 (the walk keeps only the last [`KEEP_STEPS`] step summaries): a leak of
-//!   32 bytes per step would exceed it;
-//! * the bus load of every 1,000-step window is within [`LOAD_TOLERANCE`] (relative) of the
-//!   first window's, its frame rate within [`FRAME_RATE_TOLERANCE`] and its mean step period
-//!   within [`PERIOD_TOLERANCE`]: each about four times the spread measured (docs/sil.md).
+//! * the controller's histories are bounded at [`Soak::history_capacity`] entries, so that every
+//!   one of them is full well before [`Soak::rss_from`] (the phase history, three entries a
+//!   step, after a third of the capacity in steps, the landings after the capacity), and the
+//!   resident memory grows by less than [`Soak::rss_growth_bound_kb`] from there to the end
+//!   (the walk keeps only the last [`KEEP_STEPS`] step summaries): a leak of 32 bytes per step
+//!   would exceed the long run's bound, of 80 bytes per step the short run's;
+//! * the bus load of every window is within [`Soak::load_tolerance`] (relative) of the first
+//!   window's, its frame rate within [`Soak::frame_rate_tolerance`] and its mean step period
+//!   within [`Soak::period_tolerance`]: each about four times the spread measured
+//!   (docs/sil.md).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
@@ -25,24 +32,59 @@ use sil::FirmwareInTheLoop;
 use sim::engine::control::{ActuatorSegment, AnkleController, AnkleSensing, ControlError};
 use sim::stride::walk::{WalkOptions, WalkRequest};
 
-const STEPS: usize = 10_000;
-const EVERY: usize = 1_000;
 /// Step summaries the walk keeps (the rest are streamed to the callback).
 const KEEP_STEPS: usize = 10;
-/// Entries each history of the controller keeps (`SilConfig::history_capacity`).
-const HISTORY_CAPACITY: usize = 1_000;
-/// Largest growth of VmRSS from step 2,000 to step 10,000 [kB] (measured: 8 kB; 256 kB over
-/// 8,000 steps is 32 bytes per step).
-const RSS_GROWTH_BOUND_KB: u64 = 256;
-/// Largest relative difference of a window's bus load from the first window's (measured:
-/// 7.6e-4).
-const LOAD_TOLERANCE: f64 = 3e-3;
-/// Largest relative difference of a window's frame rate from the first window's (measured:
-/// 3.3e-5).
-const FRAME_RATE_TOLERANCE: f64 = 1.3e-4;
-/// Largest relative difference of a window's mean step period from the first window's
-/// (measured: 1.07e-5).
-const PERIOD_TOLERANCE: f64 = 4e-5;
+
+/// One soak: its length, its windows and its bounds.
+#[derive(Clone, Copy, Debug)]
+struct Soak {
+    /// Steps walked.
+    steps: usize,
+    /// Steps per window (memory and bus sampled at each window's end).
+    every: usize,
+    /// Entries each history of the controller keeps (`SilConfig::history_capacity`).
+    history_capacity: usize,
+    /// The step from which nothing may grow (every history full well before it).
+    rss_from: usize,
+    /// Largest growth of VmRSS from step `rss_from` to the end [kB].
+    rss_growth_bound_kb: u64,
+    /// Largest relative difference of a window's bus load from the first window's.
+    load_tolerance: f64,
+    /// Largest relative difference of a window's frame rate from the first window's.
+    frame_rate_tolerance: f64,
+    /// Largest relative difference of a window's mean step period from the first window's.
+    period_tolerance: f64,
+}
+
+/// 10,000 steps (measured: VmRSS growth 8 kB from step 2,000 on, against 256 kB, 32 bytes per
+/// step over 8,000 steps; window spreads 7.6e-4 load, 3.3e-5 frame rate, 1.07e-5 mean step
+/// period; re-run on today's gait: 12 kB, 7.5e-4, 5.2e-5, 1.34e-5).
+const LONG: Soak = Soak {
+    steps: 10_000,
+    every: 1_000,
+    history_capacity: 1_000,
+    rss_from: 2_000,
+    rss_growth_bound_kb: 256,
+    load_tolerance: 3e-3,
+    frame_rate_tolerance: 1.3e-4,
+    period_tolerance: 4e-5,
+};
+
+/// 1,000 steps (about 4 s in release), the same checks at a tenth of the length: histories of
+/// 50 entries (full at steps 17 and 50), memory from step 200 on (measured: no growth, in
+/// 4 kB pages; 64 kB over 800 steps is 80 bytes per step), windows of 100 steps (measured
+/// spreads 1.43e-3 load, 5.1e-4 frame rate, 4.7e-5 mean step period: a window of 100 steps
+/// scatters more than one of 1,000).
+const SHORT: Soak = Soak {
+    steps: 1_000,
+    every: 100,
+    history_capacity: 50,
+    rss_from: 200,
+    rss_growth_bound_kb: 64,
+    load_tolerance: 6e-3,
+    frame_rate_tolerance: 2e-3,
+    period_tolerance: 2e-4,
+};
 
 /// `VmRSS` and `VmHWM` of this process [kB]. Panics when `/proc/self/status` cannot be read or
 /// lacks them: without them the memory bound cannot be checked.
@@ -74,10 +116,11 @@ struct Sample {
     queue_overflows: u64,
 }
 
-/// Forwards to the firmware in the loop and samples memory and the bus every [`EVERY`] heel
+/// Forwards to the firmware in the loop and samples memory and the bus every `every` heel
 /// strikes (one per step).
 struct Sampler<'a> {
     inner: &'a mut FirmwareInTheLoop,
+    every: usize,
     strikes: usize,
     start: std::time::Instant,
     samples: Vec<Sample>,
@@ -114,7 +157,7 @@ impl AnkleController for Sampler<'_> {
     fn heel_strike(&mut self, t_s: f64) {
         self.inner.heel_strike(t_s);
         self.strikes += 1;
-        if self.strikes == self.samples.len() * EVERY {
+        if self.strikes == self.samples.len() * self.every {
             self.sample(t_s);
         }
     }
@@ -123,13 +166,28 @@ impl AnkleController for Sampler<'_> {
 #[test]
 #[ignore = "minutes in release: cargo test --release -p hil-tests --test soak -- --ignored --nocapture"]
 fn ten_thousand_steps_in_bounded_memory_without_drift() {
+    soak(LONG);
+}
+
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
+fn a_thousand_steps_in_bounded_memory_without_drift() {
+    soak(SHORT);
+}
+
+fn soak(plan: Soak) {
+    let Soak { steps, every, .. } = plan;
     let s = setup();
     let mut config = matched();
-    config.history_capacity = HISTORY_CAPACITY;
+    config.history_capacity = plan.history_capacity;
     let cap = config.history_capacity;
     let mut ctl = FirmwareInTheLoop::new(config).unwrap();
     let mut sampler = Sampler {
         inner: &mut ctl,
+        every,
         strikes: 0,
         start: std::time::Instant::now(),
         samples: Vec::new(),
@@ -138,7 +196,7 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     // Per window: sum, min and max of the step durations.
     let mut windows: Vec<(f64, f64, f64)> = Vec::new();
     let mut on_step = |step: &sim::stride::walk::StepSummary| {
-        let w = step.step / EVERY;
+        let w = step.step / every;
         if windows.len() <= w {
             windows.push((0.0, f64::INFINITY, 0.0));
         }
@@ -148,10 +206,11 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
             x.2 = x.2.max(step.duration_s);
         }
     };
-    let request = WalkRequest::new(&s.settings, STEPS)
+    let request = WalkRequest::new(&s.settings, steps)
         .options(WalkOptions {
             record: false,
             keep_steps: Some(KEEP_STEPS),
+            path_interval_s: None,
         })
         .controlled(&mut sampler)
         .on_step(&mut on_step);
@@ -172,7 +231,7 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
         let fps = (b.frames - a.frames) as f64 / (dt_ns * 1e-9);
         let (sum, min, max) =
             windows
-                .get(b.step / EVERY - 1)
+                .get(b.step / every - 1)
                 .copied()
                 .unwrap_or((f64::NAN, f64::NAN, f64::NAN));
         println!(
@@ -185,11 +244,11 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
             b.hwm_kb,
             100.0 * load,
             fps,
-            sum / EVERY as f64,
+            sum / every as f64,
             min,
             max
         );
-        loads.push((load, fps, sum / EVERY as f64));
+        loads.push((load, fps, sum / every as f64));
     }
     println!(
         "end: {} steps, failure {:?}; {} ticks, {} frames delivered, bus load {:.3} % over the run, {} error frames; histories: phase {} kept / {} elided, landings {} / {}, state {}, faults {}",
@@ -208,11 +267,11 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     );
 
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
-    assert_eq!(walk.steps_completed, STEPS);
+    assert_eq!(walk.steps_completed, steps);
     assert_eq!(walk.steps.len(), KEEP_STEPS);
     assert!(r.faults.is_empty(), "{:?}", r.faults);
     assert_eq!(r.bus.error_frames, 0);
-    assert_eq!(samples.len(), STEPS / EVERY + 1);
+    assert_eq!(samples.len(), steps / every + 1);
     assert!(samples
         .iter()
         .all(|s| s.error_frames == 0 && s.queue_overflows == 0));
@@ -225,23 +284,24 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     println!("history capacity {cap}");
     assert!(r.phase_history.len() == cap && r.history_elided.phase_history > 0);
     assert!(r.landings.len() == cap && r.history_elided.landings > 0);
-    // Memory: no growth after step 2,000 beyond the bound.
+    // Memory: no growth after `rss_from` beyond the bound.
     let at = |step: usize| samples.iter().find(|s| s.step == step).unwrap();
-    assert!(at(2_000).rss_kb > 0 && at(STEPS).rss_kb > 0);
-    let growth = at(STEPS).rss_kb.saturating_sub(at(2_000).rss_kb);
+    let from = plan.rss_from;
+    assert!(at(from).rss_kb > 0 && at(steps).rss_kb > 0);
+    let growth = at(steps).rss_kb.saturating_sub(at(from).rss_kb);
     let max_after = samples
         .iter()
-        .filter(|s| s.step >= 2_000)
+        .filter(|s| s.step >= from)
         .map(|s| s.rss_kb)
         .max()
         .unwrap();
     println!(
-        "VmRSS growth from step 2,000 to {STEPS}: {growth} kB (largest sample from 2,000 on: {max_after} kB, at 2,000: {} kB)",
-        at(2_000).rss_kb
+        "VmRSS growth from step {from} to {steps}: {growth} kB (largest sample from {from} on: {max_after} kB, at {from}: {} kB)",
+        at(from).rss_kb
     );
     assert!(
-        growth < RSS_GROWTH_BOUND_KB,
-        "VmRSS grew by {growth} kB from step 2,000 to {STEPS}"
+        growth < plan.rss_growth_bound_kb,
+        "VmRSS grew by {growth} kB from step {from} to {steps}"
     );
     // Bus statistics and gait: every window like the first.
     let (load0, fps0, period0) = loads[0];
@@ -259,15 +319,15 @@ fn ten_thousand_steps_in_bounded_memory_without_drift() {
     );
     for (k, (load, fps, period)) in loads.iter().enumerate() {
         assert!(
-            (load / load0 - 1.0).abs() < LOAD_TOLERANCE,
+            (load / load0 - 1.0).abs() < plan.load_tolerance,
             "window {k}: load {load} vs {load0}"
         );
         assert!(
-            (fps / fps0 - 1.0).abs() < FRAME_RATE_TOLERANCE,
+            (fps / fps0 - 1.0).abs() < plan.frame_rate_tolerance,
             "window {k}: {fps} frames/s vs {fps0}"
         );
         assert!(
-            (period / period0 - 1.0).abs() < PERIOD_TOLERANCE,
+            (period / period0 - 1.0).abs() < plan.period_tolerance,
             "window {k}: mean step period {period} s vs {period0} s"
         );
     }

@@ -474,7 +474,7 @@ fn report(c: &Continuation) -> serde_json::Value {
 }
 
 #[test]
-fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_reported() {
+fn period_doublings_without_a_doubled_branch_are_reported() {
     // A budget of one branch: the period doubling on branch 0 gets no period-2 branch, and
     // the report says so with the reason.
     let scene = Scene::load("simplest").unwrap();
@@ -484,7 +484,7 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
         .max_branches(1)
         .build()
         .unwrap();
-    let mut c = continuation(&scene, "slope", (0.009, 0.017, 5), &settings, &|_| {}).unwrap();
+    let c = continuation(&scene, "slope", (0.009, 0.017, 5), &settings, &|_| {}).unwrap();
     assert_eq!(c.branches.len(), 1);
     assert_eq!(c.switch_failures.len(), 1, "{:?}", c.switch_failures);
     let pd = &c.branches[0].bifurcations[0];
@@ -501,20 +501,74 @@ fn period_doublings_without_a_doubled_branch_and_unlocated_bifurcations_are_repo
     assert_eq!(v["unlocated"].as_array().unwrap().len(), 0);
     assert_eq!(v["param"], "slope");
     assert_eq!(v["param_canonical"], "slope_rad");
-    // A bifurcation detected but not located reaches the report with its bracket and why.
-    c.branches[0]
-        .unlocated
-        .push(sim::analysis::continuation::Unlocated {
-            kind: BifurcationKind::NeimarkSacker,
-            bracket: (0.011, 0.013),
-            reason: "the corrector failed".into(),
-        });
-    let v = report(&c);
-    let u = &v["unlocated"][0];
-    assert_eq!(u["kind"], "neimark_sacker");
-    assert_eq!(u["bracket"][0].as_f64(), Some(0.011));
-    assert_eq!(u["bracket"][1].as_f64(), Some(0.013));
-    assert_eq!(u["reason"], "the corrector failed");
+    // Detected but not located: `two_neimark_sacker_points_in_one_smallest_step_are_…`.
+}
+
+#[test]
+fn two_neimark_sacker_points_in_one_smallest_step_are_reported_unlocated() {
+    // The 3D walker's closed branch over the extension duration has two Neimark–Sacker points
+    // 1.1 ms apart (docs/bifurcations.md: the roll pair comes inside at 0.239952 s, the
+    // pelvis-yaw pair at 0.241056 s). With the default step control the step that takes both
+    // is halved until they come one per step, and both are located. With the smallest step
+    // equal to the first (`min_step_fraction` 0.5: no step can be halved) and a grid spacing
+    // wide enough, the first step takes both pairs through the circle at once: the product of
+    // the pairs' `|λ| − 1` keeps its sign, so neither can be located on its own, and the
+    // bifurcation is reported in `unlocated`, with its bracket and why, not as a point.
+    let scene = Scene::load("wisse3d").unwrap();
+    let range = (0.2395, 0.2455, 2);
+    let param = "ankle_extension_duration_s";
+    let settings = |min_step_fraction: Option<f64>| {
+        let b = ContinuationSettings::builder()
+            .newton(NewtonSettings::default())
+            .max_period(1);
+        match min_step_fraction {
+            Some(f) => b.min_step_fraction(f),
+            None => b,
+        }
+        .build()
+        .unwrap()
+    };
+    let halved = continuation(&scene, param, range, &settings(None), &|_| {}).unwrap();
+    let located: Vec<f64> = halved.branches[0]
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::NeimarkSacker)
+        .map(|b| b.value)
+        .collect();
+    eprintln!("halved steps: Neimark–Sacker at {located:?}");
+    assert!(halved.branches[0].unlocated.is_empty());
+    assert_eq!(located.len(), 2, "{located:?}");
+    let whole = continuation(&scene, param, range, &settings(Some(0.5)), &|_| {}).unwrap();
+    let b = &whole.branches[0];
+    eprintln!("one step: unlocated {:?}", b.unlocated);
+    assert!(
+        b.bifurcations
+            .iter()
+            .all(|x| x.kind != BifurcationKind::NeimarkSacker),
+        "{:?}",
+        b.bifurcations
+            .iter()
+            .map(|x| (x.kind, x.value))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(b.unlocated.len(), 1, "{:?}", b.unlocated);
+    let u = &b.unlocated[0];
+    assert_eq!(u.kind, BifurcationKind::NeimarkSacker);
+    let (lo, hi) = (u.bracket.0.min(u.bracket.1), u.bracket.0.max(u.bracket.1));
+    assert_eq!(lo, range.0);
+    assert!(
+        located.iter().all(|&x| lo < x && x < hi),
+        "{located:?} not in {:?}",
+        u.bracket
+    );
+    assert!(u.reason.contains("no single crossing"), "{}", u.reason);
+    // The report carries it with its bracket and why.
+    let v = report(&whole);
+    let r = &v["unlocated"][0];
+    assert_eq!(r["kind"], "neimark_sacker");
+    assert_eq!(r["bracket"][0].as_f64(), Some(u.bracket.0));
+    assert_eq!(r["bracket"][1].as_f64(), Some(u.bracket.1));
+    assert_eq!(r["reason"].as_str(), Some(u.reason.as_str()));
 }
 
 #[test]

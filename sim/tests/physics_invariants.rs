@@ -308,24 +308,83 @@ proptest! {
     }
 
     #[test]
-    fn mirroring_link_states_is_an_involution(
+    fn mirroring_link_states_is_an_involution_and_mirrors_the_body(
         angles in prop::collection::vec(-3.0..3.0f64, 3),
         p in prop::array::uniform3(-1.0..1.0f64),
         w in prop::array::uniform3(-1.0..1.0f64),
         v in prop::array::uniform3(-1.0..1.0f64),
+        b in prop::array::uniform3(-1.0..1.0f64),
     ) {
-        let r = sim::engine::rotation_about(&Vector3::x(), angles[0])
-            * sim::engine::rotation_about(&Vector3::y(), angles[1])
-            * sim::engine::rotation_about(&Vector3::z(), angles[2]);
-        let s = LinkStates { r: vec![r], p: vec![p.into()], w: vec![w.into()], v: vec![v.into()] };
+        let s = link_state(&angles, p, w, v);
         let m = s.mirrored();
-        // A proper rotation stays proper, and the reflection is not the identity.
-        prop_assert!((m.r[0].determinant() - 1.0).abs() < 1e-12);
+        // The mirrored state is the mirror image of the body: every point of it, where it is
+        // and how it moves (which the identity, or a reflection that forgets ω is an axial
+        // vector, or an improper rotation, all fail: `a_wrong_mirror_fails_the_mirror_check`).
+        prop_assert!(mirror_residual(&s, &m, &b.into()) < 1e-14);
         let back = m.mirrored();
-        prop_assert!((back.r[0] - r).amax() < 1e-15);
+        prop_assert!((back.r[0] - s.r[0]).amax() < 1e-15);
         prop_assert!((back.p[0] - Vector3::from(p)).amax() < 1e-15);
         prop_assert!((back.w[0] - Vector3::from(w)).amax() < 1e-15);
         prop_assert!((back.v[0] - Vector3::from(v)).amax() < 1e-15);
+    }
+}
+
+/// One link's state from three Euler angles [rad], its origin [m], angular velocity [rad/s]
+/// and origin velocity [m/s].
+fn link_state(angles: &[f64], p: [f64; 3], w: [f64; 3], v: [f64; 3]) -> LinkStates {
+    let r = sim::engine::rotation_about(&Vector3::x(), angles[0])
+        * sim::engine::rotation_about(&Vector3::y(), angles[1])
+        * sim::engine::rotation_about(&Vector3::z(), angles[2]);
+    LinkStates {
+        r: vec![r],
+        p: vec![p.into()],
+        w: vec![w.into()],
+        v: vec![v.into()],
+    }
+}
+
+/// How far `m` is from the mirror image of `s` about the sagittal plane (z → −z), checked on
+/// the body point at `b_link` (link frame of `s`) by kinematics alone: the mirrored link is a
+/// proper rotation, and the point of it at the mirrored link coordinates `S b` is where the
+/// mirror image of `s`'s point is (`S (p + R b)`), moving as the image moves
+/// (`S (v + ω × R b)`). The largest of the three residuals.
+fn mirror_residual(s: &LinkStates, m: &LinkStates, b_link: &Vector3<f64>) -> f64 {
+    let reflect = |x: &Vector3<f64>| Vector3::new(x.x, x.y, -x.z);
+    let (r, p, w, v) = (&s.r[0], &s.p[0], &s.w[0], &s.v[0]);
+    let (rm, pm, wm, vm) = (&m.r[0], &m.p[0], &m.w[0], &m.v[0]);
+    let arm = r * b_link;
+    let arm_m = rm * reflect(b_link);
+    let position = (pm + arm_m - reflect(&(p + arm))).amax();
+    let velocity = (vm + wm.cross(&arm_m) - reflect(&(v + w.cross(&arm)))).amax();
+    let proper = (rm.determinant() - 1.0).abs();
+    position.max(velocity).max(proper)
+}
+
+#[test]
+fn a_wrong_mirror_fails_the_mirror_check() {
+    // The check of the property above can fail: the identity, a reflection of ω as if it
+    // were a polar vector, and the improper rotation S R each miss it by far.
+    let s = link_state(
+        &[0.3, -0.7, 1.1],
+        [0.2, 0.9, -0.4],
+        [0.5, -0.3, 0.8],
+        [-0.6, 0.1, 0.7],
+    );
+    let b = Vector3::new(0.3, -0.2, 0.5);
+    assert!(mirror_residual(&s, &s.mirrored(), &b) < 1e-14);
+    let reflection = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+    let identity = s.clone();
+    let mut polar_w = s.mirrored();
+    polar_w.w[0] = reflection * s.w[0];
+    let mut improper = s.mirrored();
+    improper.r[0] = reflection * s.r[0];
+    for (name, wrong) in [
+        ("identity", &identity),
+        ("ω reflected as a polar vector", &polar_w),
+        ("S R", &improper),
+    ] {
+        let e = mirror_residual(&s, wrong, &b);
+        assert!(e > 0.1, "{name}: residual {e}");
     }
 }
 

@@ -66,6 +66,30 @@ fn garcia_stride(theta: f64, theta_dot: f64, slope: f64) -> Vector2<f64> {
     }
 }
 
+/// Garcia, Chatterjee, Ruina & Coleman (1998), long-period gait at slope 0.009, as published
+/// (to 14 digits in their code accompanying the paper): θ and θ̇ after heel strike.
+const GARCIA_THETA: f64 = 0.200_310_900_494_83;
+const GARCIA_THETA_DOT: f64 = -0.199_832_472_917_64;
+
+#[test]
+fn simplest_fixed_point_matches_garcias_published_values_to_1e_9() {
+    // Measured: 5.0e-11 (θ) and 8.7e-11 (θ̇); the bound is about ten times that (the CLI's
+    // `walker_gait_json_reproduces_garcia_fixed_point_to_1e_8` checks the same through
+    // `walker gait --json`).
+    let (_, w) = common::walker("simplest");
+    let g = common::gait(&w);
+    let (theta, theta_dot) = (g.fixed_point[0], g.fixed_point[2]);
+    let error = (theta - GARCIA_THETA)
+        .abs()
+        .max((theta_dot - GARCIA_THETA_DOT).abs());
+    eprintln!(
+        "θ {:e}, θ̇ {:e} from Garcia et al.'s values",
+        theta - GARCIA_THETA,
+        theta_dot - GARCIA_THETA_DOT
+    );
+    assert!(error < 1e-9, "θ {theta}, θ̇ {theta_dot}: {error:e}");
+}
+
 #[test]
 fn simplest_eigenvalues_match_a_hand_written_model_of_garcias_equations() {
     let (_, w) = common::walker("simplest");

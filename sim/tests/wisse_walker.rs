@@ -241,7 +241,7 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
     assert!(walk.failure.is_none(), "{:?}", walk.failure);
     assert_eq!(walk.steps.len(), 200);
     // Straight: the hip positions at the ends of steps lie on a line (alternating sides by
-    // less than a few centimetres), and the heading does not wander.
+    // less than a millimetre), and the heading does not wander.
     let pts: Vec<(f64, f64)> = walk
         .steps
         .iter()
@@ -258,8 +258,10 @@ fn the_compensated_walker_walks_200_steps_nearly_straight() {
         .iter()
         .map(|p| (p.1 - mz - slope * (p.0 - mx)).abs())
         .fold(0.0, f64::max);
+    // Measured: 0.57 mm (docs/model-identification.md); the bound is 2 mm.
+    eprintln!("largest deviation from the fitted line {worst:e} m, heading {slope:e} rad");
     assert!(
-        worst < 0.05,
+        worst < 2e-3,
         "largest deviation from the fitted line {worst} m"
     );
     let distance = (pts[199].0 - pts[0].0).hypot(pts[199].1 - pts[0].1);
