@@ -99,3 +99,50 @@ fn a_parameter_range_upside_down_is_refused() {
     let e = Scene::parse("changed.toml", &text).unwrap_err().to_string();
     assert!(e.contains("min 0.5 is above max -0.5"), "{e}");
 }
+
+/// A bad `[[shape]]` was found only by `--animate` (exit 1, a 0-byte page left): now the
+/// scene is refused when it is built, naming the shape.
+#[test]
+fn a_bad_shape_is_refused_at_load_naming_it() {
+    let shape = |link: &str, radius: &str| {
+        format!(
+            "[fall]\n\n[[shape]]\nkind = \"rod\"\nname = \"leg rod\"\nlink = \"{link}\"\n\
+             from_m = [0, 0, 0]\nto_m = [0, 1, 0]\nradius_m = {radius}\n"
+        )
+    };
+    // keep [fall]'s own keys after the shape: the shape goes before the section header
+    let with = |text: String| {
+        let fall = COMPASS.find("[fall]\n").unwrap();
+        let changed = format!(
+            "{}{}{}",
+            &COMPASS[..fall],
+            text.replacen("[fall]\n\n", "", 1),
+            &COMPASS[fall..]
+        );
+        Scene::parse("changed.toml", &changed)
+            .and_then(|s| s.setup().map(|_| ()))
+            .map_err(|e| e.to_string())
+    };
+    with(shape("stance_leg", "0.02")).unwrap();
+    for (link, radius, needle) in [
+        (
+            "thigh",
+            "0.02",
+            "shape `leg rod` (rod): unknown link `thigh`",
+        ),
+        (
+            "stance_leg",
+            "0",
+            "shape `leg rod` (rod): radius_m = 0 is not a positive length",
+        ),
+        ("stance_leg", "-1", "radius_m = -1 is not a positive length"),
+        ("stance_leg", "\"nope_m\"", "nope_m"),
+    ] {
+        let e = with(shape(link, radius)).unwrap_err();
+        assert!(e.contains(needle), "`{needle}` not in: {e}");
+    }
+    let ring = "[[shape]]\nkind = \"ring\"\nname = \"ring\"\nlink = \"hip\"\n\
+                centre_m = [0, 0, 0]\nnormal = [0, 0, 0]\nradius_m = 0.1\n";
+    let e = with(ring.to_string()).unwrap_err();
+    assert!(e.contains("shape `ring` (ring): the normal is zero"), "{e}");
+}

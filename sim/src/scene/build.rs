@@ -412,6 +412,8 @@ impl Scene {
                 error,
             })?;
         self.check_convention(&walker)?;
+        // how the bodies look: checked here, at load, not first by an animation
+        self.shapes(walker.model())?;
         Ok(Setup {
             walker,
             settings,

@@ -7,11 +7,13 @@ mod build;
 mod error;
 pub mod expr;
 pub mod file;
+mod shapes;
 pub mod text_file;
 mod usage;
 pub mod variant;
 
 pub use error::{short_number, SceneError, VariantError};
+pub use shapes::Shape;
 
 use crate::analysis::limit_cycle::{Gait, GaitGuess, GaitSearch, NewtonError, NewtonSettings};
 use crate::engine::events::Direction;

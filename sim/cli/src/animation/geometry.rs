@@ -7,8 +7,7 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 use sim::engine::model::{LinkIndex, Model};
-use sim::scene::file::{Num, ShapeDef};
-use sim::scene::{Scene, SceneError};
+use sim::scene::{Scene, SceneError, Shape};
 
 /// A point fixed in a link whose floor-frame position each frame carries.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,8 +93,8 @@ impl Figure {
         if scene.file.shapes.is_empty() {
             f.add_skeleton(model);
         }
-        for s in &scene.file.shapes {
-            f.add_shape(scene, model, s)?;
+        for s in &scene.shapes(model)? {
+            f.add_shape(model, s);
         }
         for (i, l) in model.links.iter().enumerate() {
             if l.body.mass_kg > 0.0 {
@@ -161,71 +160,47 @@ impl Figure {
         }
     }
 
-    fn add_shape(&mut self, scene: &Scene, model: &Model, s: &ShapeDef) -> Result<(), SceneError> {
-        let link_name = s.link();
-        let link = model
-            .link_index(link_name)
-            .ok_or_else(|| SceneError::Invalid(format!("shape on unknown link `{link_name}`")))?;
-        let vec = |v: &[Num; 3], what: &str| -> Result<Vector3<f64>, SceneError> {
-            Ok(Vector3::new(
-                scene.num(&v[0], what)?,
-                scene.num(&v[1], what)?,
-                scene.num(&v[2], what)?,
-            ))
-        };
-        let positive = |r: &Num, what: &str| -> Result<f64, SceneError> {
-            let r = scene.num(r, what)?;
-            if r > 0.0 {
-                Ok(r)
-            } else {
-                Err(SceneError::Invalid(format!("{what}: {r} is not positive")))
-            }
-        };
+    fn add_shape(&mut self, model: &Model, s: &Shape) {
+        let link = s.link();
+        let link_name = model.links.get(link.0).map_or("", |l| l.name.as_str());
+        let role = shape_role(s.name(), link_name);
         match s {
-            ShapeDef::Rod {
+            Shape::Rod {
                 name,
                 from_m,
                 to_m,
                 radius_m,
                 ..
             } => {
-                let what = format!("shape `{name}`");
-                let (pa, pb) = (vec(from_m, &what)?, vec(to_m, &what)?);
-                let radius_m = positive(radius_m, &what)?;
-                let (a, b) = (self.point(link, pa), self.point(link, pb));
+                let (a, b) = (self.point(link, *from_m), self.point(link, *to_m));
                 self.parts.push(Part::Rod {
                     name: name.clone(),
-                    role: shape_role(name, link_name),
+                    role,
                     a,
                     b,
-                    radius_m,
+                    radius_m: *radius_m,
                 });
             }
-            ShapeDef::Ring {
+            Shape::Ring {
                 name,
                 centre_m,
                 normal,
                 radius_m,
                 ..
             } => {
-                let what = format!("shape `{name}`");
-                let c = vec(centre_m, &what)?;
-                let n = vec(normal, &what)?;
-                let n = n
-                    .try_normalize(1e-12)
-                    .ok_or_else(|| SceneError::Invalid(format!("{what}: the normal is zero")))?;
-                let radius_m = positive(radius_m, &what)?;
-                let (centre, normal_tip) = (self.point(link, c), self.point(link, c + n));
+                let (centre, normal_tip) = (
+                    self.point(link, *centre_m),
+                    self.point(link, centre_m + normal),
+                );
                 self.parts.push(Part::Ring {
                     name: name.clone(),
-                    role: shape_role(name, link_name),
+                    role,
                     centre,
                     normal_tip,
-                    radius_m,
+                    radius_m: *radius_m,
                 });
             }
         }
-        Ok(())
     }
 }
 
@@ -333,7 +308,7 @@ mod tests {
         for (shape, message) in [
             (
                 "kind = \"rod\"\nname = \"leg\"\nlink = \"stance_leg\"\nfrom_m = [0, 0, 0]\nto_m = [0, 1, 0]\nradius_m = 0",
-                "not positive",
+                "not a positive length",
             ),
             (
                 "kind = \"ring\"\nname = \"r\"\nlink = \"stance_leg\"\ncentre_m = [0, 0, 0]\nnormal = [0, 0, 0]\nradius_m = 0.1",
