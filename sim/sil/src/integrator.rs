@@ -13,8 +13,9 @@ use sim::engine::integrators::IntegratorChoice;
 /// Over the first step of `wisse3d` (Table I, the chosen reading) with the firmware in the
 /// loop, against DOPRI5 at 1e-12 with every step ending at a tick (relative differences): step
 /// period 5.7e-10, speed and step length 1.5e-8, the impact loss 3.3e-9, the actuator work and
-/// the cost of transport 2.4e-7 (test `hil-tests/tests/sil_integrator.rs`, bounds 1.5e-7, 5e-7
-/// and 2.7e-5; docs/sil.md); the same integrator ending every step at a tick (the scheme
+/// the cost of transport 2.4e-7 (measured; test `hil-tests/tests/sil_integrator.rs` asserts
+/// 5e-9 on the period, 1.5e-7 on speed and step length, 5e-8 on the impact loss and 2.5e-6 on
+/// the work and the cost of transport; docs/sil.md); the same integrator ending every step at a tick (the scheme
 /// before, `TickStepping::EndAtEveryTick`) differs from it by 3.4e-9 at most. Over more steps
 /// the closed loop (quantised encoder, 1 ms ticks) amplifies such differences: 1.2e-4 in the
 /// 12-step mean period. It costs 2.25 right-hand-side evaluations per tick (6.4 ending every
