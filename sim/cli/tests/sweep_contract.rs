@@ -197,8 +197,8 @@ fn the_command_lines_integrator_applies_at_every_value() {
 
 #[test]
 fn a_sweep_that_cannot_start_or_runs_out_of_budget_exits_1_naming_the_unanswered_range() {
-    // No gait on steep uphill slopes: the sweep cannot start at its first 32 values; it
-    // used to exit 0.
+    // No gait on steep uphill slopes: the sweep cannot start at any value it tries; it used
+    // to exit 0.
     let out = walker(&[
         "sweep", "--scene", "simplest", "--param", "slope", "--from", "-0.5", "--to", "-0.4",
         "--points", "50",
@@ -229,6 +229,27 @@ fn a_sweep_that_cannot_start_or_runs_out_of_budget_exits_1_naming_the_unanswered
         .collect();
     assert!(values.len() > 10, "{text}");
     assert!(values.windows(2).all(|w| w[0] <= w[1]), "{values:?}");
+    // The sweep over the whole range: its gaits lie between slopes 0 and 0.019, far
+    // from its start; it tried its first 32 values only and answered none. Now its start is
+    // searched across the range: the branch is found and followed both ways.
+    let out = walker(&[
+        "sweep", "--scene", "simplest", "--param", "slope", "--from", "-0.5", "--to", "0.5",
+        "--points", "10000", "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let answered: Vec<f64> = v["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["converged"] == true)
+        .filter_map(|p| p["value"].as_f64())
+        .collect();
+    assert!(answered.len() > 100, "{} points", answered.len());
+    assert!(
+        answered.iter().all(|s| (0.0..0.0195).contains(s)),
+        "{answered:?}"
+    );
+    assert!(answered.iter().any(|s| *s < 0.001) && answered.iter().any(|s| *s > 0.01));
     // A sweep that answers every value exits 0.
     let out = walker(&[
         "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.009", "--to", "0.012",

@@ -90,12 +90,14 @@ impl Continuation {
                 .grid
                 .values
                 .iter()
-                .enumerate()
-                .map(|(i, v)| match self.no_start.get(i) {
+                .map(|v| match self.no_start.iter().find(|(g, _)| g == v) {
                     Some((_, e)) => (*v, format!("no gait to start from: {e}")),
                     None => (
                         *v,
-                        format!("no gait found to start from at the first {tried} values"),
+                        format!(
+                            "no gait found to start from at the {tried} values tried across \
+                             the range"
+                        ),
                     ),
                 })
                 .collect();
@@ -103,7 +105,7 @@ impl Continuation {
         let describe = |e: &Option<BranchEnd>| match e {
             Some(e) => format!(
                 "the branch ends at {param} = {}: {} ({})",
-                e.value,
+                crate::scene::short_number(e.value),
                 e.kind.name(),
                 e.detail
             ),
@@ -170,13 +172,11 @@ pub fn continuation(
         steps: step_control(&grid, settings),
         detect: settings.detect(),
     };
-    let Some(start) = first_point(&cont, &grid, settings, &mut out.no_start)? else {
+    let Some((start, i0)) = first_point(&cont, &grid, settings, &mut out.no_start)? else {
         return Ok(out);
     };
     let share = 1.0 / (1.0 + settings.max_period().ilog2() as f64);
-    let main = first_branch(&cont, start, &grid, out.no_start.len(), settings, &|f| {
-        progress(f * share)
-    });
+    let main = first_branch(&cont, start, &grid, i0, settings, &|f| progress(f * share));
     period_doubled_branches(&cont, main, &mut out, share, progress);
     progress(1.0);
     Ok(out)
@@ -196,18 +196,22 @@ fn step_control(grid: &Grid, settings: &ContinuationSettings) -> StepControl {
     }
 }
 
-/// The first point of branch 0: the corrected gait ([`long_period_gait`]) at the first grid
-/// value that has one (of at most [`ContinuationSettings::start_attempts`]); the values
-/// before it are added to `no_start` with the reason.
+/// The first point of branch 0 and its grid index: the corrected gait ([`long_period_gait`])
+/// at the first grid value, in [`start_order`], that has one (of at most
+/// [`ContinuationSettings::start_attempts`]); the values tried before it are added to
+/// `no_start` with the reason.
 fn first_point(
     cont: &Continuer,
     grid: &Grid,
     settings: &ContinuationSettings,
     no_start: &mut Vec<(f64, String)>,
-) -> Result<Option<(BranchPoint, Linearisation)>, SweepError> {
+) -> Result<Option<((BranchPoint, Linearisation), usize)>, SweepError> {
     let family = cont.family;
     let setup_for = |s: &Scene| family.setup_of(s);
-    for &g in grid.values.iter().take(settings.start_attempts()) {
+    for i in start_order(grid.values.len(), settings.start_attempts()) {
+        let Some(&g) = grid.values.get(i) else {
+            continue;
+        };
         let scene = family.scene_at(g)?;
         match long_period_gait(&scene, &setup_for, settings.newton(), settings.homotopy())? {
             Ok(gait) => {
@@ -218,7 +222,7 @@ fn first_point(
                 let along = &c * (grid.to - grid.from).signum();
                 let constraint = arclength::Constraint { c, b: g };
                 match cont.correct(&x, &constraint, None, &along, true) {
-                    Ok(s) => return Ok(Some(s)),
+                    Ok(s) => return Ok(Some((s, i))),
                     Err(e) => no_start.push((g, format!("the corrector at the gait failed: {e}"))),
                 }
             }
@@ -227,6 +231,34 @@ fn first_point(
     }
     Ok(None)
 }
+
+/// The grid indices tried for a sweep's first gait, at most `attempts` of the `n`: the first
+/// [`SEQUENTIAL_STARTS`] in order (a start near `from`, as before), then spread over the rest
+/// by halving (the van der Corput sequence: the middle, the quarters, the eighths, ...), so a
+/// range whose gaits lie in a small part of it far from `from` is still found (the simplest
+/// walker from a slope of −0.5 to 0.5, whose gaits lie between 0 and 0.019, found none in its
+/// first 32 values).
+fn start_order(n: usize, attempts: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n.min(SEQUENTIAL_STARTS)).collect();
+    let rest = n.saturating_sub(SEQUENTIAL_STARTS);
+    // each halving level adds as many fractions as all before it: bounded by 2n fractions
+    let mut k: u32 = 1;
+    let last_k = u32::try_from(n.saturating_mul(2)).unwrap_or(u32::MAX);
+    while order.len() < attempts.min(n) && k < last_k {
+        // the k-th van der Corput fraction in base 2
+        let fraction = f64::from(k.reverse_bits()) / 4_294_967_296.0;
+        k += 1;
+        let i = SEQUENTIAL_STARTS + (fraction * rest as f64) as usize;
+        if i < n && !order.contains(&i) {
+            order.push(i);
+        }
+    }
+    order.truncate(attempts);
+    order
+}
+
+/// Grid values a sweep's start tries in order before it spreads ([`start_order`]).
+const SEQUENTIAL_STARTS: usize = 4;
 
 /// Branch 0 from `start` (at grid index `i0`) to the end of the grid, and, for a start after
 /// `from`, backward from it toward `from` too (joined in front).
@@ -320,5 +352,32 @@ fn period_doubled_branches(
                 2 * k
             ))),
         }
+    }
+}
+
+#[cfg(test)]
+mod start_order_tests {
+    use super::*;
+
+    #[test]
+    fn the_start_tries_the_first_values_then_spreads_over_the_range() {
+        let order = start_order(10_000, 64);
+        assert_eq!(order.len(), 64);
+        assert_eq!(&order[..5], &[0, 1, 2, 3, 4 + 9_996 / 2]);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 64, "no index twice");
+        // spread: no gap between tried indices wider than 1/32 of the range (past the first
+        // four), so any run of gaits wider than that is hit
+        let widest = sorted.windows(2).map(|w| w[1] - w[0]).max().unwrap();
+        assert!(widest <= 10_000 / 32 + 1, "{widest}");
+        // a short grid: every index once, in order first
+        assert_eq!(start_order(3, 64), vec![0, 1, 2]);
+        let all = start_order(20, 64);
+        let mut s = all.clone();
+        s.sort_unstable();
+        assert_eq!(s, (0..20).collect::<Vec<_>>());
+        assert!(start_order(10, 0).is_empty());
     }
 }

@@ -92,7 +92,7 @@ impl Default for ContinuationSettings {
             max_turn_deg: 60.0,
             detect: Detection::default(),
             stride_settings: None,
-            start_attempts: 32,
+            start_attempts: 64,
             homotopy: HomotopySettings::default(),
         }
     }
@@ -162,8 +162,8 @@ impl ContinuationSettings {
         self.stride_settings.as_ref()
     }
 
-    /// Grid values tried (from `from` on) for a first gait
-    /// ([`crate::analysis::homotopy::long_period_gait`]). Default 32.
+    /// Grid values tried for a first gait ([`crate::analysis::homotopy::long_period_gait`]):
+    /// the first four from `from` on, then spread over the range by halving. Default 64.
     pub fn start_attempts(&self) -> usize {
         self.start_attempts
     }
