@@ -196,6 +196,9 @@ fn step_control(grid: &Grid, settings: &ContinuationSettings) -> StepControl {
     }
 }
 
+/// A branch's first point, corrected, with its linearisation.
+type Start = (BranchPoint, Linearisation);
+
 /// The first point of branch 0 and its grid index: the corrected gait ([`long_period_gait`])
 /// at the first grid value, in [`start_order`], that has one (of at most
 /// [`ContinuationSettings::start_attempts`]); the values tried before it are added to
@@ -205,7 +208,7 @@ fn first_point(
     grid: &Grid,
     settings: &ContinuationSettings,
     no_start: &mut Vec<(f64, String)>,
-) -> Result<Option<((BranchPoint, Linearisation), usize)>, SweepError> {
+) -> Result<Option<(Start, usize)>, SweepError> {
     let family = cont.family;
     let setup_for = |s: &Scene| family.setup_of(s);
     for i in start_order(grid.values.len(), settings.start_attempts()) {
