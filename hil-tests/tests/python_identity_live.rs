@@ -78,7 +78,8 @@ fn python_monitor_reads_identity_and_fault_history_from_the_firmware() {
         .spawn()
         .unwrap();
     // Keep the firmware running, about 1 ms of walk time per 0.5 ms of wall time, while the
-    // monitor listens (bounded: 20 s of wall time).
+    // monitor listens; the monitor ends by its own --duration. The deadline only turns a hang
+    // into a failure, whatever the machine's load.
     let start = WallClock::now();
     let mut monitor = monitor;
     loop {
@@ -88,7 +89,7 @@ fn python_monitor_reads_identity_and_fault_history_from_the_firmware() {
             break;
         }
         assert!(
-            start.elapsed() < Duration::from_secs(20),
+            start.elapsed() < Duration::from_secs(120),
             "monitor did not finish"
         );
     }
