@@ -42,6 +42,8 @@ impl AngleEstimator {
     }
 
     /// Fold in a measured angle `z_rad` taken `dt_s` after the previous one.
+    // f32 vector and matrix arithmetic (nalgebra operators): no integer, nothing to wrap.
+    #[allow(clippy::arithmetic_side_effects)]
     pub fn update(&mut self, z_rad: f32, dt_s: f32) {
         let x = match self.x {
             None => Vector2::new(z_rad, 0.0),

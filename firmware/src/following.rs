@@ -5,6 +5,7 @@
 //! [`FOLLOWING_ERROR_TIME_S`] means the string is not where it is commanded: a reversed or
 //! failed motor, a broken string, or an encoder reading frozen away from the setpoint.
 
+use crate::convert::saturating_i16;
 use crate::time::Instant;
 
 /// Largest tolerated shortfall of the measured angle below the setpoint \[rad\]: 12 × the
@@ -41,7 +42,9 @@ impl FollowingErrorMonitor {
             return None;
         }
         let since = *self.since.get_or_insert(now);
-        (now.secs_since(since) >= FOLLOWING_ERROR_TIME_S).then_some((shortfall * 1.0e4) as i16)
+        // Detail in 0.1 mrad, saturated (an infinite shortfall reads as 32767).
+        (now.secs_since(since) >= FOLLOWING_ERROR_TIME_S)
+            .then_some(saturating_i16(shortfall * 1.0e4))
     }
 }
 

@@ -12,10 +12,27 @@
 //!
 //! No heap, no panics (clippy denies `unwrap`, `expect` and `panic` outside tests), bounded
 //! work per tick. The `defmt` feature logs state changes and faults.
+//!
+//! No silent integer wrap either: clippy's `arithmetic_side_effects`,
+//! `cast_possible_truncation`, `cast_possible_wrap` and `cast_sign_loss` are denied for the
+//! library (not its unit tests). Arithmetic is checked or saturating, wrapping only where the
+//! wrap is the meaning (counts on the encoder's circle, the bus's free-running clocks and
+//! counters, a hash), each said where it happens; sensor and wire values convert through
+//! `TryFrom` or the saturating [`convert`] functions.
 #![no_std]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::arithmetic_side_effects,
+        clippy::cast_possible_truncation,
+        clippy::cast_possible_wrap,
+        clippy::cast_sign_loss
+    )
+)]
 
 pub(crate) mod fmt;
 
+pub mod convert;
 pub mod drivers;
 pub mod estimator;
 pub mod fault_report;

@@ -11,6 +11,7 @@ use protocol::{
     ResetCause, Version, PROTOCOL_VERSION,
 };
 
+use crate::convert::saturating_i16;
 use crate::estimator::{AngleEstimator, EstimatorGains};
 use crate::fault_report::FaultReporter;
 use crate::fmt::{log_info, log_warn};
@@ -227,15 +228,15 @@ struct ContactEdges {
 fn sort_by_priority(transmit: &mut Vec<Message, MAX_TX_PER_TICK>) {
     for i in 1..transmit.len() {
         let mut j = i;
-        while j > 0 {
-            let Some([a, b]) = transmit.get_mut(j - 1..=j) else {
+        while let Some(before) = j.checked_sub(1) {
+            let Some([a, b]) = transmit.get_mut(before..=j) else {
                 break;
             };
             if a.class() <= b.class() {
                 break;
             }
             core::mem::swap(a, b);
-            j -= 1;
+            j = before;
         }
     }
 }
@@ -431,7 +432,8 @@ impl AnkleNode {
             uid_high: c.uid[2],
             reset_cause: c.reset_cause,
             params_source: c.params_source,
-            fault_history_len: self.history.len() as u8,
+            // The history holds far fewer than 255 entries; saturating were it ever more.
+            fault_history_len: u8::try_from(self.history.len()).unwrap_or(u8::MAX),
             calibration_source: c.calibration_source,
         }));
     }
@@ -440,10 +442,12 @@ impl AnkleNode {
         for (k, r) in self.history.iter().enumerate() {
             out.push(Message::FaultHistory(FaultHistoryEntry {
                 node: self.config.node,
-                entry: k as u8,
+                entry: u8::try_from(k).unwrap_or(u8::MAX),
                 code: r.code,
                 state_after: r.state_after,
                 detail: r.detail,
+                // The signal's 24-bit clock: uptime modulo 2²⁴ ms (wraps after 4.66 h, as the
+                // DBC says). Wrapping on purpose; the codec refuses anything wider.
                 uptime_ms: r.uptime_ms & 0xFF_FFFF,
             }));
         }
@@ -675,7 +679,8 @@ impl AnkleNode {
         let peer_seen = self.last_peer_heartbeat.unwrap_or(started);
         let silent_s = now.secs_since(peer_seen);
         let lost = silent_s > self.params.peer_heartbeat_timeout_s();
-        let silent_ms = (silent_s * 1000.0) as i16;
+        // Saturating: a peer silent for more than 32.767 s reads as 32767 ms.
+        let silent_ms = saturating_i16(silent_s * 1000.0);
         self.set_fault(
             out,
             now,
@@ -736,7 +741,8 @@ impl AnkleNode {
         }
         let peer_detail = self.peer_dropped_out.map(|st| st.raw() as i16);
         self.set_fault(out, now, FaultCode::PeerSafe, peer_detail);
-        self.rx_lost_total = self.rx_lost_total.wrapping_add(inputs.drivers.rx_lost);
+        // Saturating: the total never wraps back below the 32767 the detail saturates at.
+        self.rx_lost_total = self.rx_lost_total.saturating_add(inputs.drivers.rx_lost);
         let lost_detail = i16::try_from(self.rx_lost_total).unwrap_or(i16::MAX);
         self.set_fault(
             out,

@@ -3,7 +3,8 @@
 //! the STM32G431's own flash through embassy-stm32, in the tests a RAM flash with NOR rules.
 //!
 //! Keys: each [`ParamId`]'s raw value holds its wire value (i32, 1e-6 of the SI unit); key
-//! [`KEY_ENCODER_ZERO`] holds the calibration (`zero_counts | reversed << 16`). Loading
+//! [`KEY_ENCODER_ZERO`] holds the calibration (`zero_counts | reversed << 16`,
+//! [`AngleCalibration::to_stored_word`]; a word with other bits set is refused). Loading
 //! applies stored parameters through [`ReflexParams::set`], so a stored value outside its
 //! range or inconsistent with the others is refused like a wire command would be.
 
@@ -84,7 +85,7 @@ impl<S: NorFlash> ParamStore<S> {
                 .await
                 .map_err(|_| StoreError::Flash)?;
         }
-        let word = u32::from(calibration.zero_counts) | (u32::from(calibration.reversed) << 16);
+        let word = calibration.to_stored_word();
         self.map
             .store_item(&mut buf, &KEY_ENCODER_ZERO, &word)
             .await
@@ -132,13 +133,11 @@ impl<S: NorFlash> ParamStore<S> {
             .fetch_item::<u32>(&mut buf, &KEY_ENCODER_ZERO)
             .await
         {
-            Ok(Some(w)) => (
-                AngleCalibration {
-                    zero_counts: (w & 0x3FFF) as u16,
-                    reversed: w >> 16 & 1 == 1,
-                },
-                ConfigSource::Flash,
-            ),
+            // A word with undefined bits is no calibration: the default, marked unreadable.
+            Ok(Some(w)) => match AngleCalibration::from_stored_word(w) {
+                Some(c) => (c, ConfigSource::Flash),
+                None => (default_calibration, ConfigSource::FlashUnreadable),
+            },
             Ok(None) => (default_calibration, ConfigSource::Defaults),
             Err(_) => (default_calibration, ConfigSource::FlashUnreadable),
         };

@@ -22,7 +22,9 @@ use protocol::{
 
 use crate::node::{AnkleNode, ConfigError, DriverHealth, NodeConfig, TickInputs};
 use crate::reflex::ActuatorCommand;
-use crate::sensors::{with_simulated_noise, AngleCalibration, AngleSample, EncoderError};
+use crate::sensors::{
+    offset_counts, with_simulated_noise, AngleCalibration, AngleSample, EncoderError,
+};
 use crate::time::Instant;
 
 /// Control period \[µs\].
@@ -102,13 +104,10 @@ pub struct Scenario {
 }
 
 const fn flags(codes: &[FaultCode]) -> u16 {
-    let mut m = 0;
-    let mut i = 0;
-    while i < codes.len() {
-        m |= codes[i].flag();
-        i += 1;
+    match codes {
+        [first, rest @ ..] => first.flag() | flags(rest),
+        [] => 0,
     }
-    m
 }
 
 const fn set(param: ParamId, micro: i32) -> CommandKind {
@@ -476,7 +475,7 @@ impl World {
                     frozen = true;
                 }
                 Glitch::Jump { at, counts: d } if at == tick => {
-                    counts = (counts as i32 + d as i32).rem_euclid(16384) as u16;
+                    counts = offset_counts(counts, i32::from(d));
                 }
                 _ => {}
             }
@@ -508,7 +507,8 @@ impl World {
             {
                 let _ = rx.push(Message::HeelStrike(HeelStrike {
                     node: NodeId::RightAnkle,
-                    step_count: stride as u16,
+                    // The signal counts strides modulo 2¹⁶ (it wraps): on purpose.
+                    step_count: (stride & 0xFFFF) as u16,
                     time_us: tick.wrapping_mul(1000),
                 }));
             }
@@ -565,7 +565,7 @@ impl<W: Write> Buffered<W> {
 
 impl<W: Write> Write for Buffered<W> {
     fn write_str(&mut self, s: &str) -> core::fmt::Result {
-        if self.buf.len() + s.len() > self.buf.capacity() {
+        if self.buf.len().saturating_add(s.len()) > self.buf.capacity() {
             self.flush()?;
         }
         if self.buf.push_str(s).is_err() {
@@ -613,12 +613,12 @@ pub fn run<W: Write, H: TickHook>(
             drivers: DriverHealth::default(),
         };
         let phase_before = node.phase();
-        let now = Instant::from_micros(tick as u64 * TICK_US);
+        let now = Instant::from_micros(u64::from(tick).saturating_mul(TICK_US));
         let o = hook.around(tick, || node.tick(now, &inputs));
         world.last_command = o.actuator;
 
         if phase_before != ReflexPhase::Push && o.phase == ReflexPhase::Push {
-            s.pushes += 1;
+            s.pushes = s.pushes.saturating_add(1);
         }
         let released = matches!(
             phase_before,
@@ -629,9 +629,9 @@ pub fn run<W: Write, H: TickHook>(
                 && f.transition == FaultTransition::Raised)
         });
         if released && (late_raised || node.faults().contains(FaultCode::PeerHeelStrikeLate)) {
-            s.releases_by_lift_off += 1;
+            s.releases_by_lift_off = s.releases_by_lift_off.saturating_add(1);
         } else if released {
-            s.releases_by_peer += 1;
+            s.releases_by_peer = s.releases_by_peer.saturating_add(1);
         }
         let bits = o.actuator.bits();
         s.actuator_digest = fnv(s.actuator_digest, &bits.to_le_bytes());
@@ -642,7 +642,7 @@ pub fn run<W: Write, H: TickHook>(
         }
         for m in &o.transmit {
             if let Ok(f) = m.encode() {
-                s.frames += 1;
+                s.frames = s.frames.saturating_add(1);
                 s.frame_digest = fnv(s.frame_digest, &f.id.raw().to_le_bytes());
                 s.frame_digest = fnv(s.frame_digest, f.payload());
             }

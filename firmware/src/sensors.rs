@@ -1,5 +1,6 @@
 //! Sensor samples as the node sees them, and their plausibility checks (range, rate, stuck).
 
+use crate::convert::saturating_i16;
 use crate::params::{ReflexParams, ANKLE_ANGLE_LIMIT_RAD};
 use crate::time::Instant;
 
@@ -60,15 +61,22 @@ pub struct AngleCalibration {
 }
 
 impl AngleCalibration {
-    /// Ankle angle for a reading \[rad\], wrapped to (−π, π].
+    /// Ankle angle for a reading \[rad\], wrapped to (−π, π]. Any `counts` and zero, even
+    /// past the 14 bits, give an angle: only their difference modulo one revolution counts.
     pub fn angle_rad(&self, counts: u16) -> f32 {
-        let n = ENCODER_COUNTS_PER_REV as i32;
-        let mut d = (counts as i32 - self.zero_counts as i32).rem_euclid(n);
-        if d > n / 2 {
-            d -= n;
-        }
+        // Modulo 2¹⁶, then modulo 2¹⁴ (which divides 2¹⁶): the difference modulo one
+        // revolution. Wrapping is the meaning here — the counts are a position on a circle.
+        let d = i32::from(counts.wrapping_sub(self.zero_counts) % ENCODER_COUNTS_PER_REV);
+        // 0..16384: past half a revolution is the negative side; |d| ≤ 8192 after this, so
+        // neither the subtraction nor the negation can saturate.
+        let half = i32::from(ENCODER_COUNTS_PER_REV / 2);
+        let mut d = if d > half {
+            d.saturating_sub(i32::from(ENCODER_COUNTS_PER_REV))
+        } else {
+            d
+        };
         if self.reversed {
-            d = -d;
+            d = d.saturating_neg();
         }
         d as f32 * (core::f32::consts::TAU / ENCODER_COUNTS_PER_REV as f32)
     }
@@ -82,16 +90,42 @@ impl AngleCalibration {
         let n = ENCODER_COUNTS_PER_REV as f32;
         let per_rad = n / core::f32::consts::TAU;
         let within_rev = libm::fmodf(libm::roundf(angle_rad * per_rad), n);
-        // |within_rev| < n = 16384 (or NaN, which casts to 0): exact as an i32.
+        // |within_rev| < n = 16384 and integer-valued (NaN and ±∞ take the 0): exact as an
+        // i32, and its negation cannot saturate.
+        #[allow(clippy::cast_possible_truncation)]
         let mut d = if within_rev.is_finite() {
             within_rev as i32
         } else {
             0
         };
         if self.reversed {
-            d = -d;
+            d = d.saturating_neg();
         }
-        (i32::from(self.zero_counts) + d).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
+        offset_counts(self.zero_counts, d)
+    }
+
+    /// Bit of [`Self::to_stored_word`] that holds `reversed`.
+    const REVERSED_BIT: u32 = 1 << 16;
+
+    /// The calibration as the parameter store's word: `zero_counts` in bits 0..=15,
+    /// `reversed` in bit 16, the rest zero.
+    pub fn to_stored_word(&self) -> u32 {
+        let reversed = if self.reversed { Self::REVERSED_BIT } else { 0 };
+        u32::from(self.zero_counts) | reversed
+    }
+
+    /// The calibration a stored word holds, the zero reduced to one revolution (the same
+    /// angle: only the counts modulo 2¹⁴ matter); `None` when a bit above 16 is set — no
+    /// version wrote one, so the word is not a calibration, refused rather than cut.
+    pub fn from_stored_word(word: u32) -> Option<Self> {
+        if word & !(Self::REVERSED_BIT | 0xFFFF) != 0 {
+            return None;
+        }
+        let zero = u16::try_from(word & 0xFFFF).ok()?;
+        Some(AngleCalibration {
+            zero_counts: zero % ENCODER_COUNTS_PER_REV,
+            reversed: word & Self::REVERSED_BIT != 0,
+        })
     }
 }
 
@@ -112,12 +146,32 @@ pub const SIMULATED_CALIBRATION: AngleCalibration = AngleCalibration {
 /// does not move at all for the stuck timeout is a failed sensor ([`Plausibility`]). Every
 /// simulated encoder (scenarios, host tests, the simulator) adds this to its counts.
 pub fn simulated_noise_counts(n: u32) -> i32 {
-    (n.wrapping_mul(2_654_435_761) >> 30) as i32 % 3 - 1
+    // Knuth's multiplicative hash: the product modulo 2³² is the hash (wrapping on purpose);
+    // its top two bits (0..=3) give (h mod 3) − 1.
+    match n.wrapping_mul(2_654_435_761) >> 30 {
+        1 => 0,
+        2 => 1,
+        _ => -1,
+    }
 }
 
 /// `counts` plus [`simulated_noise_counts`], wrapped to the encoder's range.
 pub fn with_simulated_noise(counts: u16, n: u32) -> u16 {
-    (counts as i32 + simulated_noise_counts(n)).rem_euclid(ENCODER_COUNTS_PER_REV as i32) as u16
+    offset_counts(counts, simulated_noise_counts(n))
+}
+
+/// `counts` moved by `delta` around the circle, reduced to one revolution (0..16384).
+/// Wrapping is the meaning (an absolute encoder's position modulo a revolution); it is exact
+/// for any `counts` and any `delta`, `i32::MIN` and `i32::MAX` included — no intermediate
+/// value overflows or saturates.
+pub fn offset_counts(counts: u16, delta: i32) -> u16 {
+    let rev = i32::from(ENCODER_COUNTS_PER_REV);
+    // Both terms below 2¹⁶ after the reduction of `delta`: the sum cannot saturate.
+    let r = i32::from(counts)
+        .saturating_add(delta.rem_euclid(rev))
+        .rem_euclid(rev);
+    // `rem_euclid` by a positive modulus: 0..16384, a u16 without loss.
+    u16::try_from(r).unwrap_or(0)
 }
 
 /// What the plausibility checks found in one sample; `Some(detail)` when a check fails,
@@ -130,7 +184,7 @@ pub struct SensorFindings {
     pub range: Option<i16>,
     /// Rate above the limit (detail: rate in 10 mrad/s, saturated).
     pub rate: Option<i16>,
-    /// No change while the actuator drives (detail: the stuck counts, as i16).
+    /// No change while the actuator drives (detail: the stuck counts, saturated at 32767).
     pub stuck: Option<i16>,
 }
 
@@ -143,11 +197,6 @@ pub struct Plausibility {
     /// Time [µs] the reading has stayed the same across consecutive driven ticks.
     still_driven_us: u64,
     stuck_at: Option<u16>,
-}
-
-fn saturate_i16(x: f32) -> i16 {
-    // Float-to-int `as` saturates and maps NaN to 0.
-    x as i16
 }
 
 impl Plausibility {
@@ -173,14 +222,14 @@ impl Plausibility {
             Ok(s) => *s,
         };
         if s.angle_rad.is_nan() || s.angle_rad.abs() > ANKLE_ANGLE_LIMIT_RAD {
-            f.range = Some(saturate_i16(s.angle_rad * 1.0e4));
+            f.range = Some(saturating_i16(s.angle_rad * 1.0e4));
         }
         if let Some((t, prev)) = self.last_good {
             let dt = now.secs_since(t);
             if dt > 0.0 {
                 let rate = (s.angle_rad - prev.angle_rad) / dt;
                 if rate.abs() > params.max_angular_rate_rad_per_s() {
-                    f.rate = Some(saturate_i16(rate * 100.0));
+                    f.rate = Some(saturating_i16(rate * 100.0));
                 }
             }
         }
@@ -197,7 +246,8 @@ impl Plausibility {
         }
         // A stuck reading stays a fault, driving or not, until the reading changes.
         match self.stuck_at {
-            Some(c) if c == s.counts => f.stuck = Some(c as i16),
+            // Counts are 14 bits from a healthy sensor; anything past i16 reads as its limit.
+            Some(c) if c == s.counts => f.stuck = Some(i16::try_from(c).unwrap_or(i16::MAX)),
             _ => self.stuck_at = None,
         }
         self.last_good = Some((now, s));

@@ -26,13 +26,17 @@ impl Instant {
     pub fn secs_since(self, earlier: Instant) -> f32 {
         self.micros_since(earlier) as f32 * 1.0e-6
     }
-    /// Uptime in wrapping milliseconds, as sent on the bus.
+    /// Uptime in wrapping milliseconds, as sent on the bus: modulo 2³² ms (49.7 days), the
+    /// wire's free-running clock (the heartbeat and fault `uptime` signals say it wraps).
     pub const fn uptime_ms(self) -> u32 {
-        (self.0 / 1000) as u32
+        // Wrapping on purpose: the low 32 bits are the clock modulo 2³².
+        ((self.0 / 1000) & 0xFFFF_FFFF) as u32
     }
-    /// Uptime in wrapping microseconds, as sent on the bus.
+    /// Uptime in wrapping microseconds, as sent on the bus: modulo 2³² µs (71.6 min), the
+    /// heel strike's `time` signal (documented to wrap after 4295 s).
     pub const fn uptime_us(self) -> u32 {
-        self.0 as u32
+        // Wrapping on purpose: the low 32 bits are the clock modulo 2³².
+        (self.0 & 0xFFFF_FFFF) as u32
     }
 }
 

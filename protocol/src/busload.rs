@@ -18,14 +18,20 @@ use crate::signal::MessageSpec;
 const G_STANDARD: u32 = 34;
 
 /// Worst-case length of a standard data frame with `dlc` data bytes \[bits\], stuffing included.
+/// Any `dlc` (even past the 8 of classic CAN) gives the formula's value: at most 2,605 bits
+/// for 255, so the saturating operations never saturate.
 pub const fn worst_case_frame_bits(dlc: u8) -> u32 {
-    let exposed = G_STANDARD + 8 * dlc as u32;
-    exposed + 13 + (exposed - 1) / 4
+    let exposed = G_STANDARD.saturating_add((dlc as u32).saturating_mul(8));
+    exposed
+        .saturating_add(13)
+        .saturating_add(exposed.saturating_sub(1) / 4)
 }
 
 /// Length of the same frame without any stuff bits \[bits\].
 pub const fn unstuffed_frame_bits(dlc: u8) -> u32 {
-    G_STANDARD + 8 * dlc as u32 + 13
+    G_STANDARD
+        .saturating_add((dlc as u32).saturating_mul(8))
+        .saturating_add(13)
 }
 
 /// One message's share of the bus.
@@ -63,7 +69,8 @@ impl BusLoad {
 /// addressed at a time (a broadcast replaces the per-ankle frames).
 fn active_identifiers(spec: &MessageSpec) -> u32 {
     match spec.direction {
-        crate::signal::Direction::FromNode(n) => n.len() as u32,
+        // A handful of nodes; saturating, never truncating, were there more than 2³² − 1.
+        crate::signal::Direction::FromNode(n) => u32::try_from(n.len()).unwrap_or(u32::MAX),
         crate::signal::Direction::ToNode(_) => 1,
     }
 }

@@ -69,6 +69,18 @@ pub enum EncodeError {
     },
     /// A field's value cannot be represented on the wire.
     ValueOutOfRange(RangeError),
+    /// A field's raw value does not fit its signal (e.g. a fault-history uptime of 2²⁴ ms or
+    /// more in the 24-bit field); refused rather than cut to the signal's width.
+    RawOutOfRange {
+        /// The signal's name, as in the DBC file.
+        signal: &'static str,
+        /// The raw (unscaled) value given.
+        raw: i64,
+        /// Smallest raw value of the signal.
+        min: i64,
+        /// Largest raw value of the signal.
+        max: i64,
+    },
     /// The message cannot come from or go to that node (e.g. ankle telemetry from the host).
     InvalidNode {
         /// The message class.
@@ -91,6 +103,12 @@ impl fmt::Display for EncodeError {
                 write!(f, "buffer of {available} bytes, message needs {needed}")
             }
             EncodeError::ValueOutOfRange(e) => write!(f, "{e}"),
+            EncodeError::RawOutOfRange {
+                signal,
+                raw,
+                min,
+                max,
+            } => write!(f, "signal {signal}: raw value {raw} outside [{min}, {max}]"),
             EncodeError::InvalidNode { class, node_raw } => {
                 write!(f, "{class:?} cannot use node field 0x{node_raw:X}")
             }

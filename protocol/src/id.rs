@@ -229,7 +229,10 @@ impl CanId {
         if raw > 0x7FF {
             return Err(DecodeError::UnknownId { raw: raw as u32 });
         }
-        match MessageClass::from_raw((raw >> Self::NODE_BITS) as u8) {
+        // raw ≤ 0x7FF (checked above), so raw >> 4 ≤ 0x7F fits a u8 exactly.
+        #[allow(clippy::cast_possible_truncation)]
+        let class_raw = (raw >> Self::NODE_BITS) as u8;
+        match MessageClass::from_raw(class_raw) {
             Some(class) => Ok(CanId {
                 class,
                 node_raw: (raw & 0x0F) as u8,

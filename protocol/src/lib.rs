@@ -10,7 +10,22 @@
 //!   vectors are generated from it.
 //! * `no_std`, no heap, no panics. The `std` feature adds `std::error::Error` impls, the DBC
 //!   renderer and the test vectors; `defmt` adds `defmt::Format` impls.
+//!
+//! Integers are never wrapped silently: clippy's `arithmetic_side_effects`,
+//! `cast_possible_truncation`, `cast_possible_wrap` and `cast_sign_loss` are denied for the
+//! library (not its unit tests); the codec refuses a raw value outside its signal
+//! ([`EncodeError::RawOutOfRange`]) and reads every field through `TryFrom`
+//! ([`signal::SignalSpec::get_as`]).
 #![no_std]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::arithmetic_side_effects,
+        clippy::cast_possible_truncation,
+        clippy::cast_possible_wrap,
+        clippy::cast_sign_loss
+    )
+)]
 
 pub mod busload;
 #[cfg(feature = "std")]

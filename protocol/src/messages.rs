@@ -754,7 +754,8 @@ pub struct FaultHistoryEntry {
     pub state_after: NodeState,
     /// Offending raw value.
     pub detail: i16,
-    /// Uptime at the raise \[ms\], 24 bits on the wire (wraps after 4.66 h).
+    /// Uptime at the raise \[ms\], 24 bits on the wire (wraps after 4.66 h): the sender
+    /// reduces its clock modulo 2²⁴; [`Message::encode`] refuses 2²⁴ or more.
     pub uptime_ms: u32,
 }
 
@@ -893,7 +894,9 @@ impl Message {
     ///
     /// # Errors
     /// [`EncodeError::InvalidNode`] when the message cannot use its node (e.g. a heel strike
-    /// "from" the host).
+    /// "from" the host); [`EncodeError::RawOutOfRange`] when a field does not fit its signal
+    /// (of the field types, only [`FaultHistoryEntry::uptime_ms`] can: 24 bits on the wire).
+    /// A value is refused, never cut to the signal's width.
     pub fn encode(&self) -> Result<RawFrame, EncodeError> {
         let mut data = [0u8; 8];
         let len = self.encode_into(&mut data)?;
@@ -908,7 +911,8 @@ impl Message {
     ///
     /// # Errors
     /// [`EncodeError::BufferTooShort`] when `buf` is shorter than the message's DLC;
-    /// [`EncodeError::InvalidNode`] as for [`Message::encode`].
+    /// [`EncodeError::InvalidNode`] and [`EncodeError::RawOutOfRange`] as for
+    /// [`Message::encode`]. On an error `buf` is left as it was.
     pub fn encode_into(&self, buf: &mut [u8]) -> Result<u8, EncodeError> {
         use layout::*;
         let id = self.id();
@@ -931,79 +935,79 @@ impl Message {
         let mut b = [0u8; 8];
         match self {
             Message::HeelStrike(m) => {
-                heel_strike::STEP_COUNT.put(&mut b, m.step_count as i64);
-                heel_strike::TIME_US.put(&mut b, m.time_us as i64);
+                heel_strike::STEP_COUNT.put(&mut b, m.step_count)?;
+                heel_strike::TIME_US.put(&mut b, m.time_us)?;
             }
             Message::AnkleState(m) => {
-                ankle_state::ANGLE.put(&mut b, m.angle.0 as i64);
-                ankle_state::RATE.put(&mut b, m.rate.0 as i64);
-                ankle_state::ACTUATOR_POSITION.put(&mut b, m.actuator_position.0 as i64);
-                ankle_state::PHASE.put(&mut b, m.phase.raw() as i64);
+                ankle_state::ANGLE.put(&mut b, m.angle.0)?;
+                ankle_state::RATE.put(&mut b, m.rate.0)?;
+                ankle_state::ACTUATOR_POSITION.put(&mut b, m.actuator_position.0)?;
+                ankle_state::PHASE.put(&mut b, m.phase.raw())?;
             }
             Message::Heartbeat(m) => {
-                heartbeat::STATE.put(&mut b, m.state.raw() as i64);
-                heartbeat::FAULT_FLAGS.put(&mut b, m.faults.bits() as i64);
-                heartbeat::UPTIME_MS.put(&mut b, m.uptime_ms as i64);
+                heartbeat::STATE.put(&mut b, m.state.raw())?;
+                heartbeat::FAULT_FLAGS.put(&mut b, m.faults.bits())?;
+                heartbeat::UPTIME_MS.put(&mut b, m.uptime_ms)?;
             }
             Message::Command(m) => match m.kind {
                 CommandKind::EmergencyStop => {
-                    emergency_stop::OPCODE.put(&mut b, Opcode::EmergencyStop.raw() as i64);
+                    emergency_stop::OPCODE.put(&mut b, Opcode::EmergencyStop.raw())?;
                 }
-                CommandKind::Enable => command::OPCODE.put(&mut b, Opcode::Enable.raw() as i64),
-                CommandKind::Disable => command::OPCODE.put(&mut b, Opcode::Disable.raw() as i64),
+                CommandKind::Enable => command::OPCODE.put(&mut b, Opcode::Enable.raw())?,
+                CommandKind::Disable => command::OPCODE.put(&mut b, Opcode::Disable.raw())?,
                 CommandKind::SetParam { param, value } => {
-                    command::OPCODE.put(&mut b, Opcode::SetParam.raw() as i64);
-                    command::PARAM_ID.put(&mut b, param.raw() as i64);
-                    command::PARAM_VALUE.put(&mut b, value.0 as i64);
+                    command::OPCODE.put(&mut b, Opcode::SetParam.raw())?;
+                    command::PARAM_ID.put(&mut b, param.raw())?;
+                    command::PARAM_VALUE.put(&mut b, value.0)?;
                 }
                 CommandKind::GetParam { param } => {
-                    command::OPCODE.put(&mut b, Opcode::GetParam.raw() as i64);
-                    command::PARAM_ID.put(&mut b, param.raw() as i64);
+                    command::OPCODE.put(&mut b, Opcode::GetParam.raw())?;
+                    command::PARAM_ID.put(&mut b, param.raw())?;
                 }
                 other => {
                     let op = other.opcode();
-                    command::OPCODE.put(&mut b, op.raw() as i64);
+                    command::OPCODE.put(&mut b, op.raw())?;
                 }
             },
             Message::ParamAck(m) => {
-                param_ack::PARAM_ID.put(&mut b, m.param.raw() as i64);
-                param_ack::STATUS.put(&mut b, m.status.raw() as i64);
-                param_ack::PARAM_VALUE.put(&mut b, m.value.0 as i64);
+                param_ack::PARAM_ID.put(&mut b, m.param.raw())?;
+                param_ack::STATUS.put(&mut b, m.status.raw())?;
+                param_ack::PARAM_VALUE.put(&mut b, m.value.0)?;
             }
             Message::Fault(m) => {
-                fault::CODE.put(&mut b, m.code.raw() as i64);
-                fault::TRANSITION.put(&mut b, m.transition.raw() as i64);
-                fault::DETAIL.put(&mut b, m.detail as i64);
-                fault::UPTIME_MS.put(&mut b, m.uptime_ms as i64);
+                fault::CODE.put(&mut b, m.code.raw())?;
+                fault::TRANSITION.put(&mut b, m.transition.raw())?;
+                fault::DETAIL.put(&mut b, m.detail)?;
+                fault::UPTIME_MS.put(&mut b, m.uptime_ms)?;
             }
             Message::Version(m) => {
-                version::PROTOCOL.put(&mut b, m.protocol as i64);
-                version::MAJOR.put(&mut b, m.major as i64);
-                version::MINOR.put(&mut b, m.minor as i64);
-                version::PATCH.put(&mut b, m.patch as i64);
-                version::BUILD.put(&mut b, m.build as i64);
+                version::PROTOCOL.put(&mut b, m.protocol)?;
+                version::MAJOR.put(&mut b, m.major)?;
+                version::MINOR.put(&mut b, m.minor)?;
+                version::PATCH.put(&mut b, m.patch)?;
+                version::BUILD.put(&mut b, m.build)?;
             }
             Message::Identity(m) => {
-                identity::UID_LOW.put(&mut b, m.uid_low as i64);
-                identity::UID_MID.put(&mut b, m.uid_mid as i64);
+                identity::UID_LOW.put(&mut b, m.uid_low)?;
+                identity::UID_MID.put(&mut b, m.uid_mid)?;
             }
             Message::BootInfo(m) => {
-                boot_info::UID_HIGH.put(&mut b, m.uid_high as i64);
-                boot_info::RESET_CAUSE.put(&mut b, m.reset_cause.raw() as i64);
-                boot_info::PARAMS_SOURCE.put(&mut b, m.params_source.raw() as i64);
-                boot_info::FAULT_HISTORY_LEN.put(&mut b, m.fault_history_len as i64);
-                boot_info::CALIBRATION_SOURCE.put(&mut b, m.calibration_source.raw() as i64);
+                boot_info::UID_HIGH.put(&mut b, m.uid_high)?;
+                boot_info::RESET_CAUSE.put(&mut b, m.reset_cause.raw())?;
+                boot_info::PARAMS_SOURCE.put(&mut b, m.params_source.raw())?;
+                boot_info::FAULT_HISTORY_LEN.put(&mut b, m.fault_history_len)?;
+                boot_info::CALIBRATION_SOURCE.put(&mut b, m.calibration_source.raw())?;
             }
             Message::CommandAck(m) => {
-                command_ack::OPCODE.put(&mut b, m.opcode.raw() as i64);
-                command_ack::RESULT.put(&mut b, m.result.raw() as i64);
+                command_ack::OPCODE.put(&mut b, m.opcode.raw())?;
+                command_ack::RESULT.put(&mut b, m.result.raw())?;
             }
             Message::FaultHistory(m) => {
-                fault_history::ENTRY.put(&mut b, m.entry as i64);
-                fault_history::CODE.put(&mut b, m.code.raw() as i64);
-                fault_history::STATE_AFTER.put(&mut b, m.state_after.raw() as i64);
-                fault_history::DETAIL.put(&mut b, m.detail as i64);
-                fault_history::UPTIME_MS.put(&mut b, (m.uptime_ms & 0xFF_FFFF) as i64);
+                fault_history::ENTRY.put(&mut b, m.entry)?;
+                fault_history::CODE.put(&mut b, m.code.raw())?;
+                fault_history::STATE_AFTER.put(&mut b, m.state_after.raw())?;
+                fault_history::DETAIL.put(&mut b, m.detail)?;
+                fault_history::UPTIME_MS.put(&mut b, m.uptime_ms)?;
             }
         }
         let n = spec.dlc as usize;
@@ -1078,7 +1082,7 @@ impl Message {
                     }
                     Opcode::SetParam => CommandKind::SetParam {
                         param: enum_field(&command::PARAM_ID, &b, ParamId::from_raw)?,
-                        value: ParamValue(command::PARAM_VALUE.get(&b) as i32),
+                        value: ParamValue(command::PARAM_VALUE.get_as(&b)?),
                     },
                     Opcode::GetParam => {
                         zero(&command::PARAM_VALUE)?;
@@ -1113,62 +1117,62 @@ impl Message {
             }
             MessageClass::HeelStrike => Message::HeelStrike(HeelStrike {
                 node: sender(id.class, id.node_raw)?,
-                step_count: heel_strike::STEP_COUNT.get(&b) as u16,
-                time_us: heel_strike::TIME_US.get(&b) as u32,
+                step_count: heel_strike::STEP_COUNT.get_as(&b)?,
+                time_us: heel_strike::TIME_US.get_as(&b)?,
             }),
             MessageClass::AnkleState => Message::AnkleState(AnkleState {
                 node: sender(id.class, id.node_raw)?,
-                angle: Angle(ankle_state::ANGLE.get(&b) as i16),
-                rate: AngularRate(ankle_state::RATE.get(&b) as i16),
-                actuator_position: Angle(ankle_state::ACTUATOR_POSITION.get(&b) as i16),
+                angle: Angle(ankle_state::ANGLE.get_as(&b)?),
+                rate: AngularRate(ankle_state::RATE.get_as(&b)?),
+                actuator_position: Angle(ankle_state::ACTUATOR_POSITION.get_as(&b)?),
                 phase: enum_field(&ankle_state::PHASE, &b, ReflexPhase::from_raw)?,
             }),
             MessageClass::Heartbeat => {
-                let raw_flags = heartbeat::FAULT_FLAGS.get(&b);
+                let raw_flags: u16 = heartbeat::FAULT_FLAGS.get_as(&b)?;
                 Message::Heartbeat(Heartbeat {
                     node: sender(id.class, id.node_raw)?,
                     state: enum_field(&heartbeat::STATE, &b, NodeState::from_raw)?,
-                    faults: FaultFlags::from_bits(raw_flags as u16).ok_or(
+                    faults: FaultFlags::from_bits(raw_flags).ok_or(
                         DecodeError::ValueOutOfRange {
                             signal: heartbeat::FAULT_FLAGS.name,
-                            raw: raw_flags,
+                            raw: i64::from(raw_flags),
                         },
                     )?,
-                    uptime_ms: heartbeat::UPTIME_MS.get(&b) as u32,
+                    uptime_ms: heartbeat::UPTIME_MS.get_as(&b)?,
                 })
             }
             MessageClass::ParamAck => Message::ParamAck(ParamAck {
                 node: sender(id.class, id.node_raw)?,
                 param: enum_field(&param_ack::PARAM_ID, &b, ParamId::from_raw)?,
                 status: enum_field(&param_ack::STATUS, &b, ParamStatus::from_raw)?,
-                value: ParamValue(param_ack::PARAM_VALUE.get(&b) as i32),
+                value: ParamValue(param_ack::PARAM_VALUE.get_as(&b)?),
             }),
             MessageClass::Fault => Message::Fault(FaultEvent {
                 node: sender(id.class, id.node_raw)?,
                 code: enum_field(&fault::CODE, &b, FaultCode::from_raw)?,
                 transition: enum_field(&fault::TRANSITION, &b, FaultTransition::from_raw)?,
-                detail: fault::DETAIL.get(&b) as i16,
-                uptime_ms: fault::UPTIME_MS.get(&b) as u32,
+                detail: fault::DETAIL.get_as(&b)?,
+                uptime_ms: fault::UPTIME_MS.get_as(&b)?,
             }),
             MessageClass::Version => Message::Version(Version {
                 node: sender(id.class, id.node_raw)?,
-                protocol: version::PROTOCOL.get(&b) as u8,
-                major: version::MAJOR.get(&b) as u8,
-                minor: version::MINOR.get(&b) as u8,
-                patch: version::PATCH.get(&b) as u8,
-                build: version::BUILD.get(&b) as u32,
+                protocol: version::PROTOCOL.get_as(&b)?,
+                major: version::MAJOR.get_as(&b)?,
+                minor: version::MINOR.get_as(&b)?,
+                patch: version::PATCH.get_as(&b)?,
+                build: version::BUILD.get_as(&b)?,
             }),
             MessageClass::Identity => Message::Identity(Identity {
                 node: sender(id.class, id.node_raw)?,
-                uid_low: identity::UID_LOW.get(&b) as u32,
-                uid_mid: identity::UID_MID.get(&b) as u32,
+                uid_low: identity::UID_LOW.get_as(&b)?,
+                uid_mid: identity::UID_MID.get_as(&b)?,
             }),
             MessageClass::BootInfo => Message::BootInfo(BootInfo {
                 node: sender(id.class, id.node_raw)?,
-                uid_high: boot_info::UID_HIGH.get(&b) as u32,
+                uid_high: boot_info::UID_HIGH.get_as(&b)?,
                 reset_cause: enum_field(&boot_info::RESET_CAUSE, &b, ResetCause::from_raw)?,
                 params_source: enum_field(&boot_info::PARAMS_SOURCE, &b, ConfigSource::from_raw)?,
-                fault_history_len: boot_info::FAULT_HISTORY_LEN.get(&b) as u8,
+                fault_history_len: boot_info::FAULT_HISTORY_LEN.get_as(&b)?,
                 calibration_source: enum_field(
                     &boot_info::CALIBRATION_SOURCE,
                     &b,
@@ -1182,11 +1186,11 @@ impl Message {
             }),
             MessageClass::FaultHistory => Message::FaultHistory(FaultHistoryEntry {
                 node: sender(id.class, id.node_raw)?,
-                entry: fault_history::ENTRY.get(&b) as u8,
+                entry: fault_history::ENTRY.get_as(&b)?,
                 code: enum_field(&fault_history::CODE, &b, FaultCode::from_raw)?,
                 state_after: enum_field(&fault_history::STATE_AFTER, &b, NodeState::from_raw)?,
-                detail: fault_history::DETAIL.get(&b) as i16,
-                uptime_ms: fault_history::UPTIME_MS.get(&b) as u32,
+                detail: fault_history::DETAIL.get_as(&b)?,
+                uptime_ms: fault_history::UPTIME_MS.get_as(&b)?,
             }),
         };
         Ok(msg)

@@ -1,6 +1,7 @@
 //! Signal and message layout tables: the single definition that the codec reads and writes
 //! through, and that the DBC file and the bus-load figure are generated from.
 
+use crate::error::{DecodeError, EncodeError};
 use crate::id::{MessageClass, NodeId, Target};
 
 /// Wire representation of one signal. All signals are byte-aligned and little-endian.
@@ -79,11 +80,12 @@ pub struct SignalSpec {
 impl SignalSpec {
     /// Start bit in DBC little-endian (Intel) numbering.
     pub const fn start_bit(&self) -> u32 {
-        self.byte as u32 * 8
+        // At most 255 × 8: the saturation is never reached.
+        (self.byte as u32).saturating_mul(8)
     }
     /// Length \[bits\].
     pub const fn bits(&self) -> u32 {
-        self.kind.bytes() as u32 * 8
+        (self.kind.bytes() as u32).saturating_mul(8)
     }
     /// Physical value of a raw count. Fractional scales divide by the (integral) counts per
     /// unit so that decimal scales print as short decimals (4294967295 µs → 4294.967295 s).
@@ -103,30 +105,69 @@ impl SignalSpec {
         self.phys(self.kind.raw_max())
     }
 
-    /// Write `raw` little-endian at this signal's place. The value is truncated to the
-    /// signal's width (callers pass values that already fit); out-of-buffer bytes are skipped.
-    pub fn put(&self, buf: &mut [u8; 8], raw: i64) {
+    /// Write `raw` little-endian at this signal's place (two's complement for signed kinds);
+    /// bytes past the payload (none in a valid layout) are skipped.
+    ///
+    /// # Errors
+    /// [`EncodeError::RawOutOfRange`] when `raw` is outside [`Kind::raw_min`]..=[`Kind::raw_max`]
+    /// of the signal: a value is refused, never cut to the signal's width. Nothing is written
+    /// then.
+    pub fn put(&self, buf: &mut [u8; 8], raw: impl Into<i64>) -> Result<(), EncodeError> {
+        let raw: i64 = raw.into();
+        let (min, max) = (self.kind.raw_min(), self.kind.raw_max());
+        if raw < min || raw > max {
+            return Err(EncodeError::RawOutOfRange {
+                signal: self.name,
+                raw,
+                min,
+                max,
+            });
+        }
+        // In range: the low `bytes()` bytes of the little-endian i64 are the wire value.
         let bytes = raw.to_le_bytes();
-        for i in 0..self.kind.bytes() as usize {
-            if let (Some(dst), Some(src)) = (buf.get_mut(self.byte as usize + i), bytes.get(i)) {
-                *dst = *src;
-            }
+        let width = usize::from(self.kind.bytes());
+        for (dst, src) in buf
+            .iter_mut()
+            .skip(usize::from(self.byte))
+            .zip(bytes.iter().take(width))
+        {
+            *dst = *src;
+        }
+        Ok(())
+    }
+
+    /// Read the raw value (sign-extended for signed kinds). Any bytes give a value in
+    /// [`Kind::raw_min`]..=[`Kind::raw_max`]; bytes past the payload (none in a valid layout)
+    /// read as zero.
+    pub fn get(&self, buf: &[u8; 8]) -> i64 {
+        // Every kind is at most 4 bytes wide; unused high bytes stay zero.
+        let mut le = [0u8; 4];
+        let width = usize::from(self.kind.bytes());
+        for (dst, src) in le
+            .iter_mut()
+            .zip(buf.iter().skip(usize::from(self.byte)).take(width))
+        {
+            *dst = *src;
+        }
+        let [b0, b1, _, _] = le;
+        match self.kind {
+            Kind::I16 => i64::from(i16::from_le_bytes([b0, b1])),
+            Kind::I32 => i64::from(i32::from_le_bytes(le)),
+            Kind::U8 | Kind::U16 | Kind::U24 | Kind::U32 => i64::from(u32::from_le_bytes(le)),
         }
     }
 
-    /// Read the raw value (sign-extended for signed kinds).
-    pub fn get(&self, buf: &[u8; 8]) -> i64 {
-        let mut v: u64 = 0;
-        let n = self.kind.bytes() as usize;
-        for i in 0..n {
-            let b = buf.get(self.byte as usize + i).copied().unwrap_or(0);
-            v |= (b as u64) << (8 * i);
-        }
-        match self.kind {
-            Kind::I16 => v as u16 as i16 as i64,
-            Kind::I32 => v as u32 as i32 as i64,
-            _ => v as i64,
-        }
+    /// Read the raw value as the field type `T` of the decoded message.
+    ///
+    /// # Errors
+    /// [`DecodeError::ValueOutOfRange`] when the raw value does not fit `T` (a layout whose
+    /// signal is wider than its field): refused, never truncated.
+    pub fn get_as<T: TryFrom<i64>>(&self, buf: &[u8; 8]) -> Result<T, DecodeError> {
+        let raw = self.get(buf);
+        T::try_from(raw).map_err(|_| DecodeError::ValueOutOfRange {
+            signal: self.name,
+            raw,
+        })
     }
 }
 

@@ -15,8 +15,13 @@ macro_rules! scaled {
             pub const SCALE: f64 = $scale;
             /// SI unit of [`Self::to_si`].
             pub const UNIT: &'static str = $unit;
+            // The nearest f32 to a decimal scale: a rounding of a constant, not a wrap.
+            #[allow(clippy::cast_possible_truncation)]
             const INV_SCALE_F32: f32 = (1.0 / $scale) as f32;
+            #[allow(clippy::cast_possible_truncation)]
             const SCALE_F32: f32 = $scale as f32;
+            /// 2^(bits − 1) = −MIN, exact in f32: the first integer above the raw range.
+            const RAW_LIMIT_F32: f32 = -(<$raw>::MIN as f32);
 
             /// Smallest representable physical value [unit].
             pub fn min_si() -> f32 {
@@ -30,11 +35,16 @@ macro_rules! scaled {
             /// Quantise a physical value (round to nearest count).
             ///
             /// # Errors
-            /// [`RangeError`] for NaN or a value that does not fit the raw type.
+            /// [`RangeError`] for NaN, ±∞ or a value that does not fit the raw type.
             pub fn from_si(value: f32) -> Result<Self, RangeError> {
                 let r = libm::roundf(value * Self::INV_SCALE_F32);
-                if r >= <$raw>::MIN as f32 && r <= <$raw>::MAX as f32 {
-                    Ok($name(r as $raw))
+                // `MAX as f32` rounds up to 2^(bits−1) for 32 bits, so the upper bound is the
+                // exact, exclusive −MIN: a value that would only fit by saturating is refused.
+                if (-Self::RAW_LIMIT_F32..Self::RAW_LIMIT_F32).contains(&r) {
+                    // An integer-valued float in MIN..=MAX: the cast is exact.
+                    #[allow(clippy::cast_possible_truncation)]
+                    let raw = r as $raw;
+                    Ok($name(raw))
                 } else {
                     Err(RangeError {
                         signal: $sig,
@@ -47,8 +57,11 @@ macro_rules! scaled {
 
             /// Quantise, saturating at the representable range (NaN gives 0).
             pub fn saturating_from_si(value: f32) -> Self {
-                // `as` casts from float saturate and map NaN to 0.
-                $name(libm::roundf(value * Self::INV_SCALE_F32) as $raw)
+                // Float-to-int `as` saturates at MIN/MAX and maps NaN to 0 — what this
+                // function promises (telemetry of an out-of-range or NaN estimate); no wrap.
+                #[allow(clippy::cast_possible_truncation)]
+                let raw = libm::roundf(value * Self::INV_SCALE_F32) as $raw;
+                $name(raw)
             }
 
             /// The physical value [unit].
@@ -174,7 +187,11 @@ impl FaultCode {
     }
     /// The bit of this fault in [`FaultFlags`].
     pub const fn flag(self) -> u16 {
-        1 << (self as u8 - 1)
+        // Codes are 1..=11 (bits 0..=10); a code past bit 15 would have no bit (0).
+        match 1u16.checked_shl((self as u8).saturating_sub(1) as u32) {
+            Some(bit) => bit,
+            None => 0,
+        }
     }
 }
 
@@ -380,13 +397,13 @@ impl FaultFlags {
 
     /// Every defined bit.
     pub const fn defined_bits() -> u16 {
-        let mut m = 0u16;
-        let mut i = 0;
-        while i < FaultCode::ALL.len() {
-            m |= FaultCode::ALL[i].flag();
-            i += 1;
+        const fn bits_of(codes: &[FaultCode]) -> u16 {
+            match codes {
+                [first, rest @ ..] => first.flag() | bits_of(rest),
+                [] => 0,
+            }
         }
-        m
+        bits_of(FaultCode::ALL)
     }
 
     /// From raw bits; `None` if an undefined bit is set.

@@ -4,6 +4,7 @@
 use embedded_hal::digital::{Error as _, ErrorKind as PinErrorKind, OutputPin};
 use embedded_hal::pwm::{Error as _, ErrorKind as PwmErrorKind, SetDutyCycle};
 
+use crate::convert::duty_from_fraction;
 use crate::reflex::ActuatorCommand;
 
 /// Why the actuator could not apply a command.
@@ -123,8 +124,7 @@ impl<P: SetDutyCycle, D: OutputPin> PwmDirActuator<P, D> {
             self.dir.set_low()
         }
         .map_err(|e| ActuatorError::Pin(e.kind()))?;
-        let max = self.pwm.max_duty_cycle() as f32;
-        let duty = (libm::fabsf(signed_duty) * max) as u16;
+        let duty = duty_from_fraction(libm::fabsf(signed_duty), self.pwm.max_duty_cycle());
         self.pwm
             .set_duty_cycle(duty)
             .map_err(|e| ActuatorError::Pwm(e.kind()))
@@ -208,7 +208,7 @@ impl<P: SetDutyCycle> Actuator for ServoActuator<P> {
             ActuatorCommand::Released => 0,
             ActuatorCommand::Position { ankle_angle_rad } => {
                 let f = self.pulse_us(ankle_angle_rad) / self.range.period_us;
-                (f * self.pwm.max_duty_cycle() as f32) as u16
+                duty_from_fraction(f, self.pwm.max_duty_cycle())
             }
         };
         self.pwm

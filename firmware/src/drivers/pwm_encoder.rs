@@ -49,14 +49,27 @@ pub fn decode(frame: PwmFrame, period_range_ticks: (u32, u32)) -> Result<u16, En
     if frame.period_ticks < lo || frame.period_ticks > hi || frame.period_ticks == 0 {
         return Err(EncoderError::NoSignal);
     }
-    // Units of the high time, rounded: high × 4119 / period (u64: no overflow).
-    let units = ((frame.high_ticks as u64 * FRAME_UNITS as u64 + frame.period_ticks as u64 / 2)
-        / frame.period_ticks as u64) as u32;
-    if units < HEADER_UNITS {
-        return Err(EncoderError::ErrorFlag { word: units as u16 });
-    }
-    let angle12 = (units - HEADER_UNITS).min(MAX_ANGLE_12);
-    Ok((angle12 * 4) as u16)
+    // Units of the high time, rounded: high × 4119 / period. In u64 nothing saturates
+    // (below 2⁴⁴ + 2³¹); a high time longer than the period (a glitch) gives more than 4119
+    // units, saturated to u32 rather than wrapped into a plausible angle, and reads as full
+    // scale below.
+    let high = u64::from(frame.high_ticks);
+    let period = u64::from(frame.period_ticks);
+    let units = high
+        .saturating_mul(u64::from(FRAME_UNITS))
+        .saturating_add(period / 2)
+        .checked_div(period)
+        .ok_or(EncoderError::NoSignal)?;
+    let units = u32::try_from(units).unwrap_or(u32::MAX);
+    let Some(data_units) = units.checked_sub(HEADER_UNITS) else {
+        // Fewer than 16 units: fits a u16.
+        return Err(EncoderError::ErrorFlag {
+            word: u16::try_from(units).unwrap_or(u16::MAX),
+        });
+    };
+    // At most 4095 after the `min`: a u16, and × 4 (≤ 16380) cannot saturate.
+    let angle12 = u16::try_from(data_units.min(MAX_ANGLE_12)).unwrap_or(u16::MAX);
+    Ok(angle12.saturating_mul(4))
 }
 
 /// The encoder on a PWM-input timer.
@@ -80,8 +93,9 @@ impl<C: PwmCapture> PwmAngleEncoder<C> {
         nominal_period_ticks: u32,
         max_missed: u8,
     ) -> Self {
-        let lo = nominal_period_ticks / 5 * 4;
-        let hi = nominal_period_ticks / 5 * 6;
+        // ±20 %; saturating: a nominal period past u32::MAX / 6 × 5 keeps u32::MAX as the top.
+        let lo = (nominal_period_ticks / 5).saturating_mul(4);
+        let hi = (nominal_period_ticks / 5).saturating_mul(6);
         PwmAngleEncoder {
             capture,
             calibration,

@@ -53,6 +53,7 @@
 //!   target in `release_timeout_ticks`: off and an error (the node raises `Actuator` and goes
 //!   `Safe`).
 
+use crate::convert::saturating_i32;
 use crate::drivers::actuator::{Actuator, ActuatorError};
 use crate::reflex::ActuatorCommand;
 
@@ -297,8 +298,12 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> SpoolMotor<B, E, I> {
     /// measured angle `m`, having begun at the measured angle `m_start`.
     fn rest_target(&self, s: i32, m: f32, m_start: f32) -> i32 {
         let back = self.config.counts_per_ankle_rad * (m - m_start);
-        // Saturating float-to-int conversion; a NaN angle gives 0 counts back.
-        let back = if back.is_finite() { back as i32 } else { 0 };
+        // Saturating float-to-int conversion; a NaN or infinite angle gives 0 counts back.
+        let back = if back.is_finite() {
+            saturating_i32(back)
+        } else {
+            0
+        };
         s.saturating_sub(back.max(0))
             .saturating_sub(self.config.slack_counts)
             .max(self.config.spool_min_counts)
@@ -454,7 +459,9 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
 }
 
 /// Extends a 16-bit hardware counter (a timer in encoder mode) to 32 bits, assuming less
-/// than half a wrap (32,768 counts) between two reads.
+/// than half a wrap (32,768 counts) between two reads. The extended position saturates at
+/// the ends of `i32` (2³¹ counts, far past any spool's travel) rather than wrap to the other
+/// end.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CounterUnwrap {
     last: Option<u16>,
@@ -465,10 +472,13 @@ impl CounterUnwrap {
     /// Feed the counter's value, get the extended position.
     pub fn update(&mut self, raw: u16) -> i32 {
         if let Some(prev) = self.last {
+            // The hardware counter wraps modulo 2¹⁶; the modular difference read as two's
+            // complement is the signed step (|step| < 2¹⁵ between reads). Wrapping on purpose.
+            #[allow(clippy::cast_possible_wrap)]
             let step = raw.wrapping_sub(prev) as i16;
-            self.total = self.total.wrapping_add(step as i32);
+            self.total = self.total.saturating_add(i32::from(step));
         } else {
-            self.total = raw as i32;
+            self.total = i32::from(raw);
         }
         self.last = Some(raw);
         self.total
