@@ -6,40 +6,15 @@
 //! what the server did (counters, answers), never how long it took.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
 
 use canbus::frame::Frame;
 use canbus::socketcand::{ServerConfig, SocketcandServer};
 
-const DEADLINE: Duration = Duration::from_secs(60);
-
-fn read_until(s: &mut TcpStream, want: &str) -> String {
-    s.set_read_timeout(Some(Duration::from_millis(50))).unwrap();
-    let mut got = String::new();
-    let mut b = [0u8; 4096];
-    let end = Instant::now() + DEADLINE;
-    while !got.contains(want) && Instant::now() < end {
-        match s.read(&mut b) {
-            Ok(0) => break,
-            Ok(n) => got.push_str(&String::from_utf8_lossy(&b[..n])),
-            Err(_) => {}
-        }
-    }
-    got
-}
-
-fn wait_until(mut done: impl FnMut() -> bool) -> bool {
-    let end = Instant::now() + DEADLINE;
-    while Instant::now() < end {
-        if done() {
-            return true;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    false
-}
+mod common;
+use common::{read_until, wait_until, DEADLINE};
 
 /// A monitor: connects, opens the bus in rawmode.
 fn monitor(addr: SocketAddr) -> TcpStream {

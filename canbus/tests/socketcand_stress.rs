@@ -16,6 +16,9 @@ use std::time::{Duration, Instant};
 use canbus::socketcand::{ServerConfig, SocketcandServer};
 use canbus::Frame;
 
+mod common;
+use common::{read_until, wait_until, DEADLINE};
+
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 fn one_at_a_time() -> MutexGuard<'static, ()> {
@@ -39,11 +42,6 @@ fn vm_rss_bytes() -> u64 {
 
 const MIB: u64 = 1024 * 1024;
 
-/// How long any wait may take before the test fails instead of hanging: far beyond what any
-/// of them takes (milliseconds), far below the 600 s write timeout a shutdown that waited on a
-/// stalled client would take.
-const DEADLINE: Duration = Duration::from_secs(60);
-
 fn config() -> ServerConfig {
     ServerConfig {
         rawmode_grace: Duration::from_millis(1),
@@ -51,35 +49,6 @@ fn config() -> ServerConfig {
         allow_send: true,
         ..ServerConfig::default()
     }
-}
-
-/// Read until `want` is in the text, the connection closes or [`DEADLINE`] passes.
-fn read_until(s: &mut TcpStream, want: &str) -> String {
-    s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
-    let mut got = String::new();
-    let mut b = [0u8; 4096];
-    let end = Instant::now() + DEADLINE;
-    while !got.contains(want) && Instant::now() < end {
-        match s.read(&mut b) {
-            Ok(0) => break,
-            Ok(n) => got.push_str(&String::from_utf8_lossy(&b[..n])),
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-            Err(_) => break,
-        }
-    }
-    got
-}
-
-/// Whether `done` comes true before [`DEADLINE`].
-fn wait_until(mut done: impl FnMut() -> bool) -> bool {
-    let end = Instant::now() + DEADLINE;
-    while Instant::now() < end {
-        if done() {
-            return true;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    done()
 }
 
 /// Shut the server down on another thread; panics if it has not returned by [`DEADLINE`].
