@@ -83,7 +83,7 @@ pub struct ServerConfig {
     /// Frames from clients (`< send ... >`) are put on the bus; otherwise they are refused
     /// and the server is read-only. Default false.
     pub allow_send: bool,
-    /// The kernel send buffer of each client socket (`SO_SNDBUF`) [bytes]: how much a client
+    /// The kernel send buffer of each client socket (`SO_SNDBUF`) \[bytes\]: how much a client
     /// that stopped reading can be sent before its output stalls. Default 32 KiB.
     pub socket_send_buffer_bytes: usize,
 }

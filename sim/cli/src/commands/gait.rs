@@ -1,7 +1,7 @@
 //! `walker gait`: find the periodic gait of a scene and its stability.
 //!
 //! At the scene's default values, Newton from its guess; elsewhere the longer-period of that
-//! and the defaults' gait followed to the requested values ([`nominal_gait`]), so the
+//! and the defaults' gait followed to the requested values ([`sim::analysis::homotopy::nominal_gait`]), so the
 //! long-period gait comes back wherever its branch reaches (`walker gaits` lists them all).
 
 use super::{print_json, shown};
