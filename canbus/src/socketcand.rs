@@ -30,7 +30,10 @@
 //!   and entered rawmode within [`ServerConfig::open_timeout`] is dropped
 //!   ([`ServerStats::clients_idle`]); when the server is full, a new connection takes the place
 //!   of the oldest client not yet in rawmode (also counted there), so idle connections never
-//!   lock a monitor out. Only when every client is in rawmode is a new one answered
+//!   lock a monitor out; failing that, of the oldest client in rawmode whose queue is full
+//!   (it does not read: [`ServerStats::clients_stalled`]). Evicted clients are closed, told
+//!   `< error dropped to make room for a new client >` when their socket has room for it. Only when every client is in rawmode
+//!   and reading is a new one answered
 //!   `< error too many clients ... >`, closed and counted in [`ServerStats::clients_refused`];
 //! * per client, memory for at most [`ServerConfig::client_queue_frames`] queued frames (taken
 //!   as needed, not up front), 64 KiB of output and 64 KiB of unparsed input; a client whose
@@ -458,13 +461,26 @@ fn admit(stream: TcpStream, shared: &Arc<Shared>) {
     let mut clients = lock(&shared.clients);
     let max = shared.config.max_clients;
     if clients.len() >= max {
-        // The oldest client not yet in rawmode (and not already leaving) gives up its place.
-        if let Some(pos) = clients.iter().position(|c| {
-            !c.state.rawmode.load(Ordering::Acquire) && !c.state.evicted.load(Ordering::Acquire)
-        }) {
+        // The oldest client not yet in rawmode gives up its place, else the oldest in rawmode
+        // that is not reading (its queue full: every frame for it lost), so neither idle nor
+        // stalled clients lock a monitor out; one already leaving is not counted twice.
+        let leaving = |c: &Client| c.state.evicted.load(Ordering::Acquire);
+        let idle = clients
+            .iter()
+            .position(|c| !c.state.rawmode.load(Ordering::Acquire) && !leaving(c));
+        let stalled = || {
+            clients
+                .iter()
+                .position(|c| !leaving(c) && lock(&c.state.full_since).is_some())
+        };
+        let evict = match idle {
+            Some(pos) => Some((pos, &shared.counters.clients_idle)),
+            None => stalled().map(|pos| (pos, &shared.counters.clients_stalled)),
+        };
+        if let Some((pos, counter)) = evict {
             if let Some(old) = clients.get(pos) {
                 old.state.evicted.store(true, Ordering::Release);
-                bump(&shared.counters.clients_idle);
+                bump(counter);
             }
             let old = clients.remove(pos);
             // Its thread sees the flag within a poll and closes; the acceptor's reap would
@@ -749,6 +765,7 @@ fn serve_client(mut stream: TcpStream, shared: &Shared, me: &ClientState) {
         let now = Instant::now();
         let mut busy = false;
         if me.evicted.load(Ordering::Acquire) {
+            let _ = stream.write(b"< error dropped to make room for a new client >");
             return;
         }
         if !matches!(s.phase, Phase::Raw { .. })

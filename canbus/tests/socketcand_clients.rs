@@ -178,3 +178,49 @@ fn the_server_is_read_only_unless_sending_is_allowed() {
         }
     }
 }
+
+/// Rawmode clients that stopped reading do not lock a monitor out while they wait for their
+/// write timeout (the review found 21 s of lock-out): when the server is full, a new monitor
+/// takes the place of one whose queue is full, and that one is told why.
+#[test]
+fn stalled_clients_give_way_to_a_new_monitor_at_once() {
+    let server = SocketcandServer::bind(
+        "127.0.0.1:0",
+        ServerConfig {
+            rawmode_grace: Duration::from_millis(1),
+            // only eviction can free a place within the test
+            write_timeout: Duration::from_secs(600),
+            client_queue_frames: 256,
+            ..ServerConfig::default()
+        },
+    )
+    .unwrap();
+    let addr = server.local_addr();
+    let max = ServerConfig::default().max_clients;
+    let mut silent: Vec<TcpStream> = (0..max).map(|_| monitor(addr)).collect();
+    assert!(wait_until(|| server.rawmode_clients() == max));
+    // frames until every silent client's queue is full
+    let mut i = 0u32;
+    assert!(wait_until(|| {
+        for _ in 0..2000 {
+            server.publish(&frame(i), u64::from(i) * 1000).unwrap();
+            i = i.wrapping_add(1);
+        }
+        server.stats().frames_dropped >= 8 * 100
+    }));
+    let mut m = monitor(addr);
+    let st = server.stats();
+    assert_eq!(st.clients_refused, 0, "{st:?}");
+    assert_eq!(st.clients_stalled, 1, "{st:?}");
+    server.publish(&frame(7), 1_000).unwrap();
+    assert!(read_until(&mut m, "< frame 072").contains("< frame 072"));
+    // the oldest silent client was closed, told why when its socket had room for it (after
+    // whatever frames it had been sent)
+    let told = read_until(&mut silent[0], "make room for a new client >");
+    let mut rest = [0u8; 64];
+    assert!(
+        matches!(std::io::Read::read(&mut silent[0], &mut rest), Ok(0)),
+        "the evicted client is closed; read so far ends {}",
+        &told[told.len().saturating_sub(200)..]
+    );
+}

@@ -66,8 +66,8 @@ enum Command {
     /// Orbit diagram: the attractor (periodic, chaotic or a fall) at each value of one
     /// parameter, from the previous value's attractor.
     OrbitDiagram(orbit_diagram::OrbitDiagramArgs),
-    /// Stability map: max |λ| of the long-period gait over a grid of two parameters, filled
-    /// by continuation along rows.
+    /// Stability map: max |λ| of the gait `walker gait` finds at each cell of a grid of two
+    /// parameters (every cell by the same rule).
     StabilityMap(stability_map::StabilityMapArgs),
     /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
     Tune(tune::TuneArgs),

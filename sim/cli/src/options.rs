@@ -153,12 +153,12 @@ impl Common {
         let kind = settings.integrator.kind();
         if adaptive && self.step_s.is_some() {
             return Err(InputError::Other(format!(
-                "--step-s sets the fixed step of meijaard and rk4; the integrator here is {kind},                  which chooses its own steps (use --rtol, or --integrator rk4)"
+                "--step-s sets the fixed step of meijaard and rk4; the integrator here is {kind}, which chooses its own steps (use --rtol, or --integrator rk4)"
             )));
         }
         if !adaptive && self.rtol.is_some() {
             return Err(InputError::Other(format!(
-                "--rtol sets the tolerance of dopri5 and dop853; the integrator here is {kind},                  with a fixed step (use --step-s, or --integrator dop853)"
+                "--rtol sets the tolerance of dopri5 and dop853; the integrator here is {kind}, with a fixed step (use --step-s, or --integrator dop853)"
             )));
         }
         // A step too small for the stride's budgets would only run out of them, slowly.

@@ -158,3 +158,143 @@ fn the_issue_s_reproductions_agree_and_find_a_gait() {
         }
     }
 }
+
+/// `walker gait` at `p1 = v1`, `p2 = v2`.
+fn gait_at(scene: &str, (p1, v1): (&str, f64), (p2, v2): (&str, f64)) -> Reported {
+    let (s1, s2) = (format!("{p1}={v1:?}"), format!("{p2}={v2:?}"));
+    let g = json(&["gait", "--scene", scene, "--set", &s1, "--set", &s2]);
+    reported(
+        &g["max_abs_eigenvalue"],
+        &g["step_period_s"],
+        &g["gait_source"],
+    )
+}
+
+/// Every cell of a multi-cell map is `walker gait`'s gait at the cell's values: a map that
+/// followed its row from the neighbouring cell (the issue's bug) crossed a fold onto the
+/// short-period gait there, which a 1×1 map cannot show.
+fn map_cells_agree(
+    scene: &str,
+    (p1, a1, b1, n1): (&str, f64, f64, usize),
+    (p2, a2, b2, n2): (&str, f64, f64, usize),
+) -> Result<(), TestCaseError> {
+    let (x, y) = (
+        format!("{p1}={a1:?}:{b1:?}:{n1}"),
+        format!("{p2}={a2:?}:{b2:?}:{n2}"),
+    );
+    let map = json(&["stability-map", "--scene", scene, "--x", &x, "--y", &y]);
+    let xs: Vec<f64> = map["x"]["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let ys: Vec<f64> = map["y"]["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    prop_assert_eq!((xs.len(), ys.len()), (n1, n2), "{}", map);
+    for (j, &vy) in ys.iter().enumerate() {
+        for (i, &vx) in xs.iter().enumerate() {
+            let cell = reported(
+                &map["max_abs_eigenvalue"][j][i],
+                &map["step_period_s"][j][i],
+                &map["gait_source"][j][i],
+            );
+            let gait = gait_at(scene, (p1, vx), (p2, vy));
+            prop_assert_eq!(
+                cell,
+                gait,
+                "{} cell {},{} at {}={}, {}={}",
+                scene,
+                i,
+                j,
+                p1,
+                vx,
+                p2,
+                vy
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Every point of a tune with several evaluations is `walker gait`'s gait at its values (the
+/// issue's tune warm-started each point from the last fixed point and reported other gaits).
+fn tune_points_agree(
+    scene: &str,
+    (p1, lo, hi): (&str, f64, f64),
+    evaluations: usize,
+) -> Result<(), TestCaseError> {
+    let vary = format!("{p1}={lo:?}:{hi:?}");
+    let n = evaluations.to_string();
+    let tune = json(&[
+        "tune",
+        "--scene",
+        scene,
+        "--vary",
+        &vary,
+        "--evaluations",
+        &n,
+    ]);
+    let history = tune["history"].as_array().unwrap();
+    prop_assert!(history.len() >= 3, "{}", tune);
+    for point in history {
+        let v = point["values"][0].as_f64().unwrap();
+        let s = format!("{p1}={v:?}");
+        let g = json(&["gait", "--scene", scene, "--set", &s]);
+        prop_assert_eq!(
+            reported(
+                &point["max_abs_eigenvalue"],
+                &point["step_period_s"],
+                &point["gait_source"]
+            ),
+            reported(
+                &g["max_abs_eigenvalue"],
+                &g["step_period_s"],
+                &g["gait_source"]
+            ),
+            "{} tune point {}={}",
+            scene,
+            p1,
+            v
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn compass_maps_and_tunes(slope in 0.0f64..0.1, width in 0.002f64..0.02, leg_mass in 1.0f64..19.0) {
+        map_cells_agree("compass", ("slope_rad", slope, slope + width, 3), ("leg_mass_kg", leg_mass, leg_mass + 1.0, 2))?;
+        tune_points_agree("compass", ("slope_rad", slope, slope + width), 6)?;
+    }
+
+    #[test]
+    fn simplest_maps_and_tunes(slope in 0.002f64..0.017, hip_mass in 0.5f64..1.5) {
+        map_cells_agree("simplest", ("slope_rad", slope, slope + 0.002, 3), ("hip_mass_kg", hip_mass, hip_mass + 0.2, 2))?;
+        tune_points_agree("simplest", ("slope_rad", slope, slope + 0.002), 5)?;
+    }
+
+    #[test]
+    fn kneed2d_maps_and_tunes(slope in 0.035f64..0.06, hip_mass in 0.3f64..0.7) {
+        map_cells_agree("kneed2d", ("slope_rad", slope, slope + 0.005, 2), ("hip_mass_kg", hip_mass, hip_mass + 0.1, 2))?;
+        tune_points_agree("kneed2d", ("slope_rad", slope, slope + 0.005), 4)?;
+    }
+}
+
+/// The issue's map row, whose cells followed the row across a fold: every cell is `walker
+/// gait`'s.
+#[test]
+fn the_issue_s_map_row_is_walker_gait_cell_by_cell() {
+    map_cells_agree(
+        "compass",
+        ("slope_rad", 0.00202, 0.01, 5),
+        ("leg_mass_kg", 19.2, 19.2, 1),
+    )
+    .unwrap();
+}

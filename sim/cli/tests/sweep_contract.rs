@@ -250,6 +250,27 @@ fn a_sweep_that_cannot_start_or_runs_out_of_budget_exits_1_naming_the_unanswered
         "{answered:?}"
     );
     assert!(answered.iter().any(|s| *s < 0.001) && answered.iter().any(|s| *s > 0.01));
+    // The unanswered values, named as two runs on either side of the answered ones, each
+    // with its own reason: behind the start the branch's end going back, ahead the budget.
+    let err = common::stderr(&out);
+    let runs: Vec<&str> = err.lines().filter(|l| l.contains("unanswered")).collect();
+    assert_eq!(runs.len(), 2, "{err}");
+    assert!(
+        runs[0].contains("values of slope from -0.5 to ") && runs[0].contains("event_change"),
+        "{err}"
+    );
+    assert!(
+        runs[1].contains("to 0.5 unanswered") && runs[1].contains("budget"),
+        "{err}"
+    );
+    let lowest_after = answered.iter().copied().fold(f64::INFINITY, f64::min);
+    let run_from: f64 = runs[1]
+        .split("values of slope from ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    assert!(run_from > lowest_after, "{err}");
     // A sweep that answers every value exits 0.
     let out = walker(&[
         "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.009", "--to", "0.012",

@@ -1,4 +1,5 @@
-//! `walker stability-map`: the largest |eigenvalue| of the long-period gait over a grid of
+//! `walker stability-map`: the largest |eigenvalue| of the scene's gait (the one rule of
+//! `walker gait`, [`sim::analysis::homotopy::GaitRule`]) at each cell of a grid of
 //! two parameters ([`sim::analysis::stability_map`]), as text, JSON or a heat map.
 
 use super::print_json;
@@ -103,7 +104,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     if let Some(dir) = &plot {
         let fig = HeatMap {
             title: format!(
-                "{}: stability of the long-period gait",
+                "{}: stability of its gait (as walker gait finds it)",
                 labels::walker_name(&scene)
             ),
             x_label: labels::parameter_label(&scene, &x.name),
@@ -129,7 +130,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
 fn print_text(out: &mut dyn Write, r: &StabilityMapReport) -> std::io::Result<()> {
     writeln!(
         out,
-        "max |λ| of the long-period gait ('-': no gait), rows {} (down), columns {} (across)",
+        "max |λ| of the gait `walker gait` finds at each cell ('-': no gait), rows {} (down), columns {} (across)",
         r.y.name, r.x.name
     )?;
     write!(out, "{:>12}", "")?;

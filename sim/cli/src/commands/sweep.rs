@@ -145,34 +145,50 @@ struct Unanswered {
 
 impl Unanswered {
     fn describe(&self, param: &str) -> String {
+        let (from, to) = (grid_value(self.from), grid_value(self.to));
         if self.count == 1 {
-            format!("{param} = {} unanswered: {}", self.from, self.reason)
+            format!("{param} = {from} unanswered: {}", self.reason)
         } else {
             format!(
-                "{} values of {param} from {} to {} unanswered: {} (at {}: {})",
-                self.count, self.from, self.to, self.kind, self.from, self.reason
+                "{} values of {param} from {from} to {to} unanswered: {} (at {from}: {})",
+                self.count, self.kind, self.reason
             )
         }
     }
 }
 
+/// A grid value for people: without the grid arithmetic's last-digit noise
+/// (`-0.4995999599959996` is `-0.4996`), in short form.
+fn grid_value(x: f64) -> String {
+    let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+    sim::scene::short_number(rounded)
+}
+
 /// The values without a gait on branch 0 (no start, a corrector that failed, values past its
-/// end), grouped into runs of one reason in parameter order.
+/// ends), grouped into runs of one reason in parameter order; an answered value ends a run.
 fn unanswered_ranges(r: &SweepReport) -> Vec<Unanswered> {
-    let mut failed: Vec<(f64, &str)> = r
+    let mut on_branch_0: Vec<(f64, Option<&str>)> = r
         .points
         .iter()
         .filter_map(|p| match p {
-            SweepPointRecord::Failed(e) if e.branch == 0 => Some((e.value, e.reason.as_str())),
+            SweepPointRecord::Failed(e) if e.branch == 0 => {
+                Some((e.value, Some(e.reason.as_str())))
+            }
+            SweepPointRecord::Converged(g) if g.branch == 0 => Some((g.value, None)),
             _ => None,
         })
         .collect();
-    failed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    on_branch_0.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut runs: Vec<Unanswered> = Vec::new();
-    for (value, reason) in failed {
+    let mut open = false;
+    for (value, reason) in on_branch_0 {
+        let Some(reason) = reason else {
+            open = false;
+            continue;
+        };
         let kind = reason.split(':').next().unwrap_or(reason);
         match runs.last_mut() {
-            Some(run) if run.kind == kind => {
+            Some(run) if open && run.kind == kind => {
                 run.count += 1;
                 run.to = value;
             }
@@ -184,6 +200,7 @@ fn unanswered_ranges(r: &SweepReport) -> Vec<Unanswered> {
                 reason: reason.to_string(),
             }),
         }
+        open = true;
     }
     runs
 }

@@ -116,17 +116,27 @@ impl Continuation {
             .iter()
             .map(|(g, why)| (*g, format!("the corrector at this value failed: {why}")))
             .collect();
+        // The branch's reach on the `from` side: values beyond it are behind its start, past
+        // the end it met going back (`end_before`), not past its forward end.
+        let toward_to = (self.grid.to - self.grid.from).signum();
+        let reach_back = b
+            .grid
+            .iter()
+            .map(|p| p.value * toward_to)
+            .fold(f64::INFINITY, f64::min);
         for &g in &self.grid.values {
             let hit = b.grid.iter().any(|p| p.value == g) || b.missed.iter().any(|m| m.0 == g);
             if hit {
                 continue;
             }
-            let reason = match self.no_start.iter().find(|(v, _)| *v == g) {
-                Some((_, e)) => match &b.end_before {
+            let behind = g * toward_to < reach_back;
+            let reason = match (self.no_start.iter().find(|(v, _)| *v == g), behind) {
+                (Some((_, e)), _) => match &b.end_before {
                     Some(_) => format!("{}; no gait to start from: {e}", describe(&b.end_before)),
                     None => format!("no gait to start from: {e}"),
                 },
-                None => describe(&b.end),
+                (None, true) => describe(&b.end_before),
+                (None, false) => describe(&b.end),
             };
             out.push((g, reason));
         }
