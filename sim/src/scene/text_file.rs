@@ -27,11 +27,29 @@ pub enum TextFileError {
     NotUtf8,
 }
 
+/// `path` opened for reading with `O_NONBLOCK`, which never waits for a FIFO's writer (and
+/// changes nothing for a regular file).
+#[cfg(unix)]
+fn open_without_blocking(path: &Path) -> std::io::Result<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+}
+
+/// `path` opened for reading.
+#[cfg(not(unix))]
+fn open_without_blocking(path: &Path) -> std::io::Result<std::fs::File> {
+    std::fs::File::open(path)
+}
+
 /// The text of the regular file at `path`, of at most `max_bytes` bytes; `what` names what it
 /// should be in the error ("a scene file").
 ///
 /// # Errors
-/// A [`TextFileError`]: not a regular file (checked before it is opened), too large, unreadable
+/// A [`TextFileError`]: not a regular file (checked before it is opened, and on what was
+/// opened), too large, unreadable
 /// or not UTF-8.
 pub fn read_text_file(
     path: &Path,
@@ -47,9 +65,15 @@ pub fn read_text_file(
     if meta.len() > max_bytes {
         return Err(too_large);
     }
+    // Opened without blocking (a path swapped for a FIFO after the check above would block an
+    // ordinary open until a writer came), and checked again on what was opened.
+    let file = open_without_blocking(path).map_err(io)?;
+    if !file.metadata().map_err(io)?.is_file() {
+        return Err(TextFileError::NotARegularFile);
+    }
     let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(max_bytes.saturating_add(1)).read_to_end(&mut bytes))
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
         .map_err(io)?;
     if bytes.len() as u64 > max_bytes {
         return Err(too_large);
@@ -60,6 +84,32 @@ pub fn read_text_file(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What `read_text_file` opens, it opens without waiting: a FIFO with no writer (a path
+    /// swapped for one after the type check) is opened at once and refused on what was opened.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_opened_without_waiting_and_refused() {
+        let fifo = std::env::temp_dir().join(format!("walker-text-fifo-{}", std::process::id()));
+        let _ = std::fs::remove_file(&fifo);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let (tx, rx) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || {
+            let f = open_without_blocking(&path).unwrap();
+            let _ = tx.send(f.metadata().unwrap().is_file());
+        });
+        // a deadline that only turns a hang (an ordinary open) into a failure
+        let is_file = rx
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .expect("opened without waiting for a writer");
+        assert!(!is_file);
+        std::fs::remove_file(&fifo).unwrap();
+    }
 
     #[test]
     fn only_small_regular_utf8_files_are_read() {
