@@ -23,6 +23,7 @@ fn a_grazing_mid_swing_contact_inside_one_step_is_caught() {
             StrideRequest::new(&w.settings).options(StrideOptions {
                 record: false,
                 contact: true,
+                ..StrideOptions::default()
             }),
         )
         .unwrap();

@@ -395,6 +395,7 @@ fn roll_freedom_of_the_pelvis_shrinks_the_lateral_centre_of_pressure() {
                 StrideRequest::new(&w.settings).options(StrideOptions {
                     record: false,
                     contact: true,
+                    ..StrideOptions::default()
                 }),
             )
             .unwrap()

@@ -6,7 +6,7 @@ use super::settings::StrideSettings;
 use crate::engine::control::AnkleController;
 use crate::engine::integrators::Sample;
 
-/// What a stride keeps besides its result.
+/// What a stride keeps besides its result, and the floor it ends on.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StrideOptions {
     /// Keep every accepted sample (in [`super::StrideResult::trajectory`], or in the request's
@@ -15,6 +15,12 @@ pub struct StrideOptions {
     /// Compute the contact load, lateral centre of pressure and swing clearance at every
     /// accepted sample (for reports; costs one more evaluation per step).
     pub contact: bool,
+    /// The floor where the swing foot lands, above the stance foot's floor \[m\], measured
+    /// along the floor's normal (up positive): a step up (> 0) or down (< 0) at this stride's
+    /// heel strike; the floor stays at the new level (the next stride's floor is where its
+    /// stance foot stands). The heel strike is the swing foot reaching that level ahead of
+    /// the stance contact. Default 0: one plane.
+    pub floor_step_m: f64,
 }
 
 /// A controller moving the stance ankle's string during a stride.
@@ -59,6 +65,12 @@ impl<'a> StrideRequest<'a> {
             control: None,
             sink: None,
         }
+    }
+
+    /// Ending on a floor `floor_step_m` above the stance foot's ([`StrideOptions::floor_step_m`]).
+    pub fn floor_step(mut self, floor_step_m: f64) -> Self {
+        self.options.floor_step_m = floor_step_m;
+        self
     }
 
     /// With these recording options.

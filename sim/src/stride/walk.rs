@@ -277,6 +277,7 @@ pub fn walk(
         let options = StrideOptions {
             record: sampling,
             contact: false,
+            floor_step_m: 0.0,
         };
         let mut request = StrideRequest::new(settings)
             .options(options)

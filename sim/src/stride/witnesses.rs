@@ -130,6 +130,9 @@ impl WitnessEvaluator<Sample> for Witnesses<'_> {
 pub(super) struct Witnesses<'a> {
     pub(super) walker: &'a Walker,
     pub(super) kin: Kinematics,
+    /// The landing floor above the stance foot's \[m\] ([`super::StrideOptions::floor_step_m`]):
+    /// the swing foot's height is measured from it.
+    pub(super) floor_step_m: f64,
 }
 
 impl<'a> Witnesses<'a> {
@@ -137,6 +140,7 @@ impl<'a> Witnesses<'a> {
         Self {
             walker,
             kin: Kinematics::new(walker.model()),
+            floor_step_m: 0.0,
         }
     }
 
@@ -158,7 +162,7 @@ impl<'a> Witnesses<'a> {
         let heading = self.heading();
         WitnessValues {
             t_s: s.t_s,
-            foot_height_m: p_foot.y,
+            foot_height_m: p_foot.y - self.floor_step_m,
             foot_height_rate_m_s: self.kin.velocity_of(foot.link, &p_foot).y,
             foot_ahead_m: (p_foot - p_contact).dot(&heading),
             foot_ahead_rate_m_s: (self.kin.velocity_of(foot.link, &p_foot)

@@ -172,10 +172,11 @@ impl StrideWorkspace<'_> {
         for c in walker.initially_locked() {
             engine.phase.active[c.0] = false;
         }
-        let wit = self
+        let mut wit = self
             .witnesses
             .take()
             .unwrap_or_else(|| Witnesses::new(walker));
+        wit.floor_step_m = options.floor_step_m;
         let start = Start {
             walker,
             settings,

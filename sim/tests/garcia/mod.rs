@@ -348,3 +348,54 @@ pub fn period2_near(gamma: f64, p1: &Period1) -> Option<[State; 2]> {
 pub fn period2_eigenvalues(gamma: f64, x: State) -> Option<[(f64, f64); 2]> {
     Some(eigenvalues(&jacobian_n(gamma, [x.theta, x.theta_dot], 2)?))
 }
+
+/// The swing foot's height above the stance foot's floor, along the slope normal (legs of
+/// length 1; the swing leg at `θ − φ` from the normal).
+fn foot_height(y: &Y) -> f64 {
+    y[0].cos() - (y[0] - y[1]).cos()
+}
+
+/// How far the swing foot is ahead of the stance foot along the slope.
+fn foot_ahead_of_stance(y: &Y) -> f64 {
+    -y[0].sin() + (y[0] - y[1]).sin()
+}
+
+/// One stride from any state `y0 = [θ, φ, θ̇, φ̇]` onto a floor `h` above the stance foot's
+/// (a step up for `h > 0`, down for `h < 0`), for the floor-step tests. The heel strike is the
+/// swing foot's height falling through `h` while the foot is ahead (more than 1e-3); the
+/// impact is Garcia's eq. (4) with the angle between the legs `φ⁻` in place of `2θ⁻` (the
+/// hip's angular momentum about the new contact, massless legs):
+///   θ⁺ = θ⁻ − φ⁻, φ⁺ = −φ⁻, θ̇⁺ = cos φ⁻ θ̇⁻, φ̇⁺ = cos φ⁻ (1 − cos φ⁻) θ̇⁻.
+/// The state after it and the stride time, or `None` on a fall.
+pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f64)> {
+    let above = |y: &Y| foot_height(y) - h;
+    let mut y: Y = y0;
+    let mut t = 0.0;
+    while t < MAX_TIME {
+        let next = rk4(gamma, &y, H);
+        if !next.iter().all(|v| v.is_finite()) || next[0].abs() > std::f64::consts::FRAC_PI_2 {
+            return None;
+        }
+        if above(&y) > 0.0 && above(&next) <= 0.0 && foot_ahead_of_stance(&next) > 1e-3 {
+            let (mut lo, mut hi) = (0.0, H);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if above(&rk4(gamma, &y, mid)) > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let s_hit = 0.5 * (lo + hi);
+            let pre = rk4(gamma, &y, s_hit);
+            let c = pre[1].cos();
+            return Some((
+                [pre[0] - pre[1], -pre[1], c * pre[2], c * (1.0 - c) * pre[2]],
+                t + s_hit,
+            ));
+        }
+        y = next;
+        t += H;
+    }
+    None
+}

@@ -133,6 +133,7 @@ pub fn report(
                 StrideRequest::new(&setup.settings).options(StrideOptions {
                     record,
                     contact: true,
+                    ..StrideOptions::default()
                 }),
             )
             .ok()

@@ -86,6 +86,7 @@ pub(super) fn stride(
     let wit = PlanarWitnesses {
         points,
         min_hip_height_m: start.walker.fall().min_hip_height_m,
+        floor_step_m: start.options.floor_step_m,
     };
     match tree.dof() {
         1 => stride_n::<1>(start, tree, wit, q0, qd0),

@@ -13,6 +13,9 @@ pub(super) struct PlanarWitnesses<'w> {
     pub(super) points: &'w PlanarPoints,
     /// Fallen when the hip is lower than this above the floor \[m\].
     pub(super) min_hip_height_m: f64,
+    /// The landing floor above the stance foot's \[m\]: the swing foot's height is measured
+    /// from it.
+    pub(super) floor_step_m: f64,
 }
 
 impl PlanarWitnesses<'_> {
@@ -30,7 +33,7 @@ impl PlanarWitnesses<'_> {
         let heading_x = if c.abs() > 1e-9 { c / c.abs() } else { 1.0 };
         WitnessValues {
             t_s: s.t_s,
-            foot_height_m: p_foot[1],
+            foot_height_m: p_foot[1] - self.floor_step_m,
             foot_height_rate_m_s: v_foot[1],
             foot_ahead_m: (p_foot[0] - p_contact[0]) * heading_x,
             foot_ahead_rate_m_s: (v_foot[0] - v_contact[0]) * heading_x,
