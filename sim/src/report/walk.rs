@@ -3,6 +3,7 @@
 use super::StartRecord;
 use crate::scene::Scene;
 use crate::stride::walk::{StepSummary, Walk, WalkFailure};
+use crate::stride::Floor;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -21,6 +22,10 @@ pub struct WalkReport {
     pub steps: Vec<StepSummary>,
     /// What the walk started from (`null` when the caller did not say).
     pub start: Option<StartRecord>,
+    /// The floor walked over (`{"kind": "plane"}`, `step` with `at_heel_strike` and
+    /// `height_m`, `rough` with `sigma_m` and `seed`); each step's `floor_step_m` is the level
+    /// it landed on.
+    pub floor: Floor,
 }
 
 impl WalkReport {
@@ -33,6 +38,7 @@ impl WalkReport {
             failure: walk.failure.clone(),
             steps: walk.steps.clone(),
             start: None,
+            floor: Floor::Plane,
         }
     }
 }

@@ -14,7 +14,7 @@ use crate::engine::kinematics::Kinematics;
 use crate::engine::math::{rotation_about, sagittal_reflection};
 use crate::engine::walker::Walker;
 use crate::stride::{
-    FailureKind, StrideEvent, StrideOptions, StrideRequest, StrideSettings, StrideWorkspace,
+    FailureKind, Floor, StrideEvent, StrideOptions, StrideRequest, StrideSettings, StrideWorkspace,
 };
 use nalgebra::{DVector, Matrix3, Vector3};
 use serde::Serialize;
@@ -70,6 +70,8 @@ pub struct StepSummary {
     pub start_t_walk_s: f64,
     /// Duration \[s\].
     pub duration_s: f64,
+    /// The floor this step landed on, above the one it started from \[m\] (0 on one plane).
+    pub floor_step_m: f64,
     /// Distance between the contacts \[m\].
     pub step_length_m: f64,
     /// Yaw of the new stance foot relative to the old one, in the step's own (mirrored) stance
@@ -171,6 +173,8 @@ pub struct WalkRequest<'a> {
     /// Called with every integration sample, in the floor frame, as its stride completes
     /// (streaming: the walk keeps none of them unless recording).
     pub on_sample: Option<&'a mut dyn FnMut(&PathSample)>,
+    /// The floor walked over. Default: one plane.
+    pub floor: Floor,
 }
 
 impl<'a> WalkRequest<'a> {
@@ -183,6 +187,7 @@ impl<'a> WalkRequest<'a> {
             controller: None,
             on_step: None,
             on_sample: None,
+            floor: Floor::Plane,
         }
     }
 
@@ -212,6 +217,11 @@ impl<'a> WalkRequest<'a> {
             on_sample: Some(on_sample),
             ..self
         }
+    }
+
+    /// Over `floor`.
+    pub fn floor(self, floor: Floor) -> Self {
+        Self { floor, ..self }
     }
 
     /// With these options.
@@ -252,7 +262,9 @@ pub fn walk(
         mut controller,
         mut on_step,
         mut on_sample,
+        floor,
     } = request;
+    let mut floor_heights = floor.heights();
     let (record, keep_steps) = (options.record, options.keep_steps);
     let path_interval_s = options.path_interval_s;
     let sampling = record || on_sample.is_some();
@@ -274,10 +286,11 @@ pub fn walk(
     let mut workspace = StrideWorkspace::new(walker);
     for step in 0..steps {
         samples.clear();
+        let floor_step_m = floor_heights.next_step_m();
         let options = StrideOptions {
             record: sampling,
             contact: false,
-            floor_step_m: 0.0,
+            floor_step_m,
         };
         let mut request = StrideRequest::new(settings)
             .options(options)
@@ -323,6 +336,7 @@ pub fn walk(
                     step,
                     start_t_walk_s: t0,
                     duration_s: r.duration_s,
+                    floor_step_m,
                     step_length_m: r.step_m.norm(),
                     heading_change_rad: r.heading_change_rad,
                     hip_floor_m: [p_hip.x, p_hip.y, p_hip.z],

@@ -21,6 +21,7 @@ use sim::analysis::homotopy::GaitRule;
 use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::stride::walk::WalkRequest;
+use sim::stride::Floor;
 use sim::stride::SearchBudget;
 use std::io::Write;
 use std::process::ExitCode;
@@ -65,6 +66,12 @@ pub struct WalkArgs {
     /// Write a self-contained HTML page that plays the walk in 3D (docs/animation.md).
     #[arg(long, value_name = "FILE.html")]
     pub animate: Option<std::path::PathBuf>,
+    /// The floor: `plane` (default), `step:at=K,height_m=H` (the K-th heel strike lands on a
+    /// step of H m, up positive, measured along the slope's normal; the floor stays there),
+    /// `rough:sigma_m=S[,seed=N]` (at every heel strike the level changes by a normal draw of
+    /// standard deviation S m, reproducible from the seed).
+    #[arg(long, value_name = "SPEC", default_value = "plane")]
+    pub floor: String,
 }
 
 /// Runs `walker walk`: exit code 1 if there is no gait to start from, 3 if the walker fell
@@ -81,7 +88,11 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         plot,
         plot_with,
         animate,
+        floor,
     } = args;
+    let floor: Floor = floor
+        .parse()
+        .map_err(|e: sim::stride::FloorError| InputError::Other(format!("--{e}")))?;
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     // Flags the walk would ignore are refused, not dropped in silence.
     if plot_with.is_some() && plot.is_none() {
@@ -186,6 +197,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         }
     };
     let mut request = WalkRequest::new(&setup.settings, steps)
+        .floor(floor)
         .recording(plot.is_some() || animation.is_some())
         .path_interval(animation::PATH_SAMPLE_INTERVAL_S)
         .on_step(&mut tick);
@@ -232,6 +244,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     }
     let mut report = WalkReport::new(&scene, &walk);
     report.start = Some(start_record);
+    report.floor = floor;
     if common.json {
         print_json(&report)?;
     } else {
@@ -270,6 +283,20 @@ fn print_text(
     )?;
     if let Some(start) = &r.start {
         writeln!(out, "start: {}", start.describe())?;
+    }
+    match r.floor {
+        Floor::Plane => {}
+        Floor::Step {
+            at_heel_strike,
+            height_m,
+        } => writeln!(
+            out,
+            "floor: a step of {height_m} m (up positive, along the slope's normal) at heel strike {at_heel_strike}"
+        )?,
+        Floor::Rough { sigma_m, seed } => writeln!(
+            out,
+            "floor: rough, the level changing by a normal draw of sd {sigma_m} m at every heel strike (seed {seed})"
+        )?,
     }
     writeln!(
         out,
