@@ -46,7 +46,7 @@ fn the_simplest_walker_onto_a_step_matches_the_hand_written_model() {
                 .walker
                 .stride(&q, &qd, StrideRequest::new(settings).floor_step(h))
                 .unwrap_or_else(|f| panic!("γ {gamma}, h {h}: {f}"));
-            let (y1, t1) = garcia::stride_onto_step(gamma, y0, h).expect("the model walks");
+            let (y1, t1, _) = garcia::stride_onto_step(gamma, y0, h).expect("the model walks");
             let engine = DVector::from_vec(vec![
                 r.q_next[stance],
                 -r.q_next[swing],
@@ -65,6 +65,85 @@ fn the_simplest_walker_onto_a_step_matches_the_hand_written_model() {
                 (r.step_m.y - h).abs() < 1e-9,
                 "γ {gamma} h {h}: step {:?}",
                 r.step_m
+            );
+        }
+    }
+}
+
+/// The gait sensitivity norm of the model, by central differences of its stride map over its
+/// four state entries and the floor step (Hobbelen & Wisse's definition, written here apart
+/// from the engine's): (step time, step length, both).
+fn model_gsn(gamma: f64, y: [f64; 4]) -> (f64, f64, f64) {
+    let d = 1e-6;
+    let map = |y: [f64; 4], e: f64| garcia::stride_onto_step(gamma, y, e).unwrap();
+    let mut a = [[0.0; 4]; 4];
+    let mut c = [[0.0; 4]; 2];
+    for k in 0..4 {
+        let (mut yp, mut ym) = (y, y);
+        yp[k] += d;
+        ym[k] -= d;
+        let (sp, tp, lp) = map(yp, 0.0);
+        let (sm, tm, lm) = map(ym, 0.0);
+        for i in 0..4 {
+            a[i][k] = (sp[i] - sm[i]) / (2.0 * d);
+        }
+        c[0][k] = (tp - tm) / (2.0 * d);
+        c[1][k] = (lp - lm) / (2.0 * d);
+    }
+    let (sp, tp, lp) = map(y, d);
+    let (sm, tm, lm) = map(y, -d);
+    let mut x: Vec<f64> = (0..4).map(|i| (sp[i] - sm[i]) / (2.0 * d)).collect();
+    let dg = [(tp - tm) / (2.0 * d), (lp - lm) / (2.0 * d)];
+    let mut sums = [dg[0] * dg[0], dg[1] * dg[1]];
+    for _ in 0..100_000 {
+        let y0: f64 = (0..4).map(|k| c[0][k] * x[k]).sum();
+        let y1: f64 = (0..4).map(|k| c[1][k] * x[k]).sum();
+        sums[0] += y0 * y0;
+        sums[1] += y1 * y1;
+        if y0 * y0 + y1 * y1 <= 1e-16 * (sums[0] + sums[1]) {
+            break;
+        }
+        x = (0..4)
+            .map(|i| (0..4).map(|k| a[i][k] * x[k]).sum())
+            .collect();
+    }
+    (sums[0].sqrt(), sums[1].sqrt(), (sums[0] + sums[1]).sqrt())
+}
+
+#[test]
+fn the_gait_sensitivity_norm_of_the_simplest_walker_matches_the_hand_written_model() {
+    for gamma in [0.004, 0.009] {
+        let mut scene = Scene::load("simplest").unwrap();
+        scene.set("slope_rad", gamma).unwrap();
+        let w = scene.setup().unwrap();
+        let g = common::gait(&w);
+        let gsn = sim::analysis::gait_sensitivity::gait_sensitivity_norm(
+            &w.walker,
+            &w.settings,
+            &g,
+            1e-6,
+        )
+        .unwrap();
+        let (q, qd) = w.walker.unpack(&g.fixed_point);
+        let names: Vec<&str> = w
+            .walker
+            .model()
+            .coordinates
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect();
+        let at = |n: &str| names.iter().position(|c| *c == n).unwrap();
+        let (stance, swing) = (at("stance_leg"), at("swing_leg"));
+        let y = [q[stance], -q[swing], qd[stance], -qd[swing]];
+        let (t, l, both) = model_gsn(gamma, y);
+        eprintln!(
+            "γ {gamma}: GSN step time {} (model {t}), step length {} (model {l}), both {} (model {both}), {} strides",
+            gsn.step_time, gsn.step_length, gsn.both, gsn.strides_summed
+        );
+        for (ours, theirs) in [(gsn.step_time, t), (gsn.step_length, l), (gsn.both, both)] {
+            assert!(
+                (ours - theirs).abs() <= 1e-5 * theirs,
+                "γ {gamma}: {ours} against {theirs}"
             );
         }
     }

@@ -5,6 +5,7 @@
 pub mod accuracy;
 pub mod census;
 pub mod continuation;
+pub mod gait_sensitivity;
 pub mod homotopy;
 pub mod limit_cycle;
 pub mod orbit_diagram;

@@ -366,8 +366,9 @@ fn foot_ahead_of_stance(y: &Y) -> f64 {
 /// impact is Garcia's eq. (4) with the angle between the legs `φ⁻` in place of `2θ⁻` (the
 /// hip's angular momentum about the new contact, massless legs):
 ///   θ⁺ = θ⁻ − φ⁻, φ⁺ = −φ⁻, θ̇⁺ = cos φ⁻ θ̇⁻, φ̇⁺ = cos φ⁻ (1 − cos φ⁻) θ̇⁻.
-/// The state after it and the stride time, or `None` on a fall.
-pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f64)> {
+/// The state after it, the stride time and the step length (the distance between the feet at
+/// heel strike), or `None` on a fall.
+pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f64, f64)> {
     let above = |y: &Y| foot_height(y) - h;
     let mut y: Y = y0;
     let mut t = 0.0;
@@ -389,9 +390,11 @@ pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f
             let s_hit = 0.5 * (lo + hi);
             let pre = rk4(gamma, &y, s_hit);
             let c = pre[1].cos();
+            let length = foot_ahead_of_stance(&pre).hypot(foot_height(&pre));
             return Some((
                 [pre[0] - pre[1], -pre[1], c * pre[2], c * (1.0 - c) * pre[2]],
                 t + s_hit,
+                length,
             ));
         }
         y = next;
