@@ -11,25 +11,52 @@ use nalgebra::DVector;
 use sim::scene::Scene;
 use sim::stride::{EvaluationPath, StrideOptions, StrideRequest, StrideSettings};
 
-#[test]
-fn the_simplest_walker_onto_a_step_matches_the_hand_written_model() {
-    for gamma in [0.004, 0.009] {
-        let mut scene = Scene::load("simplest").unwrap();
-        scene.set("slope_rad", gamma).unwrap();
-        let w = scene.setup().unwrap();
-        let g = common::gait(&w);
-        let (q, qd) = w.walker.unpack(&g.fixed_point);
-        let names: Vec<&str> = w
-            .walker
+/// The simplest walker's gait at slope `gamma`, with its stance and swing coordinates' indices
+/// and its state in Garcia's variables (θ = stance_leg, φ = −swing_leg).
+struct Simplest {
+    w: sim::scene::Setup,
+    g: sim::analysis::limit_cycle::Gait,
+    stance: usize,
+    swing: usize,
+    y: [f64; 4],
+}
+
+fn simplest_gait(gamma: f64) -> Simplest {
+    let mut scene = Scene::load("simplest").unwrap();
+    scene.set("slope_rad", gamma).unwrap();
+    let w = scene.setup().unwrap();
+    let g = common::gait(&w);
+    let (q, qd) = w.walker.unpack(&g.fixed_point);
+    let at = |n: &str| {
+        w.walker
             .model()
             .coordinates
             .iter()
-            .map(|c| c.name.as_str())
-            .collect();
-        let at = |n: &str| names.iter().position(|c| *c == n).unwrap();
-        let (stance, swing) = (at("stance_leg"), at("swing_leg"));
-        // Garcia's variables: θ = stance_leg, φ = −swing_leg.
-        let y0 = [q[stance], -q[swing], qd[stance], -qd[swing]];
+            .position(|c| c.name == n)
+            .unwrap()
+    };
+    let (stance, swing) = (at("stance_leg"), at("swing_leg"));
+    let y = [q[stance], -q[swing], qd[stance], -qd[swing]];
+    Simplest {
+        w,
+        g,
+        stance,
+        swing,
+        y,
+    }
+}
+
+#[test]
+fn the_simplest_walker_onto_a_step_matches_the_hand_written_model() {
+    for gamma in [0.004, 0.009] {
+        let Simplest {
+            w,
+            g,
+            stance,
+            swing,
+            y: y0,
+        } = simplest_gait(gamma);
+        let (q, qd) = w.walker.unpack(&g.fixed_point);
         // the fixed-size engine (the simplest walker takes it) and the general one
         let general = StrideSettings {
             evaluation: EvaluationPath::General,
@@ -113,10 +140,7 @@ fn model_gsn(gamma: f64, y: [f64; 4]) -> (f64, f64, f64) {
 #[test]
 fn the_gait_sensitivity_norm_of_the_simplest_walker_matches_the_hand_written_model() {
     for gamma in [0.004, 0.009] {
-        let mut scene = Scene::load("simplest").unwrap();
-        scene.set("slope_rad", gamma).unwrap();
-        let w = scene.setup().unwrap();
-        let g = common::gait(&w);
+        let Simplest { w, g, y, .. } = simplest_gait(gamma);
         let gsn = sim::analysis::gait_sensitivity::gait_sensitivity_norm(
             &w.walker,
             &w.settings,
@@ -124,17 +148,6 @@ fn the_gait_sensitivity_norm_of_the_simplest_walker_matches_the_hand_written_mod
             1e-6,
         )
         .unwrap();
-        let (q, qd) = w.walker.unpack(&g.fixed_point);
-        let names: Vec<&str> = w
-            .walker
-            .model()
-            .coordinates
-            .iter()
-            .map(|c| c.name.as_str())
-            .collect();
-        let at = |n: &str| names.iter().position(|c| *c == n).unwrap();
-        let (stance, swing) = (at("stance_leg"), at("swing_leg"));
-        let y = [q[stance], -q[swing], qd[stance], -qd[swing]];
         let (t, l, both) = model_gsn(gamma, y);
         eprintln!(
             "γ {gamma}: GSN step time {} (model {t}), step length {} (model {l}), both {} (model {both}), {} strides",
