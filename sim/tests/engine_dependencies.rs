@@ -4,9 +4,11 @@
 
 /// Every dependency the engine may have: the numerics, serialisation, errors, rayon for
 /// parallel stride evaluations (independent Jacobian columns, parameter sides), the
-/// dependency-free extension profile it shares with the firmware, and `libm` (musl's math,
-/// also the firmware's) for the planar fast path's `sincos`.
-const ALLOWED: [&str; 9] = [
+/// dependency-free extension profile it shares with the firmware, `libm` (musl's math, also
+/// the firmware's) for the planar fast path's `sincos`, `libc` for opening a user's file
+/// without blocking (`O_NONBLOCK`), and `rand`, `rand_chacha`, `rand_distr` for the rough
+/// floor's seeded normal draws.
+const ALLOWED: [&str; 13] = [
     "ankle-profile",
     "nalgebra",
     "num-dual",
@@ -16,6 +18,10 @@ const ALLOWED: [&str; 9] = [
     "thiserror",
     "rayon",
     "libm",
+    "libc",
+    "rand",
+    "rand_chacha",
+    "rand_distr",
 ];
 
 const FORBIDDEN: [&str; 12] = [
