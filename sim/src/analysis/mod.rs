@@ -9,6 +9,7 @@ pub mod gait_sensitivity;
 pub mod homotopy;
 pub mod limit_cycle;
 pub mod orbit_diagram;
+pub mod robustness;
 pub mod stability;
 pub mod stability_map;
 pub mod tune;

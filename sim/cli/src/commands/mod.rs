@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod gait;
 pub mod gaits;
 pub mod orbit_diagram;
+pub mod robustness;
 pub mod scenes;
 pub mod sil;
 pub mod stability_map;

@@ -1,0 +1,318 @@
+//! `walker robustness`: how much disturbance the gait `walker gait` finds survives: the gait
+//! sensitivity norm, the largest step down and up, the largest change of each rate, and the
+//! mean first-passage time on rough floors (docs/robustness.md).
+
+use super::{print_json, shown};
+use crate::input_error::InputError;
+use crate::limits;
+use crate::options::Common;
+use crate::output;
+use crate::progress::Progress;
+use crate::search_progress::SearchProgress;
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use sim::analysis::gait_sensitivity::{gait_sensitivity_norm, GaitSensitivity};
+use sim::analysis::homotopy::GaitRule;
+use sim::analysis::robustness::{
+    mean_first_passage, step_thresholds, velocity_thresholds, FirstPassage, FirstPassageOptions,
+    Recovery, StepThresholds, ThresholdOptions, VelocityThreshold,
+};
+use sim::report::GaitReport;
+use sim::stride::SearchBudget;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::Arc;
+
+/// Options of `walker robustness`.
+#[derive(Args)]
+pub struct RobustnessArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// A rough floor's standard deviation for the mean first-passage time [m] (repeatable;
+    /// default: 0.001, 0.003 and 0.01 leg lengths).
+    #[arg(long = "sigma-m", value_name = "SIGMA", allow_hyphen_values = true)]
+    pub sigma_m: Vec<f64>,
+    /// Monte Carlo walks per roughness.
+    #[arg(long, default_value_t = 100)]
+    pub mfpt_runs: usize,
+    /// Most strides of one Monte Carlo walk (a walk that takes them all is censored).
+    #[arg(long, default_value_t = 200)]
+    pub mfpt_strides: usize,
+    /// The first Monte Carlo walk's floor seed (walk r has seed + r).
+    #[arg(long, default_value_t = 0)]
+    pub mfpt_seed: u64,
+}
+
+/// Most Monte Carlo walks per roughness, and most strides of one.
+const MAX_MFPT_RUNS: usize = 100_000;
+const MAX_MFPT_STRIDES: usize = 1_000_000;
+/// Most Monte Carlo strides per roughness (runs × strides per run).
+const MAX_MFPT_TOTAL_STRIDES: usize = 100_000_000;
+/// Most roughness values.
+const MAX_SIGMAS: usize = 64;
+
+/// A threshold pair as the contract gives it.
+#[derive(Serialize)]
+struct Signs {
+    positive: f64,
+    negative: f64,
+}
+
+/// Where survival starts again past each step threshold (`null`: not up to the limit).
+#[derive(Serialize)]
+struct Again {
+    down: Option<f64>,
+    up: Option<f64>,
+}
+
+/// The report (the contract's fields first; `step_thresholds` and `velocity_thresholds` with
+/// every detail).
+#[derive(Serialize)]
+struct RobustnessReport {
+    scene: String,
+    gait: GaitReport,
+    gait_sensitivity_norm: Option<GaitSensitivity>,
+    step_down_max_m: Option<f64>,
+    step_up_max_m: Option<f64>,
+    survived_again_from_m: Option<Again>,
+    velocity_perturbation_max: Option<BTreeMap<String, Signs>>,
+    mfpt: Vec<FirstPassage>,
+    step_thresholds: Option<StepThresholds>,
+    velocity_thresholds: Option<Vec<VelocityThreshold>>,
+    return_rule: sim::analysis::robustness::ReturnRule,
+    /// A measure that could not be computed, and why.
+    errors: BTreeMap<String, String>,
+}
+
+/// Runs `walker robustness`: exit code 1 when no gait is found or a measure fails.
+pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
+    let RobustnessArgs {
+        common,
+        sigma_m,
+        mfpt_runs,
+        mfpt_strides,
+        mfpt_seed,
+    } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let runs = limits::count("--mfpt-runs", mfpt_runs, 1, MAX_MFPT_RUNS)?;
+    let strides = limits::count("--mfpt-strides", mfpt_strides, 1, MAX_MFPT_STRIDES)?;
+    if runs.saturating_mul(strides) > MAX_MFPT_TOTAL_STRIDES {
+        return Err(InputError::Other(format!(
+            "--mfpt-runs × --mfpt-strides must be at most {MAX_MFPT_TOTAL_STRIDES} strides, got \
+             {runs} × {strides}"
+        ))
+        .into());
+    }
+    if sigma_m.len() > MAX_SIGMAS {
+        return Err(InputError::Other(format!(
+            "--sigma-m given {} times; at most {MAX_SIGMAS}",
+            sigma_m.len()
+        ))
+        .into());
+    }
+    if let Some(bad) = sigma_m.iter().find(|s| !(s.is_finite() && **s >= 0.0)) {
+        return Err(InputError::Other(format!(
+            "--sigma-m {}: a standard deviation must be a finite number ≥ 0",
+            sim::scene::short_number(*bad)
+        ))
+        .into());
+    }
+    let walker = &setup.walker;
+    let budget = Arc::new(SearchBudget::new(common.max_strides));
+    let sourced = {
+        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
+        GaitRule::new(&common.setup_for(), &common.newton(), &common.homotopy())
+            .with_budget(Arc::clone(&budget))
+            .gait(&scene)?
+    };
+    let source = sourced.as_ref().ok().map(|(_, s)| *s);
+    let result = sourced.map(|(g, _)| g);
+    let (mut gait_report, _) = super::gait::report(&scene, &setup, &result, false);
+    gait_report.gait_source = source;
+    let mut report = RobustnessReport {
+        scene: scene.name().to_owned(),
+        gait: gait_report,
+        gait_sensitivity_norm: None,
+        step_down_max_m: None,
+        step_up_max_m: None,
+        survived_again_from_m: None,
+        velocity_perturbation_max: None,
+        mfpt: Vec::new(),
+        step_thresholds: None,
+        velocity_thresholds: None,
+        return_rule: sim::analysis::robustness::ReturnRule::default(),
+        errors: BTreeMap::new(),
+    };
+    let Ok(gait) = &result else {
+        return finish(&common, &report, ExitCode::from(1));
+    };
+    let recovery = Recovery::new(walker, &setup.settings, gait);
+    let leg_m = recovery.leg_length_m();
+    let sigmas = if sigma_m.is_empty() {
+        vec![1e-3 * leg_m, 3e-3 * leg_m, 1e-2 * leg_m]
+    } else {
+        sigma_m
+    };
+    let progress = Progress::new(3 + sigmas.len(), "robustness measures", !common.json);
+    match gait_sensitivity_norm(walker, &setup.settings, gait, common.perturbation) {
+        Ok(g) => report.gait_sensitivity_norm = Some(g),
+        Err(e) => {
+            report
+                .errors
+                .insert("gait_sensitivity_norm".into(), e.to_string());
+        }
+    }
+    progress.tick();
+    let steps = step_thresholds(&recovery, &ThresholdOptions::steps());
+    report.step_down_max_m = Some(steps.down.max);
+    report.step_up_max_m = Some(steps.up.max);
+    report.survived_again_from_m = Some(Again {
+        down: steps.down.survived_again_from,
+        up: steps.up.survived_again_from,
+    });
+    report.step_thresholds = Some(steps);
+    progress.tick();
+    let rates = velocity_thresholds(&recovery, &ThresholdOptions::rates());
+    report.velocity_perturbation_max = Some(
+        rates
+            .iter()
+            .map(|v| {
+                (
+                    v.coordinate.clone(),
+                    Signs {
+                        positive: v.positive.max,
+                        negative: v.negative.max,
+                    },
+                )
+            })
+            .collect(),
+    );
+    report.velocity_thresholds = Some(rates);
+    progress.tick();
+    let options = FirstPassageOptions {
+        runs,
+        strides_per_run: strides,
+        seed: mfpt_seed,
+    };
+    for sigma in sigmas {
+        match mean_first_passage(&recovery, sigma, &options) {
+            Ok(m) => report.mfpt.push(m),
+            Err(e) => {
+                report
+                    .errors
+                    .insert(format!("mfpt sigma_m={sigma}"), e.to_string());
+            }
+        }
+        progress.tick();
+    }
+    progress.finish();
+    let code = if report.errors.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    };
+    finish(&common, &report, code)
+}
+
+fn finish(common: &Common, report: &RobustnessReport, code: ExitCode) -> Result<ExitCode> {
+    if common.json {
+        print_json(report)?;
+    } else {
+        output::text(|out| print_text(out, report))?;
+    }
+    Ok(code)
+}
+
+fn print_text(out: &mut dyn Write, r: &RobustnessReport) -> std::io::Result<()> {
+    writeln!(out, "scene: {}", r.scene)?;
+    let g = match &r.gait.outcome {
+        sim::report::GaitOutcome::NotFound(e) => {
+            return writeln!(out, "no gait found: {}", e.error);
+        }
+        sim::report::GaitOutcome::Found(g) => g,
+    };
+    writeln!(
+        out,
+        "gait: {}, step period {:.6} s, max |λ| = {:.6} ({})",
+        r.gait
+            .gait_source
+            .map_or("the scene's guess", |s| s.describe()),
+        shown(g.step_period_s),
+        shown(g.max_abs_eigenvalue),
+        if g.stable { "stable" } else { "unstable" }
+    )?;
+    if let Some(n) = &r.gait_sensitivity_norm {
+        writeln!(
+            out,
+            "gait sensitivity norm (floor step): step time {:.6} s/m, step length {:.6} m/m, \
+             both {:.6} ({} strides summed)",
+            n.step_time, n.step_length, n.both, n.strides_summed
+        )?;
+    }
+    if let Some(s) = &r.step_thresholds {
+        writeln!(
+            out,
+            "return to the gait: within {:e} (∞-norm of the stride-map state) in {} strides",
+            r.return_rule.tolerance, r.return_rule.max_strides
+        )?;
+        for (what, t) in [("down", &s.down), ("up", &s.up)] {
+            let beyond = t
+                .beyond
+                .map_or_else(|| "the scan's limit".to_owned(), |o| o.name());
+            let again = t.survived_again_from.map_or_else(
+                || "none up to the limit".to_owned(),
+                |h| format!("{h:.7} m"),
+            );
+            writeln!(
+                out,
+                "largest step {what:<4} survived: {:.7} m ({:.5} leg lengths; beyond: {beyond}); \
+                 survived again from: {again}",
+                t.max,
+                t.max / s.leg_length_m
+            )?;
+        }
+    }
+    if let Some(v) = &r.velocity_thresholds {
+        writeln!(out, "largest change of each rate survived:")?;
+        for t in v {
+            writeln!(
+                out,
+                "    {:<28} +{:.7}  −{:.7}",
+                t.coordinate, t.positive.max, t.negative.max
+            )?;
+        }
+    }
+    if !r.mfpt.is_empty() {
+        writeln!(
+            out,
+            "mean first-passage time on a rough floor (steps, 95 % interval):"
+        )?;
+        for m in &r.mfpt {
+            let steps = m
+                .steps
+                .map_or_else(|| "no fall".to_owned(), |s| format!("{s:.1}"));
+            let high = m
+                .ci_high
+                .map_or_else(|| "∞".to_owned(), |s| format!("{s:.1}"));
+            writeln!(
+                out,
+                "    σ = {:.6} m: {steps} [{:.1}, {high}] ({} walks, {} fell, {} censored at {} \
+                 strides; {} strides)",
+                m.sigma_m,
+                m.ci_low,
+                m.runs,
+                m.failed,
+                m.censored,
+                m.strides_per_run,
+                m.strides_simulated
+            )?;
+        }
+    }
+    for (what, e) in &r.errors {
+        writeln!(out, "{what}: {e}")?;
+    }
+    Ok(())
+}
