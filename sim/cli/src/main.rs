@@ -31,7 +31,8 @@ mod sweep_figures;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
-    accuracy, gait, gaits, orbit_diagram, robustness, scenes, sil, stability_map, sweep, tune, walk,
+    accuracy, basin, gait, gaits, orbit_diagram, robustness, scenes, sil, stability_map, sweep,
+    tune, walk,
 };
 use input_error::InputError;
 use sim::scene::SceneError;
@@ -74,6 +75,9 @@ enum Command {
     /// How much disturbance the gait survives: gait sensitivity norm, largest step down and
     /// up, largest change of each rate, mean first-passage time on rough floors.
     Robustness(robustness::RobustnessArgs),
+    /// A slice of the gait's basin of attraction in two stride-map coordinates just after
+    /// heel strike: which states return to the gait, and in how many strides.
+    Basin(basin::BasinArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
     /// the fixed point, eigenvalues and heel-strike time against a tight reference.
     Accuracy(accuracy::AccuracyArgs),
@@ -108,6 +112,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::StabilityMap(args) => stability_map::run(args),
         Command::Tune(args) => tune::run(args),
         Command::Robustness(args) => robustness::run(args),
+        Command::Basin(args) => basin::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),
     }

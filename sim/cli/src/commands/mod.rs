@@ -2,6 +2,7 @@
 //! and prints its report as text or JSON.
 
 pub mod accuracy;
+pub mod basin;
 pub mod gait;
 pub mod gaits;
 pub mod orbit_diagram;

@@ -1,0 +1,291 @@
+//! `walker basin`: a slice of the basin of attraction of the gait `walker gait` finds, through
+//! its fixed point, in two stride-map coordinates just after heel strike
+//! ([`sim::analysis::robustness::basin`]), as text, JSON or a figure.
+
+use super::print_json;
+use crate::export;
+use crate::heatmap::HeatMap;
+use crate::input_error::InputError;
+use crate::labels;
+use crate::limits;
+use crate::options::Common;
+use crate::output;
+use crate::search_progress::SearchProgress;
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use sim::analysis::homotopy::GaitRule;
+use sim::analysis::orbit_diagram::linspace;
+use sim::analysis::robustness::{basin_slice, BasinAxis, BasinCell, Outcome, Recovery, ReturnRule};
+use sim::report::GaitReport;
+use sim::stride::SearchBudget;
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::Arc;
+
+/// Options of `walker basin`.
+#[derive(Args)]
+pub struct BasinArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// The x axis: `COORD=FROM:TO:N`, a stride-map coordinate (`walker gait` lists them:
+    /// `stance_leg`, `stance_leg_dot`, ...) and N values from FROM to TO (1 to 500).
+    #[arg(long, value_name = "COORD=FROM:TO:N", allow_hyphen_values = true)]
+    pub x: String,
+    /// The y axis: `COORD=FROM:TO:N` (at most 40,000 cells in all).
+    #[arg(long, value_name = "COORD=FROM:TO:N", allow_hyphen_values = true)]
+    pub y: String,
+    /// Strides a cell may take to return to the gait (1 to 10,000).
+    #[arg(long, default_value_t = 100)]
+    pub strides: usize,
+    /// Write the figure (basin.svg, .png, .pdf) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
+/// Most strides of a cell.
+const MAX_CELL_STRIDES: usize = 10_000;
+
+/// The report (the contract's fields, then details).
+#[derive(Serialize)]
+struct BasinReport {
+    scene: String,
+    x: BasinAxis,
+    y: BasinAxis,
+    /// One row per y value: `gait`, `periodic`, the failure kind, `not_settled`,
+    /// `off_section`.
+    outcome: Vec<Vec<String>>,
+    /// Strides each cell took (to return, settle or fail).
+    strides: Vec<Vec<usize>>,
+    /// The period of a `periodic` cell, else `null`.
+    period: Vec<Vec<Option<usize>>>,
+    fraction_returning: f64,
+    /// The position coordinate solved to keep the swing foot on the floor.
+    solved_coordinate: Option<String>,
+    return_rule: ReturnRule,
+    gait: GaitReport,
+}
+
+/// Parses `COORD=FROM:TO:N` of option `flag`.
+fn axis(flag: &str, spec: &str) -> Result<BasinAxis, InputError> {
+    let bad = |why: &str| {
+        InputError::Other(format!(
+            "{flag} `{spec}`: {why} (expected COORD=FROM:TO:N, e.g. stance_leg=0.15:0.25:41)"
+        ))
+    };
+    let (name, range) = spec.split_once('=').ok_or_else(|| bad("no `=`"))?;
+    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
+    let [from, to, n] = parts.as_slice() else {
+        return Err(bad("expected three fields after `=`"));
+    };
+    let number = |what: &str, s: &str| -> Result<f64, InputError> {
+        s.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(&format!("{what} `{s}` is not a finite number")))
+    };
+    let (from, to) = (number("FROM", from)?, number("TO", to)?);
+    let n: usize = n
+        .parse()
+        .map_err(|_| bad(&format!("N `{n}` is not a count")))?;
+    let n = limits::count(&format!("{flag} N"), n, 1, limits::MAX_MAP_AXIS_POINTS)?;
+    if n > 1 && from == to {
+        return Err(bad("FROM and TO are equal"));
+    }
+    Ok(BasinAxis {
+        name: name.trim().to_owned(),
+        values: linspace(from, to, n),
+    })
+}
+
+/// Runs `walker basin`: exit code 1 when no gait is found.
+pub fn run(args: BasinArgs) -> Result<ExitCode> {
+    let BasinArgs {
+        common,
+        x,
+        y,
+        strides,
+        plot,
+    } = args;
+    let scene = common.scene()?;
+    let setup = common.setup(&scene)?;
+    let (x, y) = (axis("--x", &x)?, axis("--y", &y)?);
+    let cells = x.values.len() * y.values.len();
+    limits::count("--x N × --y N", cells, 1, limits::MAX_MAP_CELLS)?;
+    let strides = limits::count("--strides", strides, 1, MAX_CELL_STRIDES)?;
+    // The names before the gait search: a wrong one fails at once.
+    let names = setup.walker.map_names();
+    for a in [&x, &y] {
+        if !names.contains(&a.name) {
+            return Err(InputError::Other(format!(
+                "`{}` is not a stride-map coordinate of {} (it has: {})",
+                a.name,
+                scene.name(),
+                names.join(", ")
+            ))
+            .into());
+        }
+    }
+    if x.name == y.name {
+        return Err(InputError::Other(format!(
+            "--x and --y both slice `{}`: give two different coordinates",
+            x.name
+        ))
+        .into());
+    }
+    if let Some(dir) = &plot {
+        output::create_dir("--plot", dir)?;
+    }
+    let budget = Arc::new(SearchBudget::new(common.max_strides));
+    let sourced = {
+        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
+        GaitRule::new(&common.setup_for(), &common.newton(), &common.homotopy())
+            .with_budget(Arc::clone(&budget))
+            .gait(&scene)?
+    };
+    let source = sourced.as_ref().ok().map(|(_, s)| *s);
+    let result = sourced.map(|(g, _)| g);
+    let (mut gait_report, _) = super::gait::report(&scene, &setup, &result, false);
+    gait_report.gait_source = source;
+    let gait = match &result {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("walker basin: no gait found: {e}");
+            if common.json {
+                print_json(&gait_report)?;
+            }
+            return Ok(ExitCode::from(1));
+        }
+    };
+    let rule = ReturnRule {
+        max_strides: strides,
+        ..ReturnRule::default()
+    };
+    let recovery = Recovery::new(&setup.walker, &setup.settings, gait).with_rule(rule);
+    let slice = basin_slice(&recovery, x, y).map_err(|e| InputError::Other(e.to_string()))?;
+    let map = |f: &dyn Fn(&BasinCell) -> String| -> Vec<Vec<String>> {
+        slice
+            .cells
+            .iter()
+            .map(|r| r.iter().map(f).collect())
+            .collect()
+    };
+    let report = BasinReport {
+        scene: scene.name().to_owned(),
+        outcome: map(&BasinCell::name),
+        strides: slice
+            .cells
+            .iter()
+            .map(|r| r.iter().map(BasinCell::strides).collect())
+            .collect(),
+        period: slice
+            .cells
+            .iter()
+            .map(|r| {
+                r.iter()
+                    .map(|c| match c {
+                        BasinCell::Strides(Outcome::Periodic { period, .. }) => Some(*period),
+                        _ => None,
+                    })
+                    .collect()
+            })
+            .collect(),
+        fraction_returning: slice.fraction_returning,
+        solved_coordinate: slice.solved_coordinate.clone(),
+        return_rule: rule,
+        x: slice.x.clone(),
+        y: slice.y.clone(),
+        gait: gait_report,
+    };
+    if let Some(dir) = &plot {
+        let fig = HeatMap {
+            title: format!(
+                "{}: basin of attraction of its gait, {:.1} % of the window returns",
+                labels::walker_name(&scene),
+                100.0 * slice.fraction_returning
+            ),
+            x_label: slice.x.name.clone(),
+            y_label: slice.y.name.clone(),
+            z_label: "strides to return (red) / to fail or settle elsewhere (blue, negative)"
+                .into(),
+            x: slice.x.values.clone(),
+            y: slice.y.values.clone(),
+            z: slice
+                .cells
+                .iter()
+                .map(|r| {
+                    r.iter()
+                        .map(|c| match c {
+                            BasinCell::Strides(o @ Outcome::Gait { .. }) => {
+                                Some(o.strides() as f64)
+                            }
+                            BasinCell::Strides(o) => Some(-(o.strides() as f64)),
+                            BasinCell::OffSection => None,
+                        })
+                        .collect()
+                })
+                .collect(),
+            level: 0.0,
+            contour_label: "edge of the basin".into(),
+            missing_label: "swing foot cannot reach the floor".into(),
+        };
+        export::write_figure("--plot", dir, "basin", &fig.to_svg(820.0, 620.0))?;
+    }
+    if common.json {
+        print_json(&report)?;
+    } else {
+        output::text(|out| print_text(out, &report))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One letter per outcome in the text grid.
+fn letter(name: &str) -> char {
+    match name {
+        "gait" => 'o',
+        "periodic" => 'p',
+        "fell_forward" => 'F',
+        "fell_backward" => 'B',
+        "not_settled" => '?',
+        "off_section" => ' ',
+        _ => 'x',
+    }
+}
+
+fn print_text(out: &mut dyn Write, r: &BasinReport) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "basin of attraction of the gait `walker gait` finds ({}), rows {} (down), columns {} \
+         (across)",
+        r.gait
+            .gait_source
+            .map_or("the scene's guess", |s| s.describe()),
+        r.y.name,
+        r.x.name
+    )?;
+    writeln!(
+        out,
+        "o back on the gait (within {:e} in {} strides), p another periodic motion, F fell \
+         forward, B fell backward, ? not settled, x other failure, blank: swing foot off the floor",
+        r.return_rule.tolerance, r.return_rule.max_strides
+    )?;
+    if let Some(c) = &r.solved_coordinate {
+        writeln!(out, "{c} solved to keep the swing foot on the floor")?;
+    }
+    for (yv, row) in r.y.values.iter().zip(&r.outcome) {
+        let cells: String = row.iter().map(|n| letter(n)).collect();
+        writeln!(out, "{yv:>12.6} {cells}")?;
+    }
+    writeln!(
+        out,
+        "{:>12} x from {} to {}",
+        "",
+        r.x.values.first().copied().unwrap_or(f64::NAN),
+        r.x.values.last().copied().unwrap_or(f64::NAN)
+    )?;
+    writeln!(
+        out,
+        "fraction of the window returning to the gait: {:.6}",
+        r.fraction_returning
+    )
+}
