@@ -193,3 +193,15 @@ impl Common {
         }
     }
 }
+
+/// The help of `--floor` (`walker walk`, `walker sil`).
+pub const FLOOR_HELP: &str = "The floor: `plane` (default), `step:at=K,height_m=H` (the K-th \
+    heel strike lands on a step of H m, up positive, measured along the slope's normal; the \
+    floor stays there), `rough:sigma_m=S[,seed=N]` (at every heel strike the level changes by \
+    a normal draw of standard deviation S m, reproducible from the seed)";
+
+/// A `--floor` option's floor, or bad input naming the option.
+pub fn floor(spec: &str) -> Result<sim::stride::Floor, InputError> {
+    spec.parse()
+        .map_err(|e: sim::stride::FloorError| InputError::Other(format!("--{e}")))
+}

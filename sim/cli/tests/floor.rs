@@ -57,3 +57,37 @@ fn a_step_lands_where_it_is_asked_and_a_rough_floor_repeats_from_its_seed() {
         assert!(stderr(&out).contains("--floor"), "{}", stderr(&out));
     }
 }
+
+#[test]
+fn sil_walks_the_same_floors_with_the_firmware_in_the_loop() {
+    let sil = |floor: &str| -> Value {
+        let out = walker(&[
+            "sil", "--scene", "wisse3d", "--steps", "4", "--floor", floor, "--json",
+        ]);
+        serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{floor}: {e}: {}", stderr(&out)))
+    };
+    let plane = sil("plane");
+    assert_eq!(plane["floor"]["kind"], "plane");
+    // a zero step is the plane to the bit, firmware and all
+    assert_eq!(sil("step:at=2,height_m=0")["steps"], plane["steps"]);
+    let down = sil("step:at=2,height_m=-0.001");
+    let floors: Vec<f64> = down["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["floor_step_m"].as_f64().unwrap())
+        .collect();
+    assert_eq!(floors[..2], [0.0, -0.001]);
+    assert_eq!(down["steps"][0], plane["steps"][0]);
+    assert_ne!(
+        down["steps"][1]["duration_s"],
+        plane["steps"][1]["duration_s"]
+    );
+    // bad input names the option
+    let out = walker(&[
+        "sil", "--scene", "wisse3d", "--steps", "4", "--floor", "bumpy",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--floor `bumpy`"), "{}", stderr(&out));
+}

@@ -113,6 +113,24 @@ impl std::str::FromStr for Floor {
 }
 
 impl Floor {
+    /// The floor in words for a report; `None` for one plane.
+    pub fn describe(&self) -> Option<String> {
+        match *self {
+            Floor::Plane => None,
+            Floor::Step {
+                at_heel_strike,
+                height_m,
+            } => Some(format!(
+                "a step of {height_m} m (up positive, along the slope's normal) at heel strike \
+                 {at_heel_strike}"
+            )),
+            Floor::Rough { sigma_m, seed } => Some(format!(
+                "rough, the level changing by a normal draw of sd {sigma_m} m at every heel \
+                 strike (seed {seed})"
+            )),
+        }
+    }
+
     /// The heights its strides end on, in order.
     pub fn heights(&self) -> FloorHeights {
         let rough = match *self {

@@ -21,7 +21,7 @@ use sim::engine::integrators::IntegratorChoice;
 use sim::report::{IdealGaitRecord, StartRecord, WalkGaitRecord};
 use sim::scene::Setup;
 use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
-use sim::stride::SearchBudget;
+use sim::stride::{Floor, SearchBudget};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
@@ -107,6 +107,8 @@ pub struct SilArgs {
     /// states and the bus events as they happen (docs/animation.md).
     #[arg(long, value_name = "FILE.html")]
     pub animate: Option<std::path::PathBuf>,
+    #[arg(long, value_name = "SPEC", default_value = "plane", help = crate::options::FLOOR_HELP)]
+    pub floor: String,
 }
 
 /// The `walker sil --json` object. `Bus` is the bus statistics' type (the `canbus` crate's,
@@ -155,6 +157,8 @@ struct SilWalkReport<'a, Bus: Serialize> {
     sensor_faults_applied: &'a [sil::AppliedSensorFault],
     /// The ankles' actuator (`motor`, `servo`).
     actuator: &'static str,
+    /// The floor walked over (`{kind, ...}`, as `walker walk` reports it).
+    floor: Floor,
 }
 
 /// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
@@ -164,6 +168,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     let (actuator_choice, steps) =
         check_options(&args.actuator, args.steps, args.estop_at, args.realtime)?;
     let animation = animation::open(args.animate.as_deref(), steps)?;
+    let floor = crate::options::floor(&args.floor)?;
     let wait_client = wait_client_timeout(args.wait_client, args.socketcand.is_some())?;
     let common = &args.common;
     let candump = &args.candump;
@@ -194,6 +199,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         record: animation.is_some(),
         realtime: args.realtime,
         show_progress: !common.json,
+        floor,
     };
     let (q, qd) = walker.unpack(&ideal.fixed_point);
     let walk = walk_with_firmware(&walker, (&q, &qd), &stride_settings, &mut ctl, &plan);
@@ -231,6 +237,7 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
         firmware_params_written,
         warnings: &warnings,
         actuator: actuator_choice.name(),
+        floor,
     };
     write_report(&ran.report(), common.json, steps)?;
     Ok(walk_exit_code(&walk))
@@ -423,6 +430,7 @@ struct WalkPlan {
     record: bool,
     realtime: Option<f64>,
     show_progress: bool,
+    floor: Floor,
 }
 
 /// The walk from the ideal gait's start state `(q, qd)` with the firmware actuating the
@@ -455,6 +463,7 @@ fn walk_with_firmware(
             qd,
             WalkRequest::new(stride_settings, plan.steps)
                 .options(options)
+                .floor(plan.floor)
                 .controlled(ctl)
                 .on_step(&mut tick),
         ),
@@ -468,6 +477,7 @@ fn walk_with_firmware(
                 qd,
                 WalkRequest::new(stride_settings, plan.steps)
                     .options(options)
+                    .floor(plan.floor)
                     .controlled(&mut paced)
                     .on_step(&mut tick),
             )
@@ -491,6 +501,7 @@ struct WalkRun<'a> {
     firmware_params_written: BTreeMap<&'static str, f64>,
     warnings: &'a [String],
     actuator: &'static str,
+    floor: Floor,
 }
 
 impl<'a> WalkRun<'a> {
@@ -530,6 +541,7 @@ impl<'a> WalkRun<'a> {
             steps: &walk.steps[walk.steps.len() - kept..],
             sensor_faults_applied: &self.firmware.sensor_faults_applied,
             actuator: self.actuator,
+            floor: self.floor,
         }
     }
 }
@@ -578,6 +590,9 @@ fn print_text<Bus: Serialize>(
             )?;
             writeln!(out, "{}", labels::emergency_stop_label(t))?;
         }
+    }
+    if let Some(floor) = r.floor.describe() {
+        writeln!(out, "floor: {floor}")?;
     }
     if let Some(f) = r.failure {
         writeln!(out, "failure: {}", failure_text(f))?;

@@ -66,11 +66,7 @@ pub struct WalkArgs {
     /// Write a self-contained HTML page that plays the walk in 3D (docs/animation.md).
     #[arg(long, value_name = "FILE.html")]
     pub animate: Option<std::path::PathBuf>,
-    /// The floor: `plane` (default), `step:at=K,height_m=H` (the K-th heel strike lands on a
-    /// step of H m, up positive, measured along the slope's normal; the floor stays there),
-    /// `rough:sigma_m=S[,seed=N]` (at every heel strike the level changes by a normal draw of
-    /// standard deviation S m, reproducible from the seed).
-    #[arg(long, value_name = "SPEC", default_value = "plane")]
+    #[arg(long, value_name = "SPEC", default_value = "plane", help = crate::options::FLOOR_HELP)]
     pub floor: String,
 }
 
@@ -90,9 +86,7 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
         animate,
         floor,
     } = args;
-    let floor: Floor = floor
-        .parse()
-        .map_err(|e: sim::stride::FloorError| InputError::Other(format!("--{e}")))?;
+    let floor: Floor = crate::options::floor(&floor)?;
     let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
     // Flags the walk would ignore are refused, not dropped in silence.
     if plot_with.is_some() && plot.is_none() {
@@ -284,19 +278,8 @@ fn print_text(
     if let Some(start) = &r.start {
         writeln!(out, "start: {}", start.describe())?;
     }
-    match r.floor {
-        Floor::Plane => {}
-        Floor::Step {
-            at_heel_strike,
-            height_m,
-        } => writeln!(
-            out,
-            "floor: a step of {height_m} m (up positive, along the slope's normal) at heel strike {at_heel_strike}"
-        )?,
-        Floor::Rough { sigma_m, seed } => writeln!(
-            out,
-            "floor: rough, the level changing by a normal draw of sd {sigma_m} m at every heel strike (seed {seed})"
-        )?,
+    if let Some(floor) = r.floor.describe() {
+        writeln!(out, "floor: {floor}")?;
     }
     writeln!(
         out,
