@@ -1,7 +1,7 @@
 // The animation page's drawing code. Everything it shows comes from the data the walker
 // binary computed (the key points' floor-frame positions per frame, from the engine's forward
 // kinematics); this file only decodes and draws them. The page API for tests and scripts:
-// window.walker = { ready, error, duration_s, frames, frameTime(i), seek(t_s), play(),
+// window.walker = { ready, error, duration_s, frames, floorLevels, frameTime(i), seek(t_s), play(),
 // pause(), time() }.
 import * as THREE from "three";
 
@@ -61,14 +61,50 @@ const floor = new THREE.Mesh(
 );
 floor.rotation.x = -Math.PI / 2;
 floor.position.set(cx, -0.0005, cz);
-world.add(floor);
+// A floor that steps up or down (walker walk --floor): a terrace under each step, at its
+// stance foot's level, instead of the plane and the grid.
+const terraces = data.floor_levels || [];
+const levelOfStep = new Map(terraces.map((t) => [t.step, t.y_m]));
+if (terraces.length > 0) {
+  const terraceMaterial = new THREE.MeshStandardMaterial({
+    color: 0xdfe3e8, side: THREE.DoubleSide, roughness: 1,
+  });
+  const edgeMaterial = new THREE.LineBasicMaterial({ color: 0x7a838d });
+  const edgeLine = (x0, y0, x1, y1) => {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.BufferAttribute(new Float32Array([
+      x0, y0, cz - span / 2, x0, y0, cz + span / 2, x1, y1, cz + span / 2, x1, y1, cz - span / 2,
+      x0, y0, cz - span / 2]), 3));
+    world.add(new THREE.Line(g, edgeMaterial));
+  };
+  terraces.forEach((t, i) => {
+    // the level's top
+    const top = new THREE.Mesh(new THREE.PlaneGeometry(t.x_to_m - t.x_from_m, span), terraceMaterial);
+    top.rotation.x = -Math.PI / 2;
+    top.position.set((t.x_from_m + t.x_to_m) / 2, t.y_m - 0.0005, cz);
+    world.add(top);
+    edgeLine(t.x_from_m, t.y_m, t.x_to_m, t.y_m);
+    // the riser up or down to the next level
+    const next = terraces[i + 1];
+    if (next && next.y_m !== t.y_m) {
+      const riser = new THREE.Mesh(new THREE.PlaneGeometry(span, Math.abs(next.y_m - t.y_m)), terraceMaterial);
+      riser.rotation.y = Math.PI / 2;
+      riser.position.set(t.x_to_m, (t.y_m + next.y_m) / 2 - 0.0005, cz);
+      world.add(riser);
+    }
+  });
+} else {
+  world.add(floor);
+}
 // A grid around the walker, moved in whole metres so its lines stay put on the floor.
 const GRID_SIZE_M = 12;
 const grid = new THREE.GridHelper(GRID_SIZE_M, Math.round(GRID_SIZE_M / data.grid_m), 0x9aa3ad, 0xc3c9d0);
+grid.visible = terraces.length === 0;
 world.add(grid);
 const pathPositions = new Float32Array(3 * N);
 for (let i = 0; i < N; i++) {
-  pathPositions.set([origin[3 * i], 0.001, origin[3 * i + 2]], 3 * i);
+  const level = levelOfStep.get(stepNumber[i]) || 0;
+  pathPositions.set([origin[3 * i], level + 0.001, origin[3 * i + 2]], 3 * i);
 }
 const pathGeometry = new THREE.BufferGeometry();
 pathGeometry.setAttribute("position", new THREE.BufferAttribute(pathPositions, 3));
@@ -281,6 +317,8 @@ resize();
 
 api.duration_s = duration;
 api.frames = N;
+// Levels drawn under the steps (0 on one plane).
+api.floorLevels = terraces.length;
 api.frameTime = (i) => times[Math.min(Math.max(Math.trunc(Number(i)), 0), N - 1)];
 api.time = () => t;
 api.seek = (s) => { t = Math.min(Math.max(Number(s), 0), duration); setPlaying(false); render(); return frameAt(t); };

@@ -102,6 +102,10 @@ struct PageData<'a> {
     /// Radius of the sphere drawn for 1 kg \[m\].
     mass_sphere_m: f64,
     parts: &'a [geometry::Part],
+    /// The floor's levels under each step where a floor steps up or down (`walker walk
+    /// --floor`); absent on one plane.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    floor_levels: Vec<Terrace>,
     track: track::Track,
     events: &'a [timeline::Event],
 }
@@ -160,12 +164,72 @@ impl Animation<'_> {
             grid_m: 0.25,
             mass_sphere_m: 0.04,
             parts: &figure.parts,
+            floor_levels: terraces(self.walk),
             track,
             events: &self.events,
         };
         let json = serde_json::to_string(&data).map_err(AnimationError::Json)?;
         Ok(page::html(&title, &json))
     }
+}
+
+/// The floor under one step, in the floor frame: the stance foot's level from halfway back
+/// to the previous stance foot to halfway on to the next (the model meets the floor only at
+/// the feet, so where between them the level changes is a drawing's choice).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+struct Terrace {
+    /// The step as people number it (from 1, as the page's frames).
+    step: usize,
+    /// Along the walk (floor frame's x) \[m\].
+    x_from_m: f64,
+    /// \[m\]
+    x_to_m: f64,
+    /// The level along the floor's normal (floor frame's y) \[m\].
+    y_m: f64,
+}
+
+/// The terraces under a walk's steps: each step's level the sum of the floor steps landed on
+/// before it, from its stance frame's origin (in the floor frame) halfway to its neighbours';
+/// none when every step is on one plane.
+fn terraces(walk: &sim::stride::walk::Walk) -> Vec<Terrace> {
+    if walk.steps.iter().all(|s| s.floor_step_m == 0.0) {
+        return Vec::new();
+    }
+    let mut origins: Vec<(usize, f64)> = Vec::new();
+    for s in &walk.path {
+        if origins.last().is_none_or(|(k, _)| *k != s.step) {
+            origins.push((s.step, s.floor.p_m.x));
+        }
+    }
+    let x: Vec<f64> = origins.iter().map(|(_, x)| *x).collect();
+    // a step's length to extend the first and the last terrace by
+    let reach = x
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.5f64, f64::max);
+    let level = |step: usize| -> f64 {
+        walk.steps
+            .iter()
+            .filter(|s| s.step < step)
+            .map(|s| s.floor_step_m)
+            .sum()
+    };
+    origins
+        .iter()
+        .enumerate()
+        .map(|(i, (step, _))| Terrace {
+            step: labels::step_number(*step),
+            x_from_m: if i == 0 {
+                x[0] - 2.0 * reach
+            } else {
+                0.5 * (x[i - 1] + x[i])
+            },
+            x_to_m: x
+                .get(i + 1)
+                .map_or(x[i] + 4.0 * reach, |next| 0.5 * (x[i] + next)),
+            y_m: level(*step),
+        })
+        .collect()
 }
 
 /// Why a page could not be made.

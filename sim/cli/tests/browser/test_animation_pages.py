@@ -64,6 +64,12 @@ def test_page_loads_and_shows_the_walker_moving(browser, path):
     state = page.evaluate("({ready: walker.ready, error: walker.error, d: walker.duration_s, n: walker.frames})")
     assert state["error"] is None, state["error"]
     assert state["ready"] and state["d"] > 0 and state["n"] > 1, state
+    # A walk over a floor that steps draws a level under each step; one plane draws none.
+    levels = page.evaluate("walker.floorLevels")
+    if "step-down" in os.path.basename(path):
+        assert levels > 1, f"{levels} floor levels drawn for a floor with a step"
+    else:
+        assert levels == 0, f"{levels} floor levels drawn on one plane"
     # It plays by itself: walk time advances.
     start = page.evaluate("walker.time()")
     page.wait_for_timeout(700)
