@@ -17,6 +17,7 @@
 
 use crate::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings, SetupFor};
 use crate::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
+use crate::analysis::robustness::{Quantity, QuantityError};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -43,6 +44,9 @@ pub struct MapCell {
     pub fixed_point: DVector<f64>,
     /// Where the gait came from (as `walker gait`'s `gait_source`).
     pub source: GaitSource,
+    /// The map's other quantity of this gait ([`stability_map_of`]), or why it could not be
+    /// had; `None` without one.
+    pub quantity: Option<Result<f64, QuantityError>>,
 }
 
 /// The map: one row per y value, one cell per x value; `Err` where no gait was found.
@@ -60,6 +64,7 @@ impl MapCell {
             step_period_s: g.stride.duration_s,
             fixed_point: g.fixed_point.clone(),
             source,
+            quantity: None,
         }
     }
 }
@@ -76,6 +81,25 @@ pub fn stability_map(
     y: &Axis,
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
+    progress: &(dyn Fn() + Sync),
+) -> Result<StabilityMap, SceneError> {
+    stability_map_of(scene, setup_for, x, y, newton, homotopy, None, progress)
+}
+
+/// [`stability_map`] with `quantity` of each cell's gait too (a robustness measure,
+/// [`MapCell::quantity`]), computed with the cell's own stride settings.
+///
+/// # Errors
+/// As [`stability_map`].
+#[allow(clippy::too_many_arguments)]
+pub fn stability_map_of(
+    scene: &Scene,
+    setup_for: &SetupFor<'_>,
+    x: &Axis,
+    y: &Axis,
+    newton: &NewtonSettings,
+    homotopy: &HomotopySettings,
+    quantity: Option<&Quantity>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<StabilityMap, SceneError> {
     let mut check = scene.clone();
@@ -95,7 +119,14 @@ pub fn stability_map(
             let mut at = scene.clone();
             at.set(&x.name, x.values[k % nx])?;
             at.set(&y.name, y.values[k / nx])?;
-            let cell = rule.gait(&at)?.map(|(g, source)| MapCell::of(&g, source));
+            let mut cell = rule
+                .gait(&at)?
+                .map(|(g, source)| (MapCell::of(&g, source), g));
+            if let (Some(q), Ok((c, g))) = (quantity, &mut cell) {
+                let setup = setup_for(&at)?;
+                c.quantity = Some(q.of(&setup.walker, &setup.settings, g));
+            }
+            let cell = cell.map(|(c, _)| c);
             progress();
             Ok(cell)
         })

@@ -2,6 +2,7 @@
 //! a grid of two parameters, `null` where there is no gait.
 
 use crate::analysis::homotopy::GaitSource;
+use crate::analysis::robustness::{Quantity, QuantityError};
 use crate::analysis::stability_map::{Axis, StabilityMap};
 use serde::Serialize;
 
@@ -26,6 +27,22 @@ pub struct StabilityMapReport {
     /// Where each cell's gait came from, as `walker gait`'s `gait_source` at the cell's values
     /// (`null`: no gait).
     pub gait_source: Vec<Vec<Option<GaitSource>>>,
+    /// The map's other quantity (`--quantity`), absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantity: Option<QuantityGrid>,
+}
+
+/// A robustness measure over the grid.
+#[derive(Clone, Debug, Serialize)]
+pub struct QuantityGrid {
+    /// The quantity (`{name, ...}`: `gsn`, `step_down`, `mfpt` with its `sigma_m`, ...).
+    pub quantity: Quantity,
+    /// Its unit.
+    pub unit: &'static str,
+    /// Its value (`null`: no gait, or it could not be had).
+    pub values: Vec<Vec<Option<f64>>>,
+    /// Why it could not be had at a cell with a gait (`null` elsewhere).
+    pub errors: Vec<Vec<Option<String>>>,
 }
 
 /// An axis of the grid.
@@ -47,6 +64,44 @@ impl From<&Axis> for AxisRecord {
 }
 
 impl StabilityMapReport {
+    /// The report of `map` over `x` × `y` of scene `scene`, with `quantity` when the map has
+    /// one ([`crate::analysis::stability_map::stability_map_of`]).
+    pub fn with_quantity(
+        scene: &str,
+        x: &Axis,
+        y: &Axis,
+        map: &StabilityMap,
+        quantity: &Quantity,
+    ) -> Self {
+        fn cells<T>(
+            map: &StabilityMap,
+            f: impl Fn(&Result<f64, QuantityError>) -> Option<T>,
+        ) -> Vec<Vec<Option<T>>> {
+            map.rows
+                .iter()
+                .map(|r| {
+                    r.iter()
+                        .map(|c| {
+                            c.as_ref()
+                                .ok()
+                                .and_then(|c| c.quantity.as_ref())
+                                .and_then(&f)
+                        })
+                        .collect()
+                })
+                .collect()
+        }
+        Self {
+            quantity: Some(QuantityGrid {
+                quantity: *quantity,
+                unit: quantity.unit(),
+                values: cells(map, |q| q.as_ref().ok().copied()),
+                errors: cells(map, |q| q.as_ref().err().map(ToString::to_string)),
+            }),
+            ..Self::new(scene, x, y, map)
+        }
+    }
+
     /// The report of `map` over `x` × `y` of scene `scene`.
     pub fn new(scene: &str, x: &Axis, y: &Axis, map: &StabilityMap) -> Self {
         let grid =
@@ -89,6 +144,7 @@ impl StabilityMapReport {
                         .collect()
                 })
                 .collect(),
+            quantity: None,
         }
     }
 }

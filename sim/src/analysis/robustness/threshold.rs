@@ -255,27 +255,40 @@ fn threshold(
     }
 }
 
+/// A step down or up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StepDirection {
+    /// The floor lower.
+    Down,
+    /// The floor higher.
+    Up,
+}
+
+/// The largest step in `direction` the gait survives (module documentation), in metres.
+pub fn step_threshold(
+    recovery: &Recovery<'_>,
+    options: &ThresholdOptions,
+    direction: StepDirection,
+) -> Threshold {
+    let d = FloorStep {
+        recovery,
+        sign: match direction {
+            StepDirection::Down => -1.0,
+            StepDirection::Up => 1.0,
+        },
+    };
+    threshold(recovery, &d, options, recovery.leg_length_m())
+}
+
 /// The largest step down and up the gait survives (module documentation).
 pub fn step_thresholds(recovery: &Recovery<'_>, options: &ThresholdOptions) -> StepThresholds {
-    let leg_length_m = recovery.leg_length_m();
     let (down, up) = rayon::join(
-        || {
-            let d = FloorStep {
-                recovery,
-                sign: -1.0,
-            };
-            threshold(recovery, &d, options, leg_length_m)
-        },
-        || {
-            let d = FloorStep {
-                recovery,
-                sign: 1.0,
-            };
-            threshold(recovery, &d, options, leg_length_m)
-        },
+        || step_threshold(recovery, options, StepDirection::Down),
+        || step_threshold(recovery, options, StepDirection::Up),
     );
     StepThresholds {
-        leg_length_m,
+        leg_length_m: recovery.leg_length_m(),
         down,
         up,
     }
