@@ -206,8 +206,8 @@ where
 pub enum Outcome {
     /// Within the tolerance of the gait after this many strides.
     Gait { strides: usize },
-    /// `‖x_k − x_{k−p}‖∞ ≤ tol` for this smallest `p` in 1..=8 (`k − p ≥ 0`, `x_0` the start),
-    /// without having reached the gait first.
+    /// Not within the tolerance of the gait after all the strides allowed (`K`), and
+    /// `‖x_K − x_{K−p}‖∞ ≤ tol` for this smallest `p` in 1..=8.
     Periodic { period: usize },
     /// A stride failed.
     Fell,
@@ -231,8 +231,14 @@ pub struct BasinSlice {
 }
 
 /// The outcome of a walk from `x0` on a level floor (see [`Outcome`]): after each stride
-/// `k = 1..=max_strides`, first the gait (`‖x_k − x*‖∞ ≤ tol`), then the smallest period
-/// `p ≤ 8` with `k − p ≥ 0` and `‖x_k − x_{k−p}‖∞ ≤ tol`.
+/// `k = 1..=max_strides` (`K`), the gait if `‖x_k − x*‖∞ ≤ tol` (the walk ends there), a fall
+/// if the stride failed; after all `K` strides, periodic with the smallest `p ≤ 8` (`K − p ≥ 0`,
+/// `x_0 = x0`) with `‖x_K − x_{K−p}‖∞ ≤ tol`, else not settled.
+///
+/// Periodicity is judged only at the end: a walk that spirals into the gait (complex
+/// multipliers) has `‖x_k − x_{k−p}‖∞ ≤ tol` at some stride while still farther than `tol`
+/// from the gait, a stride or a few before it gets within `tol`; judged there, such a walk
+/// would be called periodic (period 1 to 4 seen on the simplest walker's basin at 0.009).
 pub fn outcome<F>(stride: &mut F, x0: &X, fixed_point: &X, max_strides: usize, tol: f64) -> Outcome
 where
     F: FnMut(&X, f64) -> Option<(X, f64, f64)>,
@@ -245,12 +251,13 @@ where
         if dist(&x, fixed_point) <= tol {
             return Outcome::Gait { strides: k };
         }
-        if let Some(p) = (1..=8.min(k)).find(|&p| dist(&x, &history[k - p]) <= tol) {
-            return Outcome::Periodic { period: p };
-        }
         history.push(x);
     }
-    Outcome::NotSettled
+    let k = max_strides;
+    match (1..=8.min(k)).find(|&p| dist(&history[k], &history[k - p]) <= tol) {
+        Some(period) => Outcome::Periodic { period },
+        None => Outcome::NotSettled,
+    }
 }
 
 /// Solves the section's position constraint for swing_leg: the swing foot at floor level,
