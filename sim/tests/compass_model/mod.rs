@@ -286,10 +286,9 @@ fn locate(p: &Params, y: &Y, h: f64, f: impl Fn(&Y) -> f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// One stride from `y0` onto a floor `h` above the stance foot's (a step up for `h > 0`,
-/// down for `h < 0`): the state after heel strike (legs swapped), the stride time and the
-/// step length (the distance between the feet at heel strike), or `None` on a fall.
-pub fn stride_onto_step(p: &Params, y0: Y, h: f64) -> Option<(Y, f64, f64)> {
+/// The swing phase from `y0` up to heel strike on a floor `h` above the stance foot's: the
+/// state just before the impact and the time, or `None` on a fall.
+pub fn swing_onto_step(p: &Params, y0: Y, h: f64) -> Option<(Y, f64)> {
     let above = |y: &Y| foot_height(p, y) - h;
     let falling = |a: f64, b: f64| a > 0.0 && b <= 0.0;
     let mut y = y0;
@@ -326,8 +325,7 @@ pub fn stride_onto_step(p: &Params, y0: Y, h: f64) -> Option<(Y, f64, f64)> {
                 if fall_at.is_some_and(|s| s < s_hit) {
                     return None;
                 }
-                let length = foot_ahead(p, &pre).hypot(foot_height(p, &pre));
-                return Some((impact(p, &pre)?, t + s_hit, length));
+                return Some((pre, t + s_hit));
             }
             // A scuff behind the stance foot: ignored.
         }
@@ -338,6 +336,15 @@ pub fn stride_onto_step(p: &Params, y0: Y, h: f64) -> Option<(Y, f64, f64)> {
         t += dt;
     }
     None
+}
+
+/// One stride from `y0` onto a floor `h` above the stance foot's (a step up for `h > 0`,
+/// down for `h < 0`): the state after heel strike (legs swapped), the stride time and the
+/// step length (the distance between the feet at heel strike), or `None` on a fall.
+pub fn stride_onto_step(p: &Params, y0: Y, h: f64) -> Option<(Y, f64, f64)> {
+    let (pre, t) = swing_onto_step(p, y0, h)?;
+    let length = foot_ahead(p, &pre).hypot(foot_height(p, &pre));
+    Some((impact(p, &pre)?, t, length))
 }
 
 /// The stride map onto a level floor.
