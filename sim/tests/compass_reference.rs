@@ -13,7 +13,13 @@ use sim::stride::StrideRequest;
 
 /// The engine's compass gait in the stride-map order (stance_leg, swing_leg, their rates),
 /// with the setup and the coordinates' indices.
-fn engine_gait() -> (sim::scene::Setup, sim::analysis::limit_cycle::Gait, [f64; 4], usize, usize) {
+fn engine_gait() -> (
+    sim::scene::Setup,
+    sim::analysis::limit_cycle::Gait,
+    [f64; 4],
+    usize,
+    usize,
+) {
     let scene = Scene::load("compass").unwrap();
     let w = scene.setup().unwrap();
     let g = common::gait(&w);

@@ -37,16 +37,21 @@ fn compass_stride() -> impl FnMut(&X, f64) -> Option<(X, f64, f64)> {
     move |x: &X, h: f64| compass_model::stride_onto_step(&p, *x, h)
 }
 
-/// The threshold's bracket: its surviving end survives and a disturbance `tol` beyond fails
-/// (both by the same rule), unless every grid value survived.
+/// The threshold's brackets: no wider than `tol`, their surviving ends survive and their
+/// failing ends fail (both by the same rule), unless every grid value survived. (Survival is
+/// not monotone in the disturbance at that scale, so only the bracket's own ends are
+/// checked.)
 fn check_bracket(t: &Threshold, tol: f64, mut survives: impl FnMut(f64) -> bool) {
     assert!(t.threshold > 0.0, "{t:?}");
     assert!(survives(t.threshold), "{t:?}");
-    if !t.all_survived {
-        assert!(!survives(t.threshold + tol), "{t:?}");
+    if let Some((s, f)) = t.bracket {
+        assert!(s == t.threshold && f - s <= tol && !survives(f), "{t:?}");
+    } else {
+        assert!(t.all_survived, "{t:?}");
     }
-    if let Some(s) = t.survived_again_from {
-        assert!(s > t.threshold && survives(s) && !survives(s - tol), "{t:?}");
+    if let Some((f, s)) = t.again_bracket {
+        assert_eq!(Some(s), t.survived_again_from);
+        assert!(s - f <= tol && survives(s) && !survives(f), "{t:?}");
     }
 }
 
@@ -90,7 +95,11 @@ fn velocity_thresholds(
 fn step_thresholds_of_the_simplest_walker() {
     for gamma in [0.004, 0.009] {
         let x = simplest_gait(gamma);
-        step_thresholds(&format!("simplest γ {gamma}"), &mut garcia::engine_stride(gamma), &x);
+        step_thresholds(
+            &format!("simplest γ {gamma}"),
+            &mut garcia::engine_stride(gamma),
+            &x,
+        );
     }
 }
 
@@ -195,8 +204,11 @@ fn basin_slice_of_the_simplest_walker_80() {
     assert!(b.fraction_returning > 0.0 && b.fraction_returning < 1.0);
 }
 
-
+/// Slow (about 40 s alone): run with `--ignored`. Fractions returning measured on the window
+/// stance_leg 0.15..0.25 × stance_leg_dot −0.25..−0.15: 0.0625 (20×20), 0.063125 (40×40),
+/// 0.06359375 (80×80), 0.064765625 (160×160).
 #[test]
+#[ignore]
 fn basin_slice_of_the_simplest_walker_160() {
     let b = simplest_basin(160);
     assert!(b.fraction_returning > 0.0 && b.fraction_returning < 1.0);

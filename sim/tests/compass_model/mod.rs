@@ -262,7 +262,7 @@ pub fn impact(p: &Params, y: &Y) -> Option<Y> {
     let w2 = (a11 * h_trailing - a21 * h_total) / det;
     let out = after(w1, w2);
     let lift = points(p, &out)[3].v[1];
-    if !(lift > 0.0) || !out.iter().all(|v| v.is_finite()) {
+    if lift.is_nan() || lift <= 0.0 || !out.iter().all(|v| v.is_finite()) {
         return None;
     }
     Some(out)
@@ -352,6 +352,7 @@ pub fn stride(p: &Params, y0: Y) -> Option<(Y, f64, f64)> {
     stride_onto_step(p, y0, 0.0)
 }
 
+#[allow(clippy::needless_range_loop)]
 fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> Option<[f64; 4]> {
     for col in 0..4 {
         let piv = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;

@@ -400,8 +400,9 @@ pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f
             let after = [pre[0] - pre[1], -pre[1], c * pre[2], c * (1.0 - c) * pre[2]];
             // The old stance foot (now the swing foot) must move up: the rate of
             // cos θ − cos(θ − φ) after the impact.
-            let lift = -after[0].sin() * after[2] + (after[0] - after[1]).sin() * (after[2] - after[3]);
-            if !(lift > 0.0) {
+            let lift =
+                -after[0].sin() * after[2] + (after[0] - after[1]).sin() * (after[2] - after[3]);
+            if lift.is_nan() || lift <= 0.0 {
                 return None;
             }
             return Some((after, t + s_hit, length));

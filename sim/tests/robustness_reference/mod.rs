@@ -69,19 +69,24 @@ pub struct Threshold {
     /// The smallest disturbance beyond the threshold that survives again (the bracket's
     /// surviving end), if a grid value beyond the first failure survives.
     pub survived_again_from: Option<f64>,
+    /// The final bracket of the first bisection, (surviving end, failing end); `None` when
+    /// every grid value survived.
+    pub bracket: Option<(f64, f64)>,
+    /// The final bracket of the second, (failing end, surviving end).
+    pub again_bracket: Option<(f64, f64)>,
     /// How many disturbances were tried.
     pub trials: usize,
 }
 
 /// Bisects `[lo, hi]` where `survives(lo) != survives(hi)` to a bracket of width `≤ tol`;
-/// the bracket's surviving end.
+/// the final bracket `(lo, hi)`.
 fn bisect(
     survives: &mut impl FnMut(f64) -> bool,
     (mut lo, mut hi): (f64, f64),
     lo_survives: bool,
     tol: f64,
     trials: &mut usize,
-) -> f64 {
+) -> (f64, f64) {
     while hi - lo > tol {
         let mid = 0.5 * (lo + hi);
         *trials += 1;
@@ -91,11 +96,7 @@ fn bisect(
             hi = mid;
         }
     }
-    if lo_survives {
-        lo
-    } else {
-        hi
-    }
+    (lo, hi)
 }
 
 /// The threshold of a disturbance of size `s` (see the module's definitions): grid `iΔ` for
@@ -121,15 +122,23 @@ pub fn threshold(
             threshold: grid(n_max),
             all_survived: true,
             survived_again_from: None,
+            bracket: None,
+            again_bracket: None,
             trials,
         };
     };
-    let threshold = bisect(&mut survives, (grid(i - 1), grid(i)), true, tol, &mut trials);
-    let mut survived_again_from = None;
+    let bracket = bisect(
+        &mut survives,
+        (grid(i - 1), grid(i)),
+        true,
+        tol,
+        &mut trials,
+    );
+    let mut again_bracket = None;
     for j in i + 1..=n_max {
         trials += 1;
         if survives(grid(j)) {
-            survived_again_from = Some(bisect(
+            again_bracket = Some(bisect(
                 &mut survives,
                 (grid(j - 1), grid(j)),
                 false,
@@ -140,9 +149,11 @@ pub fn threshold(
         }
     }
     Threshold {
-        threshold,
+        threshold: bracket.0,
         all_survived: false,
-        survived_again_from,
+        survived_again_from: again_bracket.map(|b| b.1),
+        bracket: Some(bracket),
+        again_bracket,
         trials,
     }
 }
