@@ -367,14 +367,20 @@ fn foot_ahead_of_stance(y: &Y) -> f64 {
 /// hip's angular momentum about the new contact, massless legs):
 ///   θ⁺ = θ⁻ − φ⁻, φ⁺ = −φ⁻, θ̇⁺ = cos φ⁻ θ̇⁻, φ̇⁺ = cos φ⁻ (1 − cos φ⁻) θ̇⁻.
 /// The state after it, the stride time and the step length (the distance between the feet at
-/// heel strike), or `None` on a fall.
+/// heel strike), or `None` on a fall: as the simplest scene's `[fall]` and the engine's stride
+/// loop have it, the hip falls below half the leg (cos θ < 1/2), or the hip, behind the stance
+/// foot (θ > 0), starts moving backward (θ̇ turns from negative to non-negative), or no heel
+/// strike within 20 time units; or the old stance foot does not move up after the impact.
 pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f64, f64)> {
     let above = |y: &Y| foot_height(y) - h;
     let mut y: Y = y0;
     let mut t = 0.0;
     while t < MAX_TIME {
         let next = rk4(gamma, &y, H);
-        if !next.iter().all(|v| v.is_finite()) || next[0].abs() > std::f64::consts::FRAC_PI_2 {
+        if !next.iter().all(|v| v.is_finite())
+            || (y[0].cos() > 0.5 && next[0].cos() <= 0.5)
+            || (next[0] > 0.0 && y[2] < 0.0 && next[2] >= 0.0)
+        {
             return None;
         }
         if above(&y) > 0.0 && above(&next) <= 0.0 && foot_ahead_of_stance(&next) > 1e-3 {
@@ -391,14 +397,33 @@ pub fn stride_onto_step(gamma: f64, y0: [f64; 4], h: f64) -> Option<([f64; 4], f
             let pre = rk4(gamma, &y, s_hit);
             let c = pre[1].cos();
             let length = foot_ahead_of_stance(&pre).hypot(foot_height(&pre));
-            return Some((
-                [pre[0] - pre[1], -pre[1], c * pre[2], c * (1.0 - c) * pre[2]],
-                t + s_hit,
-                length,
-            ));
+            let after = [pre[0] - pre[1], -pre[1], c * pre[2], c * (1.0 - c) * pre[2]];
+            // The old stance foot (now the swing foot) must move up: the rate of
+            // cos θ − cos(θ − φ) after the impact.
+            let lift =
+                -after[0].sin() * after[2] + (after[0] - after[1]).sin() * (after[2] - after[3]);
+            if lift.is_nan() || lift <= 0.0 {
+                return None;
+            }
+            return Some((after, t + s_hit, length));
         }
         y = next;
         t += H;
     }
     None
+}
+
+/// A state `[θ, φ, θ̇, φ̇]` in the engine's stride-map order (stance_leg, swing_leg relative
+/// to the stance leg, their rates): `(θ, −φ, θ̇, −φ̇)`. Its own inverse.
+pub fn to_engine(y: &[f64; 4]) -> [f64; 4] {
+    [y[0], -y[1], y[2], -y[3]]
+}
+
+/// [`stride_onto_step`] in the engine's stride-map order (see [`to_engine`]), for the
+/// reference robustness routines.
+pub fn engine_stride(gamma: f64) -> impl FnMut(&[f64; 4], f64) -> Option<([f64; 4], f64, f64)> {
+    move |x: &[f64; 4], h: f64| {
+        let (y, t, l) = stride_onto_step(gamma, to_engine(x), h)?;
+        Some((to_engine(&y), t, l))
+    }
 }
