@@ -56,7 +56,10 @@ fn the_heading_is_cyclic_on_level_ground_and_a_state_on_a_slope() {
         assert_eq!(level.walker.relabel().cyclic, vec![yaw], "{name}");
         assert!(level.walker.relabel().symmetry_broken.is_empty(), "{name}");
         let level_names = level.walker.map_names();
-        assert!(!level_names.iter().any(|n| n.starts_with(HEADING)), "{name}");
+        assert!(
+            !level_names.iter().any(|n| n.starts_with(HEADING)),
+            "{name}"
+        );
         for slope in [0.01, -0.01, 1e-9] {
             let sloped = scene_at(name, slope).setup().unwrap();
             let r = sloped.walker.relabel();
@@ -150,7 +153,11 @@ fn wisse3d_gait_on_a_slope_has_its_heading_in_the_map_and_balances_energy() {
     let heading_mode = found
         .eigenvalue_modes
         .iter()
-        .find(|m| m.dominant.first().is_some_and(|(c, s)| c == HEADING && *s > 0.9))
+        .find(|m| {
+            m.dominant
+                .first()
+                .is_some_and(|(c, s)| c == HEADING && *s > 0.9)
+        })
         .expect("a mode of the heading");
     assert!(
         heading_mode.eigenvalue[0] < -0.9 && heading_mode.eigenvalue[0] > -1.0,
@@ -243,5 +250,8 @@ fn a_vanishing_slope_reproduces_the_level_gait() {
     let mut extra: Vec<f64> = unmatched.iter().map(|z| z.re).collect();
     extra.sort_by(f64::total_cmp);
     assert!((extra[0] + 1.0).abs() < 1e-4, "{extra:?}");
-    assert!(extra[1].abs() < 1e-4 && unmatched.iter().all(|z| z.im.abs() < 1e-6), "{unmatched:?}");
+    assert!(
+        extra[1].abs() < 1e-4 && unmatched.iter().all(|z| z.im.abs() < 1e-6),
+        "{unmatched:?}"
+    );
 }

@@ -203,8 +203,8 @@ impl FoundGait {
         let g_m_s2 = walker.model().gravity_floor_m_s2.norm();
         let s = &g.stride;
         let gravity = walker.model().gravity_floor_m_s2;
-        let slope_work = (gravity.x != 0.0 || gravity.z != 0.0)
-            .then(|| mass * gravity.dot(&s.step_m));
+        let slope_work =
+            (gravity.x != 0.0 || gravity.z != 0.0).then(|| mass * gravity.dot(&s.step_m));
         let actuator = walker.ankle().map(|_| {
             let cost = s.actuator_work_j / (mass * n.progress_m);
             let put_in = match slope_work {

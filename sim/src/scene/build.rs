@@ -362,7 +362,9 @@ fn released_joint(r: &str) -> Result<JointKind, SceneError> {
 fn cyclic_symmetry(model: &Model, c: CoordIndex) -> Result<bool, String> {
     let link = &model.links[model.coordinates[c.0].link.0];
     if link.parent.is_some() {
-        return Err("is not a root joint: only a rotation of the whole walker can be cyclic".into());
+        return Err(
+            "is not a root joint: only a rotation of the whole walker can be cyclic".into(),
+        );
     }
     let JointKind::Revolute { axis_parent } = link.joint else {
         return Err(
