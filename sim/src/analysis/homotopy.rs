@@ -13,6 +13,8 @@
 //! step halving.
 
 use crate::analysis::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
+use crate::engine::model::CoordIndex;
+use crate::engine::walker::Walker;
 use crate::scene::{Scene, SceneError, Setup};
 use crate::stride::{SearchBudget, SharedBudget};
 use nalgebra::DVector;
@@ -77,15 +79,28 @@ impl Default for HomotopySettings {
 
 /// The last (at most two) gaits of a path, at path coordinates `s`: a secant predictor, and
 /// one guarded Newton step from it.
+///
+/// The stride map of one model can change its coordinates along a path: a 3D walker's heading
+/// is cyclic on level ground and a state on a slope ([`crate::engine::relabel::Relabel`]).
+/// A gait in other coordinates than the last one's starts the path afresh (no secant through
+/// both), and a predictor is carried into the coordinates of the walker it is corrected on, a
+/// coordinate the gait's map lacks at 0 with its rate (the heading of a straight gait).
 #[derive(Clone, Debug, Default)]
 pub struct Secant {
     /// `(s, fixed point, step period [s])`, oldest first.
     history: Vec<(f64, DVector<f64>, f64)>,
+    /// The stride-map coordinates of the gaits in `history`.
+    coordinates: Vec<CoordIndex>,
 }
 
 impl Secant {
-    /// Appends the gait `g` at `s` (keeps the last two).
+    /// Appends the gait `g` at `s` (keeps the last two; only `g` when its stride-map
+    /// coordinates differ from the last gait's).
     pub fn push(&mut self, s: f64, g: &Gait) {
+        if self.coordinates != g.map_coordinates {
+            self.history.clear();
+            self.coordinates.clone_from(&g.map_coordinates);
+        }
         self.history
             .push((s, g.fixed_point.clone(), g.stride.duration_s));
         if self.history.len() > 2 {
@@ -121,6 +136,7 @@ impl Secant {
         guard: &HomotopySettings,
     ) -> Option<Result<Gait, NewtonError>> {
         let (predictor, period) = self.predict(s)?;
+        let predictor = in_coordinates(&predictor, &self.coordinates, &setup.walker);
         let corrector = guard.corrector(newton);
         let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).find(&predictor);
         Some(g.and_then(|g| {
@@ -137,6 +153,27 @@ impl Secant {
             }
         }))
     }
+}
+
+/// The stride-map vector `v` (values then rates of `coordinates`) in `walker`'s stride-map
+/// coordinates: itself when they are the same; otherwise coordinate by coordinate, one that
+/// `coordinates` lacks at 0 with its rate.
+fn in_coordinates(v: &DVector<f64>, coordinates: &[CoordIndex], walker: &Walker) -> DVector<f64> {
+    let target = walker.map_coordinates();
+    if target == coordinates {
+        return v.clone();
+    }
+    let dof = walker.model().dof();
+    let n = coordinates.len();
+    let mut q = DVector::zeros(dof);
+    let mut qd = DVector::zeros(dof);
+    for (i, c) in coordinates.iter().enumerate() {
+        if c.0 < dof {
+            q[c.0] = v[i];
+            qd[c.0] = v[n + i];
+        }
+    }
+    walker.pack(&q, &qd)
 }
 
 /// The scene at its default parameter values (parameters that act on nothing keep theirs).

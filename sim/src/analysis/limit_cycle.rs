@@ -6,6 +6,7 @@
 //! search usually starts from the scene's [`GaitGuess`] ([`GaitSearch::find_from_guess`]).
 
 use crate::analysis::variational::VariationalError;
+use crate::engine::model::CoordIndex;
 use crate::engine::walker::Walker;
 use crate::stride::{
     FailureCause, FailureKind, Schedule, StepSchedule, StrideFailure, StrideRequest, StrideResult,
@@ -156,6 +157,11 @@ pub struct Gait {
     pub newton: NewtonSettings,
     /// The stride settings it was integrated with.
     pub stride_settings: StrideSettings,
+    /// The coordinates whose values and rates make up the stride-map vectors (the fixed point,
+    /// the Jacobian's rows and columns): [`Walker::map_coordinates`] of the walker it was found
+    /// for. The same model has a longer map on a slope, where its heading is a state, than on
+    /// level ground, where the heading is cyclic.
+    pub map_coordinates: Vec<CoordIndex>,
 }
 
 impl Gait {
@@ -402,6 +408,7 @@ impl<'a> GaitSearch<'a> {
                     stride,
                     newton: *self.newton,
                     stride_settings: self.settings.clone(),
+                    map_coordinates: self.walker.map_coordinates(),
                 });
             }
             if it == settings.max_iterations {

@@ -109,9 +109,15 @@ pub struct ActuatorFigures {
     /// `cost_of_transport_j_per_kg_m`.
     #[serde(flatten)]
     pub cost_of_transport: CostOfTransport,
-    /// Actuator work minus impact loss minus damper dissipation \[J\]: over a periodic stride on
-    /// level ground the actuator's work is what the impacts and dampers take, so this checks
-    /// the quadrature.
+    /// Work done by gravity over the periodic stride on a slope \[J\]: the potential energy
+    /// released, `M g_floor · c` with `M` the total mass and `c` the step between the contacts
+    /// (over a periodic stride the centre of mass moves by `c` along the floor and returns to
+    /// its height above it). Absent on level ground, where it is 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slope_work_j_per_step: Option<f64>,
+    /// Actuator work plus the slope's work minus impact loss minus damper dissipation \[J\]:
+    /// over a periodic stride the energy put in (by the actuator, and by gravity on a slope) is
+    /// what the impacts and dampers take, so this checks the quadrature.
     pub energy_balance_residual_j: f64,
 }
 
@@ -196,13 +202,21 @@ impl FoundGait {
         let mass = walker.model().total_mass_kg();
         let g_m_s2 = walker.model().gravity_floor_m_s2.norm();
         let s = &g.stride;
+        let gravity = walker.model().gravity_floor_m_s2;
+        let slope_work =
+            (gravity.x != 0.0 || gravity.z != 0.0).then(|| mass * gravity.dot(&s.step_m));
         let actuator = walker.ankle().map(|_| {
             let cost = s.actuator_work_j / (mass * n.progress_m);
+            let put_in = match slope_work {
+                Some(w) => s.actuator_work_j + w,
+                None => s.actuator_work_j,
+            };
             ActuatorFigures {
                 actuator_work_j_per_step: s.actuator_work_j,
                 damping_dissipation_j_per_step: s.damping_dissipation_j,
                 cost_of_transport: CostOfTransport { j_per_kg_m: cost },
-                energy_balance_residual_j: s.actuator_work_j
+                slope_work_j_per_step: slope_work,
+                energy_balance_residual_j: put_in
                     - s.impact_energy_loss_j
                     - s.damping_dissipation_j,
             }

@@ -42,8 +42,9 @@ impl Names<'_> {
 }
 
 impl Scene {
-    /// The model (`[world]`, `[[link]]`, `[[point]]`) and the floor slope \[rad\].
-    pub(super) fn model(&self) -> Result<(Model, f64), SceneError> {
+    /// The model (`[world]`, `[[link]]`, `[[point]]`); the floor's slope enters as the
+    /// direction of gravity in the floor frame.
+    pub(super) fn model(&self) -> Result<Model, SceneError> {
         let f = &self.file;
         let g = self.num(&f.world.gravity_m_s2, "world.gravity_m_s2")?;
         if g <= 0.0 {
@@ -64,7 +65,7 @@ impl Scene {
                 self.vec3(&Some(p.position_m.clone()), &p.name)?,
             )?;
         }
-        Ok((model, slope))
+        Ok(model)
     }
 
     /// Adds one `[[link]]`: its joint, body, spring and damper.
@@ -192,11 +193,28 @@ impl Scene {
         })
     }
 
-    /// The relabelling (`[relabel]`); cyclic coordinates must be root joints on level ground
-    /// (`slope_rad` 0).
-    pub(super) fn relabel(&self, names: &Names, slope_rad: f64) -> Result<Relabel, SceneError> {
+    /// The relabelling (`[relabel]`), with the declared cyclic coordinates sorted by
+    /// [`cyclic_symmetry`]: those the floor and gravity are invariant to stay cyclic (left out
+    /// of the stride map), those only the slope's gravity breaks (the heading on a slope) become
+    /// states of the map ([`Relabel::symmetry_broken`]), any other is an error.
+    pub(super) fn relabel(&self, names: &Names) -> Result<Relabel, SceneError> {
         let r = &self.file.relabel;
-        let relabel = Relabel {
+        let model = names.0;
+        let mut cyclic = Vec::new();
+        let mut symmetry_broken = Vec::new();
+        for name in &r.cyclic {
+            let c = names.coord(name)?;
+            match cyclic_symmetry(model, c) {
+                Ok(true) => cyclic.push(c),
+                Ok(false) => symmetry_broken.push(c),
+                Err(why) => {
+                    return Err(SceneError::Invalid(format!(
+                        "relabel.cyclic: `{name}` {why}"
+                    )))
+                }
+            }
+        }
+        Ok(Relabel {
             pairs: r
                 .pairs
                 .iter()
@@ -208,26 +226,12 @@ impl Scene {
                 .map(|[a, b]| Ok((names.point(a)?, names.point(b)?)))
                 .collect::<Result<Vec<_>, SceneError>>()?,
             mirror: r.mirror,
-            cyclic: r
-                .cyclic
-                .iter()
-                .map(|c| names.coord(c))
-                .collect::<Result<Vec<_>, _>>()?,
+            cyclic,
+            symmetry_broken,
             fixed: Vec::new(),
             tolerance: 1e-13,
             max_iterations: 50,
-        };
-        let model = names.0;
-        for c in &relabel.cyclic {
-            let l = &model.links[model.coordinates[c.0].link.0];
-            if l.parent.is_some() || slope_rad != 0.0 {
-                return Err(SceneError::Invalid(format!(
-                    "cyclic coordinate `{}` must be a root joint on level ground",
-                    model.coordinates[c.0].name
-                )));
-            }
-        }
-        Ok(relabel)
+        })
     }
 
     /// The integrator and the stride time budget \[s\] (`[integrator]`).
@@ -338,6 +342,49 @@ fn released_joint(r: &str) -> Result<JointKind, SceneError> {
     })
 }
 
+/// Whether the coordinate `c`, declared cyclic, is a symmetry of the walker on this floor.
+///
+/// A coordinate is cyclic when the dynamics and the floor are invariant to it, so that the
+/// stride map can be taken modulo it. The floor is a plane and gravity a uniform field; the
+/// walker's position on the plane is already taken modulo (every stride is expressed about its
+/// own stance contact), so what a scene declares cyclic is a root joint's rotation about the
+/// floor's normal (y), the heading:
+/// - the floor is invariant to it on any slope (a rotation about a normal maps the plane onto
+///   itself), gravity only when it points along the normal (level ground). On a slope the
+///   heading decides which way is downhill: it is then a state of the stride map, `Ok(false)`
+///   (the gait walks straight downhill, heading 0 up to the stance foot's yaw within the stride,
+///   by the sagittal mirror symmetry, which a slope keeps since gravity has no z component);
+/// - anything else (a joint that is not the root, a prismatic root, a rotation about another
+///   axis) moves the walker off the floor or is already taken care of: `Err(why)`.
+///
+/// `Ok(true)`: cyclic. Level ground is decided exactly (gravity's in-plane components are 0
+/// when `slope_rad` is 0), so a level scene's stride map does not change.
+fn cyclic_symmetry(model: &Model, c: CoordIndex) -> Result<bool, String> {
+    let link = &model.links[model.coordinates[c.0].link.0];
+    if link.parent.is_some() {
+        return Err(
+            "is not a root joint: only a rotation of the whole walker can be cyclic".into(),
+        );
+    }
+    let JointKind::Revolute { axis_parent } = link.joint else {
+        return Err(
+            "is not a revolute joint: the position on the floor is already taken modulo (each \
+             stride is expressed about its own stance contact); only the heading can be cyclic"
+                .into(),
+        );
+    };
+    let normal = Vector3::y();
+    if axis_parent.cross(&normal).norm() > 1e-12 * axis_parent.norm() {
+        return Err(format!(
+            "turns about {:?}, not about the floor's normal [0, 1, 0]: that would tilt the walker \
+             into the floor",
+            axis_parent.as_slice()
+        ));
+    }
+    let g = model.gravity_floor_m_s2;
+    Ok(g.x == 0.0 && g.z == 0.0)
+}
+
 /// The fall rule can fire: the hip at the guess stands above `fall.min_hip_height_m` (a walker
 /// that starts below it would never be seen to fall).
 fn check_fall_height(
@@ -371,12 +418,12 @@ impl Scene {
     /// integrator, the guess and the ankle reflex.
     pub fn setup(&self) -> Result<Setup, SceneError> {
         let f = &self.file;
-        let (model, slope) = self.model()?;
+        let model = self.model()?;
         let names = Names(&model);
         let heel_strike = self.heel_strike(&names)?;
         let knees = self.knees(&names)?;
         let fall = self.fall(&names)?;
-        let relabel = self.relabel(&names, slope)?;
+        let relabel = self.relabel(&names)?;
         let (integrator, max_stride_time_s) = self.integrator()?;
         let (guess_q, guess_qd) = self.guess(&names)?;
         let ankle = self.ankle_reflex(&names)?;

@@ -22,8 +22,16 @@ pub struct Relabel {
     pub point_pairs: Vec<(PointIndex, PointIndex)>,
     /// Reflect about the sagittal plane (3D walkers).
     pub mirror: bool,
-    /// Root coordinates that are cyclic (heading): reported and then set to zero.
+    /// Root coordinates that are cyclic (the heading on level ground): reported and then set
+    /// to zero, and left out of the stride map. A coordinate is cyclic when the dynamics and
+    /// the floor are invariant to it; the scene builder decides which are
+    /// ([`crate::scene::Scene::setup`]).
     pub cyclic: Vec<CoordIndex>,
+    /// Coordinates the scene declares cyclic whose symmetry the floor breaks: the heading
+    /// about the floor's normal on a slope (turning changes which way is downhill). They are
+    /// ordinary coordinates here, states of the stride map like any other (empty on level
+    /// ground).
+    pub symmetry_broken: Vec<CoordIndex>,
     /// Coordinates held at zero (locked at the start of a stride), not solved for.
     pub fixed: Vec<CoordIndex>,
     /// Gauss-Newton tolerance on the pose residual [m or rad].
