@@ -43,6 +43,49 @@ pub struct RobustnessArgs {
     /// The first Monte Carlo walk's floor seed (walk r has seed + r).
     #[arg(long, default_value_t = 0)]
     pub mfpt_seed: u64,
+    /// The measures to take, comma-separated: `gsn`, `steps` (step down and up), `rates`
+    /// (the change of each rate), `mfpt`; the others are reported as `null`.
+    #[arg(long, value_name = "LIST", default_value = "gsn,steps,rates,mfpt")]
+    pub measures: String,
+    /// The scan's grid step of the rate thresholds, in natural rates sqrt(g/L), up to 0.25 of
+    /// them (the step thresholds scan every 0.001 leg lengths up to 0.25; both are bisected
+    /// to 1e-7 of their scale).
+    #[arg(long, value_name = "FRACTION", default_value_t = 1e-2)]
+    pub rate_scan_step: f64,
+    /// Strides a disturbed walker may take to come back within 1e-6 of the gait (the
+    /// issue's rule: 100; a gait with max |λ| near 1 returns slowly).
+    #[arg(long, value_name = "STRIDES", default_value_t = 100)]
+    pub return_strides: usize,
+}
+
+/// The measures `--measures` names.
+#[derive(Clone, Copy, Debug, Default)]
+struct Measures {
+    gsn: bool,
+    steps: bool,
+    rates: bool,
+    mfpt: bool,
+}
+
+impl Measures {
+    fn parse(list: &str) -> Result<Self, InputError> {
+        let mut m = Measures::default();
+        for name in list.split(',').map(str::trim) {
+            let slot = match name {
+                "gsn" => &mut m.gsn,
+                "steps" => &mut m.steps,
+                "rates" => &mut m.rates,
+                "mfpt" => &mut m.mfpt,
+                other => {
+                    return Err(InputError::Other(format!(
+                        "--measures: unknown measure `{other}` (expected gsn, steps, rates, mfpt)"
+                    )))
+                }
+            };
+            *slot = true;
+        }
+        Ok(m)
+    }
 }
 
 /// Most Monte Carlo walks per roughness, and most strides of one.
@@ -94,7 +137,19 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
         mfpt_runs,
         mfpt_strides,
         mfpt_seed,
+        measures,
+        rate_scan_step,
+        return_strides,
     } = args;
+    let return_strides = limits::count("--return-strides", return_strides, 1, 100_000)?;
+    let measures = Measures::parse(&measures)?;
+    if !(rate_scan_step.is_finite() && (1e-6..=0.5).contains(&rate_scan_step)) {
+        return Err(InputError::Other(format!(
+            "--rate-scan-step must be from 1e-6 to 0.5 natural rates, got {}",
+            sim::scene::short_number(rate_scan_step)
+        ))
+        .into());
+    }
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
     let runs = limits::count("--mfpt-runs", mfpt_runs, 1, MAX_MFPT_RUNS)?;
@@ -149,7 +204,12 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     let Ok(gait) = &result else {
         return finish(&common, &report, ExitCode::from(1));
     };
-    let recovery = Recovery::new(walker, &setup.settings, gait);
+    let rule = sim::analysis::robustness::ReturnRule {
+        max_strides: return_strides,
+        ..Default::default()
+    };
+    report.return_rule = rule;
+    let recovery = Recovery::new(walker, &setup.settings, gait).with_rule(rule);
     let leg_m = recovery.leg_length_m();
     let sigmas = if sigma_m.is_empty() {
         vec![1e-3 * leg_m, 3e-3 * leg_m, 1e-2 * leg_m]
@@ -157,47 +217,35 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
         sigma_m
     };
     let progress = Progress::new(3 + sigmas.len(), "robustness measures", !common.json);
-    match gait_sensitivity_norm(walker, &setup.settings, gait, common.perturbation) {
-        Ok(g) => report.gait_sensitivity_norm = Some(g),
-        Err(e) => {
-            report
-                .errors
-                .insert("gait_sensitivity_norm".into(), e.to_string());
+    if measures.gsn {
+        match gait_sensitivity_norm(walker, &setup.settings, gait, common.perturbation) {
+            Ok(g) => report.gait_sensitivity_norm = Some(g),
+            Err(e) => {
+                report
+                    .errors
+                    .insert("gait_sensitivity_norm".into(), e.to_string());
+            }
         }
     }
     progress.tick();
-    let steps = step_thresholds(&recovery, &ThresholdOptions::steps());
-    report.step_down_max_m = Some(steps.down.max);
-    report.step_up_max_m = Some(steps.up.max);
-    report.survived_again_from_m = Some(Again {
-        down: steps.down.survived_again_from,
-        up: steps.up.survived_again_from,
-    });
-    report.step_thresholds = Some(steps);
+    if measures.steps {
+        steps_into(&mut report, &recovery);
+    }
     progress.tick();
-    let rates = velocity_thresholds(&recovery, &ThresholdOptions::rates());
-    report.velocity_perturbation_max = Some(
-        rates
-            .iter()
-            .map(|v| {
-                (
-                    v.coordinate.clone(),
-                    Signs {
-                        positive: v.positive.max,
-                        negative: v.negative.max,
-                    },
-                )
-            })
-            .collect(),
-    );
-    report.velocity_thresholds = Some(rates);
+    if measures.rates {
+        let options = ThresholdOptions {
+            scan_step: rate_scan_step,
+            ..ThresholdOptions::rates()
+        };
+        rates_into(&mut report, &recovery, &options);
+    }
     progress.tick();
     let options = FirstPassageOptions {
         runs,
         strides_per_run: strides,
         seed: mfpt_seed,
     };
-    for sigma in sigmas {
+    for sigma in sigmas.into_iter().filter(|_| measures.mfpt) {
         match mean_first_passage(&recovery, sigma, &options) {
             Ok(m) => report.mfpt.push(m),
             Err(e) => {
@@ -215,6 +263,38 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
         ExitCode::from(1)
     };
     finish(&common, &report, code)
+}
+
+/// The step thresholds into the report.
+fn steps_into(report: &mut RobustnessReport, recovery: &Recovery<'_>) {
+    let steps = step_thresholds(recovery, &ThresholdOptions::steps());
+    report.step_down_max_m = Some(steps.down.max);
+    report.step_up_max_m = Some(steps.up.max);
+    report.survived_again_from_m = Some(Again {
+        down: steps.down.survived_again_from,
+        up: steps.up.survived_again_from,
+    });
+    report.step_thresholds = Some(steps);
+}
+
+/// The rate thresholds into the report.
+fn rates_into(report: &mut RobustnessReport, recovery: &Recovery<'_>, options: &ThresholdOptions) {
+    let rates = velocity_thresholds(recovery, options);
+    report.velocity_perturbation_max = Some(
+        rates
+            .iter()
+            .map(|v| {
+                (
+                    v.coordinate.clone(),
+                    Signs {
+                        positive: v.positive.max,
+                        negative: v.negative.max,
+                    },
+                )
+            })
+            .collect(),
+    );
+    report.velocity_thresholds = Some(rates);
 }
 
 fn finish(common: &Common, report: &RobustnessReport, code: ExitCode) -> Result<ExitCode> {

@@ -36,10 +36,9 @@ impl Default for ReturnRule {
 /// Longest period of another periodic motion recognised (strides).
 pub const MAX_PERIOD: usize = 8;
 
-/// Another periodic motion is recognised only this many tolerances or more from the gait's
-/// fixed point: a slow return to the gait (`|λ|` near 1) also repeats itself closely from one
-/// stride to the next.
-pub const ELSEWHERE_FACTOR: f64 = 1e3;
+/// Another periodic motion repeats within this fraction of its distance from the gait (and
+/// within the tolerance): a walk still returning slowly to the gait moves more per stride.
+pub const REPEAT_FRACTION: f64 = 1e-3;
 
 /// How strides from a disturbed state ended.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -50,9 +49,10 @@ pub enum Outcome {
         /// Strides taken.
         strides: usize,
     },
-    /// Settled on another periodic motion of `period` strides (a period-1 one is another
-    /// gait) after `strides` strides: `x_k` within the tolerance of `x_{k−period}` and at
-    /// least [`ELSEWHERE_FACTOR`] tolerances from the gait.
+    /// Not back on the gait after every stride allowed (`strides`), but on another periodic
+    /// motion of `period` strides (a period-1 one is another gait): the last state `x_K`
+    /// within the tolerance of `x_{K−period}`, and within [`REPEAT_FRACTION`] of its distance
+    /// from the gait; the smallest such period.
     Periodic {
         /// Its period in strides (1 to [`MAX_PERIOD`]).
         period: usize,
@@ -107,7 +107,7 @@ impl Outcome {
 /// Until when [`Recovery::follow`] strides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Until {
-    /// Back on the gait or settled on another periodic motion (or failed).
+    /// Back on the gait, or every stride taken (then judged periodic or not), or failed.
     Settled,
     /// A failure only (a Monte Carlo walk on a rough floor): every stride allowed is taken.
     Failure,
@@ -152,8 +152,10 @@ impl<'a> Recovery<'a> {
         until: Until,
     ) -> Outcome {
         let mut x = x0.clone();
-        // The last states, newest last, for recognising another periodic motion.
+        // The last states x_{k−MAX_PERIOD} ..= x_k (x_0 the start), newest last, for
+        // recognising another periodic motion once every stride is taken.
         let mut recent: VecDeque<DVector<f64>> = VecDeque::with_capacity(MAX_PERIOD + 1);
+        recent.push_back(x.clone());
         for k in 1..=self.rule.max_strides {
             let (q, qd) = self.walker.unpack(&x);
             let request = StrideRequest::new(self.settings).floor_step(floor_step_m(k));
@@ -172,34 +174,34 @@ impl<'a> Recovery<'a> {
                     strides: k,
                 };
             }
-            if until == Until::Failure {
-                continue;
-            }
-            if distance_inf(&x, self.fixed_point) <= self.rule.tolerance {
+            if until == Until::Settled && distance_inf(&x, self.fixed_point) <= self.rule.tolerance
+            {
                 return Outcome::Gait { strides: k };
             }
-            // x_k against x_{k−p}, p = 1..: `recent` holds x_{k−1}, x_{k−2}, ... newest last.
-            // Only clearly away from the gait (a slow return also repeats itself closely).
-            let elsewhere =
-                distance_inf(&x, self.fixed_point) >= ELSEWHERE_FACTOR * self.rule.tolerance;
-            if let Some(period) = recent
-                .iter()
-                .rev()
-                .position(|old| elsewhere && distance_inf(&x, old) <= self.rule.tolerance)
-            {
-                return Outcome::Periodic {
-                    period: period + 1,
-                    strides: k,
-                };
-            }
-            if recent.len() == MAX_PERIOD {
+            if recent.len() == MAX_PERIOD + 1 {
                 recent.pop_front();
             }
             recent.push_back(x.clone());
         }
-        Outcome::NotSettled {
-            strides: self.rule.max_strides,
+        let strides = self.rule.max_strides;
+        if until == Until::Failure {
+            return Outcome::NotSettled { strides };
         }
+        // x_K against x_{K−p}, p = 1..: judged only after every stride (a walk that spirals
+        // into the gait repeats itself closely on the way)
+        let last = recent.len() - 1;
+        let x_last = &recent[last];
+        // ... and within a thousandth of its distance from the gait: a slow return
+        // (`|λ|` near 1) moves a hundredth of that distance or more per stride
+        let within = self
+            .rule
+            .tolerance
+            .min(REPEAT_FRACTION * distance_inf(x_last, self.fixed_point));
+        (1..=last.min(MAX_PERIOD))
+            .find(|&p| distance_inf(x_last, &recent[last - p]) <= within)
+            .map_or(Outcome::NotSettled { strides }, |period| {
+                Outcome::Periodic { period, strides }
+            })
     }
 
     /// The walker's leg length for scaling tolerances: the distance from the stance contact

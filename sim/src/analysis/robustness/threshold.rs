@@ -16,8 +16,8 @@
 //! "Every disturbance up to it" is therefore checked on the scan's grid (a failure island
 //! narrower than `Δ` between two grid values can be missed); the boundary itself is located
 //! to the resolution. Step heights: `Δ = 1e-3 L`, limit `0.25 L`, resolution `1e-7 L` (`L` the
-//! leg length, [`super::Recovery::leg_length_m`]); rates: the same multiples of the natural
-//! rate `sqrt(g/L)`, limit `1.0 sqrt(g/L)`.
+//! leg length, [`super::Recovery::leg_length_m`]); rates: `Δ = 1e-2`, limit `0.25` and
+//! resolution `1e-7` of the natural rate `sqrt(g/L)` ([`ThresholdOptions`]).
 
 use super::recovery::{Outcome, Recovery, Until};
 use crate::stride::StrideWorkspace;
@@ -46,11 +46,11 @@ impl ThresholdOptions {
         }
     }
 
-    /// For rate perturbations (scale: `sqrt(g/L)`): `Δ = 1e-3`, limit 1, resolution 1e-7.
+    /// For rate perturbations (scale: `sqrt(g/L)`): `Δ = 1e-2`, limit 0.25, resolution 1e-7.
     pub fn rates() -> Self {
         Self {
-            scan_step: 1e-3,
-            limit: 1.0,
+            scan_step: 1e-2,
+            limit: 0.25,
             resolution: 1e-7,
         }
     }
