@@ -247,3 +247,52 @@ fn bad_input_is_refused_with_a_clear_message() {
         assert!(out.stdout.is_empty(), "{args:?}");
     }
 }
+
+#[test]
+fn a_map_of_a_measure_equals_the_measure_at_each_cell() {
+    let map = json(&[
+        "stability-map",
+        "--scene",
+        "compass",
+        "--x",
+        "slope_rad=0.03:0.05:2",
+        "--y",
+        "leg_com_from_hip_m=0.5:0.5:1",
+        "--quantity",
+        "step_down",
+        "--json",
+    ]);
+    assert_eq!(map["quantity"]["quantity"]["name"], "step_down");
+    assert_eq!(map["quantity"]["unit"], "m");
+    for (i, slope) in ["0.03", "0.05"].iter().enumerate() {
+        let set = format!("slope_rad={slope}");
+        let r = json(&[
+            "robustness",
+            "--scene",
+            "compass",
+            "--set",
+            &set,
+            "--measures",
+            "steps",
+            "--json",
+        ]);
+        assert_eq!(
+            map["quantity"]["values"][0][i], r["step_down_max_m"],
+            "{slope}"
+        );
+        assert!(r["gait_sensitivity_norm"].is_null() && r["mfpt"] == serde_json::json!([]));
+    }
+    let out = walker(&[
+        "stability-map",
+        "--scene",
+        "compass",
+        "--x",
+        "slope_rad=0.03:0.05:2",
+        "--y",
+        "leg_com_from_hip_m=0.5:0.5:1",
+        "--sigma-m",
+        "0.01",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--quantity mfpt"), "{}", stderr(&out));
+}

@@ -14,7 +14,8 @@ use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::orbit_diagram::linspace;
-use sim::analysis::stability_map::{stability_map, Axis};
+use sim::analysis::robustness::{FirstPassageOptions, Quantity};
+use sim::analysis::stability_map::{stability_map_of, Axis};
 use sim::report::StabilityMapReport;
 use sim::scene::Scene;
 use std::io::Write;
@@ -34,6 +35,14 @@ pub struct StabilityMapArgs {
     /// Write the heat map (stability_map.svg) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
+    /// Also map a robustness measure of each cell's gait: `gsn`, `step_down`, `step_up`,
+    /// `mfpt` (with --sigma-m), or `max_abs_eigenvalue` (docs/robustness.md); the JSON's
+    /// `quantity`, and the heat map draws it.
+    #[arg(long, value_name = "NAME")]
+    pub quantity: Option<String>,
+    /// The rough floor's standard deviation of `--quantity mfpt` [m].
+    #[arg(long = "sigma-m", value_name = "SIGMA")]
+    pub sigma_m: Option<f64>,
 }
 
 /// Parses `PARAM=FROM:TO:N` for option `flag` of `scene` (the parameter by its canonical name).
@@ -71,9 +80,34 @@ fn axis(flag: &str, spec: &str, scene: &Scene) -> Result<Axis, InputError> {
 
 /// Runs `walker stability-map`.
 pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
-    let StabilityMapArgs { common, x, y, plot } = args;
+    let StabilityMapArgs {
+        common,
+        x,
+        y,
+        plot,
+        quantity,
+        sigma_m,
+    } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
+    let quantity = quantity
+        .map(|name| {
+            if let Some(s) = sigma_m.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+                return Err(InputError::Other(format!(
+                    "--sigma-m {}: a standard deviation must be a finite number ≥ 0",
+                    sim::scene::short_number(s)
+                )));
+            }
+            Quantity::parse(&name, sigma_m, FirstPassageOptions::default())
+                .map_err(|e| InputError::Other(format!("--quantity: {e}")))
+        })
+        .transpose()?;
+    if sigma_m.is_some() && !matches!(quantity, Some(Quantity::Mfpt { .. })) {
+        return Err(InputError::Other(
+            "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
+        )
+        .into());
+    }
     let (x, y) = (axis("--x", &x, &scene)?, axis("--y", &y, &scene)?);
     if x.name == y.name {
         return Err(InputError::Other(format!(
@@ -89,18 +123,46 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     }
     let progress = Progress::new(cells, "stability map", !common.json);
     let homotopy = common.homotopy();
-    let map = stability_map(
+    let map = stability_map_of(
         &scene,
         &common.setup_for(),
         &x,
         &y,
         &common.newton(),
         &homotopy,
+        quantity.as_ref(),
         &|| progress.tick(),
     )
     .map_err(InputError::Scene)?;
     progress.finish();
-    let report = StabilityMapReport::new(scene.name(), &x, &y, &map);
+    let report = match &quantity {
+        Some(q) => StabilityMapReport::with_quantity(scene.name(), &x, &y, &map, q),
+        None => StabilityMapReport::new(scene.name(), &x, &y, &map),
+    };
+    if let (Some(dir), Some(q)) = (&plot, &report.quantity) {
+        let values: Vec<f64> = q.values.iter().flatten().flatten().copied().collect();
+        let mut sorted = values.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+        let fig = HeatMap {
+            title: format!(
+                "{}: {} of its gait (as walker gait finds it)",
+                labels::walker_name(&scene),
+                q.quantity.name()
+            ),
+            x_label: labels::parameter_label(&scene, &x.name),
+            y_label: labels::parameter_label(&scene, &y.name),
+            z_label: format!("{} [{}]", q.quantity.name(), q.quantity.unit()),
+            x: x.values.clone(),
+            y: y.values.clone(),
+            z: q.values.clone(),
+            level: median,
+            contour_label: "the median over the map".into(),
+            missing_label: "no gait, or not measured".into(),
+        };
+        let name = format!("stability_map_{}", q.quantity.name());
+        export::write_figure("--plot", dir, &name, &fig.to_svg(820.0, 620.0))?;
+    }
     if let Some(dir) = &plot {
         let fig = HeatMap {
             title: format!(
@@ -147,6 +209,29 @@ fn print_text(out: &mut dyn Write, r: &StabilityMapReport) -> std::io::Result<()
             }
         }
         writeln!(out)?;
+    }
+    if let Some(q) = &r.quantity {
+        writeln!(
+            out,
+            "{} [{}] of the same gaits ('-': no gait or not measured)",
+            q.quantity.name(),
+            q.quantity.unit()
+        )?;
+        write!(out, "{:>12}", "")?;
+        for x in &r.x.values {
+            write!(out, " {x:>11.4}")?;
+        }
+        writeln!(out)?;
+        for (y, row) in r.y.values.iter().zip(&q.values) {
+            write!(out, "{y:>12.5}")?;
+            for v in row {
+                match v {
+                    Some(v) => write!(out, " {v:>11.5e}")?,
+                    None => write!(out, " {:>11}", "-")?,
+                }
+            }
+            writeln!(out)?;
+        }
     }
     Ok(())
 }
