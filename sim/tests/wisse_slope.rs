@@ -255,3 +255,31 @@ fn a_vanishing_slope_reproduces_the_level_gait() {
         "{unmatched:?}"
     );
 }
+
+/// A state of the walker on a slope (its heading in the map) given to the walker on level
+/// ground is refused with the reason, never unpacked into the wrong coordinates or a panic
+/// (a sweep of the slope through 0 hit this).
+#[test]
+fn a_state_of_another_map_length_is_refused_not_misread() {
+    let level = scene_at("wisse3d", 0.0).setup().unwrap();
+    let sloped = scene_at("wisse3d", 0.01).setup().unwrap();
+    let (n_level, n_sloped) = (
+        2 * level.walker.map_coordinates().len(),
+        2 * sloped.walker.map_coordinates().len(),
+    );
+    assert_eq!(n_sloped, n_level + 2);
+    let newton = NewtonSettings::default();
+    for (setup, len) in [(&level, n_sloped), (&sloped, n_level)] {
+        let search =
+            sim::analysis::limit_cycle::GaitSearch::new(&setup.walker, &setup.settings, &newton);
+        let e = search.stride_map(&DVector::zeros(len)).unwrap_err();
+        assert_eq!(e.kind, sim::stride::FailureKind::InvalidConfiguration);
+        assert!(
+            e.detail().contains(&format!("{len} entries")),
+            "{}",
+            e.detail()
+        );
+        let (q, _) = setup.walker.unpack(&DVector::zeros(len));
+        assert!(q.iter().any(|v| v.is_nan()), "unpacked to NaN, not misread");
+    }
+}

@@ -237,6 +237,16 @@ impl<'a> GaitSearch<'a> {
         v: &DVector<f64>,
     ) -> Result<(DVector<f64>, StrideResult), StrideFailure> {
         let w = self.walker;
+        let expected = 2 * w.map_coordinates().len();
+        if v.len() != expected {
+            return Err(StrideFailure::new(
+                0.0,
+                crate::stride::FailureCause::MapLength {
+                    expected,
+                    got: v.len(),
+                },
+            ));
+        }
         let (q, qd) = w.unpack(v);
         let r = workspace.stride(&q, &qd, StrideRequest::new(self.settings))?;
         Ok((w.pack(&r.q_next, &r.qd_next), r))

@@ -208,15 +208,20 @@ impl Walker {
         DVector::from_fn(2 * n, |i, _| if i < n { q[c[i].0] } else { qd[c[i - n].0] })
     }
 
-    /// Unpacks a stride-map vector (cyclic coordinates and their rates are zero).
+    /// Unpacks a stride-map vector (cyclic coordinates and their rates are zero). A vector of
+    /// another length than the map's (another walker's state) unpacks to NaN, which every
+    /// stride refuses as a non-finite state; the stride map checks the length first
+    /// ([`crate::stride::FailureCause::MapLength`]).
     pub fn unpack(&self, x: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
         let c = self.map_coordinates();
         let n = c.len();
+        let fits = x.len() == 2 * n;
+        let at = |i: usize| if fits { x[i] } else { f64::NAN };
         let mut q = DVector::zeros(self.model.dof());
         let mut qd = DVector::zeros(self.model.dof());
         for (i, ci) in c.iter().enumerate() {
-            q[ci.0] = x[i];
-            qd[ci.0] = x[n + i];
+            q[ci.0] = at(i);
+            qd[ci.0] = at(n + i);
         }
         (q, qd)
     }

@@ -120,6 +120,20 @@ pub enum FailureCause {
     /// `ankle_reflex` section): a request that does not fit the walker.
     #[error("a controlled stride needs a scene with an ankle_reflex section")]
     NoAnkleReflex,
+    /// A stride-map vector of another length than the walker's map: a state of another
+    /// walker (the map changes size where a symmetry breaks, e.g. the 3D walker's heading,
+    /// cyclic on level ground and a state on a slope).
+    #[error(
+        "a stride-map vector of {got} entries for a walker whose stride map has {expected} \
+         (the map changes size where a symmetry breaks: the 3D walker's heading is a state on a \
+         slope and cyclic on level ground)"
+    )]
+    MapLength {
+        /// The walker's map length.
+        expected: usize,
+        /// The vector's.
+        got: usize,
+    },
     /// The search's budget of strides is spent: the stride was not run.
     #[error("the search's budget of {limit_strides} strides is spent (--max-strides)")]
     SearchBudget {
@@ -285,7 +299,7 @@ impl FailureCause {
     /// The kind of failure this cause is.
     pub fn kind(&self) -> FailureKind {
         match self {
-            Self::NoAnkleReflex => FailureKind::InvalidConfiguration,
+            Self::NoAnkleReflex | Self::MapLength { .. } => FailureKind::InvalidConfiguration,
             Self::SearchBudget { .. } => FailureKind::SearchBudgetExhausted,
             Self::NonFiniteInitialState
             | Self::NonFiniteState
