@@ -7,8 +7,9 @@
 /// dependency-free extension profile it shares with the firmware, `libm` (musl's math, also
 /// the firmware's) for the planar fast path's `sincos`, `libc` for opening a user's file
 /// without blocking (`O_NONBLOCK`), and `rand`, `rand_chacha`, `rand_distr` for the rough
-/// floor's seeded normal draws.
-const ALLOWED: [&str; 13] = [
+/// floor's seeded normal draws, and `cmaes` for `walker optimize` (a well-kept implementation
+/// of Hansen's CMA-ES with restarts, seeded, on the same nalgebra; without its plotting).
+const ALLOWED: [&str; 14] = [
     "ankle-profile",
     "nalgebra",
     "num-dual",
@@ -22,6 +23,7 @@ const ALLOWED: [&str; 13] = [
     "rand",
     "rand_chacha",
     "rand_distr",
+    "cmaes",
 ];
 
 const FORBIDDEN: [&str; 12] = [
