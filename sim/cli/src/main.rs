@@ -31,7 +31,7 @@ mod sweep_figures;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
-    accuracy, gait, gaits, orbit_diagram, scenes, sil, stability_map, sweep, tune, walk,
+    accuracy, gait, gaits, optimize, orbit_diagram, scenes, sil, stability_map, sweep, tune, walk,
 };
 use input_error::InputError;
 use sim::scene::SceneError;
@@ -71,6 +71,10 @@ enum Command {
     StabilityMap(stability_map::StabilityMapArgs),
     /// Search parameters within bounds for the smallest largest |eigenvalue| (Nelder-Mead).
     Tune(tune::TuneArgs),
+    /// Design optimisation: CMA-ES over scene parameters for an objective of the gait (gsn,
+    /// max_abs_eigenvalue, cost_of_transport), every candidate's gait by `walker gait`'s rule,
+    /// under constraints on the gait.
+    Optimize(optimize::OptimizeArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
     /// the fixed point, eigenvalues and heel-strike time against a tight reference.
     Accuracy(accuracy::AccuracyArgs),
@@ -104,6 +108,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::OrbitDiagram(args) => orbit_diagram::run(args),
         Command::StabilityMap(args) => stability_map::run(args),
         Command::Tune(args) => tune::run(args),
+        Command::Optimize(args) => optimize::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),
     }

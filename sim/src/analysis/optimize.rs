@@ -592,11 +592,27 @@ pub fn check(scene: &Scene, settings: &OptimizeSettings<'_>) -> Result<(), Optim
             quantity: settings.objective.quantity(),
         });
     }
-    if let Some(c) = settings.constraints.iter().find(|c| !c.quantity.available()) {
+    if let Some(c) = settings
+        .constraints
+        .iter()
+        .find(|c| !c.quantity.available())
+    {
         return Err(OptimizeError::NotAvailable {
             what: "constraint",
             quantity: c.quantity,
         });
+    }
+    let wants_cost = settings.objective.quantity() == Quantity::CostOfTransport
+        || settings
+            .constraints
+            .iter()
+            .any(|c| c.quantity == Quantity::CostOfTransport);
+    if wants_cost && (settings.setup_for)(scene)?.walker.ankle().is_none() {
+        return Err(OptimizeError::Invalid(format!(
+            "cost_of_transport: scene `{}` has no actuated ankle (its energy comes from the \
+             slope); `walker gait` reports a cost of transport for actuated walkers only",
+            scene.name()
+        )));
     }
     Ok(())
 }
@@ -663,7 +679,12 @@ impl Evaluator<'_> {
             .settings
             .params
             .iter()
-            .map(|p| (p.name.clone(), scene.values.get(&p.name).copied().unwrap_or(0.0)))
+            .map(|p| {
+                (
+                    p.name.clone(),
+                    scene.values.get(&p.name).copied().unwrap_or(0.0),
+                )
+            })
             .collect();
         let mut e = Evaluation {
             index: None,

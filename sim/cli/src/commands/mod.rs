@@ -4,6 +4,7 @@
 pub mod accuracy;
 pub mod gait;
 pub mod gaits;
+pub mod optimize;
 pub mod orbit_diagram;
 pub mod scenes;
 pub mod sil;
