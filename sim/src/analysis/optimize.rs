@@ -7,12 +7,13 @@
 //! CMA-ES (Hansen's covariance matrix adaptation evolution strategy, the `cmaes` crate) runs
 //! in **normalised coordinates**: each varied parameter `p ∈ [MIN, MAX]` is `u = (p − MIN) /
 //! (MAX − MIN) ∈ [0, 1]`. The first run starts at the scene's design (its values, clamped to
-//! the box) with step size [`INITIAL_STEP`] and the default population `4 + ⌊3 ln n⌋`. When
-//! a run stops by itself (its spread of values or of points has collapsed, ...) the search is
-//! restarted with twice the population (IPOP, Auger & Hansen 2005), from the best feasible
-//! design so far, at the initial step size. Every run's random draws come from `--seed` (run
-//! `k` is seeded by [`run_seed`]), and each generation is evaluated in parallel with its
-//! results kept in the order CMA-ES drew them: the same seed gives the same search, bit for
+//! the box) with step size [`OptimizeSettings::initial_step`] (default [`INITIAL_STEP`]) and
+//! the default population `4 + ⌊3 ln n⌋`. When a run stops by itself (its spread of values or
+//! of points has collapsed, ...) the search is restarted with twice the population (IPOP,
+//! Auger & Hansen 2005), from the best feasible design so far, at the initial step size. Every
+//! run's random draws come from `--seed` (run `k` is seeded by [`run_seed`]); each generation
+//! is evaluated in parallel (rayon) in the order CMA-ES drew it, and listed in CMA-ES's ranking
+//! (ties by their coordinates): the same seed gives the same search, bit for
 //! bit, whatever the number of threads.
 //!
 //! # The budget
@@ -47,7 +48,8 @@ use serde::{Serialize, Serializer};
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 
-/// The initial step size of CMA-ES in normalised coordinates (a quarter of each range).
+/// The default initial step size of CMA-ES in normalised coordinates (a quarter of each
+/// range; [`OptimizeSettings::initial_step`]).
 pub const INITIAL_STEP: f64 = 0.25;
 
 /// The weight of the squared distance (normalised) a candidate lay outside the box.
@@ -518,6 +520,10 @@ pub struct OptimizeSettings<'a> {
     pub budget: usize,
     /// The seed of every random draw.
     pub seed: u64,
+    /// CMA-ES's initial step size in normalised coordinates (0 < · ≤ 1; default
+    /// [`INITIAL_STEP`]); each restart starts with it again. Smaller for a design whose gait
+    /// is found only near the start.
+    pub initial_step: f64,
     /// Builds the setup at each design (the caller's solver overrides).
     pub setup_for: &'a SetupFor<'a>,
     /// The fixed-point search.
@@ -563,6 +569,12 @@ pub fn check(scene: &Scene, settings: &OptimizeSettings<'_>) -> Result<(), Optim
         return Err(OptimizeError::Invalid(
             "nothing to vary (give at least one NAME=MIN:MAX)".to_owned(),
         ));
+    }
+    if !(settings.initial_step > 0.0 && settings.initial_step <= 1.0) {
+        return Err(OptimizeError::Invalid(format!(
+            "the initial step must be above 0 and at most 1 (normalised), got {}",
+            settings.initial_step
+        )));
     }
     if settings.budget == 0 {
         return Err(OptimizeError::Invalid(
@@ -954,7 +966,7 @@ pub fn optimize(
     };
     let lambda0 = 4 + (3.0 * (n as f64).ln()).floor() as usize;
     let (mut run, mut lambda) = (0, lambda0);
-    let (mut mean, mut sigma) = (start.clone(), INITIAL_STEP);
+    let (mut mean, mut sigma) = (start.clone(), settings.initial_step);
     let mut remaining = settings.budget;
     while remaining >= 2 {
         let population = lambda.min(remaining);
@@ -989,7 +1001,7 @@ pub fn optimize(
                         .collect()
                 },
             );
-            sigma = INITIAL_STEP;
+            sigma = settings.initial_step;
         } else {
             // A last, shorter generation from where this run is.
             mean = cma.mean().as_slice().to_vec();

@@ -62,6 +62,11 @@ pub struct OptimizeArgs {
     /// number of threads.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// CMA-ES's initial step size, in normalised coordinates (each range 0 to 1): above 0, at
+    /// most 1. Smaller keeps the first generations near the scene's design (where its gait is
+    /// found).
+    #[arg(long, default_value_t = INITIAL_STEP)]
+    pub initial_step: f64,
     /// Write the objective's history (history.svg, .png, .pdf) into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<std::path::PathBuf>,
@@ -121,6 +126,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         constraint,
         budget,
         seed,
+        initial_step,
         plot,
     } = args;
     let scene = common.scene()?;
@@ -150,6 +156,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         constraints: &constraints,
         budget,
         seed,
+        initial_step,
         setup_for: &setup_for,
         newton: &newton,
         homotopy: &homotopy,
@@ -184,7 +191,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         method: Method {
             algorithm: "CMA-ES (cmaes crate), IPOP restarts",
             coordinates: "normalised: (value - MIN) / (MAX - MIN)",
-            initial_step: INITIAL_STEP,
+            initial_step,
             bounds: "clipped to the box, ranked with a penalty on the squared distance outside",
             bound_penalty: BOUND_PENALTY,
             restarts: "a run that stops by itself restarts with twice the population from \
