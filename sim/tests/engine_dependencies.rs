@@ -7,9 +7,11 @@
 /// dependency-free extension profile it shares with the firmware, `libm` (musl's math, also
 /// the firmware's) for the planar fast path's `sincos`, `libc` for opening a user's file
 /// without blocking (`O_NONBLOCK`), and `rand`, `rand_chacha`, `rand_distr` for the rough
-/// floor's seeded normal draws, and `statrs` for the chi-square quantiles of the first-passage
-/// time's exact interval (the same version the `cmaes` optimiser uses).
-const ALLOWED: [&str; 14] = [
+/// floor's seeded normal draws, `statrs` for the chi-square quantiles of the first-passage
+/// time's exact interval (the same version the `cmaes` optimiser uses), and `cmaes` for
+/// `walker optimize` (a well-kept implementation of Hansen's CMA-ES with restarts, seeded, on
+/// the same nalgebra; without its plotting).
+const ALLOWED: [&str; 15] = [
     "ankle-profile",
     "nalgebra",
     "num-dual",
@@ -24,6 +26,7 @@ const ALLOWED: [&str; 14] = [
     "rand_chacha",
     "rand_distr",
     "statrs",
+    "cmaes",
 ];
 
 const FORBIDDEN: [&str; 12] = [

@@ -31,8 +31,8 @@ mod sweep_figures;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
-    accuracy, basin, gait, gaits, orbit_diagram, robustness, scenes, sil, stability_map, sweep,
-    tune, walk,
+    accuracy, basin, gait, gaits, optimize, orbit_diagram, robustness, scenes, sil, stability_map,
+    sweep, tune, walk,
 };
 use input_error::InputError;
 use sim::scene::SceneError;
@@ -78,6 +78,10 @@ enum Command {
     /// A slice of the gait's basin of attraction in two stride-map coordinates just after
     /// heel strike: which states return to the gait, and in how many strides.
     Basin(basin::BasinArgs),
+    /// Design optimisation: CMA-ES over scene parameters for an objective of the gait (gsn,
+    /// max_abs_eigenvalue, cost_of_transport), every candidate's gait by `walker gait`'s rule,
+    /// under constraints on the gait.
+    Optimize(optimize::OptimizeArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
     /// the fixed point, eigenvalues and heel-strike time against a tight reference.
     Accuracy(accuracy::AccuracyArgs),
@@ -113,6 +117,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Tune(args) => tune::run(args),
         Command::Robustness(args) => robustness::run(args),
         Command::Basin(args) => basin::run(args),
+        Command::Optimize(args) => optimize::run(args),
         Command::Accuracy(args) => accuracy::run(args),
         Command::Sil(args) => sil::run(args),
     }

@@ -262,7 +262,7 @@ fn a_map_of_a_measure_equals_the_measure_at_each_cell() {
         "step_down",
         "--json",
     ]);
-    assert_eq!(map["quantity"]["quantity"]["name"], "step_down");
+    assert_eq!(map["quantity"]["name"], "step_down");
     assert_eq!(map["quantity"]["unit"], "m");
     for (i, slope) in ["0.03", "0.05"].iter().enumerate() {
         let set = format!("slope_rad={slope}");
@@ -295,4 +295,39 @@ fn a_map_of_a_measure_equals_the_measure_at_each_cell() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--quantity mfpt"), "{}", stderr(&out));
+}
+
+#[test]
+fn optimize_maximises_the_step_down_and_its_best_is_the_measure_there() {
+    let r = json(&[
+        "optimize",
+        "--scene",
+        "compass",
+        "--vary",
+        "leg_com_from_hip_m=0.4:0.6",
+        "--objective",
+        "step_down",
+        "--budget",
+        "12",
+        "--json",
+    ]);
+    assert_eq!(r["objective"], "step_down");
+    let best = r["best"]["value"].as_f64().unwrap();
+    let b = r["best"]["parameters"]["leg_com_from_hip_m"]
+        .as_f64()
+        .unwrap();
+    // not worse than the scene's design (the search keeps the best it saw)
+    assert!(best >= r["default"]["value"].as_f64().unwrap() - 1e-12);
+    let set = format!("leg_com_from_hip_m={b}");
+    let at = json(&[
+        "robustness",
+        "--scene",
+        "compass",
+        "--set",
+        &set,
+        "--measures",
+        "steps",
+        "--json",
+    ]);
+    assert_eq!(at["step_down_max_m"].as_f64().unwrap(), best);
 }

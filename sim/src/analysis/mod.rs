@@ -1,6 +1,7 @@
 //! What is computed from strides: gaits (fixed points of the stride map) and their stability,
 //! exact stride Jacobians, homotopies and continuation of gaits through their bifurcations, the
-//! census of gaits, orbit diagrams, stability maps, tuning, and speed against error.
+//! census of gaits, orbit diagrams, stability maps, tuning, design optimisation (CMA-ES), and
+//! speed against error.
 
 pub mod accuracy;
 pub mod census;
@@ -8,7 +9,9 @@ pub mod continuation;
 pub mod gait_sensitivity;
 pub mod homotopy;
 pub mod limit_cycle;
+pub mod optimize;
 pub mod orbit_diagram;
+pub mod quantity;
 pub mod robustness;
 pub mod stability;
 pub mod stability_map;

@@ -17,7 +17,7 @@
 
 use crate::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings, SetupFor};
 use crate::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
-use crate::analysis::robustness::{Quantity, QuantityError};
+use crate::analysis::quantity::{Quantity, QuantityError, QuantityOptions};
 use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -99,7 +99,7 @@ pub fn stability_map_of(
     y: &Axis,
     newton: &NewtonSettings,
     homotopy: &HomotopySettings,
-    quantity: Option<&Quantity>,
+    quantity: Option<(Quantity, &QuantityOptions)>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<StabilityMap, SceneError> {
     let mut check = scene.clone();
@@ -122,9 +122,9 @@ pub fn stability_map_of(
             let mut cell = rule
                 .gait(&at)?
                 .map(|(g, source)| (MapCell::of(&g, source), g));
-            if let (Some(q), Ok((c, g))) = (quantity, &mut cell) {
+            if let (Some((q, options)), Ok((c, g))) = (quantity, &mut cell) {
                 let setup = setup_for(&at)?;
-                c.quantity = Some(q.of(&setup.walker, &setup.settings, g));
+                c.quantity = Some(q.evaluate(&setup, g, options));
             }
             let cell = cell.map(|(c, _)| c);
             progress();

@@ -2,7 +2,7 @@
 //! a grid of two parameters, `null` where there is no gait.
 
 use crate::analysis::homotopy::GaitSource;
-use crate::analysis::robustness::{Quantity, QuantityError};
+use crate::analysis::quantity::{Quantity, QuantityError, QuantityOptions};
 use crate::analysis::stability_map::{Axis, StabilityMap};
 use serde::Serialize;
 
@@ -35,10 +35,12 @@ pub struct StabilityMapReport {
 /// A robustness measure over the grid.
 #[derive(Clone, Debug, Serialize)]
 pub struct QuantityGrid {
-    /// The quantity (`{name, ...}`: `gsn`, `step_down`, `mfpt` with its `sigma_m`, ...).
-    pub quantity: Quantity,
+    /// The quantity (`gsn`, `step_down`, `mfpt`, ...).
+    pub name: Quantity,
     /// Its unit.
     pub unit: &'static str,
+    /// The rough floor of `mfpt` \[m\] (`null` for the others).
+    pub sigma_m: Option<f64>,
     /// Its value (`null`: no gait, or it could not be had).
     pub values: Vec<Vec<Option<f64>>>,
     /// Why it could not be had at a cell with a gait (`null` elsewhere).
@@ -71,7 +73,8 @@ impl StabilityMapReport {
         x: &Axis,
         y: &Axis,
         map: &StabilityMap,
-        quantity: &Quantity,
+        quantity: Quantity,
+        options: &QuantityOptions,
     ) -> Self {
         fn cells<T>(
             map: &StabilityMap,
@@ -93,8 +96,9 @@ impl StabilityMapReport {
         }
         Self {
             quantity: Some(QuantityGrid {
-                quantity: *quantity,
+                name: quantity,
                 unit: quantity.unit(),
+                sigma_m: options.sigma_m.filter(|_| quantity == Quantity::Mfpt),
                 values: cells(map, |q| q.as_ref().ok().copied()),
                 errors: cells(map, |q| q.as_ref().err().map(ToString::to_string)),
             }),

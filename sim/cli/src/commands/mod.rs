@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod basin;
 pub mod gait;
 pub mod gaits;
+pub mod optimize;
 pub mod orbit_diagram;
 pub mod robustness;
 pub mod scenes;

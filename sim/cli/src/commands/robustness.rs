@@ -358,10 +358,19 @@ fn print_text(out: &mut dyn Write, r: &RobustnessReport) -> std::io::Result<()> 
     if let Some(v) = &r.velocity_thresholds {
         writeln!(out, "largest change of each rate survived:")?;
         for t in v {
+            let shown_max = |t: &sim::analysis::robustness::Threshold| {
+                if t.at_limit {
+                    format!("≥{:.7} (the scan's limit)", t.max)
+                } else {
+                    format!("{:.7}", t.max)
+                }
+            };
             writeln!(
                 out,
-                "    {:<28} +{:.7}  −{:.7}",
-                t.coordinate, t.positive.max, t.negative.max
+                "    {:<28} +{}  −{}",
+                t.coordinate,
+                shown_max(&t.positive),
+                shown_max(&t.negative)
             )?;
         }
     }

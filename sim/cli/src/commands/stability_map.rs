@@ -14,7 +14,7 @@ use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::orbit_diagram::linspace;
-use sim::analysis::robustness::{FirstPassageOptions, Quantity};
+use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis};
 use sim::report::StabilityMapReport;
 use sim::scene::Scene;
@@ -90,19 +90,24 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
+    let options = QuantityOptions {
+        sigma_m,
+        ..Default::default()
+    };
     let quantity = quantity
         .map(|name| {
-            if let Some(s) = sigma_m.filter(|s| !(s.is_finite() && *s >= 0.0)) {
-                return Err(InputError::Other(format!(
-                    "--sigma-m {}: a standard deviation must be a finite number ≥ 0",
-                    sim::scene::short_number(s)
-                )));
-            }
-            Quantity::parse(&name, sigma_m, FirstPassageOptions::default())
-                .map_err(|e| InputError::Other(format!("--quantity: {e}")))
+            let q = Quantity::parse(&name).ok_or_else(|| {
+                InputError::Other(format!(
+                    "--quantity `{name}`: expected one of {}",
+                    Quantity::names()
+                ))
+            })?;
+            q.check(&options)
+                .map_err(|e| InputError::Other(format!("--quantity {q}: {e}")))?;
+            Ok::<_, InputError>(q)
         })
         .transpose()?;
-    if sigma_m.is_some() && !matches!(quantity, Some(Quantity::Mfpt { .. })) {
+    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
         return Err(InputError::Other(
             "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
         )
@@ -130,13 +135,13 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
         &y,
         &common.newton(),
         &homotopy,
-        quantity.as_ref(),
+        quantity.map(|q| (q, &options)),
         &|| progress.tick(),
     )
     .map_err(InputError::Scene)?;
     progress.finish();
     let report = match &quantity {
-        Some(q) => StabilityMapReport::with_quantity(scene.name(), &x, &y, &map, q),
+        Some(q) => StabilityMapReport::with_quantity(scene.name(), &x, &y, &map, *q, &options),
         None => StabilityMapReport::new(scene.name(), &x, &y, &map),
     };
     if let (Some(dir), Some(q)) = (&plot, &report.quantity) {
@@ -148,11 +153,11 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
             title: format!(
                 "{}: {} of its gait (as walker gait finds it)",
                 labels::walker_name(&scene),
-                q.quantity.name()
+                q.name.name()
             ),
             x_label: labels::parameter_label(&scene, &x.name),
             y_label: labels::parameter_label(&scene, &y.name),
-            z_label: format!("{} [{}]", q.quantity.name(), q.quantity.unit()),
+            z_label: format!("{} [{}]", q.name.name(), q.name.unit()),
             x: x.values.clone(),
             y: y.values.clone(),
             z: q.values.clone(),
@@ -160,7 +165,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
             contour_label: "the median over the map".into(),
             missing_label: "no gait, or not measured".into(),
         };
-        let name = format!("stability_map_{}", q.quantity.name());
+        let name = format!("stability_map_{}", q.name.name());
         export::write_figure("--plot", dir, &name, &fig.to_svg(820.0, 620.0))?;
     }
     if let Some(dir) = &plot {
@@ -214,8 +219,8 @@ fn print_text(out: &mut dyn Write, r: &StabilityMapReport) -> std::io::Result<()
         writeln!(
             out,
             "{} [{}] of the same gaits ('-': no gait or not measured)",
-            q.quantity.name(),
-            q.quantity.unit()
+            q.name.name(),
+            q.name.unit()
         )?;
         write!(out, "{:>12}", "")?;
         for x in &r.x.values {

@@ -17,13 +17,11 @@
 
 pub mod basin;
 pub mod first_passage;
-pub mod quantity;
 pub mod recovery;
 pub mod threshold;
 
 pub use basin::{basin_slice, BasinAxis, BasinCell, BasinSlice};
 pub use first_passage::{mean_first_passage, FirstPassage, FirstPassageOptions};
-pub use quantity::{Quantity, QuantityError, QUANTITY_NAMES};
 pub use recovery::{Outcome, Recovery, ReturnRule};
 pub use threshold::{
     step_threshold, step_thresholds, velocity_thresholds, StepDirection, StepThresholds, Threshold,
