@@ -264,3 +264,21 @@ fn the_text_compares_the_best_design_with_the_scenes_and_the_plot_is_written() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn every_candidates_gait_is_the_one_walker_gait_finds_at_its_values() {
+    let (_, j) = optimize_json(
+        &["--objective", "gsn", "--budget", "6", "--seed", "3"],
+        None,
+    );
+    for e in j["evaluations"].as_array().unwrap() {
+        let set = format!(
+            "leg_com_from_hip_m={}",
+            e["parameters"]["leg_com_from_hip_m"]
+        );
+        let out = walker(&["gait", "--scene", "compass", "--set", &set, "--json"]);
+        let g: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(g["max_abs_eigenvalue"], e["max_abs_eigenvalue"], "{set}");
+        assert_eq!(g["gait_source"], e["gait_source"], "{set}");
+    }
+}
