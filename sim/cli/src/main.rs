@@ -12,6 +12,7 @@ mod commands;
 mod export;
 mod figures;
 mod gait_text;
+mod grid_axis;
 mod heatmap;
 mod input_error;
 mod labels;

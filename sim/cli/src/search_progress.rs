@@ -74,3 +74,31 @@ impl Drop for SearchProgress {
         }
     }
 }
+
+/// The gait of `scene` by the one gait rule ([`sim::analysis::homotopy::GaitRule`]) as a
+/// command asks for it: each setup built by `setup_for`, the options' Newton and homotopy
+/// settings, a budget of `--max-strides` strides and its progress on a terminal after a second
+/// (not with `--json`). The gait and where it came from, or why there is none.
+///
+/// # Errors
+/// A scene that cannot be built at the values the rule visits.
+pub fn rule_gait(
+    common: &crate::options::Common,
+    setup_for: &sim::analysis::homotopy::SetupFor<'_>,
+    scene: &sim::scene::Scene,
+) -> Result<
+    Result<
+        (
+            sim::analysis::limit_cycle::Gait,
+            sim::analysis::homotopy::GaitSource,
+        ),
+        sim::analysis::limit_cycle::NewtonError,
+    >,
+    sim::scene::SceneError,
+> {
+    let budget = Arc::new(SearchBudget::new(common.max_strides));
+    let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
+    sim::analysis::homotopy::GaitRule::new(setup_for, &common.newton(), &common.homotopy())
+        .with_budget(Arc::clone(&budget))
+        .gait(scene)
+}

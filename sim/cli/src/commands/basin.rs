@@ -4,24 +4,21 @@
 
 use super::print_json;
 use crate::export;
+use crate::grid_axis;
 use crate::heatmap::HeatMap;
 use crate::input_error::InputError;
 use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
-use crate::search_progress::SearchProgress;
+use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sim::analysis::homotopy::GaitRule;
-use sim::analysis::orbit_diagram::linspace;
 use sim::analysis::robustness::{basin_slice, BasinAxis, BasinCell, Outcome, Recovery, ReturnRule};
 use sim::report::GaitReport;
-use sim::stride::SearchBudget;
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::Arc;
 
 /// Options of `walker basin`.
 #[derive(Args)]
@@ -68,34 +65,9 @@ struct BasinReport {
 
 /// Parses `COORD=FROM:TO:N` of option `flag`.
 fn axis(flag: &str, spec: &str) -> Result<BasinAxis, InputError> {
-    let bad = |why: &str| {
-        InputError::Other(format!(
-            "{flag} `{spec}`: {why} (expected COORD=FROM:TO:N, e.g. stance_leg=0.15:0.25:41)"
-        ))
-    };
-    let (name, range) = spec.split_once('=').ok_or_else(|| bad("no `=`"))?;
-    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
-    let [from, to, n] = parts.as_slice() else {
-        return Err(bad("expected three fields after `=`"));
-    };
-    let number = |what: &str, s: &str| -> Result<f64, InputError> {
-        s.parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| bad(&format!("{what} `{s}` is not a finite number")))
-    };
-    let (from, to) = (number("FROM", from)?, number("TO", to)?);
-    let n: usize = n
-        .parse()
-        .map_err(|_| bad(&format!("N `{n}` is not a count")))?;
-    let n = limits::count(&format!("{flag} N"), n, 1, limits::MAX_MAP_AXIS_POINTS)?;
-    if n > 1 && from == to {
-        return Err(bad("FROM and TO are equal"));
-    }
-    Ok(BasinAxis {
-        name: name.trim().to_owned(),
-        values: linspace(from, to, n),
-    })
+    let (name, values) =
+        grid_axis::parse(flag, spec, "COORD=FROM:TO:N, e.g. stance_leg=0.15:0.25:41")?;
+    Ok(BasinAxis { name, values })
 }
 
 /// Runs `walker basin`: exit code 1 when no gait is found.
@@ -136,13 +108,7 @@ pub fn run(args: BasinArgs) -> Result<ExitCode> {
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }
-    let budget = Arc::new(SearchBudget::new(common.max_strides));
-    let sourced = {
-        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
-        GaitRule::new(&common.setup_for(), &common.newton(), &common.homotopy())
-            .with_budget(Arc::clone(&budget))
-            .gait(&scene)?
-    };
+    let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
     let (mut gait_report, _) = super::gait::report(&scene, &setup, &result, false);

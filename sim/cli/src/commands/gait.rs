@@ -11,19 +11,17 @@ use crate::figures;
 use crate::gait_text::GaitFigures;
 use crate::options::Common;
 use crate::output;
-use crate::search_progress::SearchProgress;
+use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::homotopy::{GaitRule, GaitSource};
+use sim::analysis::homotopy::GaitSource;
 use sim::analysis::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
 use sim::stride::walk::WalkRequest;
-use sim::stride::SearchBudget;
 use sim::stride::{StrideOptions, StrideRequest, StrideResult};
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::Arc;
 
 /// Options of `walker gait`.
 #[derive(Args)]
@@ -58,14 +56,7 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     }
     let animation = animation::open(animate.as_deref(), ANIMATED_STRIDES)?;
     let walker = &setup.walker;
-    let (setup_for, newton, homotopy) = (common.setup_for(), common.newton(), common.homotopy());
-    let budget = Arc::new(SearchBudget::new(common.max_strides));
-    let sourced = {
-        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
-        GaitRule::new(&setup_for, &newton, &homotopy)
-            .with_budget(Arc::clone(&budget))
-            .gait(&scene)?
-    };
+    let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
     let (mut report, figures_stride) = report(&scene, &setup, &result, plot.is_some());

@@ -8,22 +8,19 @@ use crate::limits;
 use crate::options::Common;
 use crate::output;
 use crate::progress::Progress;
-use crate::search_progress::SearchProgress;
+use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use sim::analysis::gait_sensitivity::{gait_sensitivity_norm, GaitSensitivity};
-use sim::analysis::homotopy::GaitRule;
 use sim::analysis::robustness::{
     mean_first_passage, step_thresholds, velocity_thresholds, FirstPassage, FirstPassageOptions,
     Recovery, StepThresholds, ThresholdOptions, VelocityThreshold,
 };
 use sim::report::GaitReport;
-use sim::stride::SearchBudget;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::Arc;
 
 /// Options of `walker robustness`.
 #[derive(Args)]
@@ -176,13 +173,7 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
         .into());
     }
     let walker = &setup.walker;
-    let budget = Arc::new(SearchBudget::new(common.max_strides));
-    let sourced = {
-        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
-        GaitRule::new(&common.setup_for(), &common.newton(), &common.homotopy())
-            .with_budget(Arc::clone(&budget))
-            .gait(&scene)?
-    };
+    let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
     let (mut gait_report, _) = super::gait::report(&scene, &setup, &result, false);

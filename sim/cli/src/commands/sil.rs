@@ -11,21 +11,20 @@ use crate::limits;
 use crate::options::Common;
 use crate::output::{self, PathError};
 use crate::progress::Progress;
-use crate::search_progress::SearchProgress;
+use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use sim::analysis::homotopy::{GaitRule, GaitSource};
+use sim::analysis::homotopy::GaitSource;
 use sim::analysis::limit_cycle::Gait;
 use sim::engine::integrators::IntegratorChoice;
 use sim::report::{IdealGaitRecord, StartRecord, WalkGaitRecord};
 use sim::scene::Setup;
 use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
-use sim::stride::{Floor, SearchBudget};
+use sim::stride::Floor;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::Arc;
 
 /// Options of `walker sil`.
 #[derive(Args)]
@@ -283,14 +282,7 @@ fn ideal_gait(
 ) -> Result<Option<(Setup, Gait, GaitSource)>> {
     let ideal_setup = scene.setup()?;
     let own_integrator = |s: &sim::scene::Scene| s.setup();
-    let (newton, homotopy) = (common.newton(), common.homotopy());
-    let budget = Arc::new(SearchBudget::new(common.max_strides));
-    let found = {
-        let _progress = SearchProgress::watch(&budget, "gait search", !common.json);
-        GaitRule::new(&own_integrator, &newton, &homotopy)
-            .with_budget(Arc::clone(&budget))
-            .gait(scene)?
-    };
+    let found = search_progress::rule_gait(common, &own_integrator, scene)?;
     match found {
         Ok((g, source)) => Ok(Some((ideal_setup, g, source))),
         Err(e) => {

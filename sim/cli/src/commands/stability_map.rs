@@ -4,6 +4,7 @@
 
 use super::print_json;
 use crate::export;
+use crate::grid_axis;
 use crate::heatmap::HeatMap;
 use crate::input_error::InputError;
 use crate::labels;
@@ -13,7 +14,6 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::orbit_diagram::linspace;
 use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis};
 use sim::report::StabilityMapReport;
@@ -47,34 +47,11 @@ pub struct StabilityMapArgs {
 
 /// Parses `PARAM=FROM:TO:N` for option `flag` of `scene` (the parameter by its canonical name).
 fn axis(flag: &str, spec: &str, scene: &Scene) -> Result<Axis, InputError> {
-    let bad = |why: &str| {
-        InputError::Other(format!(
-            "{flag} `{spec}`: {why} (expected PARAM=FROM:TO:N, e.g. slope_rad=0.01:0.02:11)"
-        ))
-    };
-    let (name, range) = spec.split_once('=').ok_or_else(|| bad("no `=`"))?;
-    let name = scene.parameter_name(name.trim())?;
-    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
-    let [from, to, n] = parts.as_slice() else {
-        return Err(bad("expected three fields after `=`"));
-    };
-    let number = |what: &str, s: &str| -> Result<f64, InputError> {
-        s.parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| bad(&format!("{what} `{s}` is not a finite number")))
-    };
-    let (from, to) = (number("FROM", from)?, number("TO", to)?);
-    let n: usize = n
-        .parse()
-        .map_err(|_| bad(&format!("N `{n}` is not a count")))?;
-    let n = limits::count(&format!("{flag} N"), n, 1, limits::MAX_MAP_AXIS_POINTS)?;
-    if n > 1 && from == to {
-        return Err(bad("FROM and TO are equal"));
-    }
+    let (name, values) =
+        grid_axis::parse(flag, spec, "PARAM=FROM:TO:N, e.g. slope_rad=0.01:0.02:11")?;
     Ok(Axis {
-        name,
-        values: linspace(from, to, n),
+        name: scene.parameter_name(&name)?,
+        values,
     })
 }
 
