@@ -69,7 +69,7 @@ pub struct OptimizeArgs {
     /// found).
     #[arg(long, default_value_t = INITIAL_STEP)]
     pub initial_step: f64,
-    /// The rough floor's standard deviation of `mfpt` [m] (its Monte Carlo: 100 walks of up
+    /// The rough floor's standard deviation of `mfpt`, in metres (its Monte Carlo: 100 walks of up
     /// to 200 strides, seeds from 0, as `walker robustness`).
     #[arg(long = "sigma-m", value_name = "SIGMA")]
     pub sigma_m: Option<f64>,

@@ -27,7 +27,7 @@ use std::process::ExitCode;
 pub struct RobustnessArgs {
     #[command(flatten)]
     pub common: Common,
-    /// A rough floor's standard deviation for the mean first-passage time [m] (repeatable;
+    /// A rough floor's standard deviation for the mean first-passage time, in metres (repeatable;
     /// default: 0.001, 0.003 and 0.01 leg lengths).
     #[arg(long = "sigma-m", value_name = "SIGMA", allow_hyphen_values = true)]
     pub sigma_m: Vec<f64>,

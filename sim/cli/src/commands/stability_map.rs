@@ -40,7 +40,7 @@ pub struct StabilityMapArgs {
     /// `quantity`, and the heat map draws it.
     #[arg(long, value_name = "NAME")]
     pub quantity: Option<String>,
-    /// The rough floor's standard deviation of `--quantity mfpt` [m].
+    /// The rough floor's standard deviation of `--quantity mfpt`, in metres.
     #[arg(long = "sigma-m", value_name = "SIGMA")]
     pub sigma_m: Option<f64>,
 }
