@@ -214,6 +214,7 @@ fn a_basin_slice_agrees_cell_by_cell_and_its_fraction_converges() {
                 name: "stance_leg_dot".into(),
                 values: centres(window[1], n),
             },
+            &|| {},
         )
         .unwrap();
         assert_eq!(engine.solved_coordinate.as_deref(), Some("swing_leg"));

@@ -80,8 +80,8 @@ enum Command {
     /// heel strike: which states return to the gait, and in how many strides.
     Basin(basin::BasinArgs),
     /// Design optimisation: CMA-ES over scene parameters for an objective of the gait (gsn,
-    /// max_abs_eigenvalue, cost_of_transport), every candidate's gait by `walker gait`'s rule,
-    /// under constraints on the gait.
+    /// step_down, mfpt, max_abs_eigenvalue, cost_of_transport), every candidate's gait by
+    /// `walker gait`'s rule, under constraints on the gait.
     Optimize(optimize::OptimizeArgs),
     /// Speed against error: every integrator over a range of steps or tolerances, errors of
     /// the fixed point, eigenvalues and heel-strike time against a tight reference.

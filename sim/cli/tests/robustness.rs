@@ -331,3 +331,144 @@ fn optimize_maximises_the_step_down_and_its_best_is_the_measure_there() {
     ]);
     assert_eq!(at["step_down_max_m"].as_f64().unwrap(), best);
 }
+
+#[test]
+fn an_unstable_gait_has_no_robustness_measure_and_says_so() {
+    let out = walker(&[
+        "robustness",
+        "--scene",
+        "compass",
+        "--set",
+        "slope_rad=0.2",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(r["errors"]["gait"].as_str().unwrap().contains("unstable"));
+    assert!(r["gait_sensitivity_norm"].is_null() && r["step_down_max_m"].is_null());
+    // in a map: the cell has its gait, its measure an error saying why
+    let map = json(&[
+        "stability-map",
+        "--scene",
+        "compass",
+        "--x",
+        "slope_rad=0.05:0.2:2",
+        "--y",
+        "leg_com_from_hip_m=0.5:0.5:1",
+        "--quantity",
+        "gsn",
+        "--json",
+    ]);
+    assert!(map["quantity"]["values"][0][0].as_f64().unwrap() > 0.0);
+    assert!(map["quantity"]["values"][0][1].is_null());
+    assert!(map["quantity"]["errors"][0][1]
+        .as_str()
+        .unwrap()
+        .contains("unstable"));
+}
+
+#[test]
+fn a_floor_that_never_trips_the_walker_scores_the_strides_simulated() {
+    // σ = 0: no walk falls; the value is the strides simulated (100 walks × 200), above any
+    // design that fell in the same Monte Carlo
+    let map = json(&[
+        "stability-map",
+        "--scene",
+        "compass",
+        "--x",
+        "slope_rad=0.05:0.05:1",
+        "--y",
+        "leg_com_from_hip_m=0.5:0.5:1",
+        "--quantity",
+        "mfpt",
+        "--sigma-m",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(map["quantity"]["values"][0][0].as_f64().unwrap(), 20_000.0);
+    assert_eq!(map["quantity"]["sigma_m"], 0.0);
+}
+
+#[test]
+fn a_basin_over_both_positions_keeps_only_cells_on_the_section() {
+    let r = json(&[
+        "basin",
+        "--scene",
+        "simplest",
+        "--x",
+        "stance_leg=0.15:0.25:5",
+        "--y",
+        "swing_leg=-0.5:-0.3:3",
+        "--json",
+    ]);
+    assert!(r["solved_coordinate"].is_null());
+    // swing_leg = −2 stance_leg puts the foot on the floor: of these cells only
+    // (0.15, −0.3), (0.2, −0.4) and (0.25, −0.5)
+    let on: Vec<(usize, usize)> = (0..3)
+        .flat_map(|j| (0..5).map(move |i| (j, i)))
+        .filter(|&(j, i)| r["outcome"][j][i] != "off_section")
+        .collect();
+    assert_eq!(on, vec![(0, 4), (1, 2), (2, 0)], "{}", r["outcome"]);
+}
+
+#[test]
+fn options_that_would_be_ignored_or_overreach_are_refused() {
+    for (args, needle) in [
+        (
+            vec![
+                "robustness",
+                "--scene",
+                "compass",
+                "--measures",
+                "gsn",
+                "--sigma-m",
+                "0.01",
+            ],
+            "add mfpt to --measures",
+        ),
+        (
+            vec![
+                "robustness",
+                "--scene",
+                "compass",
+                "--rate-scan-step",
+                "0.3",
+            ],
+            "--rate-scan-step",
+        ),
+        (
+            vec![
+                "optimize",
+                "--scene",
+                "compass",
+                "--vary",
+                "leg_com_from_hip_m=0.4:0.6",
+                "--objective",
+                "gsn",
+                "--sigma-m",
+                "0.002",
+            ],
+            "--sigma-m is the rough floor of mfpt",
+        ),
+        (
+            vec![
+                "stability-map",
+                "--scene",
+                "compass",
+                "--x",
+                "slope_rad=0.03:0.05:2",
+                "--y",
+                "leg_com_from_hip_m=0.5:0.5:1",
+                "--quantity",
+                "mfpt",
+                "--sigma-m",
+                "-1",
+            ],
+            "--sigma-m -1",
+        ),
+    ] {
+        let out = walker(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+}

@@ -28,7 +28,8 @@ pub enum Quantity {
     /// The largest |eigenvalue| of the stride Jacobian.
     MaxAbsEigenvalue,
     /// The mean first-passage time on a rough floor \[steps\] (the floor and the Monte Carlo
-    /// in [`QuantityOptions`]; the lower end of its interval when no walk fell).
+    /// in [`QuantityOptions`]; when no walk fell, the strides simulated: more than any design
+    /// that fell in the same Monte Carlo scores).
     Mfpt,
     /// Actuator work per unit mass and forward distance \[J/(kg m)\] (actuated walkers).
     CostOfTransport,
@@ -96,6 +97,12 @@ impl Quantity {
         Self::ALL.into_iter().find(|q| q.name() == name)
     }
 
+    /// Whether it measures how a disturbance dies out (the robustness measures): undefined at
+    /// an unstable gait.
+    pub fn needs_stable_gait(self) -> bool {
+        matches!(self, Self::Gsn | Self::StepDown | Self::StepUp | Self::Mfpt)
+    }
+
     /// The names, comma-separated (for messages).
     pub fn names() -> String {
         Self::ALL.map(Self::name).join(", ")
@@ -126,6 +133,16 @@ impl Quantity {
         options: &QuantityOptions,
     ) -> Result<f64, QuantityError> {
         let walker = &setup.walker;
+        if self.needs_stable_gait() && !gait.stable() {
+            return Err(QuantityError::Undefined {
+                quantity: self,
+                why: format!(
+                    "the gait is unstable (max |λ| = {}): a disturbance grows instead of dying \
+                     out",
+                    gait.max_abs_eigenvalue()
+                ),
+            });
+        }
         let recovery = || Recovery::new(walker, &setup.settings, gait);
         let step =
             |direction| step_threshold(&recovery(), &ThresholdOptions::steps(), direction).max;
@@ -144,7 +161,9 @@ impl Quantity {
                         why: e.to_string(),
                     },
                 )?;
-                Ok(m.steps.unwrap_or(m.ci_low))
+                // No walk fell: the strides simulated, which no design that fell in the same
+                // Monte Carlo exceeds (T/d ≤ T), so maximising never prefers falling.
+                Ok(m.steps.unwrap_or(m.strides_simulated as f64))
             }
             Self::MaxAbsEigenvalue => Ok(gait.max_abs_eigenvalue()),
             Self::CostOfTransport => {

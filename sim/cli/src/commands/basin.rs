@@ -11,6 +11,7 @@ use crate::labels;
 use crate::limits;
 use crate::options::Common;
 use crate::output;
+use crate::progress::Progress;
 use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
@@ -128,7 +129,10 @@ pub fn run(args: BasinArgs) -> Result<ExitCode> {
         ..ReturnRule::default()
     };
     let recovery = Recovery::new(&setup.walker, &setup.settings, gait).with_rule(rule);
-    let slice = basin_slice(&recovery, x, y).map_err(|e| InputError::Other(e.to_string()))?;
+    let progress = Progress::new(cells, "basin (cells)", !common.json);
+    let slice = basin_slice(&recovery, x, y, &|| progress.tick())
+        .map_err(|e| InputError::Other(e.to_string()))?;
+    progress.finish();
     let map = |f: &dyn Fn(&BasinCell) -> String| -> Vec<Vec<String>> {
         slice
             .cells

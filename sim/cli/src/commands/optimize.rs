@@ -71,7 +71,7 @@ pub struct OptimizeArgs {
     pub initial_step: f64,
     /// The rough floor's standard deviation of `mfpt`, in metres (its Monte Carlo: 100 walks of up
     /// to 200 strides, seeds from 0, as `walker robustness`).
-    #[arg(long = "sigma-m", value_name = "SIGMA")]
+    #[arg(long = "sigma-m", value_name = "SIGMA", allow_hyphen_values = true)]
     pub sigma_m: Option<f64>,
     /// Write the objective's history (history.svg, .png, .pdf) into this folder.
     #[arg(long, value_name = "DIR")]
@@ -153,6 +153,17 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         .iter()
         .map(|c| Constraint::parse(c).map_err(|e| InputError::Other(format!("--{e}"))))
         .collect::<Result<Vec<_>, _>>()?;
+    let uses_mfpt = objective.quantity() == sim::analysis::quantity::Quantity::Mfpt
+        || constraints
+            .iter()
+            .any(|c| c.quantity == sim::analysis::quantity::Quantity::Mfpt);
+    if args_sigma_m.is_some() && !uses_mfpt {
+        return Err(InputError::Other(
+            "--sigma-m is the rough floor of mfpt: give --objective mfpt or an mfpt constraint"
+                .into(),
+        )
+        .into());
+    }
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }

@@ -140,9 +140,11 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     } = args;
     let return_strides = limits::count("--return-strides", return_strides, 1, 100_000)?;
     let measures = Measures::parse(&measures)?;
-    if !(rate_scan_step.is_finite() && (1e-6..=0.5).contains(&rate_scan_step)) {
+    if !(rate_scan_step.is_finite()
+        && (1e-6..=ThresholdOptions::rates().limit).contains(&rate_scan_step))
+    {
         return Err(InputError::Other(format!(
-            "--rate-scan-step must be from 1e-6 to 0.5 natural rates, got {}",
+            "--rate-scan-step must be from 1e-6 to 0.25 natural rates (the scan's limit), got {}",
             sim::scene::short_number(rate_scan_step)
         ))
         .into());
@@ -156,6 +158,13 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
             "--mfpt-runs × --mfpt-strides must be at most {MAX_MFPT_TOTAL_STRIDES} strides, got \
              {runs} × {strides}"
         ))
+        .into());
+    }
+    if !measures.mfpt && !sigma_m.is_empty() {
+        return Err(InputError::Other(
+            "--sigma-m is the rough floor of the mean first-passage time: add mfpt to --measures"
+                .into(),
+        )
         .into());
     }
     if sigma_m.len() > MAX_SIGMAS {
@@ -195,6 +204,17 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     let Ok(gait) = &result else {
         return finish(&common, &report, ExitCode::from(1));
     };
+    if !gait.stable() {
+        // every measure here asks how a disturbance dies out: at an unstable gait it grows
+        report.errors.insert(
+            "gait".into(),
+            format!(
+                "the gait is unstable (max |λ| = {}): no robustness measure is defined there",
+                gait.max_abs_eigenvalue()
+            ),
+        );
+        return finish(&common, &report, ExitCode::from(1));
+    }
     let rule = sim::analysis::robustness::ReturnRule {
         max_strides: return_strides,
         ..Default::default()
@@ -203,7 +223,13 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     let recovery = Recovery::new(walker, &setup.settings, gait).with_rule(rule);
     let leg_m = recovery.leg_length_m();
     let sigmas = if sigma_m.is_empty() {
-        vec![1e-3 * leg_m, 3e-3 * leg_m, 1e-2 * leg_m]
+        // rounded to 12 significant digits: a leg length of 0.9999999999999999 m gives 0.001
+        let round = |x: f64| format!("{x:.12e}").parse::<f64>().unwrap_or(x);
+        vec![
+            round(1e-3 * leg_m),
+            round(3e-3 * leg_m),
+            round(1e-2 * leg_m),
+        ]
     } else {
         sigma_m
     };
@@ -339,7 +365,7 @@ fn print_text(out: &mut dyn Write, r: &RobustnessReport) -> std::io::Result<()> 
             );
             writeln!(
                 out,
-                "largest step {what:<4} survived: {:.7} m ({:.5} leg lengths; beyond: {beyond}); \
+                "largest step {what:<4} survived: {:.7e} m ({:.5e} leg lengths; beyond: {beyond}); \
                  survived again from: {again}",
                 t.max,
                 t.max / s.leg_length_m
@@ -347,13 +373,19 @@ fn print_text(out: &mut dyn Write, r: &RobustnessReport) -> std::io::Result<()> 
         }
     }
     if let Some(v) = &r.velocity_thresholds {
-        writeln!(out, "largest change of each rate survived:")?;
+        writeln!(
+            out,
+            "largest change of each rate survived (rad/s, or m/s for a slide):"
+        )?;
         for t in v {
             let shown_max = |t: &sim::analysis::robustness::Threshold| {
+                let again = t
+                    .survived_again_from
+                    .map_or_else(String::new, |a| format!(" (again from {a:.7e})"));
                 if t.at_limit {
-                    format!("≥{:.7} (the scan's limit)", t.max)
+                    format!("≥{:.7e} (the scan's limit)", t.max)
                 } else {
-                    format!("{:.7}", t.max)
+                    format!("{:.7e}{again}", t.max)
                 }
             };
             writeln!(

@@ -41,7 +41,7 @@ pub struct StabilityMapArgs {
     #[arg(long, value_name = "NAME")]
     pub quantity: Option<String>,
     /// The rough floor's standard deviation of `--quantity mfpt`, in metres.
-    #[arg(long = "sigma-m", value_name = "SIGMA")]
+    #[arg(long = "sigma-m", value_name = "SIGMA", allow_hyphen_values = true)]
     pub sigma_m: Option<f64>,
 }
 

@@ -5,7 +5,8 @@
 //! then put back on the section: the swing foot on the floor, by solving one more position
 //! coordinate (the one the swing foot's height depends on most at the fixed point, unless it
 //! is itself an axis) so that the swing foot's height above the stance contact equals the
-//! fixed point's. A cell whose swing foot cannot be brought to the floor is `off_section`.
+//! fixed point's. A cell whose swing foot cannot be brought to the floor (or, when both
+//! position coordinates are axes, is not on it within [`SECTION_TOLERANCE`]) is `off_section`.
 //! The other coordinates stay at the gait's values (rates included: a walker whose impact
 //! ties rates together, as the simplest walker's massless swing foot does, is sliced with the
 //! gait's swing rate, not the impact's).
@@ -22,6 +23,10 @@ use crate::stride::StrideWorkspace;
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
+
+/// How far (in leg lengths) the swing foot's height may be from the fixed point's for a cell
+/// to be on the section.
+pub const SECTION_TOLERANCE: f64 = 1e-9;
 
 /// One axis of a slice: a stride-map coordinate and its values.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -124,6 +129,7 @@ pub fn basin_slice(
     recovery: &Recovery<'_>,
     x: BasinAxis,
     y: BasinAxis,
+    progress: &(dyn Fn() + Sync),
 ) -> Result<BasinSlice, BasinError> {
     let walker = recovery.walker;
     let names = walker.map_names();
@@ -180,12 +186,19 @@ pub fn basin_slice(
                 let mut v = recovery.fixed_point.clone();
                 v[ix] = x.values[col];
                 v[iy] = y.values[row];
-                if let Some(i) = solved {
-                    if !on_section(&mut v, i, coords[i].0, walker, h, h_star, leg) {
-                        return BasinCell::OffSection;
-                    }
-                }
-                BasinCell::Strides(recovery.follow(ws, &v, &mut |_| 0.0, Until::Settled))
+                let on = match solved {
+                    Some(i) => on_section(&mut v, i, coords[i].0, walker, h, h_star, leg),
+                    // both position coordinates are axes: only the cells where the foot is on
+                    // the floor are on the section
+                    None => (h.at(&walker.unpack(&v).0) - h_star).abs() <= SECTION_TOLERANCE * leg,
+                };
+                let cell = if on {
+                    BasinCell::Strides(recovery.follow(ws, &v, &mut |_| 0.0, Until::Settled))
+                } else {
+                    BasinCell::OffSection
+                };
+                progress();
+                cell
             },
         )
         .collect();
@@ -224,7 +237,7 @@ fn on_section(
         if !r.is_finite() {
             return false;
         }
-        if r.abs() <= 1e-13 * leg {
+        if r.abs() <= 1e-4 * SECTION_TOLERANCE * leg {
             v[i] = q[c];
             return true;
         }
