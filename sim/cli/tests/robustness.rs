@@ -472,3 +472,64 @@ fn options_that_would_be_ignored_or_overreach_are_refused() {
         assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
     }
 }
+
+#[test]
+fn a_sweep_measures_each_period_one_gait_as_robustness_does_there() {
+    let r = json(&[
+        "sweep",
+        "--scene",
+        "compass",
+        "--param",
+        "slope_rad",
+        "--from",
+        "0.03",
+        "--to",
+        "0.05",
+        "--points",
+        "3",
+        "--quantity",
+        "step_down",
+        "--json",
+    ]);
+    let points = r["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    for p in points {
+        assert_eq!(p["quantity"]["name"], "step_down");
+        let value = p["quantity"]["value"].as_f64().unwrap();
+        let set = format!("slope_rad={}", p["value"]);
+        let at = json(&[
+            "robustness",
+            "--scene",
+            "compass",
+            "--set",
+            &set,
+            "--measures",
+            "steps",
+            "--json",
+        ]);
+        // the sweep's gait is the same fixed point (its own continuation): the same threshold
+        // to the bisection's resolution
+        let there = at["step_down_max_m"].as_f64().unwrap();
+        assert!(
+            (value - there).abs() <= 2e-7,
+            "{set}: {value} against {there}"
+        );
+    }
+    let out = walker(&[
+        "sweep",
+        "--scene",
+        "compass",
+        "--param",
+        "slope_rad",
+        "--from",
+        "0.03",
+        "--to",
+        "0.05",
+        "--points",
+        "3",
+        "--quantity",
+        "mfpt",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--sigma-m"), "{}", stderr(&out));
+}

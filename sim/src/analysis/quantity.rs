@@ -223,3 +223,31 @@ pub enum QuantityError {
     #[error("a stride failed: {0}")]
     StrideFailed(String),
 }
+
+/// `quantity` of the period-1 gait through `fixed_point` (a stride-map vector) of `scene`
+/// built by `setup_for`: the gait re-found by Newton from it (it is already a fixed point: the
+/// search costs its Jacobian), then [`Quantity::evaluate`]. For a point of a continuation
+/// (`walker sweep --quantity`), whose points carry their fixed points but not a [`Gait`].
+///
+/// # Errors
+/// A scene that cannot be built, a gait Newton does not find again, the quantity's own.
+pub fn at_fixed_point(
+    quantity: Quantity,
+    options: &QuantityOptions,
+    scene: &crate::scene::Scene,
+    setup_for: &crate::analysis::homotopy::SetupFor<'_>,
+    newton: &crate::analysis::limit_cycle::NewtonSettings,
+    fixed_point: &nalgebra::DVector<f64>,
+) -> Result<f64, QuantityError> {
+    let undefined = |why: String| QuantityError::Undefined { quantity, why };
+    let setup = setup_for(scene).map_err(|e| undefined(e.to_string()))?;
+    let gait =
+        crate::analysis::limit_cycle::GaitSearch::new(&setup.walker, &setup.settings, newton)
+            .find(fixed_point)
+            .map_err(|e| {
+                undefined(format!(
+                    "the gait was not found again from its fixed point: {e}"
+                ))
+            })?;
+    quantity.evaluate(&setup, &gait, options)
+}

@@ -43,8 +43,8 @@ pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
 pub use stability_map::{AxisRecord, StabilityMapReport};
 pub use start::{StartKind, StartRecord};
 pub use sweep::{
-    BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, SweepPointRecord,
-    SweepReport, SwitchFailureRecord, UnlocatedRecord,
+    BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, QuantityValue,
+    SweepPointRecord, SweepReport, SwitchFailureRecord, UnlocatedRecord,
 };
 pub use walk::WalkReport;
 pub use walk_gait::WalkGaitRecord;

@@ -148,6 +148,22 @@ pub struct ConvergedPoint {
     pub orbit: Option<Vec<Option<FixedPoint>>>,
     /// How the stride Jacobians were taken (`central_differences`, `variational`).
     pub jacobian_method: crate::analysis::limit_cycle::JacobianMethod,
+    /// The sweep's `--quantity` at this gait, or why it has none (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantity: Option<QuantityValue>,
+}
+
+/// A quantity's value at a sweep point, or why it has none.
+#[derive(Clone, Debug, Serialize)]
+pub struct QuantityValue {
+    /// The quantity (`gsn`, `step_down`, `mfpt`, ...).
+    pub name: crate::analysis::quantity::Quantity,
+    /// The rough floor of `mfpt` \[m\] (`null` for the others).
+    pub sigma_m: Option<f64>,
+    /// Its value (`null`: see `error`).
+    pub value: Option<f64>,
+    /// Why it has none (`null` when it has one).
+    pub error: Option<String>,
 }
 
 /// A sweep point without a gait.
@@ -364,5 +380,6 @@ fn converged(family: &Family, param: &str, id: usize, p: &BranchPoint) -> Conver
         branch: id,
         orbit: (p.period_strides() > 1).then(|| p.orbit.iter().map(name).collect()),
         jacobian_method: p.jacobian_method,
+        quantity: None,
     }
 }

@@ -14,9 +14,69 @@ use crate::sweep_figures::sweep_figures;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::continuation::{continuation, ContinuationSettings, SweepError};
-use sim::report::{SweepPointRecord, SweepReport};
+use sim::analysis::quantity::{at_fixed_point, Quantity, QuantityError, QuantityOptions};
+use sim::report::{QuantityValue, SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;
+
+/// `quantity` at every period-1 point of the sweep, in parallel, into the report's points
+/// (which list the branches' grid points in the same order).
+fn measure(
+    report: &mut SweepReport,
+    result: &sim::analysis::continuation::Continuation,
+    quantity: Quantity,
+    options: &QuantityOptions,
+    common: &Common,
+) {
+    use rayon::prelude::*;
+    let family = &result.family;
+    let points: Vec<&sim::analysis::continuation::BranchPoint> = result
+        .branches
+        .iter()
+        .flat_map(|b| b.grid.iter().map(|g| &g.point))
+        .collect();
+    let progress = Progress::new(points.len(), "sweep: measuring", !common.json);
+    let (setup_for, newton) = (common.setup_for(), common.newton());
+    let values: Vec<Result<f64, QuantityError>> = points
+        .par_iter()
+        .map(|p| {
+            let value = if p.period_strides() > 1 {
+                Err(QuantityError::Undefined {
+                    quantity,
+                    why: format!(
+                        "defined for period-1 gaits; this one repeats every {} strides",
+                        p.period_strides()
+                    ),
+                })
+            } else {
+                family
+                    .scene_at(p.value)
+                    .map_err(|e| QuantityError::Undefined {
+                        quantity,
+                        why: e.to_string(),
+                    })
+                    .and_then(|scene| {
+                        at_fixed_point(quantity, options, &scene, &setup_for, &newton, &p.orbit[0])
+                    })
+            };
+            progress.tick();
+            value
+        })
+        .collect();
+    progress.finish();
+    let converged = report.points.iter_mut().filter_map(|r| match r {
+        SweepPointRecord::Converged(c) => Some(c),
+        SweepPointRecord::Failed(_) => None,
+    });
+    for (c, v) in converged.zip(values) {
+        c.quantity = Some(QuantityValue {
+            name: quantity,
+            sigma_m: options.sigma_m.filter(|_| quantity == Quantity::Mfpt),
+            value: v.as_ref().ok().copied(),
+            error: v.err().map(|e| e.to_string()),
+        });
+    }
+}
 
 /// Resolution of the sweep's progress bar (the continuation reports a fraction done).
 const PROGRESS_STEPS: usize = 1000;
@@ -44,6 +104,14 @@ pub struct SweepArgs {
     /// The stride-map entry the bifurcation diagram plots (default: the first).
     #[arg(long, value_name = "NAME")]
     pub coordinate: Option<String>,
+    /// Also measure a robustness quantity at every period-1 gait of the sweep: `gsn`,
+    /// `step_down`, `step_up`, `mfpt` (with --sigma-m), ... (docs/robustness.md); each point's
+    /// `quantity` in the JSON, a column in the text.
+    #[arg(long, value_name = "NAME")]
+    pub quantity: Option<String>,
+    /// The rough floor's standard deviation of `--quantity mfpt`, in metres.
+    #[arg(long = "sigma-m", value_name = "SIGMA", allow_hyphen_values = true)]
+    pub sigma_m: Option<f64>,
 }
 
 /// Runs `walker sweep`.
@@ -55,6 +123,8 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
         max_period,
         plot,
         coordinate,
+        quantity,
+        sigma_m,
     } = args;
     let (param, from, to) = range.checked("a sweep")?;
     let scene = common.scene()?;
@@ -71,6 +141,29 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
             ))
         })?,
     };
+    let quantity_options = QuantityOptions {
+        sigma_m,
+        ..Default::default()
+    };
+    let quantity = quantity
+        .map(|name| {
+            let q = Quantity::parse(&name).ok_or_else(|| {
+                InputError::Other(format!(
+                    "--quantity `{name}`: expected one of {}",
+                    Quantity::names()
+                ))
+            })?;
+            q.check(&quantity_options)
+                .map_err(|e| InputError::Other(format!("--quantity {q}: {e}")))?;
+            Ok::<_, InputError>(q)
+        })
+        .transpose()?;
+    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
+        return Err(InputError::Other(
+            "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
+        )
+        .into());
+    }
     // The figures' folder before the sweep: a path that cannot be used fails at once.
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
@@ -111,7 +204,10 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
             &modulus.to_svg(900.0, 560.0),
         )?;
     }
-    let report = SweepReport::from_continuation(&result);
+    let mut report = SweepReport::from_continuation(&result);
+    if let Some(q) = quantity {
+        measure(&mut report, &result, q, &quantity_options, &common);
+    }
     if common.json {
         print_json(&report)?;
     } else {
@@ -225,11 +321,22 @@ fn print_text(out: &mut dyn Write, r: &SweepReport) -> std::io::Result<()> {
     rows.sort_by(|a, b| row_value(a).total_cmp(&row_value(b)));
     for p in rows {
         match p {
-            SweepPointRecord::Converged(g) => writeln!(
-                out,
-                "{:>14.6} {:>7} {:>7} {:>10.6} {:>8}",
-                g.value, g.branch, g.period_strides, g.max_abs_eigenvalue, g.stable
-            )?,
+            SweepPointRecord::Converged(g) => {
+                // the --quantity column: its value, or why it has none
+                let measured =
+                    g.quantity
+                        .as_ref()
+                        .map_or_else(String::new, |q| match (&q.value, &q.error) {
+                            (Some(v), _) => format!("  {}={v:.6e}", q.name),
+                            (None, Some(e)) => format!("  {}: {e}", q.name),
+                            (None, None) => String::new(),
+                        });
+                writeln!(
+                    out,
+                    "{:>14.6} {:>7} {:>7} {:>10.6} {:>8}{measured}",
+                    g.value, g.branch, g.period_strides, g.max_abs_eigenvalue, g.stable
+                )?
+            }
             SweepPointRecord::Failed(e) => writeln!(
                 out,
                 "{:>14.6} {:>7} {:>7} {:>10} {:>8}  {}",
