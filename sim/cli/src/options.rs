@@ -205,3 +205,42 @@ pub fn floor(spec: &str) -> Result<sim::stride::Floor, InputError> {
     spec.parse()
         .map_err(|e: sim::stride::FloorError| InputError::Other(format!("--{e}")))
 }
+
+/// `--quantity NAME` and `--sigma-m S` of a study (`walker stability-map`, `walker sweep`):
+/// the quantity, checked against what it needs, and its options; `--sigma-m` without
+/// `--quantity mfpt` is refused (it would be ignored).
+pub fn quantity(
+    name: Option<&str>,
+    sigma_m: Option<f64>,
+) -> Result<
+    (
+        Option<sim::analysis::quantity::Quantity>,
+        sim::analysis::quantity::QuantityOptions,
+    ),
+    InputError,
+> {
+    use sim::analysis::quantity::{Quantity, QuantityOptions};
+    let options = QuantityOptions {
+        sigma_m,
+        ..Default::default()
+    };
+    let quantity = name
+        .map(|name| {
+            let q = Quantity::parse(name).ok_or_else(|| {
+                InputError::Other(format!(
+                    "--quantity `{name}`: expected one of {}",
+                    Quantity::names()
+                ))
+            })?;
+            q.check(&options)
+                .map_err(|e| InputError::Other(format!("--quantity {q}: {e}")))?;
+            Ok::<_, InputError>(q)
+        })
+        .transpose()?;
+    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
+        return Err(InputError::Other(
+            "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
+        ));
+    }
+    Ok((quantity, options))
+}

@@ -14,7 +14,6 @@ use crate::output;
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis};
 use sim::report::StabilityMapReport;
 use sim::scene::Scene;
@@ -67,29 +66,7 @@ pub fn run(args: StabilityMapArgs) -> Result<ExitCode> {
     } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
-    let options = QuantityOptions {
-        sigma_m,
-        ..Default::default()
-    };
-    let quantity = quantity
-        .map(|name| {
-            let q = Quantity::parse(&name).ok_or_else(|| {
-                InputError::Other(format!(
-                    "--quantity `{name}`: expected one of {}",
-                    Quantity::names()
-                ))
-            })?;
-            q.check(&options)
-                .map_err(|e| InputError::Other(format!("--quantity {q}: {e}")))?;
-            Ok::<_, InputError>(q)
-        })
-        .transpose()?;
-    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
-        return Err(InputError::Other(
-            "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
-        )
-        .into());
-    }
+    let (quantity, options) = crate::options::quantity(quantity.as_deref(), sigma_m)?;
     let (x, y) = (axis("--x", &x, &scene)?, axis("--y", &y, &scene)?);
     if x.name == y.name {
         return Err(InputError::Other(format!(

@@ -141,29 +141,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
             ))
         })?,
     };
-    let quantity_options = QuantityOptions {
-        sigma_m,
-        ..Default::default()
-    };
-    let quantity = quantity
-        .map(|name| {
-            let q = Quantity::parse(&name).ok_or_else(|| {
-                InputError::Other(format!(
-                    "--quantity `{name}`: expected one of {}",
-                    Quantity::names()
-                ))
-            })?;
-            q.check(&quantity_options)
-                .map_err(|e| InputError::Other(format!("--quantity {q}: {e}")))?;
-            Ok::<_, InputError>(q)
-        })
-        .transpose()?;
-    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
-        return Err(InputError::Other(
-            "--sigma-m is the rough floor of --quantity mfpt: give --quantity mfpt too".into(),
-        )
-        .into());
-    }
+    let (quantity, quantity_options) = crate::options::quantity(quantity.as_deref(), sigma_m)?;
     // The figures' folder before the sweep: a path that cannot be used fails at once.
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
