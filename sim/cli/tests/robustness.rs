@@ -163,6 +163,15 @@ fn basin_reports_its_grid_under_the_contract() {
     assert_eq!(r["solved_coordinate"], "swing_leg");
 }
 
+/// `args` are bad input: exit code 2, a message on standard error containing `needle`, nothing
+/// on standard output.
+fn refused(args: &[&str], needle: &str) {
+    let out = walker(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    assert!(out.stdout.is_empty(), "{args:?}");
+}
+
 #[test]
 fn bad_input_is_refused_with_a_clear_message() {
     for (args, needle) in [
@@ -241,10 +250,7 @@ fn bad_input_is_refused_with_a_clear_message() {
             "--strides",
         ),
     ] {
-        let out = walker(&args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
-        assert!(out.stdout.is_empty(), "{args:?}");
+        refused(&args, needle);
     }
 }
 
@@ -467,9 +473,7 @@ fn options_that_would_be_ignored_or_overreach_are_refused() {
             "--sigma-m -1",
         ),
     ] {
-        let out = walker(&args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        refused(&args, needle);
     }
 }
 
