@@ -190,6 +190,7 @@ impl Common {
                 "variational" => JacobianMethod::Variational,
                 _ => JacobianMethod::CentralDifferences,
             },
+            ..NewtonSettings::default()
         }
     }
 }

@@ -12,12 +12,12 @@
 //! beyond [`HomotopySettings::max_period_change`] is refused as a jump to another branch) and
 //! step halving.
 
-use crate::analysis::limit_cycle::{Gait, GaitSearch, NewtonError, NewtonSettings};
+use crate::analysis::limit_cycle::{FixedPoint, Gait, GaitSearch, NewtonError, NewtonSettings};
 use crate::engine::model::CoordIndex;
 use crate::engine::walker::Walker;
 use crate::scene::{Scene, SceneError, Setup};
 use crate::stride::{SearchBudget, SharedBudget};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
 /// Builds the [`Setup`] of a scene at given parameter values: `Scene::setup` and whatever
@@ -43,6 +43,12 @@ pub struct HomotopySettings {
     pub max_period_change: f64,
     /// Newton searches allowed along one path.
     pub max_solves: usize,
+    /// Newton's tolerance at the path's intermediate gaits (at most the caller's looser one):
+    /// they only predict the next, and a corrector converged there to the caller's tolerance
+    /// (1e-11 by default, near the stride map's noise floor for the 3D walker) spends its
+    /// iterations on digits the next predictor discards. The path's end is converged to the
+    /// caller's tolerance.
+    pub path_tolerance: f64,
     /// Newton iterations allowed in one step (at most the caller's own budget): from a good
     /// predictor Newton converges in a few; more means the step is too long, and halving it
     /// is cheaper than iterating on (a failing search of the 3D walker costs seconds).
@@ -71,6 +77,7 @@ impl Default for HomotopySettings {
             max_correction: 0.1,
             max_period_change: 0.1,
             max_solves: 24,
+            path_tolerance: 1e-8,
             max_corrector_iterations: 12,
             gait_stride_budget: DEFAULT_GAIT_STRIDE_BUDGET,
         }
@@ -91,26 +98,58 @@ pub struct Secant {
     history: Vec<(f64, DVector<f64>, f64)>,
     /// The stride-map coordinates of the gaits in `history`.
     coordinates: Vec<CoordIndex>,
+    /// The matrix the last gait's Newton search stepped with (a stride Jacobian near it):
+    /// the next corrector's first Newton matrix ([`GaitSearch::converge`]).
+    newton_matrix: Option<DMatrix<f64>>,
 }
 
 impl Secant {
     /// Appends the gait `g` at `s` (keeps the last two; only `g` when its stride-map
     /// coordinates differ from the last gait's).
     pub fn push(&mut self, s: f64, g: &Gait) {
-        if self.coordinates != g.map_coordinates {
+        self.push_parts(
+            s,
+            &g.fixed_point,
+            g.stride.duration_s,
+            &g.map_coordinates,
+            Some(&g.jacobian),
+        );
+    }
+
+    /// [`Self::push`] for a fixed point whose stride Jacobian was not taken.
+    pub fn push_point(&mut self, s: f64, p: &FixedPoint) {
+        self.push_parts(
+            s,
+            &p.fixed_point,
+            p.stride.duration_s,
+            &p.map_coordinates,
+            p.newton_matrix.as_ref(),
+        );
+    }
+
+    fn push_parts(
+        &mut self,
+        s: f64,
+        v: &DVector<f64>,
+        period_s: f64,
+        coordinates: &[CoordIndex],
+        newton_matrix: Option<&DMatrix<f64>>,
+    ) {
+        if self.coordinates != coordinates {
             self.history.clear();
-            self.coordinates.clone_from(&g.map_coordinates);
+            self.coordinates = coordinates.to_vec();
         }
-        self.history
-            .push((s, g.fixed_point.clone(), g.stride.duration_s));
+        self.history.push((s, v.clone(), period_s));
         if self.history.len() > 2 {
             self.history.remove(0);
         }
+        self.newton_matrix = newton_matrix.cloned();
     }
 
     /// Forgets the path (the next step has no predictor).
     pub fn clear(&mut self) {
         self.history.clear();
+        self.newton_matrix = None;
     }
 
     /// The predictor at `s` (linear through the last two gaits, the last one alone after
@@ -135,10 +174,53 @@ impl Secant {
         newton: &NewtonSettings,
         guard: &HomotopySettings,
     ) -> Option<Result<Gait, NewtonError>> {
+        let corrector = guard.corrector(newton);
+        let search = GaitSearch::new(&setup.walker, &setup.settings, &corrector);
+        Some(
+            self.step_to_point(s, setup, newton, guard)?
+                .and_then(|p| search.gait_at(p)),
+        )
+    }
+
+    /// [`Self::step`] without the stride Jacobian at the gait found ([`GaitSearch::gait_at`]
+    /// takes it, with [`HomotopySettings::corrector`]'s settings): a path's intermediate
+    /// gaits need none. The corrector starts from the last gait's Newton matrix when the
+    /// coordinates are the same.
+    pub fn step_to_point(
+        &self,
+        s: f64,
+        setup: &Setup,
+        newton: &NewtonSettings,
+        guard: &HomotopySettings,
+    ) -> Option<Result<FixedPoint, NewtonError>> {
         let (predictor, period) = self.predict(s)?;
+        let same_coordinates = setup.walker.map_coordinates() == self.coordinates;
         let predictor = in_coordinates(&predictor, &self.coordinates, &setup.walker);
         let corrector = guard.corrector(newton);
-        let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).find(&predictor);
+        // Intermediate gaits: to the path's tolerance, from the last gait's Newton matrix. The
+        // end: to the caller's tolerance from a Jacobian of its own (a chord iteration on an
+        // older matrix converges too slowly to reach a tight tolerance in the corrector's
+        // budget).
+        let (corrector, start_matrix) = if s < 1.0 {
+            let corrector = NewtonSettings {
+                tolerance: corrector.tolerance.max(guard.path_tolerance),
+                ..corrector
+            };
+            (
+                corrector,
+                self.newton_matrix.clone().filter(|_| same_coordinates),
+            )
+        } else {
+            (corrector, None)
+        };
+        // a corrector that has moved farther than the guard allows is refused below however
+        // it ends: stopped as soon as it has
+        let leash = guard.max_correction * (1.0 + predictor.amax());
+        let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).converge_within(
+            &predictor,
+            start_matrix,
+            leash,
+        );
         Some(g.and_then(|g| {
             let moved = (&g.fixed_point - &predictor).amax();
             let jumped = moved > guard.max_correction * (1.0 + predictor.amax())
@@ -222,6 +304,26 @@ pub fn follow(
     newton: &NewtonSettings,
     settings: &HomotopySettings,
 ) -> (Result<Gait, NewtonError>, usize) {
+    let (end, solves) = follow_to_point(from, to, setup_for, start, newton, settings);
+    let corrector = settings.corrector(newton);
+    let gait = end.and_then(|(p, setup)| {
+        GaitSearch::new(&setup.walker, &setup.settings, &corrector).gait_at(p)
+    });
+    (gait, solves)
+}
+
+/// [`follow`] without the stride Jacobian at the end: the fixed point at `to` and the setup it
+/// was found on (whose [`GaitSearch`] with [`HomotopySettings::corrector`]'s settings makes it
+/// the gait [`follow`] returns, [`GaitSearch::gait_at`]). No Jacobian is taken along the
+/// path: each corrector starts from the Newton matrix of the gait before.
+pub fn follow_to_point(
+    from: &Scene,
+    to: &Scene,
+    setup_for: &SetupFor<'_>,
+    start: &Gait,
+    newton: &NewtonSettings,
+    settings: &HomotopySettings,
+) -> (Result<(FixedPoint, Setup), NewtonError>, usize) {
     let mut path = Secant::default();
     path.push(0.0, start);
     let mut s = 0.0;
@@ -238,19 +340,20 @@ pub fn follow(
             continue;
         };
         solves += 1;
-        match path.step(s_next, &setup, newton, settings) {
-            Some(Ok(g)) => {
+        match path.step_to_point(s_next, &setup, newton, settings) {
+            Some(Ok(p)) => {
                 if s_next >= 1.0 {
-                    return (Ok(g), solves);
+                    return (Ok((p, setup)), solves);
                 }
                 s = s_next;
-                path.push(s, &g);
+                path.push_point(s, &p);
                 step = (step * 2.0).min(1.0);
             }
             Some(Err(e)) if e.budget_spent() => return (Err(e), solves),
             Some(Err(e)) => {
                 last_error = e;
-                step *= 0.5;
+                // halved from the step actually tried (the last one was cut at the path's end)
+                step = 0.5 * (s_next - s);
             }
             None => break,
         }
@@ -408,9 +511,12 @@ impl<'a> GaitRule<'a> {
                 .map(|g| (g, GaitSource::Defaults)));
         }
         let defaults = at_defaults(scene)?;
+        // Both candidates are converged without their stride Jacobians; only the one kept
+        // has its Jacobian taken (the other's is the Jacobian's cost wasted).
+        let guess_search = GaitSearch::new(&setup.walker, &setup.settings, self.newton);
         let (from_guess, followed) = rayon::join(
-            || setup.find_gait(self.newton),
-            || -> Result<Result<Gait, NewtonError>, SceneError> {
+            || guess_search.converge(&setup.walker.pack(&setup.guess.q, &setup.guess.qd), None),
+            || -> Result<Result<(FixedPoint, Setup), NewtonError>, SceneError> {
                 let found;
                 let (defaults, gait) = match self.kept_defaults(&defaults, defaults_setup_for)? {
                     Some(kept) => (&kept.0, &kept.1),
@@ -420,20 +526,31 @@ impl<'a> GaitRule<'a> {
                     }
                 };
                 Ok(match gait {
-                    Ok(g) => follow(defaults, scene, setup_for, g, self.newton, self.homotopy).0,
+                    Ok(g) => {
+                        follow_to_point(defaults, scene, setup_for, g, self.newton, self.homotopy).0
+                    }
                     Err(e) => Err(e.clone()),
                 })
             },
         );
-        let followed = followed?;
-        Ok(match (from_guess, followed) {
-            (Ok(a), Ok(b)) => Ok(if b.stride.duration_s > a.stride.duration_s {
-                (b, GaitSource::ContinuedFromDefaults)
-            } else {
-                (a, GaitSource::Guess)
-            }),
-            (Ok(a), Err(_)) => Ok((a, GaitSource::Guess)),
-            (Err(_), Ok(b)) => Ok((b, GaitSource::ContinuedFromDefaults)),
+        let corrector = self.homotopy.corrector(self.newton);
+        let guess_gait = |p: FixedPoint| guess_search.gait_at(p).map(|g| (g, GaitSource::Guess));
+        let followed_gait = |(p, end): (FixedPoint, Setup)| {
+            GaitSearch::new(&end.walker, &end.settings, &corrector)
+                .gait_at(p)
+                .map(|g| (g, GaitSource::ContinuedFromDefaults))
+        };
+        Ok(match (from_guess, followed?) {
+            // the longer period is kept; should its Jacobian fail, the other
+            (Ok(a), Ok(b)) => {
+                if b.0.stride.duration_s > a.stride.duration_s {
+                    followed_gait(b).or_else(|e| guess_gait(a).map_err(|_| e))
+                } else {
+                    guess_gait(a).or_else(|e| followed_gait(b).map_err(|_| e))
+                }
+            }
+            (Ok(a), Err(_)) => guess_gait(a),
+            (Err(_), Ok(b)) => followed_gait(b),
             // a spent budget is said, whichever search spent it
             (Err(e), Err(f)) if f.budget_spent() && !e.budget_spent() => Err(f),
             (Err(e), Err(_)) => Err(e),

@@ -42,6 +42,10 @@ pub struct NewtonSettings {
     pub frozen_steps: bool,
     /// How the stride Jacobian is taken.
     pub jacobian: JacobianMethod,
+    /// Consecutive iterations whose step no halving made acceptable (the stride from every
+    /// trial failed or its residual grew) before the search gives up: a search that has
+    /// diverged from its start stops there instead of spending its whole iteration budget.
+    pub max_stalled_iterations: usize,
 }
 
 /// How the stride Jacobian is taken.
@@ -68,6 +72,7 @@ impl Default for NewtonSettings {
             max_halvings: 8,
             frozen_steps: false,
             jacobian: JacobianMethod::CentralDifferences,
+            max_stalled_iterations: 3,
         }
     }
 }
@@ -371,23 +376,97 @@ impl<'a> GaitSearch<'a> {
         }
     }
 
-    /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues.
+    /// Finds the gait by Newton-Raphson from `v0`, eq. (26), and its eigenvalues:
+    /// [`Self::converge`], then [`Self::gait_at`].
     ///
     /// # Errors
     /// [`NewtonError`]: a stride fails, the budget runs out, or `I − J` is singular.
     pub fn find(&self, v0: &DVector<f64>) -> Result<Gait, NewtonError> {
+        let point = self.converge(v0, None)?;
+        self.gait_at(point)
+    }
+
+    /// The gait at a converged `point` of this search: the stride Jacobian there (by
+    /// `newton.jacobian`) and its eigenvalues. A study that converges several candidates and
+    /// keeps one (the gait rule, a homotopy path) takes this Jacobian of the one it keeps only.
+    ///
+    /// # Errors
+    /// A stride of the Jacobian fails ([`NewtonError::StrideFailed`] at the point's iteration).
+    pub fn gait_at(&self, point: FixedPoint) -> Result<Gait, NewtonError> {
+        let FixedPoint {
+            fixed_point: v,
+            image: s,
+            iterations,
+            mut strides,
+            residual,
+            stride,
+            newton_matrix: _,
+            map_coordinates: _,
+        } = point;
+        let fail = |failure| NewtonError::StrideFailed {
+            iteration: iterations,
+            failure,
+        };
+        let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
+        strides += self.jacobian_strides(v.len(), jacobian_method, self.newton.central);
+        let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
+        Ok(Gait {
+            jacobian_method,
+            fixed_point: v,
+            jacobian: j,
+            eigenvalues,
+            iterations,
+            strides,
+            residual,
+            stride,
+            newton: *self.newton,
+            stride_settings: self.settings.clone(),
+            map_coordinates: self.walker.map_coordinates(),
+        })
+    }
+
+    /// The fixed point by Newton-Raphson from `v0`, eq. (26), without the stride Jacobian at
+    /// it ([`Self::gait_at`] takes that). `newton_matrix`: a stride Jacobian near `v0` (the
+    /// last one of a nearby search, [`FixedPoint::newton_matrix`]) to step with first instead
+    /// of taking one at `v0`; it is replaced as soon as the residual stops falling fourfold
+    /// per iteration, as the search's own is.
+    ///
+    /// # Errors
+    /// [`NewtonError`]: a stride fails, the budget runs out, or `I − J` is singular.
+    pub fn converge(
+        &self,
+        v0: &DVector<f64>,
+        newton_matrix: Option<DMatrix<f64>>,
+    ) -> Result<FixedPoint, NewtonError> {
+        self.converge_within(v0, newton_matrix, f64::INFINITY)
+    }
+
+    /// [`Self::converge`] that gives up ([`NewtonError::NotConverged`]) as soon as an iterate
+    /// is farther than `max_move` (∞-norm) from `v0`: a corrector whose result would be
+    /// refused as a jump to another branch when that far need not converge first.
+    ///
+    /// # Errors
+    /// As [`Self::converge`].
+    pub fn converge_within(
+        &self,
+        v0: &DVector<f64>,
+        newton_matrix: Option<DMatrix<f64>>,
+        max_move: f64,
+    ) -> Result<FixedPoint, NewtonError> {
         let settings = self.newton;
         let mut v = v0.clone();
         let n = v.len();
         let mut last_step = f64::INFINITY;
         // The Newton matrix is kept while the residual falls at least fourfold per iteration
         // (a chord iteration); the eigenvalues always come from a Jacobian at the converged
-        // point.
-        let mut kept: Option<DMatrix<f64>> = None;
+        // point ([`Self::gait_at`]).
+        let mut kept: Option<DMatrix<f64>> = newton_matrix.filter(|j| j.shape() == (n, n));
+        let mut last_used: Option<DMatrix<f64>> = None;
         let mut last_residual = f64::INFINITY;
         // The accepted trial's stride, reused as the next iteration's.
         let mut carried: Option<(DVector<f64>, StrideResult)> = None;
         let mut strides = 0;
+        let mut stalled = 0;
         // One workspace for Newton's own strides (residuals and line-search trials).
         let mut workspace = StrideWorkspace::new(self.walker);
         for it in 0..=settings.max_iterations {
@@ -404,20 +483,14 @@ impl<'a> GaitSearch<'a> {
             };
             let r = &s - &v;
             if last_step < settings.tolerance {
-                let (j, jacobian_method) = self.stride_jacobian_by(&v, &s).map_err(fail)?;
-                strides += self.jacobian_strides(n, jacobian_method, self.newton.central);
-                let eigenvalues = j.clone().complex_eigenvalues().iter().copied().collect();
-                return Ok(Gait {
-                    jacobian_method,
+                return Ok(FixedPoint {
+                    residual: r.amax(),
                     fixed_point: v,
-                    jacobian: j,
-                    eigenvalues,
+                    image: s,
                     iterations: it,
                     strides,
-                    residual: r.amax(),
                     stride,
-                    newton: *self.newton,
-                    stride_settings: self.settings.clone(),
+                    newton_matrix: last_used,
                     map_coordinates: self.walker.map_coordinates(),
                 });
             }
@@ -463,11 +536,20 @@ impl<'a> GaitSearch<'a> {
             // A step that no halving made acceptable is not a sign of convergence, however
             // short it has become.
             last_step = if accepted {
+                stalled = 0;
                 dv.amax() * lambda
             } else {
+                stalled += 1;
                 f64::INFINITY
             };
             v += dv * lambda;
+            if stalled >= settings.max_stalled_iterations.max(1) || (&v - v0).amax() > max_move {
+                return Err(NewtonError::NotConverged {
+                    iterations: it + 1,
+                    last_step,
+                });
+            }
+            last_used = Some(j.clone());
             kept = Some(j);
         }
         Err(NewtonError::NotConverged {
@@ -475,6 +557,29 @@ impl<'a> GaitSearch<'a> {
             last_step,
         })
     }
+}
+
+/// A fixed point of the stride map found by [`GaitSearch::converge`], before its stride
+/// Jacobian is taken ([`GaitSearch::gait_at`] makes it a [`Gait`]).
+#[derive(Clone, Debug)]
+pub struct FixedPoint {
+    /// The fixed point (stride-map vector).
+    pub fixed_point: DVector<f64>,
+    /// `S(fixed_point)`, the stride map's image of it.
+    pub image: DVector<f64>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Strides the search integrated (its Jacobians included).
+    pub strides: usize,
+    /// `|S(v) − v|` at the fixed point (∞-norm).
+    pub residual: f64,
+    /// The stride from the fixed point.
+    pub stride: StrideResult,
+    /// The last matrix Newton stepped with (a stride Jacobian near the fixed point: forward
+    /// differences by default); `None` when the start was already converged.
+    pub newton_matrix: Option<DMatrix<f64>>,
+    /// The stride-map coordinates of `fixed_point` ([`Gait::map_coordinates`]).
+    pub map_coordinates: Vec<CoordIndex>,
 }
 
 #[cfg(test)]

@@ -250,6 +250,12 @@ impl ContinuationSettings {
             "> 0",
         )?;
         count("homotopy.max_solves", h.max_solves, 1)?;
+        real(
+            "homotopy.path_tolerance",
+            h.path_tolerance,
+            h.path_tolerance > 0.0,
+            "> 0",
+        )?;
         count(
             "homotopy.max_corrector_iterations",
             h.max_corrector_iterations,
