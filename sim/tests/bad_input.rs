@@ -256,7 +256,7 @@ fn steps_that_do_not_advance_time_end_in_the_default_step_budget() {
 
 #[test]
 fn default_budgets_are_far_above_what_a_stride_uses() {
-    // The wisse3d stride from its guess (DOP853, 1e-12; measured: 1,180 evaluations) completes
+    // The wisse3d stride from its guess (DOP853, 1e-12; measured: 932 evaluations) completes
     // within a thousandth of each default budget, with the same result: the defaults are over
     // a thousand times what it uses, in steps and in evaluations. (The largest stride of the
     // engine's tests, measured: 814 steps, 12,606 evaluations, DOP853 on the wisse walkers.)
@@ -267,7 +267,7 @@ fn default_budgets_are_far_above_what_a_stride_uses() {
         StrideSettings::DEFAULT_MAX_EVALUATIONS
     );
     let r = common::stride(&w, &w.guess.q, &w.guess.qd).unwrap();
-    assert!(r.evaluations > 1000, "{}", r.evaluations);
+    assert!(r.evaluations > 900, "{}", r.evaluations);
     let mut thousandth = w.settings.clone();
     thousandth.max_steps = StrideSettings::DEFAULT_MAX_STEPS / 1000;
     thousandth.max_evaluations = StrideSettings::DEFAULT_MAX_EVALUATIONS / 1000;

@@ -361,6 +361,18 @@ pub fn follow_to_point(
     (Err(last_error), solves)
 }
 
+/// Two fixed points of one scene closer than this (∞-norm, relative to `1 + |v|∞`) are the
+/// same gait found twice ([`GaitRule`]): far above Newton's tolerance, far below the distance
+/// between two gaits of a scene.
+pub const SAME_GAIT_TOLERANCE: f64 = 1e-6;
+
+/// Whether `a` and `b` are the same gait ([`SAME_GAIT_TOLERANCE`]).
+fn same_gait(a: &FixedPoint, b: &FixedPoint) -> bool {
+    a.map_coordinates == b.map_coordinates
+        && (&a.fixed_point - &b.fixed_point).amax()
+            <= SAME_GAIT_TOLERANCE * (1.0 + a.fixed_point.amax())
+}
+
 /// Where the gait [`nominal_gait`] returns comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -390,8 +402,10 @@ impl GaitSource {
 /// Newton from its guess (as ever); elsewhere the longer-period of Newton from the guess and
 /// the defaults' gait followed to the requested values ([`follow`]) — the branch of the
 /// scene's nominal gait, which for the simplest walker is Garcia's long-period gait, wherever
-/// that branch reaches, not only near the guess. Two or three Newton searches in the usual
-/// case; every period-1 gait is [`crate::analysis::census::census`]'s job. With where it came
+/// that branch reaches, not only near the guess (when both searches find the same gait,
+/// [`SAME_GAIT_TOLERANCE`], it is that branch's: [`GaitSource::ContinuedFromDefaults`]). Two
+/// or three Newton searches in the usual case, the stride Jacobian taken of the kept gait
+/// only; every period-1 gait is [`crate::analysis::census::census`]'s job. With where it came
 /// from. The one rule for "the gait of this scene at these values": every command and study
 /// calls it (a study over many values keeps one [`GaitRule`], which finds the defaults' gait
 /// once).
@@ -543,7 +557,9 @@ impl<'a> GaitRule<'a> {
         Ok(match (from_guess, followed?) {
             // the longer period is kept; should its Jacobian fail, the other
             (Ok(a), Ok(b)) => {
-                if b.0.stride.duration_s > a.stride.duration_s {
+                // the same gait found twice is the defaults' branch (not whichever period
+                // rounding made longer)
+                if same_gait(&a, &b.0) || b.0.stride.duration_s > a.stride.duration_s {
                     followed_gait(b).or_else(|e| guess_gait(a).map_err(|_| e))
                 } else {
                     guess_gait(a).or_else(|e| followed_gait(b).map_err(|_| e))

@@ -64,23 +64,70 @@ impl Power {
         }
     }
 
-    /// The dampers' dissipation over the step `from` → `to`.
+    /// The dampers' dissipation over the step `from` → `to`: `∫ c q̇² dt` of each damped
+    /// joint with `q̇` the derivative of the cubic Hermite through both ends' values and rates
+    /// (exact for that quadratic; the trapezoid on the rates alone, second order, made the
+    /// energy balance depend on the step size: issue 31).
     #[inline]
     pub(super) fn accumulate<S: StrideState>(&mut self, from: &S, to: &S) {
         let h = to.t_s() - from.t_s();
-        let damping = &self.damping;
-        let diss = |s: &S| {
-            damping
-                .iter()
-                .map(|&(i, c)| c * s.qd(i) * s.qd(i))
-                .sum::<f64>()
-        };
-        self.dissipation_j += 0.5 * h * (diss(from) + diss(to));
+        if h <= 0.0 {
+            return;
+        }
+        let step: f64 = self
+            .damping
+            .iter()
+            .map(|&(i, c)| {
+                let (v0, v1) = (from.qd(i), to.qd(i));
+                let mean = (to.q(i) - from.q(i)) / h;
+                c * hermite_rate_square_mean(mean, v0, v1)
+            })
+            .sum();
+        self.dissipation_j += h * step;
     }
+}
+
+/// The mean over a step of `q̇²`, `q̇` the derivative of the cubic Hermite of `q` with mean rate
+/// `mean` (`Δq / h`) and end rates `v0`, `v1`: `q̇(x) = 6x(1−x)·mean + (1−4x+3x²)·v0 +
+/// (3x²−2x)·v1` on `x ∈ [0, 1]`, squared and integrated in closed form.
+fn hermite_rate_square_mean(mean: f64, v0: f64, v1: f64) -> f64 {
+    1.2 * mean * mean + (2.0 / 15.0) * (v0 * v0 + v1 * v1)
+        - 0.2 * mean * (v0 + v1)
+        - (1.0 / 15.0) * v0 * v1
 }
 
 /// The mechanical energy of `s` [J].
 pub(super) fn energy(dynamics: &mut Dynamics, model: &Model, s: &Sample) -> f64 {
     dynamics.assemble(model, &s.q, &s.qd, None);
     dynamics.energy_j(model, &s.q, &s.qd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hermite_rate_square_mean;
+
+    /// The closed form against a fine midpoint sum of the Hermite derivative squared, and a
+    /// constant rate (mean = v0 = v1 = v gives v²).
+    #[test]
+    fn the_hermite_rate_square_mean_is_its_integral() {
+        for (mean, v0, v1) in [(0.3, -1.2, 2.5), (1.0, 1.0, 1.0), (-0.7, 0.4, -2.0)] {
+            let n = 200_000;
+            let sum: f64 = (0..n)
+                .map(|k| {
+                    let x = (k as f64 + 0.5) / n as f64;
+                    let v = 6.0 * x * (1.0 - x) * mean
+                        + (1.0 - 4.0 * x + 3.0 * x * x) * v0
+                        + (3.0 * x * x - 2.0 * x) * v1;
+                    v * v
+                })
+                .sum::<f64>()
+                / n as f64;
+            let closed = hermite_rate_square_mean(mean, v0, v1);
+            assert!(
+                (sum - closed).abs() < 1e-9 * (1.0 + sum.abs()),
+                "{sum} vs {closed}"
+            );
+        }
+        assert!((hermite_rate_square_mean(2.0, 2.0, 2.0) - 4.0).abs() < 1e-15);
+    }
 }
