@@ -126,7 +126,7 @@ fn a_gait_search_stops_at_its_budget_and_says_so() {
 fn a_long_search_shows_its_strides_on_a_terminal_and_nothing_in_a_pipe() {
     let scene = compass_with_links(20);
     let cmd = format!(
-        "'{}' gait --scene '{}' --max-strides 400",
+        "'{}' gait --scene '{}' --max-strides 300",
         env!("CARGO_BIN_EXE_walker"),
         scene.display()
     );
@@ -139,15 +139,15 @@ fn a_long_search_shows_its_strides_on_a_terminal_and_nothing_in_a_pipe() {
         shown.contains("gait search [") && shown.contains("strides of its budget"),
         "{shown}"
     );
-    assert!(shown.contains("budget of 400 strides"), "{shown}");
+    assert!(shown.contains("budget of 300 strides"), "{shown}");
     let piped = walker(&[
         "gait",
         "--scene",
         scene.to_str().unwrap(),
         "--max-strides",
-        "400",
+        "300",
     ]);
     assert!(!stderr(&piped).contains("strides of its budget"));
-    assert!(String::from_utf8_lossy(&piped.stdout).contains("budget of 400 strides"));
+    assert!(String::from_utf8_lossy(&piped.stdout).contains("budget of 300 strides"));
     std::fs::remove_file(&scene).unwrap();
 }

@@ -42,9 +42,11 @@ pub struct NewtonSettings {
     pub frozen_steps: bool,
     /// How the stride Jacobian is taken.
     pub jacobian: JacobianMethod,
-    /// Consecutive iterations whose step no halving made acceptable (the stride from every
-    /// trial failed or its residual grew) before the search gives up: a search that has
-    /// diverged from its start stops there instead of spending its whole iteration budget.
+    /// Consecutive stalled iterations before the search gives up: iterations whose step no
+    /// halving made acceptable (the stride from every trial failed or its residual grew), or
+    /// whose accepted step took less than a tenth off the residual ([`STALL_FRACTION`]). A
+    /// search that has diverged from its start, or crawls on a plateau (at a fold, past the
+    /// end of a branch), stops there instead of spending its whole iteration budget.
     pub max_stalled_iterations: usize,
 }
 
@@ -76,6 +78,11 @@ impl Default for NewtonSettings {
         }
     }
 }
+
+/// An accepted Newton step that leaves more than this fraction of the residual is a stalled
+/// iteration ([`NewtonSettings::max_stalled_iterations`]): Newton near a regular fixed point
+/// removes most of it, a chord iteration at least three quarters.
+pub const STALL_FRACTION: f64 = 0.9;
 
 /// Why no fixed point was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -517,11 +524,13 @@ impl<'a> GaitSearch<'a> {
             let r_norm = r.amax();
             let mut lambda = 1.0;
             let mut accepted = settings.max_halvings == 0;
+            let mut trial_residual = f64::INFINITY;
             for _ in 0..settings.max_halvings {
                 let trial = &v + &dv * lambda;
                 strides += 1;
                 match self.stride_map_in(&mut workspace, &trial) {
                     Ok((st, sr)) if (&st - &trial).amax() < r_norm.max(settings.tolerance) => {
+                        trial_residual = (&st - &trial).amax();
                         carried = Some((st, sr));
                         accepted = true;
                         break;
@@ -536,12 +545,19 @@ impl<'a> GaitSearch<'a> {
             // A step that no halving made acceptable is not a sign of convergence, however
             // short it has become.
             last_step = if accepted {
-                stalled = 0;
                 dv.amax() * lambda
             } else {
-                stalled += 1;
                 f64::INFINITY
             };
+            // stalled: no acceptable step, or one that took less than a tenth off the
+            // residual while still longer than the tolerance (a search on a plateau, as at a
+            // fold or past the branch's end, which the iteration budget only prolongs)
+            let crawled = trial_residual > STALL_FRACTION * r_norm;
+            if !accepted || (crawled && last_step >= settings.tolerance) {
+                stalled += 1;
+            } else {
+                stalled = 0;
+            }
             v += dv * lambda;
             if stalled >= settings.max_stalled_iterations.max(1) || (&v - v0).amax() > max_move {
                 return Err(NewtonError::NotConverged {
