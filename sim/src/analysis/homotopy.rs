@@ -177,31 +177,46 @@ impl Secant {
         let corrector = guard.corrector(newton);
         let search = GaitSearch::new(&setup.walker, &setup.settings, &corrector);
         Some(
-            self.step_to_point(s, setup, newton, guard)?
+            self.correct(s, setup, newton, guard, None)?
                 .and_then(|p| search.gait_at(p)),
         )
     }
 
-    /// [`Self::step`] without the stride Jacobian at the gait found ([`GaitSearch::gait_at`]
-    /// takes it, with [`HomotopySettings::corrector`]'s settings): a path's intermediate
-    /// gaits need none. The corrector starts from the last gait's Newton matrix when the
-    /// coordinates are the same.
+    /// [`Self::step`] on a path of [`follow_to_point`], without the stride Jacobian at the
+    /// gait found ([`GaitSearch::gait_at`] takes it, with [`HomotopySettings::corrector`]'s
+    /// settings). An [`PathPoint::Intermediate`] gait is converged to
+    /// [`HomotopySettings::path_tolerance`] from the last gait's Newton matrix (when the
+    /// coordinates are the same), the [`PathPoint::End`] to the caller's tolerance from a
+    /// Jacobian of its own (a chord iteration on an older matrix converges too slowly to
+    /// reach a tight tolerance in the corrector's budget); either stops as soon as an iterate
+    /// is farther from the predictor than the guard allows (where the corrector would most
+    /// likely end refused; one that overshoots and comes back is refused too).
     pub fn step_to_point(
         &self,
         s: f64,
         setup: &Setup,
         newton: &NewtonSettings,
         guard: &HomotopySettings,
+        point: PathPoint,
+    ) -> Option<Result<FixedPoint, NewtonError>> {
+        self.correct(s, setup, newton, guard, Some(point))
+    }
+
+    /// The corrector of [`Self::step`] (`point` `None`: the caller's tolerance, a fresh
+    /// Jacobian, no early stop) and of [`Self::step_to_point`].
+    fn correct(
+        &self,
+        s: f64,
+        setup: &Setup,
+        newton: &NewtonSettings,
+        guard: &HomotopySettings,
+        point: Option<PathPoint>,
     ) -> Option<Result<FixedPoint, NewtonError>> {
         let (predictor, period) = self.predict(s)?;
         let same_coordinates = setup.walker.map_coordinates() == self.coordinates;
         let predictor = in_coordinates(&predictor, &self.coordinates, &setup.walker);
         let corrector = guard.corrector(newton);
-        // Intermediate gaits: to the path's tolerance, from the last gait's Newton matrix. The
-        // end: to the caller's tolerance from a Jacobian of its own (a chord iteration on an
-        // older matrix converges too slowly to reach a tight tolerance in the corrector's
-        // budget).
-        let (corrector, start_matrix) = if s < 1.0 {
+        let (corrector, start_matrix) = if point == Some(PathPoint::Intermediate) {
             let corrector = NewtonSettings {
                 tolerance: corrector.tolerance.max(guard.path_tolerance),
                 ..corrector
@@ -213,9 +228,11 @@ impl Secant {
         } else {
             (corrector, None)
         };
-        // a corrector that has moved farther than the guard allows is refused below however
-        // it ends: stopped as soon as it has
-        let leash = guard.max_correction * (1.0 + predictor.amax());
+        let leash = if point.is_some() {
+            guard.max_correction * (1.0 + predictor.amax())
+        } else {
+            f64::INFINITY
+        };
         let g = GaitSearch::new(&setup.walker, &setup.settings, &corrector).converge_within(
             &predictor,
             start_matrix,
@@ -235,6 +252,15 @@ impl Secant {
             }
         }))
     }
+}
+
+/// Which gait of a path [`Secant::step_to_point`] converges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathPoint {
+    /// One the path goes on from: only the next predictor uses it.
+    Intermediate,
+    /// The path's end: the gait returned.
+    End,
 }
 
 /// The stride-map vector `v` (values then rates of `coordinates`) in `walker`'s stride-map
@@ -340,7 +366,12 @@ pub fn follow_to_point(
             continue;
         };
         solves += 1;
-        match path.step_to_point(s_next, &setup, newton, settings) {
+        let point = if s_next < 1.0 {
+            PathPoint::Intermediate
+        } else {
+            PathPoint::End
+        };
+        match path.step_to_point(s_next, &setup, newton, settings, point) {
             Some(Ok(p)) => {
                 if s_next >= 1.0 {
                     return (Ok((p, setup)), solves);

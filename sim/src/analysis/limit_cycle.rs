@@ -84,6 +84,11 @@ impl Default for NewtonSettings {
 /// removes most of it, a chord iteration at least three quarters.
 pub const STALL_FRACTION: f64 = 0.9;
 
+/// A residual below this many Newton tolerances is never a plateau
+/// ([`NewtonSettings::max_stalled_iterations`]): there the stride map's own noise can hold
+/// it while the search still converges.
+pub const CRAWL_FLOOR: f64 = 1e3;
+
 /// Why no fixed point was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NewtonError {
@@ -552,7 +557,11 @@ impl<'a> GaitSearch<'a> {
             // stalled: no acceptable step, or one that took less than a tenth off the
             // residual while still longer than the tolerance (a search on a plateau, as at a
             // fold or past the branch's end, which the iteration budget only prolongs)
-            let crawled = trial_residual > STALL_FRACTION * r_norm;
+            // (a residual near the noise floor, where |Δv| can stay above the tolerance while
+            // the residual cannot fall, is not a plateau; without halvings no trial is taken)
+            let crawled = settings.max_halvings > 0
+                && r_norm > CRAWL_FLOOR * settings.tolerance
+                && trial_residual > STALL_FRACTION * r_norm;
             if !accepted || (crawled && last_step >= settings.tolerance) {
                 stalled += 1;
             } else {
@@ -592,7 +601,7 @@ pub struct FixedPoint {
     /// The stride from the fixed point.
     pub stride: StrideResult,
     /// The last matrix Newton stepped with (a stride Jacobian near the fixed point: forward
-    /// differences by default); `None` when the start was already converged.
+    /// differences by default); `None` only for a search that took no step.
     pub newton_matrix: Option<DMatrix<f64>>,
     /// The stride-map coordinates of `fixed_point` ([`Gait::map_coordinates`]).
     pub map_coordinates: Vec<CoordIndex>,
