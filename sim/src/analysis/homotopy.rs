@@ -340,8 +340,9 @@ pub fn follow(
 
 /// [`follow`] without the stride Jacobian at the end: the fixed point at `to` and the setup it
 /// was found on (whose [`GaitSearch`] with [`HomotopySettings::corrector`]'s settings makes it
-/// the gait [`follow`] returns, [`GaitSearch::gait_at`]). No Jacobian is taken along the
-/// path: each corrector starts from the Newton matrix of the gait before.
+/// the gait [`follow`] returns, [`GaitSearch::gait_at`]). No eigenvalue Jacobian is taken
+/// along the path; each intermediate corrector starts from the Newton matrix of the gait
+/// before, the end's from a Jacobian of its own ([`PathPoint`]).
 pub fn follow_to_point(
     from: &Scene,
     to: &Scene,
