@@ -473,7 +473,6 @@ impl<'a> GaitSearch<'a> {
         // (a chord iteration); the eigenvalues always come from a Jacobian at the converged
         // point ([`Self::gait_at`]).
         let mut kept: Option<DMatrix<f64>> = newton_matrix.filter(|j| j.shape() == (n, n));
-        let mut last_used: Option<DMatrix<f64>> = None;
         let mut last_residual = f64::INFINITY;
         // The accepted trial's stride, reused as the next iteration's.
         let mut carried: Option<(DVector<f64>, StrideResult)> = None;
@@ -502,7 +501,8 @@ impl<'a> GaitSearch<'a> {
                     iterations: it,
                     strides,
                     stride,
-                    newton_matrix: last_used,
+                    // the matrix of the last step (a convergence is never at iteration 0)
+                    newton_matrix: kept,
                     map_coordinates: self.walker.map_coordinates(),
                 });
             }
@@ -574,7 +574,6 @@ impl<'a> GaitSearch<'a> {
                     last_step,
                 });
             }
-            last_used = Some(j.clone());
             kept = Some(j);
         }
         Err(NewtonError::NotConverged {
