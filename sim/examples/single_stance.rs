@@ -10,9 +10,10 @@
 //! - the first event's name and time `T` (from a stride at the scene's settings), and a check
 //!   that the phase is smooth on `[0, T]`: our stride at the tightest tolerance reaches the same
 //!   first event and state as a plain integration to `T`;
-//! - for each `--rtol R` (several may be given): the first phase integrated to `T` (a fixed end
-//!   time, no event location) by DOP853 at rtol = atol = R (the scene's largest step), the
-//!   state at `T`, the evaluations and the wall time (best of `--repeats`, default 20).
+//! - for each `--rtol R` (several may be given) and each `--h-max-s H` (several may be given;
+//!   default the scene's largest step): the first phase integrated to `T` (a fixed end time, no
+//!   event location) by DOP853 at rtol = atol = R and largest step H, the state at `T`, the
+//!   evaluations and the wall time (best of `--repeats`, default 20).
 //!
 //! `cargo run --release -p sim --example single_stance -- --rtol 1e-14 --rtol 1e-8 --repeats 50`
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -99,12 +100,14 @@ fn integrate(
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut rtols = Vec::new();
+    let mut h_maxes_s: Vec<f64> = Vec::new();
     let mut repeats = 20usize;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
             "--rtol" => rtols.push(value()?.parse::<f64>()?),
+            "--h-max-s" => h_maxes_s.push(value()?.parse::<f64>()?),
             "--repeats" => repeats = value()?.parse::<usize>()?.max(1),
             other => return Err(format!("unknown argument {other}").into()),
         }
@@ -118,6 +121,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         IntegratorChoice::Dop853 { h_max_s, .. } => h_max_s,
         _ => return Err("wisse3d's integrator is not DOP853".into()),
     };
+    if h_maxes_s.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
+        return Err("--h-max-s must be a positive number of seconds".into());
+    }
+    if h_maxes_s.is_empty() {
+        h_maxes_s.push(h_max_s);
+    }
 
     // The first phase: every coordinate free but those locked at a stride's start.
     let mut phase = Phase::with_path(model, setup.settings.evaluation);
@@ -159,7 +168,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         q: q0.clone(),
         qd: qd0.clone(),
     };
-    let build = |rtol: f64| {
+    let build = |rtol: f64, h_max_s: f64| {
         IntegratorChoice::Dop853 {
             rtol,
             atol: rtol,
@@ -169,7 +178,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     };
     // Smoothness: the tight plain integration to the tight stride's event time lands on the
     // tight stride's pre-event state (no event, no impact inside [0, T]).
-    let mut tight = build(1e-14);
+    let mut tight = build(1e-14, h_max_s);
     let (end_tight, steps_tight) =
         integrate(tight.as_mut(), &mut phase, &start, event_tight.t_stride_s)?;
     let smooth_diff = (&end_tight.q - &before_tight.q)
@@ -200,8 +209,11 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
 
     let mut runs = Vec::new();
-    for &rtol in &rtols {
-        let mut integrator = build(rtol);
+    for (&h_max_s, &rtol) in h_maxes_s
+        .iter()
+        .flat_map(|h| rtols.iter().map(move |r| (h, r)))
+    {
+        let mut integrator = build(rtol, h_max_s);
         let mut best = f64::INFINITY;
         let mut end = start.clone();
         let mut evaluations = 0;
