@@ -53,6 +53,13 @@ pub struct HomotopySettings {
     /// predictor Newton converges in a few; more means the step is too long, and halving it
     /// is cheaper than iterating on (a failing search of the 3D walker costs seconds).
     pub max_corrector_iterations: usize,
+    /// Stalled iterations ([`NewtonSettings::max_stalled_iterations`]) a corrector of
+    /// [`follow_to_point`]'s path allows before its step is halved. From a predictor on the
+    /// path, an iteration that no halving makes acceptable, or that takes less than a tenth
+    /// off the residual, says the step is too long: halving it is cheaper than iterating on
+    /// (a failing wisse3d corrector took 50 to 100 strides with three). `walker sweep`'s
+    /// natural steps keep the caller's setting.
+    pub max_corrector_stalls: usize,
     /// Strides one gait of [`GaitRule`] (and so [`nominal_gait`]) may take over all its
     /// searches: Newton from the guess, the defaults' gait (a budget of its own), the path.
     /// Default [`DEFAULT_GAIT_STRIDE_BUDGET`]; `walker ... --max-strides`.
@@ -79,6 +86,7 @@ impl Default for HomotopySettings {
             max_solves: 24,
             path_tolerance: 1e-8,
             max_corrector_iterations: 12,
+            max_corrector_stalls: 1,
             gait_stride_budget: DEFAULT_GAIT_STRIDE_BUDGET,
         }
     }
@@ -216,17 +224,20 @@ impl Secant {
         let same_coordinates = setup.walker.map_coordinates() == self.coordinates;
         let predictor = in_coordinates(&predictor, &self.coordinates, &setup.walker);
         let corrector = guard.corrector(newton);
-        let (corrector, start_matrix) = if point == Some(PathPoint::Intermediate) {
-            let corrector = NewtonSettings {
-                tolerance: corrector.tolerance.max(guard.path_tolerance),
-                ..corrector
-            };
-            (
-                corrector,
+        let on_path = NewtonSettings {
+            max_stalled_iterations: guard.max_corrector_stalls,
+            ..corrector
+        };
+        let (corrector, start_matrix) = match point {
+            Some(PathPoint::Intermediate) => (
+                NewtonSettings {
+                    tolerance: corrector.tolerance.max(guard.path_tolerance),
+                    ..on_path
+                },
                 self.newton_matrix.clone().filter(|_| same_coordinates),
-            )
-        } else {
-            (corrector, None)
+            ),
+            Some(PathPoint::End) => (on_path, None),
+            None => (corrector, None),
         };
         let leash = if point.is_some() {
             guard.max_correction * (1.0 + predictor.amax())

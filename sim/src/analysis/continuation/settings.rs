@@ -260,7 +260,8 @@ impl ContinuationSettings {
             "homotopy.max_corrector_iterations",
             h.max_corrector_iterations,
             1,
-        )
+        )?;
+        count("homotopy.max_corrector_stalls", h.max_corrector_stalls, 1)
     }
 }
 
@@ -380,6 +381,11 @@ mod tests {
             ..HomotopySettings::default()
         };
         assert!(refused(b().homotopy(homotopy)).starts_with("homotopy.first_step"));
+        let homotopy = HomotopySettings {
+            max_corrector_stalls: 0,
+            ..HomotopySettings::default()
+        };
+        assert!(refused(b().homotopy(homotopy)).starts_with("homotopy.max_corrector_stalls"));
         let built = b().max_period(2).max_branches(1).build().unwrap();
         assert_eq!((built.max_period(), built.max_branches()), (2, 1));
     }
