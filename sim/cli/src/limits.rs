@@ -18,10 +18,9 @@ pub const MAX_MAP_AXIS_POINTS: usize = 500;
 /// Most cells of a stability map (`N × M`): each is a gait search.
 pub const MAX_MAP_CELLS: usize = 40_000;
 
-/// Most steps of a walk (`walker walk --steps`, `walker sil --steps`). Each completed step
-/// keeps a summary (a few hundred bytes; `walker sil --keep-steps` bounds them) and takes
-/// milliseconds to seconds: 100,000 steps is ten times the 10,000-step soak.
-pub const MAX_WALK_STEPS: usize = 100_000;
+/// Most steps of a walk (`walker walk --steps`, `walker sil --steps`): the library's bound,
+/// which the Python package checks too.
+pub use sim::stride::walk::MAX_WALK_STEPS;
 
 /// Most gait searches of `walker tune --evaluations`.
 pub const MAX_TUNE_EVALUATIONS: usize = 10_000;
