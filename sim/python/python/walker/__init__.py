@@ -1,0 +1,107 @@
+"""The walker simulator from Python: scenes, gaits and walks as numpy arrays and pandas tables.
+
+>>> import walker
+>>> scene = walker.Scene.load("compass").with_params(slope_rad=0.05)
+>>> g = walker.gait(scene)
+>>> g.max_abs_eigenvalue < 1.0
+True
+
+Every number equals the one the ``walker`` command prints with ``--json`` for the same scene
+and parameters (the same library calls and the same report). Long computations release the
+GIL and stop on Ctrl-C (``KeyboardInterrupt``). Errors are :class:`WalkerError` subclasses.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import pandas as pd
+
+from . import _walker
+from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
+from ._gait import Gait
+from ._walk import Walk
+from ._walker import DEFAULT_GAIT_STRIDE_BUDGET, MAX_WALK_STEPS, Scene
+
+__all__ = [
+    "DEFAULT_GAIT_STRIDE_BUDGET",
+    "MAX_WALK_STEPS",
+    "Gait",
+    "GaitNotFound",
+    "InputError",
+    "Scene",
+    "SceneError",
+    "StrideFailed",
+    "Walk",
+    "WalkerError",
+    "gait",
+    "scenes",
+    "walk",
+]
+
+
+def _scene(scene: Scene | str) -> Scene:
+    return scene if isinstance(scene, Scene) else Scene.load(scene)
+
+
+def scenes() -> pd.DataFrame:
+    """The built-in scenes, indexed by name: ``summary``, ``reference``,
+    ``degrees_of_freedom``, ``coordinates`` (as ``walker scenes --json`` lists them; each
+    scene's parameters are ``Scene.load(name).parameters``)."""
+    catalogue = _walker.scenes()["scenes"]
+    rows = [{k: v for k, v in s.items() if k != "parameters"} for s in catalogue]
+    return pd.DataFrame(rows).set_index("name")
+
+
+def gait(scene: Scene | str, *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -> Gait:
+    """The gait of ``scene`` (a :class:`Scene` or a scene name or path) as ``walker gait``
+    finds it: at the scene's defaults Newton from its guess, elsewhere the defaults' gait
+    followed to the scene's values (``Gait.gait_source`` says which), with the scene's
+    integrator and the command's default Newton settings.
+
+    ``max_strides`` bounds the strides the search may take (``--max-strides``).
+
+    Raises :class:`GaitNotFound` (or :class:`StrideFailed`, a subclass, when a stride of the
+    search failed) if there is none, :class:`SceneError` if the scene cannot be built,
+    ``KeyboardInterrupt`` on Ctrl-C.
+    """
+    return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
+
+
+def walk(
+    scene: Scene | str,
+    steps: int,
+    *,
+    start: str | Mapping[str, float] = "gait",
+    perturb: Mapping[str, float] | None = None,
+    floor: str = "plane",
+    path_interval_s: float | None = None,
+    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+) -> Walk:
+    """Walks up to ``steps`` strides of ``scene``, as ``walker walk`` does.
+
+    ``start``: ``"gait"`` (the gait's fixed point, found as :func:`gait` finds it),
+    ``"guess"`` (the scene's guess), or a mapping ``{stride-map entry: value}`` that replaces
+    entries of the gait's fixed point (``--start-state``). ``perturb``: ``{entry: delta}``
+    added to the start (``--perturb``). ``floor``: ``"plane"``, ``"step:at=K,height_m=H"`` or
+    ``"rough:sigma_m=S[,seed=N]"`` (``--floor``). ``path_interval_s``: keep one path sample
+    per interval instead of every integration sample.
+
+    A fall is not an error: :attr:`Walk.failure` says how the walk ended early (the command's
+    exit code 3). Raises :class:`InputError` for bad input (``steps`` outside 0 to
+    :data:`MAX_WALK_STEPS`, an unknown entry, a floor that cannot be read),
+    :class:`SceneError`, :class:`GaitNotFound` / :class:`StrideFailed` (no gait to start
+    from), ``KeyboardInterrupt`` on Ctrl-C.
+    """
+    report, path = _walker.walk(
+        _scene(scene),
+        steps,
+        start=start if isinstance(start, str) else dict(start),
+        perturb=None if perturb is None else dict(perturb),
+        floor=floor,
+        path_interval_s=path_interval_s,
+        max_strides=max_strides,
+    )
+    return Walk.from_parts(report, path)
+
+
