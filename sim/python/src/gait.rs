@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use sim::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings};
 use sim::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
 use sim::report::GaitReport;
-use sim::scene::{Scene, SceneError};
+use sim::scene::{Scene, SceneError, Setup};
 use sim::stride::SearchBudget;
 use std::sync::Arc;
 
@@ -44,20 +44,26 @@ pub fn report(scene: &Scene, budget: &Arc<SearchBudget>) -> Result<GaitReport, S
     let sourced = rule_gait(scene, budget)?;
     let setup = scene.setup()?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
-    let result = sourced.map(|(g, _)| g);
+    let mut report = gait_report(scene, &setup, &sourced.map(|(g, _)| g));
+    report.gait_source = source;
+    Ok(report)
+}
+
+/// The report of a gait search `result` at `scene`'s values (built as `setup`), with the
+/// contact figures of a stride from its fixed point, as `walker gait` and `walker gaits`
+/// report each gait.
+pub fn gait_report(scene: &Scene, setup: &Setup, result: &Result<Gait, NewtonError>) -> GaitReport {
     let stride = result
         .as_ref()
         .ok()
         .and_then(|g| setup.gait_stride(g, false));
-    let mut report = GaitReport::new(
+    GaitReport::new(
         scene,
         &setup.walker,
         &setup.settings.integrator,
-        &result,
+        result,
         stride.as_ref().map(|r| &r.contact),
-    );
-    report.gait_source = source;
-    Ok(report)
+    )
 }
 
 /// The gait of `scene`: the `walker gait --json` object as a dict (with `jacobian` and

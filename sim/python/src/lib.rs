@@ -14,6 +14,7 @@
 mod convert;
 mod errors;
 mod gait;
+mod gaits;
 mod interrupt;
 mod scene;
 mod walk;
@@ -27,6 +28,7 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::scenes, m)?)?;
     m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
     m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
+    m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;
     m.add(
         "DEFAULT_GAIT_STRIDE_BUDGET",
         sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,

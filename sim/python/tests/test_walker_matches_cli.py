@@ -118,3 +118,15 @@ def test_scenes_and_parameter_table_as_the_cli(cli):
     assert changed.values["slope_rad"] == 0.05
     assert changed.parameters.loc["slope_rad", "value"] == 0.05
     assert walker.Scene.load("compass").values["slope_rad"] != 0.05
+
+
+def test_gaits_equal_the_cli_json(cli):
+    code, expected, err = cli("gaits", "--scene", "simplest", "--set", "slope=0.015", "--json")
+    assert code == 0, err
+    found = walker.gaits(walker.Scene.load("simplest").with_params(slope=0.015))
+    assert found.report == expected
+    assert len(found.gaits) == len(expected["gaits"]) >= 2
+    assert found.searches == expected["searches"]
+    periods = list(found.table()["step_period_s"])
+    assert periods == sorted(periods, reverse=True)
+    assert all(g.gait_source is None for g in found.gaits)

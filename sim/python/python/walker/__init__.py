@@ -19,7 +19,7 @@ import pandas as pd
 
 from . import _walker
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
-from ._gait import Gait
+from ._gait import Gait, Gaits
 from ._walk import Walk
 from ._walker import DEFAULT_GAIT_STRIDE_BUDGET, MAX_WALK_STEPS, Scene
 
@@ -27,6 +27,7 @@ __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
     "MAX_WALK_STEPS",
     "Gait",
+    "Gaits",
     "GaitNotFound",
     "InputError",
     "Scene",
@@ -35,6 +36,7 @@ __all__ = [
     "Walk",
     "WalkerError",
     "gait",
+    "gaits",
     "scenes",
     "walk",
 ]
@@ -66,6 +68,14 @@ def gait(scene: Scene | str, *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -
     ``KeyboardInterrupt`` on Ctrl-C.
     """
     return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
+
+
+def gaits(scene: Scene | str) -> Gaits:
+    """Every distinct period-1 gait of ``scene``, longest step period first, as
+    ``walker gaits`` finds them (Newton from many starts, and the gaits followed from the
+    scene's defaults). No gait gives an empty list. Raises :class:`SceneError`,
+    ``KeyboardInterrupt`` on Ctrl-C."""
+    return Gaits.from_report(_walker.gaits(_scene(scene)))
 
 
 def walk(

@@ -117,11 +117,43 @@ class Gait:
         return pd.DataFrame(self.report["events"], columns=["name", "time_s"])
 
     @property
-    def gait_source(self) -> str:
-        """Where the gait comes from: ``defaults``, ``guess`` or ``continued_from_defaults``."""
-        return str(self.report["gait_source"])
+    def gait_source(self) -> str | None:
+        """Where the gait comes from: ``defaults``, ``guess`` or ``continued_from_defaults``
+        (``None`` for a gait of :func:`walker.gaits`, which lists every gait found)."""
+        return self.report.get("gait_source")
 
     @property
     def newton_iterations(self) -> int:
         """Newton iterations of the search that found it."""
         return int(self.report["newton_iterations"])
+
+
+@dataclass(frozen=True)
+class Gaits:
+    """Every distinct period-1 gait of a scene, longest step period first
+    (``walker gaits --json``)."""
+
+    report: dict[str, Any] = field(repr=False)
+    """The ``walker gaits --json`` object."""
+    gaits: list[Gait]
+    """The gaits, longest step period first."""
+    searches: int
+    """Newton searches the census ran."""
+
+    @classmethod
+    def from_report(cls, report: dict[str, Any]) -> Gaits:
+        """The gaits of a ``walker gaits --json`` object."""
+        return cls(report, [Gait.from_report(g) for g in report["gaits"]], int(report["searches"]))
+
+    def table(self) -> pd.DataFrame:
+        """One row per gait: ``step_period_s``, ``progress_m_per_step``, ``step_length_m``,
+        ``speed_m_s``, ``max_abs_eigenvalue``, ``stable``."""
+        keys = [
+            "step_period_s",
+            "progress_m_per_step",
+            "step_length_m",
+            "speed_m_s",
+            "max_abs_eigenvalue",
+            "stable",
+        ]
+        return pd.DataFrame([{k: g.report[k] for k in keys} for g in self.gaits], columns=keys)

@@ -40,6 +40,9 @@ def gait(scene: Scene, *, max_strides: int = ...) -> dict[str, Any]:
     """The ``walker gait --json`` object of the scene's gait; raises ``GaitNotFound``,
     ``StrideFailed`` or ``SceneError``."""
 
+def gaits(scene: Scene) -> dict[str, Any]:
+    """The ``walker gaits --json`` object: every period-1 gait, longest step period first."""
+
 def walk(
     scene: Scene,
     steps: int,
