@@ -15,8 +15,9 @@ pub const MAX_ORBIT_POINTS: usize = 5_000;
 /// Most values along one axis of a stability map (`walker stability-map --x K=A:B:N`).
 pub const MAX_MAP_AXIS_POINTS: usize = 500;
 
-/// Most cells of a stability map (`N × M`): each is a gait search.
-pub const MAX_MAP_CELLS: usize = 40_000;
+/// Most cells of a stability map (`N × M`): each is a gait search (the library's bound, which
+/// the Python package checks too).
+pub use sim::analysis::stability_map::MAX_MAP_CELLS;
 
 /// Most steps of a walk (`walker walk --steps`, `walker sil --steps`): the library's bound,
 /// which the Python package checks too.

@@ -12,11 +12,26 @@ use sim::scene::{Scene, SceneError, Setup};
 use sim::stride::SearchBudget;
 use std::sync::Arc;
 
+/// Builds a scene's setup with its own integrator, as `walker` does without options, for the
+/// library's studies (`sim::analysis::homotopy::SetupFor`); once `cancel` is cancelled
+/// (Ctrl-C) every later setup is refused, so a study that builds a setup per search (a
+/// stability map's cells, the rule's homotopy steps) stops at its next search.
+pub fn setup_for(
+    cancel: &SearchBudget,
+) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
+    move |s: &Scene| {
+        if cancel.is_cancelled() {
+            return Err(SceneError::Invalid("interrupted (Ctrl-C)".to_owned()));
+        }
+        s.setup()
+    }
+}
+
 /// `f` of the one gait rule (`sim::analysis::homotopy::GaitRule`) as `walker gait` applies it
 /// without options: each scene built with its own integrator, the default Newton settings,
 /// every stride taken from `budget`.
 pub fn with_rule<T>(budget: &Arc<SearchBudget>, f: impl FnOnce(&GaitRule<'_>) -> T) -> T {
-    let setup_for = |s: &Scene| s.setup();
+    let setup_for = setup_for(budget);
     let newton = NewtonSettings::default();
     let homotopy = HomotopySettings {
         gait_stride_budget: budget.limit_strides(),

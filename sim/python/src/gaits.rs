@@ -2,7 +2,7 @@
 
 use crate::convert;
 use crate::errors;
-use crate::gait::gait_report;
+use crate::gait::{gait_report, setup_for};
 use crate::interrupt;
 use crate::scene::PyScene;
 use pyo3::prelude::*;
@@ -17,7 +17,7 @@ use std::sync::Arc;
 /// `cancel` (unlimited, there to stop it).
 fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, SceneError> {
     let setup_for = |s: &Scene| -> Result<Setup, SceneError> {
-        let mut setup = s.setup()?;
+        let mut setup = setup_for(cancel)(s)?;
         setup.settings.search_budget = SharedBudget(Some(Arc::clone(cancel)));
         Ok(setup)
     };

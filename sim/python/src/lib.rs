@@ -17,6 +17,7 @@ mod gait;
 mod gaits;
 mod interrupt;
 mod scene;
+mod stability_map;
 mod walk;
 
 use pyo3::prelude::*;
@@ -29,6 +30,8 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
     m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
     m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;
+    m.add_function(wrap_pyfunction!(stability_map::stability_map, m)?)?;
+    m.add("MAX_MAP_CELLS", sim::analysis::stability_map::MAX_MAP_CELLS)?;
     m.add(
         "DEFAULT_GAIT_STRIDE_BUDGET",
         sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,

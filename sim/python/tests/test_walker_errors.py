@@ -95,3 +95,24 @@ def test_ctrl_c_stops_a_long_walk():
             walker.walk("compass", walker.MAX_WALK_STEPS, path_interval_s=10.0)
     finally:
         timer.cancel()
+
+
+def test_ctrl_c_stops_a_long_stability_map():
+    import time
+
+    import numpy as np
+
+    # 400 gait searches of the 3D walker take minutes; Ctrl-C ends the map at the next search.
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    started = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            walker.stability_map(
+                "wisse3d",
+                x=("slope_rad", np.linspace(0.04, 0.06, 20)),
+                y=("pelvic_ring_radius_m", np.linspace(0.40, 0.44, 20)),
+            )
+    finally:
+        timer.cancel()
+    assert time.monotonic() - started < 30.0

@@ -130,3 +130,32 @@ def test_gaits_equal_the_cli_json(cli):
     periods = list(found.table()["step_period_s"])
     assert periods == sorted(periods, reverse=True)
     assert all(g.gait_source is None for g in found.gaits)
+
+
+def test_stability_map_equals_the_cli_json(cli):
+    code, expected, err = cli(
+        "stability-map", "--scene", "compass", "--x", "slope_rad=0.04:0.06:3",
+        "--y", "leg_mass_kg=4:6:2", "--json",
+    )
+    assert code == 0, err
+    m = walker.stability_map(
+        "compass",
+        x=("slope", expected["x"]["values"]),  # an alias, as the command takes it
+        y=("leg_mass_kg", expected["y"]["values"]),
+    )
+    assert m.report == expected
+    assert m.x_name == "slope_rad" and m.max_abs_eigenvalue.shape == (2, 3)
+    assert np.all(np.isfinite(m.max_abs_eigenvalue))
+    frame = m.to_frame()
+    assert len(frame) == 6
+    assert frame["max_abs_eigenvalue"].tolist() == [v for row in expected["max_abs_eigenvalue"] for v in row]
+
+
+def test_stability_map_bad_axes():
+    with pytest.raises(walker.InputError, match="both vary"):
+        walker.stability_map("compass", x=("slope", [0.05]), y=("slope_rad", [0.05]))
+    with pytest.raises(walker.InputError, match="cells"):
+        walker.stability_map("compass", x=("slope", []), y=("leg_mass_kg", [5.0]))
+    with pytest.raises(walker.SceneError) as e:
+        walker.stability_map("compass", x=("slope", [0.05]), y=("no_such", [5.0]))
+    assert e.value.kind == "unknown_parameter"

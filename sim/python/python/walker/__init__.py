@@ -13,18 +13,20 @@ GIL and stop on Ctrl-C (``KeyboardInterrupt``). Errors are :class:`WalkerError` 
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import pandas as pd
 
 from . import _walker
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
 from ._gait import Gait, Gaits
+from ._stability_map import StabilityMap
 from ._walk import Walk
-from ._walker import DEFAULT_GAIT_STRIDE_BUDGET, MAX_WALK_STEPS, Scene
+from ._walker import DEFAULT_GAIT_STRIDE_BUDGET, MAX_MAP_CELLS, MAX_WALK_STEPS, Scene
 
 __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
+    "MAX_MAP_CELLS",
     "MAX_WALK_STEPS",
     "Gait",
     "Gaits",
@@ -32,12 +34,14 @@ __all__ = [
     "InputError",
     "Scene",
     "SceneError",
+    "StabilityMap",
     "StrideFailed",
     "Walk",
     "WalkerError",
     "gait",
     "gaits",
     "scenes",
+    "stability_map",
     "walk",
 ]
 
@@ -115,3 +119,21 @@ def walk(
     return Walk.from_parts(report, path)
 
 
+
+
+def stability_map(
+    scene: Scene | str,
+    x: tuple[str, Sequence[float]],
+    y: tuple[str, Sequence[float]],
+) -> StabilityMap:
+    """The gait of ``scene`` (as :func:`gait` finds it) at every cell of the grid of two
+    parameters ``x`` and ``y``, each ``(name or alias, values)``, e.g.
+    ``x=("slope_rad", np.linspace(0.01, 0.08, 29))``, as ``walker stability-map`` computes it
+    (every core). Raises :class:`SceneError` (unknown parameter, value out of range),
+    :class:`InputError` (one parameter twice, no cells, more than :data:`MAX_MAP_CELLS`),
+    ``KeyboardInterrupt`` on Ctrl-C (at the next gait search)."""
+    (xn, xv), (yn, yv) = x, y
+    report = _walker.stability_map(
+        _scene(scene), (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    )
+    return StabilityMap.from_report(report)

@@ -7,6 +7,8 @@ import pandas as pd
 
 DEFAULT_GAIT_STRIDE_BUDGET: int
 """Strides one gait search may take by default (``--max-strides``)."""
+MAX_MAP_CELLS: int
+"""Most cells of one stability map."""
 MAX_WALK_STEPS: int
 """Most steps of one walk."""
 
@@ -42,6 +44,11 @@ def gait(scene: Scene, *, max_strides: int = ...) -> dict[str, Any]:
 
 def gaits(scene: Scene) -> dict[str, Any]:
     """The ``walker gaits --json`` object: every period-1 gait, longest step period first."""
+
+def stability_map(
+    scene: Scene, x: tuple[str, list[float]], y: tuple[str, list[float]]
+) -> dict[str, Any]:
+    """The ``walker stability-map --json`` object of the grid ``x`` × ``y``."""
 
 def walk(
     scene: Scene,
