@@ -7,6 +7,7 @@
 
 use pyo3::prelude::*;
 use sim::stride::SearchBudget;
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -22,14 +23,26 @@ where
 {
     let (out, signal) = py.detach(|| {
         std::thread::scope(|s| {
-            let handle = s.spawn(work);
+            // The work's end wakes the waiting thread at once (a poll alone would add up to
+            // POLL to every call).
+            let (done_tx, done_rx) = mpsc::channel::<()>();
+            let handle = s.spawn(move || {
+                let out = work();
+                let _ = done_tx.send(());
+                out
+            });
             let mut signal: Option<PyErr> = None;
-            while !handle.is_finished() {
-                std::thread::sleep(POLL);
-                if signal.is_none() {
-                    if let Err(e) = Python::attach(|py| py.check_signals()) {
-                        budgets.iter().for_each(|b| b.cancel());
-                        signal = Some(e);
+            loop {
+                match done_rx.recv_timeout(POLL) {
+                    // Done, or the work's thread ended without sending (it panicked).
+                    Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
+                    Err(RecvTimeoutError::Timeout) => {
+                        if signal.is_none() {
+                            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                                budgets.iter().for_each(|b| b.cancel());
+                                signal = Some(e);
+                            }
+                        }
                     }
                 }
             }
