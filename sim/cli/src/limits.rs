@@ -8,9 +8,9 @@ use crate::input_error::InputError;
 /// allocates its list of points up front.
 pub const MAX_SWEEP_POINTS: usize = 10_000;
 
-/// Most values of an orbit diagram (`walker orbit-diagram --points`): each iterates up to
-/// its stride budget (2,000 strides) and keeps up to a window of states.
-pub const MAX_ORBIT_POINTS: usize = 5_000;
+/// Most values of an orbit diagram (`walker orbit-diagram --points`): the library's bound,
+/// which the Python package checks too.
+pub use sim::analysis::orbit_diagram::MAX_ORBIT_POINTS;
 
 /// Most values along one axis of a stability map (`walker stability-map --x K=A:B:N`).
 pub const MAX_MAP_AXIS_POINTS: usize = 500;

@@ -9,21 +9,24 @@ use sim::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings};
 use sim::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
 use sim::report::GaitReport;
 use sim::scene::{Scene, SceneError, Setup};
-use sim::stride::SearchBudget;
+use sim::stride::{SearchBudget, SharedBudget};
 use std::sync::Arc;
 
 /// Builds a scene's setup with its own integrator, as `walker` does without options, for the
-/// library's studies (`sim::analysis::homotopy::SetupFor`); once `cancel` is cancelled
-/// (Ctrl-C) every later setup is refused, so a study that builds a setup per search (a
-/// stability map's cells, the rule's homotopy steps) stops at its next search.
+/// library's studies (`sim::analysis::homotopy::SetupFor`), its strides taken from `budget`
+/// (a gait rule puts its own in their place). Once `budget` is cancelled (Ctrl-C) its strides
+/// fail at once and every later setup is refused, so a study stops at its next stride or
+/// search (a stability map's cells, the rule's homotopy steps).
 pub fn setup_for(
-    cancel: &SearchBudget,
+    budget: &Arc<SearchBudget>,
 ) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
     move |s: &Scene| {
-        if cancel.is_cancelled() {
+        if budget.is_cancelled() {
             return Err(SceneError::Invalid("interrupted (Ctrl-C)".to_owned()));
         }
-        s.setup()
+        let mut setup = s.setup()?;
+        setup.settings.search_budget = SharedBudget(Some(Arc::clone(budget)));
+        Ok(setup)
     }
 }
 

@@ -9,21 +9,16 @@ use pyo3::prelude::*;
 use sim::analysis::census::{census_with_progress, CensusSettings};
 use sim::analysis::limit_cycle::NewtonSettings;
 use sim::report::GaitsReport;
-use sim::scene::{Scene, SceneError, Setup};
-use sim::stride::{SearchBudget, SharedBudget};
+use sim::scene::{Scene, SceneError};
+use sim::stride::SearchBudget;
 use std::sync::Arc;
 
 /// The `walker gaits --json` report of `scene`; every stride of the census taken from
 /// `cancel` (unlimited, there to stop it).
 fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, SceneError> {
-    let setup_for = |s: &Scene| -> Result<Setup, SceneError> {
-        let mut setup = setup_for(cancel)(s)?;
-        setup.settings.search_budget = SharedBudget(Some(Arc::clone(cancel)));
-        Ok(setup)
-    };
     let found = census_with_progress(
         scene,
-        &setup_for,
+        &setup_for(cancel),
         &NewtonSettings::default(),
         &CensusSettings::default(),
         &|| {},

@@ -16,6 +16,7 @@ mod errors;
 mod gait;
 mod gaits;
 mod interrupt;
+mod orbit_diagram;
 mod scene;
 mod stability_map;
 mod walk;
@@ -30,6 +31,11 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
     m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
     m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;
+    m.add_function(wrap_pyfunction!(orbit_diagram::orbit_diagram, m)?)?;
+    m.add(
+        "MAX_ORBIT_POINTS",
+        sim::analysis::orbit_diagram::MAX_ORBIT_POINTS,
+    )?;
     m.add_function(wrap_pyfunction!(stability_map::stability_map, m)?)?;
     m.add("MAX_MAP_CELLS", sim::analysis::stability_map::MAX_MAP_CELLS)?;
     m.add(

@@ -159,3 +159,20 @@ def test_stability_map_bad_axes():
     with pytest.raises(walker.SceneError) as e:
         walker.stability_map("compass", x=("slope", [0.05]), y=("no_such", [5.0]))
     assert e.value.kind == "unknown_parameter"
+
+
+def test_orbit_diagram_equals_the_cli_json(cli):
+    code, expected, err = cli(
+        "orbit-diagram", "--scene", "simplest", "--param", "slope", "--from", "0.015",
+        "--to", "0.0175", "--points", "8", "--json",
+    )
+    assert code == 0, err
+    values = np.linspace(0.015, 0.0175, 8)
+    d = walker.orbit_diagram("simplest", "slope", values)
+    assert d.report == expected
+    assert d.param == expected["param"]
+    table = d.attractors()
+    assert list(table["attractor"]) == [p["attractor"] for p in expected["points"]]
+    # Past the period doubling (0.01509) the attractor has two strides.
+    assert table["period_strides"].iloc[0] == 1 and table["period_strides"].iloc[-1] >= 2
+    assert len(d.samples("theta")) == sum(len(p["samples"]["theta"]) for p in expected["points"])

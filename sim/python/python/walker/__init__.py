@@ -20,18 +20,27 @@ import pandas as pd
 from . import _walker
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
 from ._gait import Gait, Gaits
+from ._orbit_diagram import OrbitDiagram
 from ._stability_map import StabilityMap
 from ._walk import Walk
-from ._walker import DEFAULT_GAIT_STRIDE_BUDGET, MAX_MAP_CELLS, MAX_WALK_STEPS, Scene
+from ._walker import (
+    DEFAULT_GAIT_STRIDE_BUDGET,
+    MAX_MAP_CELLS,
+    MAX_ORBIT_POINTS,
+    MAX_WALK_STEPS,
+    Scene,
+)
 
 __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
     "MAX_MAP_CELLS",
+    "MAX_ORBIT_POINTS",
     "MAX_WALK_STEPS",
     "Gait",
     "Gaits",
     "GaitNotFound",
     "InputError",
+    "OrbitDiagram",
     "Scene",
     "SceneError",
     "StabilityMap",
@@ -40,6 +49,7 @@ __all__ = [
     "WalkerError",
     "gait",
     "gaits",
+    "orbit_diagram",
     "scenes",
     "stability_map",
     "walk",
@@ -137,3 +147,13 @@ def stability_map(
         _scene(scene), (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
     )
     return StabilityMap.from_report(report)
+
+
+def orbit_diagram(scene: Scene | str, param: str, values: Sequence[float]) -> OrbitDiagram:
+    """The attractor of the stride map at each of ``values`` of parameter ``param``, each
+    value starting from the last one's attractor, as ``walker orbit-diagram`` computes it
+    (``values`` as its ``--from``/``--to``/``--points`` give them: ``np.linspace``). Raises
+    :class:`SceneError`, :class:`InputError` (fewer than 2 or more than
+    :data:`MAX_ORBIT_POINTS` values), ``KeyboardInterrupt`` on Ctrl-C."""
+    report = _walker.orbit_diagram(_scene(scene), param, [float(v) for v in values])
+    return OrbitDiagram.from_report(report)

@@ -9,6 +9,8 @@ DEFAULT_GAIT_STRIDE_BUDGET: int
 """Strides one gait search may take by default (``--max-strides``)."""
 MAX_MAP_CELLS: int
 """Most cells of one stability map."""
+MAX_ORBIT_POINTS: int
+"""Most values of one orbit diagram."""
 MAX_WALK_STEPS: int
 """Most steps of one walk."""
 
@@ -44,6 +46,9 @@ def gait(scene: Scene, *, max_strides: int = ...) -> dict[str, Any]:
 
 def gaits(scene: Scene) -> dict[str, Any]:
     """The ``walker gaits --json`` object: every period-1 gait, longest step period first."""
+
+def orbit_diagram(scene: Scene, param: str, values: list[float]) -> dict[str, Any]:
+    """The ``walker orbit-diagram --json`` object of ``param`` over ``values``."""
 
 def stability_map(
     scene: Scene, x: tuple[str, list[float]], y: tuple[str, list[float]]
