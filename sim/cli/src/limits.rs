@@ -4,9 +4,9 @@
 
 use crate::input_error::InputError;
 
-/// Most points of a sweep (`walker sweep --points`): each is a gait search, and the sweep
-/// allocates its list of points up front.
-pub const MAX_SWEEP_POINTS: usize = 10_000;
+/// Most points of a sweep (`walker sweep --points`): the library's bound, which the Python
+/// package checks too.
+pub use sim::analysis::continuation::{MAX_SWEEP_PERIOD, MAX_SWEEP_POINTS};
 
 /// Most values of an orbit diagram (`walker orbit-diagram --points`): the library's bound,
 /// which the Python package checks too.

@@ -19,6 +19,7 @@ mod interrupt;
 mod orbit_diagram;
 mod scene;
 mod stability_map;
+mod sweep;
 mod walk;
 
 use pyo3::prelude::*;
@@ -31,6 +32,7 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
     m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
     m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_diagram::orbit_diagram, m)?)?;
     m.add(
         "MAX_ORBIT_POINTS",

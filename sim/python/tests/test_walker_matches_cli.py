@@ -176,3 +176,22 @@ def test_orbit_diagram_equals_the_cli_json(cli):
     # Past the period doubling (0.01509) the attractor has two strides.
     assert table["period_strides"].iloc[0] == 1 and table["period_strides"].iloc[-1] >= 2
     assert len(d.samples("theta")) == sum(len(p["samples"]["theta"]) for p in expected["points"])
+
+
+def test_sweep_equals_the_cli_json(cli):
+    code, expected, err = cli(
+        "sweep", "--scene", "simplest", "--param", "slope", "--from", "0.012", "--to", "0.0155",
+        "--points", "5", "--max-period", "2", "--json",
+    )
+    assert code == 0, err
+    s = walker.sweep("simplest", "slope", 0.012, 0.0155, 5, max_period=2)
+    assert s.report == expected
+    assert s.param == expected["param_canonical"]
+    table = s.points()
+    assert len(table) == len(expected["points"])
+    # The period doubling near 0.01509 is located and the doubled branch followed.
+    assert 2 in set(table["period_strides"].dropna())
+    with pytest.raises(walker.InputError, match="points"):
+        walker.sweep("simplest", "slope", 0.012, 0.0155, 1)
+    with pytest.raises(walker.InputError, match="different"):
+        walker.sweep("simplest", "slope", 0.012, 0.012, 5)

@@ -22,6 +22,7 @@ from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerE
 from ._gait import Gait, Gaits
 from ._orbit_diagram import OrbitDiagram
 from ._stability_map import StabilityMap
+from ._sweep import Sweep
 from ._walk import Walk
 from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
@@ -45,6 +46,7 @@ __all__ = [
     "SceneError",
     "StabilityMap",
     "StrideFailed",
+    "Sweep",
     "Walk",
     "WalkerError",
     "gait",
@@ -52,6 +54,7 @@ __all__ = [
     "orbit_diagram",
     "scenes",
     "stability_map",
+    "sweep",
     "walk",
 ]
 
@@ -157,3 +160,22 @@ def orbit_diagram(scene: Scene | str, param: str, values: Sequence[float]) -> Or
     :data:`MAX_ORBIT_POINTS` values), ``KeyboardInterrupt`` on Ctrl-C."""
     report = _walker.orbit_diagram(_scene(scene), param, [float(v) for v in values])
     return OrbitDiagram.from_report(report)
+
+
+def sweep(
+    scene: Scene | str,
+    param: str,
+    start: float,
+    end: float,
+    points: int,
+    *,
+    max_period: int = 1,
+) -> Sweep:
+    """The gait of ``scene`` followed as ``param`` goes from ``start`` to ``end`` at
+    ``points`` points, as ``walker sweep --param P --from START --to END --points N
+    --max-period K`` follows it (pseudo-arclength continuation through folds, bifurcations
+    located, period-doubled branches up to ``max_period`` strides per cycle). Raises
+    :class:`SceneError`, :class:`InputError`; Ctrl-C raises ``KeyboardInterrupt`` when the
+    sweep ends (the continuation has no cancel hook)."""
+    report = _walker.sweep(_scene(scene), param, start, end, points, max_period=max_period)
+    return Sweep.from_report(report)

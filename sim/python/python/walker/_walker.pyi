@@ -55,6 +55,11 @@ def stability_map(
 ) -> dict[str, Any]:
     """The ``walker stability-map --json`` object of the grid ``x`` × ``y``."""
 
+def sweep(
+    scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int = 1
+) -> dict[str, Any]:
+    """The ``walker sweep --json`` object."""
+
 def walk(
     scene: Scene,
     steps: int,
