@@ -204,12 +204,21 @@ fn run(
             ))
         })
     };
+    let finite = |x: f64, name: &str, what: &str| {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(Refused::Input(format!(
+                "{what} `{name}`: {x} is not a finite number"
+            )))
+        }
+    };
     for (name, x) in &spec.state {
-        v[index(name, "start")?] = *x;
+        v[index(name, "start")?] = finite(*x, name, "start")?;
     }
     for (name, d) in &spec.perturb {
         let i = index(name, "perturb")?;
-        v[i] += d;
+        v[i] += finite(*d, name, "perturb")?;
     }
     let (q, qd) = walker.unpack(&v);
     let mut settings = setup.settings.clone();

@@ -67,6 +67,10 @@ def test_bad_walk_options():
         walker.walk("compass", 2, perturb={"knee": 0.1})
     with pytest.raises(walker.InputError, match="start"):
         walker.walk("compass", 2, start="standing")
+    with pytest.raises(walker.InputError, match="not a finite number"):
+        walker.walk("compass", 2, perturb={"stance_leg": float("nan")})
+    with pytest.raises(walker.InputError, match="not a finite number"):
+        walker.walk("compass", 2, start={"stance_leg": float("inf")})
     with pytest.raises(walker.InputError, match="path_interval_s"):
         walker.walk("compass", 2, path_interval_s=-1.0)
     with pytest.raises(walker.InputError, match="max_strides"):
