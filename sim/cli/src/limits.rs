@@ -4,24 +4,24 @@
 
 use crate::input_error::InputError;
 
-/// Most points of a sweep (`walker sweep --points`): each is a gait search, and the sweep
-/// allocates its list of points up front.
-pub const MAX_SWEEP_POINTS: usize = 10_000;
+/// Most points of a sweep (`walker sweep --points`): the library's bound, which the Python
+/// package checks too.
+pub use sim::analysis::continuation::{MAX_SWEEP_PERIOD, MAX_SWEEP_POINTS};
 
-/// Most values of an orbit diagram (`walker orbit-diagram --points`): each iterates up to
-/// its stride budget (2,000 strides) and keeps up to a window of states.
-pub const MAX_ORBIT_POINTS: usize = 5_000;
+/// Most values of an orbit diagram (`walker orbit-diagram --points`): the library's bound,
+/// which the Python package checks too.
+pub use sim::analysis::orbit_diagram::MAX_ORBIT_POINTS;
 
 /// Most values along one axis of a stability map (`walker stability-map --x K=A:B:N`).
 pub const MAX_MAP_AXIS_POINTS: usize = 500;
 
-/// Most cells of a stability map (`N × M`): each is a gait search.
-pub const MAX_MAP_CELLS: usize = 40_000;
+/// Most cells of a stability map (`N × M`): each is a gait search (the library's bound, which
+/// the Python package checks too).
+pub use sim::analysis::stability_map::MAX_MAP_CELLS;
 
-/// Most steps of a walk (`walker walk --steps`, `walker sil --steps`). Each completed step
-/// keeps a summary (a few hundred bytes; `walker sil --keep-steps` bounds them) and takes
-/// milliseconds to seconds: 100,000 steps is ten times the 10,000-step soak.
-pub const MAX_WALK_STEPS: usize = 100_000;
+/// Most steps of a walk (`walker walk --steps`, `walker sil --steps`): the library's bound,
+/// which the Python package checks too.
+pub use sim::stride::walk::MAX_WALK_STEPS;
 
 /// Most gait searches of `walker tune --evaluations`.
 pub const MAX_TUNE_EVALUATIONS: usize = 10_000;

@@ -17,3 +17,4 @@ pub mod stability;
 pub mod stability_map;
 pub mod tune;
 pub mod variational;
+pub mod walk_start;

@@ -343,6 +343,11 @@ pub fn orbit_diagram(
     Ok(out)
 }
 
+/// Most values a caller should ask of one orbit diagram (`walker orbit-diagram --points` and
+/// `walker.orbit_diagram` in Python refuse more): each iterates up to its stride budget
+/// (2,000 strides) and keeps up to a window of states.
+pub const MAX_ORBIT_POINTS: usize = 5_000;
+
 /// `points` values evenly spaced from `from` to `to` (both included; `from` alone for one).
 pub fn linspace(from: f64, to: f64, points: usize) -> Vec<f64> {
     match points {

@@ -22,6 +22,10 @@ use crate::scene::{Scene, SceneError};
 use nalgebra::DVector;
 use rayon::prelude::*;
 
+/// Most cells a caller should ask of one map (`N × M`; `walker stability-map` and
+/// `walker.stability_map` in Python refuse more): each is a gait search.
+pub const MAX_MAP_CELLS: usize = 40_000;
+
 /// One axis of the grid: a parameter and its values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {

@@ -1,6 +1,7 @@
 //! The `walker gait` report: the gait found (or why none was), its stability and figures.
 
 use super::{eigenvalue_pairs, gait_numbers, FixedPoint};
+use super::{eigenvectors, ComplexVector, StrideJacobian};
 use super::{AnkleExtension, CostOfTransport};
 use crate::analysis::limit_cycle::{Gait, JacobianMethod, NewtonError};
 use crate::analysis::stability::{modes, EigenMode};
@@ -39,7 +40,7 @@ pub enum GaitOutcome {
     /// A fixed point was found (`converged: true`).
     Found(Box<FoundGait>),
     /// None was (`converged: false`).
-    NotFound(GaitNotFound),
+    NotFound(Box<GaitNotFound>),
 }
 
 /// A gait that was found.
@@ -51,6 +52,14 @@ pub struct FoundGait {
     pub fixed_point: FixedPoint,
     /// Eigenvalues of the stride Jacobian, `[re, im]`.
     pub eigenvalues: Vec<[f64; 2]>,
+    /// The eigenvector of each eigenvalue (in `eigenvalues`' order) as `{"re": [...], "im":
+    /// [...]}`, entries in `jacobian`'s order (`jacobian.names`), unit 2-norm with its largest
+    /// entry real and positive; `null` where inverse iteration found none.
+    pub eigenvectors: Vec<Option<ComplexVector>>,
+    /// The stride Jacobian at the fixed point: `{"names": [...], "rows": [[...]]}`, rows and
+    /// columns in the order of `names`, the stride-map entries sorted as `fixed_point` lists
+    /// them.
+    pub jacobian: StrideJacobian,
     /// Largest eigenvalue modulus.
     pub max_abs_eigenvalue: f64,
     /// All eigenvalues strictly inside the unit circle.
@@ -160,6 +169,10 @@ pub struct GaitNotFound {
     /// `null`.
     pub eigenvalues: Option<Vec<[f64; 2]>>,
     /// `null`.
+    pub eigenvectors: Option<Vec<Option<ComplexVector>>>,
+    /// `null`.
+    pub jacobian: Option<StrideJacobian>,
+    /// `null`.
     pub max_abs_eigenvalue: Option<f64>,
     /// `null`.
     pub stable: Option<bool>,
@@ -184,7 +197,7 @@ impl GaitReport {
     ) -> Self {
         let outcome = match result {
             Ok(g) => GaitOutcome::Found(Box::new(FoundGait::new(scene, walker, g, contact))),
-            Err(e) => GaitOutcome::NotFound(GaitNotFound::new(e)),
+            Err(e) => GaitOutcome::NotFound(Box::new(GaitNotFound::new(e))),
         };
         Self {
             scene: scene.name().to_string(),
@@ -221,10 +234,13 @@ impl FoundGait {
                     - s.damping_dissipation_j,
             }
         });
+        let map_names = walker.map_names();
         Self {
             converged: true,
             fixed_point: FixedPoint::of(scene, walker, g),
             eigenvalues: eigenvalue_pairs(&g.eigenvalues),
+            eigenvectors: eigenvectors(&g.jacobian, &g.eigenvalues, &map_names),
+            jacobian: StrideJacobian::new(&g.jacobian, &map_names),
             max_abs_eigenvalue: g.max_abs_eigenvalue(),
             stable: g.stable(),
             step_period_s: n.step_period_s,
@@ -243,7 +259,7 @@ impl FoundGait {
             eigenvalue_modes: modes(
                 &g.jacobian,
                 &g.eigenvalues,
-                &walker.map_names(),
+                &map_names,
                 walker.three_d_freedoms(),
             ),
             actuator,
@@ -270,6 +286,8 @@ impl GaitNotFound {
             newton_iterations,
             fixed_point: None,
             eigenvalues: None,
+            eigenvectors: None,
+            jacobian: None,
             max_abs_eigenvalue: None,
             stable: None,
             step_period_s: None,

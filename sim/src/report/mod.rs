@@ -28,6 +28,7 @@ mod orbit_diagram;
 mod scenes;
 mod stability_map;
 mod start;
+mod stride_jacobian;
 mod sweep;
 mod walk;
 mod walk_gait;
@@ -42,6 +43,7 @@ pub use orbit_diagram::{FellRecord, OrbitDiagramReport, OrbitPointRecord};
 pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
 pub use stability_map::{AxisRecord, StabilityMapReport};
 pub use start::{StartKind, StartRecord};
+pub use stride_jacobian::{eigenvectors, ComplexVector, StrideJacobian};
 pub use sweep::{
     BoundaryRecord, BranchEndRecord, BranchRecord, ConvergedPoint, FailedPoint, QuantityValue,
     SweepPointRecord, SweepReport, SwitchFailureRecord, UnlocatedRecord,

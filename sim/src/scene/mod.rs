@@ -73,6 +73,26 @@ impl Setup {
     pub fn find_gait(&self, newton: &NewtonSettings) -> Result<Gait, NewtonError> {
         GaitSearch::new(&self.walker, &self.settings, newton).find_from_guess(&self.guess)
     }
+
+    /// One stride from `gait`'s fixed point with the contact figures on (and every sample
+    /// kept when `record`): what a gait report's contact figures (and a joint-angle figure)
+    /// are read from. `None` if the stride failed.
+    pub fn gait_stride(&self, gait: &Gait, record: bool) -> Option<crate::stride::StrideResult> {
+        let (q, qd) = self.walker.unpack(&gait.fixed_point);
+        self.walker
+            .stride(
+                &q,
+                &qd,
+                crate::stride::StrideRequest::new(&self.settings).options(
+                    crate::stride::StrideOptions {
+                        record,
+                        contact: true,
+                        ..crate::stride::StrideOptions::default()
+                    },
+                ),
+            )
+            .ok()
+    }
 }
 
 /// A scene file with its parameter values.

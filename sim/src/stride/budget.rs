@@ -2,7 +2,7 @@
 //! (a compass with 50 extra pendulum links: 209 strides of 30 ms for each Newton Jacobian)
 //! can run for hours; with a budget it stops, saying so, and its count shows its progress.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// At most `limit` strides; each stride run with settings that carry the budget takes one
@@ -13,6 +13,7 @@ use std::sync::Arc;
 pub struct SearchBudget {
     limit_strides: usize,
     used_strides: AtomicUsize,
+    cancelled: AtomicBool,
 }
 
 impl SearchBudget {
@@ -21,6 +22,7 @@ impl SearchBudget {
         Self {
             limit_strides,
             used_strides: AtomicUsize::new(0),
+            cancelled: AtomicBool::new(false),
         }
     }
 
@@ -34,8 +36,23 @@ impl SearchBudget {
         self.used_strides.load(Ordering::Relaxed)
     }
 
-    /// Takes one stride: `false` when none is left (and nothing is taken).
+    /// Spends the budget: every later [`Self::take`] fails, so the search stops at its next
+    /// stride as if the budget had run out.
+    pub fn cancel(&self) {
+        self.cancelled.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`Self::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::Relaxed)
+    }
+
+    /// Takes one stride: `false` when none is left or the budget was cancelled (and nothing
+    /// is taken).
     pub fn take(&self) -> bool {
+        if self.is_cancelled() {
+            return false;
+        }
         self.used_strides
             .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |u| {
                 (u < self.limit_strides).then_some(u + 1)
@@ -84,5 +101,15 @@ mod tests {
         let shared = SharedBudget(Some(b));
         assert_eq!(shared.take(), Err(1000));
         assert_eq!(SharedBudget::default().take(), Ok(()));
+    }
+
+    #[test]
+    fn a_cancelled_budget_gives_nothing_more() {
+        let b = SearchBudget::new(10);
+        assert!(b.take());
+        b.cancel();
+        assert!(!b.take());
+        assert_eq!(b.used_strides(), 1);
+        assert!(b.is_cancelled());
     }
 }

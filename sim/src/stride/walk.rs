@@ -157,6 +157,12 @@ pub struct Walk {
     pub path: Vec<PathSample>,
 }
 
+/// Most steps a caller should ask of one walk (`walker walk --steps`, `walker sil --steps`,
+/// `walker.walk` in Python refuse more). Each completed step keeps a summary (a few hundred
+/// bytes; `walker sil --keep-steps` bounds them) and takes milliseconds to seconds: 100,000
+/// steps is ten times the 10,000-step soak.
+pub const MAX_WALK_STEPS: usize = 100_000;
+
 /// Everything a walk is asked to do.
 pub struct WalkRequest<'a> {
     /// How each stride is integrated.

@@ -19,7 +19,7 @@ use sim::analysis::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
 use sim::scene::{Scene, Setup};
 use sim::stride::walk::WalkRequest;
-use sim::stride::{StrideOptions, StrideRequest, StrideResult};
+use sim::stride::StrideResult;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -112,26 +112,15 @@ pub fn report(
     result: &Result<Gait, NewtonError>,
     record: bool,
 ) -> (GaitReport, Option<StrideResult>) {
-    let walker = &setup.walker;
     // One more stride from the fixed point: the report's contact figures and, for the
     // joint-angle figure, its samples.
-    let figures_stride = result.as_ref().ok().and_then(|g| {
-        let (q, qd) = walker.unpack(&g.fixed_point);
-        walker
-            .stride(
-                &q,
-                &qd,
-                StrideRequest::new(&setup.settings).options(StrideOptions {
-                    record,
-                    contact: true,
-                    ..StrideOptions::default()
-                }),
-            )
-            .ok()
-    });
+    let figures_stride = result
+        .as_ref()
+        .ok()
+        .and_then(|g| setup.gait_stride(g, record));
     let report = GaitReport::new(
         scene,
-        walker,
+        &setup.walker,
         &setup.settings.integrator,
         result,
         figures_stride.as_ref().map(|r| &r.contact),

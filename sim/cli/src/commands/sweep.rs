@@ -130,7 +130,7 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     let scene = common.scene()?;
     let base = common.setup(&scene)?;
     let points = limits::count("--points", points, 2, limits::MAX_SWEEP_POINTS)?;
-    let max_period = limits::count("--max-period", max_period, 1, 64)?;
+    let max_period = limits::count("--max-period", max_period, 1, limits::MAX_SWEEP_PERIOD)?;
     let names = base.walker.map_names();
     let coordinate_index = match &coordinate {
         None => 0,

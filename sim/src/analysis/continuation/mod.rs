@@ -144,6 +144,15 @@ impl Continuation {
     }
 }
 
+/// Most points a caller should ask of one sweep (`walker sweep --points` and `walker.sweep`
+/// in Python refuse more): each is a gait search, and the sweep allocates its list of points
+/// up front.
+pub const MAX_SWEEP_POINTS: usize = 10_000;
+
+/// Longest period a sweep follows (`--max-period`, strides per cycle of the period-doubled
+/// branches).
+pub const MAX_SWEEP_PERIOD: usize = 64;
+
 /// Pseudo-arclength continuation of `scene`'s gait in `param` from `from` to `to`: the gait
 /// at `from` that `walker gait` returns there ([`long_period_gait`]: the branch of the scene's
 /// nominal gait; if none, the next grid value's), followed with the

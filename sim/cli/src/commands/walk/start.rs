@@ -12,43 +12,27 @@ use sim::scene::text_file::read_text_file;
 use sim::scene::Scene;
 
 /// The gait of scene `other` (with this scene's shared parameter values) by the one gait
-/// rule, mapped onto this walker's stride-map entries by name, with where it came from.
-/// `None` (after a message) if it has no gait.
+/// rule, mapped onto this walker's stride-map entries by name, with where it came from
+/// ([`sim::analysis::walk_start::other_scene_gait`]). `None` (after a message) if it has no
+/// gait.
 pub fn from_other_scene(
     other: &str,
     scene: &Scene,
     walker: &Walker,
     rule: &GaitRule<'_>,
 ) -> Result<Option<(DVector<f64>, StartRecord)>> {
-    let mut other_scene = Scene::load(other)?;
-    for (k, val) in &scene.values {
-        if other_scene.file.parameters.contains_key(k) {
-            other_scene.set(k, *val)?;
-        }
-    }
-    let oset = other_scene.setup()?;
-    let ow = &oset.walker;
-    let (og, source) = match rule.gait(&other_scene)? {
-        Ok(g) => g,
+    match sim::analysis::walk_start::other_scene_gait(other, scene, walker, rule)? {
+        Ok(start) => Ok(Some((
+            start.state,
+            StartRecord::gait(start.scene.name(), &start.gait, start.source),
+        ))),
         Err(e) => {
             output::note(format_args!(
                 "error: scene `{other}` has no gait to start from: {e}"
             ));
-            return Ok(None);
-        }
-    };
-    let names = walker.map_names();
-    let onames = ow.map_names();
-    let mut v = DVector::zeros(names.len());
-    for (i, n) in names.iter().enumerate() {
-        if let Some(j) = onames.iter().position(|m| m == n) {
-            v[i] = og.fixed_point[j];
+            Ok(None)
         }
     }
-    Ok(Some((
-        v,
-        StartRecord::gait(other_scene.name(), &og, source),
-    )))
 }
 
 /// The entries a start-state file sets, as (stride-map index, value); every problem with the

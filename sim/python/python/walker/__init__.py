@@ -1,0 +1,181 @@
+"""The walker simulator from Python: scenes, gaits and walks as numpy arrays and pandas tables.
+
+>>> import walker
+>>> scene = walker.Scene.load("compass").with_params(slope_rad=0.05)
+>>> g = walker.gait(scene)
+>>> g.max_abs_eigenvalue < 1.0
+True
+
+Every number equals the one the ``walker`` command prints with ``--json`` for the same scene
+and parameters (the same library calls and the same report). Long computations release the
+GIL and stop on Ctrl-C (``KeyboardInterrupt``). Errors are :class:`WalkerError` subclasses.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import pandas as pd
+
+from . import _walker
+from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
+from ._gait import Gait, Gaits
+from ._orbit_diagram import OrbitDiagram
+from ._stability_map import StabilityMap
+from ._sweep import Sweep
+from ._walk import Walk
+from ._walker import (
+    DEFAULT_GAIT_STRIDE_BUDGET,
+    MAX_MAP_CELLS,
+    MAX_ORBIT_POINTS,
+    MAX_WALK_STEPS,
+    Scene,
+)
+
+__all__ = [
+    "DEFAULT_GAIT_STRIDE_BUDGET",
+    "MAX_MAP_CELLS",
+    "MAX_ORBIT_POINTS",
+    "MAX_WALK_STEPS",
+    "Gait",
+    "Gaits",
+    "GaitNotFound",
+    "InputError",
+    "OrbitDiagram",
+    "Scene",
+    "SceneError",
+    "StabilityMap",
+    "StrideFailed",
+    "Sweep",
+    "Walk",
+    "WalkerError",
+    "gait",
+    "gaits",
+    "orbit_diagram",
+    "scenes",
+    "stability_map",
+    "sweep",
+    "walk",
+]
+
+
+def _scene(scene: Scene | str) -> Scene:
+    return scene if isinstance(scene, Scene) else Scene.load(scene)
+
+
+def scenes() -> pd.DataFrame:
+    """The built-in scenes, indexed by name: ``summary``, ``reference``,
+    ``degrees_of_freedom``, ``coordinates`` (as ``walker scenes --json`` lists them; each
+    scene's parameters are ``Scene.load(name).parameters``)."""
+    catalogue = _walker.scenes()["scenes"]
+    rows = [{k: v for k, v in s.items() if k != "parameters"} for s in catalogue]
+    return pd.DataFrame(rows).set_index("name")
+
+
+def gait(scene: Scene | str, *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -> Gait:
+    """The gait of ``scene`` (a :class:`Scene` or a scene name or path) as ``walker gait``
+    finds it: at the scene's defaults Newton from its guess, elsewhere the defaults' gait
+    followed to the scene's values (``Gait.gait_source`` says which), with the scene's
+    integrator and the command's default Newton settings.
+
+    ``max_strides`` bounds the strides the search may take (``--max-strides``).
+
+    Raises :class:`GaitNotFound` (or :class:`StrideFailed`, a subclass, when a stride of the
+    search failed) if there is none, :class:`SceneError` if the scene cannot be built,
+    ``KeyboardInterrupt`` on Ctrl-C.
+    """
+    return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
+
+
+def gaits(scene: Scene | str) -> Gaits:
+    """Every distinct period-1 gait of ``scene``, longest step period first, as
+    ``walker gaits`` finds them (Newton from many starts, and the gaits followed from the
+    scene's defaults). No gait gives an empty list. Raises :class:`SceneError`,
+    ``KeyboardInterrupt`` on Ctrl-C."""
+    return Gaits.from_report(_walker.gaits(_scene(scene)))
+
+
+def walk(
+    scene: Scene | str,
+    steps: int,
+    *,
+    start: str | Mapping[str, float] = "gait",
+    perturb: Mapping[str, float] | None = None,
+    floor: str = "plane",
+    path_interval_s: float | None = None,
+    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+) -> Walk:
+    """Walks up to ``steps`` strides of ``scene``, as ``walker walk`` does.
+
+    ``start``: ``"gait"`` (the gait's fixed point, found as :func:`gait` finds it),
+    ``"guess"`` (the scene's guess), or a mapping ``{stride-map entry: value}`` that replaces
+    entries of the gait's fixed point (``--start-state``). ``perturb``: ``{entry: delta}``
+    added to the start (``--perturb``). ``floor``: ``"plane"``, ``"step:at=K,height_m=H"`` or
+    ``"rough:sigma_m=S[,seed=N]"`` (``--floor``). ``path_interval_s``: keep one path sample
+    per interval instead of every integration sample.
+
+    A fall is not an error: :attr:`Walk.failure` says how the walk ended early (the command's
+    exit code 3). Raises :class:`InputError` for bad input (``steps`` outside 0 to
+    :data:`MAX_WALK_STEPS`, an unknown entry, a floor that cannot be read),
+    :class:`SceneError`, :class:`GaitNotFound` / :class:`StrideFailed` (no gait to start
+    from), ``KeyboardInterrupt`` on Ctrl-C.
+    """
+    report, path = _walker.walk(
+        _scene(scene),
+        steps,
+        start=start if isinstance(start, str) else dict(start),
+        perturb=None if perturb is None else dict(perturb),
+        floor=floor,
+        path_interval_s=path_interval_s,
+        max_strides=max_strides,
+    )
+    return Walk.from_parts(report, path)
+
+
+
+
+def stability_map(
+    scene: Scene | str,
+    x: tuple[str, Sequence[float]],
+    y: tuple[str, Sequence[float]],
+) -> StabilityMap:
+    """The gait of ``scene`` (as :func:`gait` finds it) at every cell of the grid of two
+    parameters ``x`` and ``y``, each ``(name or alias, values)``, e.g.
+    ``x=("slope_rad", np.linspace(0.01, 0.08, 29))``, as ``walker stability-map`` computes it
+    (every core). Raises :class:`SceneError` (unknown parameter, value out of range),
+    :class:`InputError` (one parameter twice, no cells, more than :data:`MAX_MAP_CELLS`),
+    ``KeyboardInterrupt`` on Ctrl-C (at the next gait search)."""
+    (xn, xv), (yn, yv) = x, y
+    report = _walker.stability_map(
+        _scene(scene), (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    )
+    return StabilityMap.from_report(report)
+
+
+def orbit_diagram(scene: Scene | str, param: str, values: Sequence[float]) -> OrbitDiagram:
+    """The attractor of the stride map at each of ``values`` of parameter ``param``, each
+    value starting from the last one's attractor, as ``walker orbit-diagram`` computes it
+    (``values`` as its ``--from``/``--to``/``--points`` give them: ``np.linspace``). Raises
+    :class:`SceneError`, :class:`InputError` (fewer than 2 or more than
+    :data:`MAX_ORBIT_POINTS` values), ``KeyboardInterrupt`` on Ctrl-C."""
+    report = _walker.orbit_diagram(_scene(scene), param, [float(v) for v in values])
+    return OrbitDiagram.from_report(report)
+
+
+def sweep(
+    scene: Scene | str,
+    param: str,
+    start: float,
+    end: float,
+    points: int,
+    *,
+    max_period: int = 1,
+) -> Sweep:
+    """The gait of ``scene`` followed as ``param`` goes from ``start`` to ``end`` at
+    ``points`` points, as ``walker sweep --param P --from START --to END --points N
+    --max-period K`` follows it (pseudo-arclength continuation through folds, bifurcations
+    located, period-doubled branches up to ``max_period`` strides per cycle). Raises
+    :class:`SceneError`, :class:`InputError`; Ctrl-C raises ``KeyboardInterrupt`` when the
+    sweep ends (the continuation has no cancel hook)."""
+    report = _walker.sweep(_scene(scene), param, start, end, points, max_period=max_period)
+    return Sweep.from_report(report)

@@ -1,0 +1,47 @@
+"""A gait followed over one parameter: :class:`Sweep`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import pandas as pd
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """The gait followed by continuation over one parameter (``walker sweep --json``);
+    the branches, bifurcations (``stability_boundaries``) and branch ends are in ``report``."""
+
+    report: dict[str, Any] = field(repr=False)
+    """The ``walker sweep --json`` object."""
+    param: str
+    """The parameter followed (its canonical name)."""
+
+    @classmethod
+    def from_report(cls, report: dict[str, Any]) -> Sweep:
+        """The sweep of a ``walker sweep --json`` object."""
+        return cls(report, report["param_canonical"])
+
+    def points(self) -> pd.DataFrame:
+        """One row per point along the branches: ``value``, ``converged``, ``branch``,
+        ``period_strides``, ``max_abs_eigenvalue``, ``stable``, ``step_period_s``,
+        ``step_length_m`` (NaN where no gait was found)."""
+        keys = [
+            "value",
+            "converged",
+            "branch",
+            "period_strides",
+            "max_abs_eigenvalue",
+            "stable",
+            "step_period_s",
+            "step_length_m",
+        ]
+        return pd.DataFrame(
+            [{k: p.get(k) for k in keys} for p in self.report["points"]], columns=keys
+        )
+
+    def stability_boundaries(self) -> pd.DataFrame:
+        """The located bifurcations (folds, period doublings, Neimark–Sacker), one row each,
+        as the JSON lists them."""
+        return pd.DataFrame(self.report["stability_boundaries"])

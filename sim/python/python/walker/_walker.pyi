@@ -1,0 +1,74 @@
+"""Type stubs of the extension module ``walker._walker`` (the Rust side of ``walker``)."""
+
+from typing import Any, Mapping
+
+import numpy as np
+import pandas as pd
+
+DEFAULT_GAIT_STRIDE_BUDGET: int
+"""Strides one gait search may take by default (``--max-strides``)."""
+MAX_MAP_CELLS: int
+"""Most cells of one stability map."""
+MAX_ORBIT_POINTS: int
+"""Most values of one orbit diagram."""
+MAX_WALK_STEPS: int
+"""Most steps of one walk."""
+
+class Scene:
+    """A scene: a walker described by a scene file (built-in or a path), with parameter
+    values. Read-only: :meth:`with_params` returns a new scene."""
+
+    @staticmethod
+    def load(name_or_path: str) -> Scene:
+        """Loads a built-in scene by name or a scene file by path; raises ``SceneError``."""
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+    @property
+    def values(self) -> dict[str, float]:
+        """The parameter values by name (units in :attr:`parameters`)."""
+    @property
+    def parameters(self) -> pd.DataFrame:
+        """The parameter table indexed by name: value, default, unit, min, max, doc, aliases."""
+    def describe(self) -> dict[str, Any]:
+        """The ``walker scenes NAME --json`` object: summary, reference, degrees of freedom,
+        coordinates, parameters."""
+    def with_params(self, **params: float) -> Scene:
+        """A new scene with these parameters (by name or alias) set; raises ``SceneError``
+        (unknown parameter, not a finite number, out of range) or ``InputError``."""
+
+def scenes() -> dict[str, Any]:
+    """The ``walker scenes --json`` object."""
+
+def gait(scene: Scene, *, max_strides: int = ...) -> dict[str, Any]:
+    """The ``walker gait --json`` object of the scene's gait; raises ``GaitNotFound``,
+    ``StrideFailed`` or ``SceneError``."""
+
+def gaits(scene: Scene) -> dict[str, Any]:
+    """The ``walker gaits --json`` object: every period-1 gait, longest step period first."""
+
+def orbit_diagram(scene: Scene, param: str, values: list[float]) -> dict[str, Any]:
+    """The ``walker orbit-diagram --json`` object of ``param`` over ``values``."""
+
+def stability_map(
+    scene: Scene, x: tuple[str, list[float]], y: tuple[str, list[float]]
+) -> dict[str, Any]:
+    """The ``walker stability-map --json`` object of the grid ``x`` × ``y``."""
+
+def sweep(
+    scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int = 1
+) -> dict[str, Any]:
+    """The ``walker sweep --json`` object."""
+
+def walk(
+    scene: Scene,
+    steps: int,
+    *,
+    start: str | Mapping[str, float] | None = None,
+    perturb: Mapping[str, float] | None = None,
+    floor: str = "plane",
+    path_interval_s: float | None = None,
+    max_strides: int = ...,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``(report, path)``: the ``walker walk --json`` object and the path's numpy arrays
+    (``time_s``, ``step``, ``q``, ``qdot``, ``hip_floor_m``) with ``coordinates``."""

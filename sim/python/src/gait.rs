@@ -1,0 +1,113 @@
+//! `walker.gait`: the gait `walker gait` finds, as its `--json` report.
+
+use crate::convert;
+use crate::errors;
+use crate::interrupt;
+use crate::scene::PyScene;
+use pyo3::prelude::*;
+use sim::analysis::homotopy::{GaitRule, GaitSource, HomotopySettings};
+use sim::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
+use sim::report::GaitReport;
+use sim::scene::{Scene, SceneError, Setup};
+use sim::stride::{SearchBudget, SharedBudget};
+use std::sync::Arc;
+
+/// Builds a scene's setup with its own integrator, as `walker` does without options, for the
+/// library's studies (`sim::analysis::homotopy::SetupFor`), its strides taken from `budget`
+/// (a gait rule puts its own in their place). Once `budget` is cancelled (Ctrl-C) its strides
+/// fail at once and every later setup is refused, so a study stops at its next stride or
+/// search (a stability map's cells, the rule's homotopy steps).
+pub fn setup_for(
+    budget: &Arc<SearchBudget>,
+) -> impl Fn(&Scene) -> Result<Setup, SceneError> + Sync + '_ {
+    move |s: &Scene| {
+        if budget.is_cancelled() {
+            return Err(SceneError::Invalid("interrupted (Ctrl-C)".to_owned()));
+        }
+        let mut setup = s.setup()?;
+        setup.settings.search_budget = SharedBudget(Some(Arc::clone(budget)));
+        Ok(setup)
+    }
+}
+
+/// `f` of the one gait rule (`sim::analysis::homotopy::GaitRule`) as `walker gait` applies it
+/// without options: each scene built with its own integrator, the default Newton settings,
+/// every stride taken from `budget`.
+pub fn with_rule<T>(budget: &Arc<SearchBudget>, f: impl FnOnce(&GaitRule<'_>) -> T) -> T {
+    let setup_for = setup_for(budget);
+    let newton = NewtonSettings::default();
+    let homotopy = HomotopySettings {
+        gait_stride_budget: budget.limit_strides(),
+        ..HomotopySettings::default()
+    };
+    f(&GaitRule::new(&setup_for, &newton, &homotopy).with_budget(Arc::clone(budget)))
+}
+
+/// The gait of `scene` by [`with_rule`]'s rule, and where it came from.
+///
+/// # Errors
+/// The scene cannot be built at the values the rule visits.
+pub fn rule_gait(
+    scene: &Scene,
+    budget: &Arc<SearchBudget>,
+) -> Result<Result<(Gait, GaitSource), NewtonError>, SceneError> {
+    with_rule(budget, |rule| rule.gait(scene))
+}
+
+/// The `walker gait --json` report of `scene`'s gait search (found or not).
+///
+/// # Errors
+/// The scene cannot be built.
+pub fn report(scene: &Scene, budget: &Arc<SearchBudget>) -> Result<GaitReport, SceneError> {
+    let sourced = rule_gait(scene, budget)?;
+    let setup = scene.setup()?;
+    let source = sourced.as_ref().ok().map(|(_, s)| *s);
+    let mut report = gait_report(scene, &setup, &sourced.map(|(g, _)| g));
+    report.gait_source = source;
+    Ok(report)
+}
+
+/// The report of a gait search `result` at `scene`'s values (built as `setup`), with the
+/// contact figures of a stride from its fixed point, as `walker gait` and `walker gaits`
+/// report each gait.
+pub fn gait_report(scene: &Scene, setup: &Setup, result: &Result<Gait, NewtonError>) -> GaitReport {
+    let stride = result
+        .as_ref()
+        .ok()
+        .and_then(|g| setup.gait_stride(g, false));
+    GaitReport::new(
+        scene,
+        &setup.walker,
+        &setup.settings.integrator,
+        result,
+        stride.as_ref().map(|r| &r.contact),
+    )
+}
+
+/// The gait of `scene`: the `walker gait --json` object as a dict (with `jacobian` and
+/// `eigenvectors`). The search may take at most `max_strides` strides. Runs without the GIL;
+/// Ctrl-C stops it. Raises `walker.SceneError`, `walker.GaitNotFound` or
+/// `walker.StrideFailed` (a stride of the search failed).
+#[pyfunction]
+#[pyo3(signature = (scene, *, max_strides = sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET))]
+pub fn gait<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    max_strides: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    if max_strides == 0 {
+        return Err(errors::input_error(
+            py,
+            "max_strides must be at least 1 (strides one gait search may take)",
+        ));
+    }
+    let budget = Arc::new(SearchBudget::new(max_strides));
+    let scene = &scene.inner;
+    let report = interrupt::run(py, &[&budget], || report(scene, &budget))?
+        .map_err(|e| errors::scene_error(py, &e))?;
+    let dict = convert::report(py, &report)?;
+    if matches!(report.outcome, sim::report::GaitOutcome::NotFound(_)) {
+        return Err(errors::gait_not_found(py, &dict));
+    }
+    Ok(dict)
+}

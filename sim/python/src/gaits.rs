@@ -1,0 +1,49 @@
+//! `walker.gaits`: every period-1 gait of a scene, as `walker gaits --json` lists them.
+
+use crate::convert;
+use crate::errors;
+use crate::gait::{gait_report, setup_for};
+use crate::interrupt;
+use crate::scene::PyScene;
+use pyo3::prelude::*;
+use sim::analysis::census::{census_with_progress, CensusSettings};
+use sim::analysis::limit_cycle::NewtonSettings;
+use sim::report::GaitsReport;
+use sim::scene::{Scene, SceneError};
+use sim::stride::SearchBudget;
+use std::sync::Arc;
+
+/// The `walker gaits --json` report of `scene`; every stride of the census taken from
+/// `cancel` (unlimited, there to stop it).
+fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, SceneError> {
+    let found = census_with_progress(
+        scene,
+        &setup_for(cancel),
+        &NewtonSettings::default(),
+        &CensusSettings::default(),
+        &|| {},
+    )?;
+    let setup = scene.setup()?;
+    Ok(GaitsReport {
+        scene: scene.name().to_string(),
+        gaits: found
+            .gaits
+            .into_iter()
+            .map(|g| gait_report(scene, &setup, &Ok(g)))
+            .collect(),
+        searches: found.searches,
+    })
+}
+
+/// Every distinct period-1 gait of `scene`, longest step period first: the
+/// `walker gaits --json` object as a dict (`gaits`, each as `walker.gait`'s report but without
+/// `gait_source`; `searches`). No gait gives an empty list (the command's exit code 1). Runs
+/// without the GIL; Ctrl-C stops it. Raises `walker.SceneError`.
+#[pyfunction]
+pub fn gaits<'py>(py: Python<'py>, scene: &PyScene) -> PyResult<Bound<'py, PyAny>> {
+    let cancel = Arc::new(SearchBudget::new(usize::MAX));
+    let scene = &scene.inner;
+    let report = interrupt::run(py, &[&cancel], || report(scene, &cancel))?
+        .map_err(|e| errors::scene_error(py, &e))?;
+    convert::report(py, &report)
+}

@@ -1,0 +1,49 @@
+//! The `walker._walker` extension module: the simulator's scenes, gaits and walks for Python.
+//!
+//! Each function runs the same library calls as the `walker` command and hands back the same
+//! report (`sim::report`), converted from its JSON form into Python dicts and lists, plus numpy
+//! arrays where the data is numeric and large (a walk's path). The pure-Python package
+//! `walker` (python/walker/) wraps these into objects with numpy arrays and pandas tables;
+//! users import `walker`, not this module.
+//!
+//! Long computations run with the GIL released and stop on Ctrl-C (the `interrupt` module).
+
+// pyo3's macros expand to `unsafe` blocks (the CPython ABI); this crate writes none itself.
+#![allow(unsafe_code)]
+
+mod convert;
+mod errors;
+mod gait;
+mod gaits;
+mod interrupt;
+mod orbit_diagram;
+mod scene;
+mod stability_map;
+mod sweep;
+mod walk;
+
+use pyo3::prelude::*;
+
+/// The extension module `walker._walker`.
+#[pymodule]
+fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<scene::PyScene>()?;
+    m.add_function(wrap_pyfunction!(scene::scenes, m)?)?;
+    m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
+    m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
+    m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(orbit_diagram::orbit_diagram, m)?)?;
+    m.add(
+        "MAX_ORBIT_POINTS",
+        sim::analysis::orbit_diagram::MAX_ORBIT_POINTS,
+    )?;
+    m.add_function(wrap_pyfunction!(stability_map::stability_map, m)?)?;
+    m.add("MAX_MAP_CELLS", sim::analysis::stability_map::MAX_MAP_CELLS)?;
+    m.add(
+        "DEFAULT_GAIT_STRIDE_BUDGET",
+        sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
+    )?;
+    m.add("MAX_WALK_STEPS", sim::stride::walk::MAX_WALK_STEPS)?;
+    Ok(())
+}

@@ -1,0 +1,122 @@
+"""Bad input gives a clear Python exception carrying the CLI's message and the values it names."""
+
+from __future__ import annotations
+
+import _thread
+import threading
+
+import pytest
+
+import walker
+
+
+def cli_error(cli, *args: str) -> str:
+    code, _, err = cli(*args)
+    assert code == 2, err
+    assert err.startswith("error: "), err
+    return err.removeprefix("error: ").strip()
+
+
+def test_unknown_scene(cli):
+    with pytest.raises(walker.SceneError) as e:
+        walker.Scene.load("no-such-scene")
+    assert e.value.kind == "unknown_scene"
+    assert e.value.name == "no-such-scene"
+    assert "compass" in e.value.available
+    assert str(e.value) == cli_error(cli, "gait", "--scene", "no-such-scene")
+    assert isinstance(e.value, walker.WalkerError) and isinstance(e.value, ValueError)
+
+
+def test_unknown_parameter(cli):
+    with pytest.raises(walker.SceneError) as e:
+        walker.Scene.load("compass").with_params(no_such_param=1.0)
+    assert e.value.kind == "unknown_parameter"
+    assert (e.value.scene, e.value.name) == ("compass", "no_such_param")
+    assert str(e.value) == cli_error(cli, "gait", "--scene", "compass", "--set", "no_such_param=1")
+
+
+def test_out_of_range_value(cli):
+    with pytest.raises(walker.SceneError) as e:
+        walker.Scene.load("compass").with_params(leg_mass_kg=-1.0)
+    assert e.value.kind == "out_of_range"
+    assert e.value.name == "leg_mass_kg" and e.value.value == -1.0
+    assert e.value.min == 0.0 or e.value.min > 0.0
+    assert str(e.value) == cli_error(cli, "gait", "--scene", "compass", "--set", "leg_mass_kg=-1")
+
+
+def test_not_a_number_and_not_finite():
+    with pytest.raises(walker.SceneError) as e:
+        walker.Scene.load("compass").with_params(slope_rad=float("nan"))
+    assert e.value.kind == "not_a_number"
+    with pytest.raises(walker.InputError):
+        walker.Scene.load("compass").with_params(slope_rad="steep")
+    with pytest.raises(walker.InputError, match="already set"):
+        walker.Scene.load("compass").with_params(slope_rad=0.05, slope=0.05)
+
+
+@pytest.mark.parametrize("steps", [-1, walker.MAX_WALK_STEPS + 1])
+def test_bad_steps(steps):
+    with pytest.raises(walker.InputError, match="steps must be between 0 and 100000"):
+        walker.walk("compass", steps)
+
+
+def test_bad_walk_options():
+    with pytest.raises(walker.InputError, match="floor"):
+        walker.walk("compass", 2, floor="bumpy")
+    with pytest.raises(walker.InputError, match="not an entry of the stride map"):
+        walker.walk("compass", 2, perturb={"knee": 0.1})
+    with pytest.raises(walker.InputError, match="start"):
+        walker.walk("compass", 2, start="standing")
+    with pytest.raises(walker.InputError, match="not a finite number"):
+        walker.walk("compass", 2, perturb={"stance_leg": float("nan")})
+    with pytest.raises(walker.InputError, match="not a finite number"):
+        walker.walk("compass", 2, start={"stance_leg": float("inf")})
+    with pytest.raises(walker.InputError, match="path_interval_s"):
+        walker.walk("compass", 2, path_interval_s=-1.0)
+    with pytest.raises(walker.InputError, match="max_strides"):
+        walker.gait("compass", max_strides=0)
+
+
+def test_gait_not_found_carries_the_cli_report(cli):
+    code, expected, _ = cli("gait", "--scene", "compass", "--max-strides", "3", "--json")
+    assert code == 1 and expected["converged"] is False
+    with pytest.raises(walker.GaitNotFound) as e:
+        walker.gait("compass", max_strides=3)
+    assert e.value.report == expected
+    assert str(e.value) == expected["error"]
+    assert e.value.newton_iterations == expected["newton_iterations"]
+    # A stride of the search ran out of the budget: the failure says so.
+    assert isinstance(e.value, walker.StrideFailed)
+    assert e.value.failure == expected["failure"] and e.value.failure is not None
+
+
+def test_ctrl_c_stops_a_long_walk():
+    # Delivered while the walk runs without the GIL: the walk stops at its next stride.
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            walker.walk("compass", walker.MAX_WALK_STEPS, path_interval_s=10.0)
+    finally:
+        timer.cancel()
+
+
+def test_ctrl_c_stops_a_long_stability_map():
+    import time
+
+    import numpy as np
+
+    # 400 gait searches of the 3D walker take minutes; Ctrl-C ends the map at the next search.
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    started = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            walker.stability_map(
+                "wisse3d",
+                x=("slope_rad", np.linspace(0.04, 0.06, 20)),
+                y=("pelvic_ring_radius_m", np.linspace(0.40, 0.44, 20)),
+            )
+    finally:
+        timer.cancel()
+    assert time.monotonic() - started < 30.0
