@@ -211,6 +211,7 @@ fn soak(plan: Soak) {
             record: false,
             keep_steps: Some(KEEP_STEPS),
             path_interval_s: None,
+            max_path_samples: None,
         })
         .controlled(&mut sampler)
         .on_step(&mut on_step);

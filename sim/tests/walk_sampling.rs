@@ -78,3 +78,46 @@ fn a_stream_without_recording_keeps_no_path() {
     assert!(walked.path.is_empty());
     assert!(n > 20, "{n}");
 }
+
+#[test]
+fn a_bounded_path_stops_at_its_bound_says_where_and_the_walk_goes_on() {
+    let (_, w) = common::walker("compass");
+    let g = common::gait(&w);
+    let (q, qd) = common::start_state(&w, &g);
+    let steps = 3;
+    let full = common::walk(&w, &q, &qd, steps, true);
+    assert_eq!(full.path_cut_t_walk_s, None);
+    let bound = full.path.len() / 2;
+    let cut = walk(
+        &w.walker,
+        &q,
+        &qd,
+        WalkRequest::new(&w.settings, steps)
+            .recording(true)
+            .max_path_samples(bound),
+    );
+    // the first `bound` samples of the whole path, and where it stopped
+    assert_eq!(cut.path.len(), bound);
+    let t = |p: &[PathSample]| p.iter().map(|s| s.t_walk_s).collect::<Vec<_>>();
+    assert_eq!(t(&cut.path), t(&full.path[..bound]));
+    assert_eq!(cut.path_cut_t_walk_s, Some(full.path[bound - 1].t_walk_s));
+    // the walk itself is the same
+    assert_eq!(cut.steps_completed, steps);
+    assert_eq!(
+        cut.steps.last().unwrap().state,
+        full.steps.last().unwrap().state
+    );
+    // a bound the path never reaches changes nothing
+    let roomy = walk(
+        &w.walker,
+        &q,
+        &qd,
+        WalkRequest::new(&w.settings, steps)
+            .recording(true)
+            .max_path_samples(full.path.len()),
+    );
+    assert_eq!(
+        (roomy.path.len(), roomy.path_cut_t_walk_s),
+        (full.path.len(), None)
+    );
+}

@@ -568,6 +568,7 @@ mod tests {
                     floor: sim::stride::walk::FloorFrame::default(),
                 })
                 .collect(),
+            path_cut_t_walk_s: None,
         }
     }
 

@@ -7,6 +7,32 @@ use pyo3::types::{PyDict, PyList};
 use serde::Serialize;
 use serde_json::Value;
 
+/// A count argument `name` as a `usize` within `min..=max`, or `walker.InputError` naming the
+/// range (a negative, huge or non-integer value included: Python's own conversion would say
+/// "can't convert negative int to unsigned" or "int too large").
+pub fn count_in(
+    py: Python<'_>,
+    value: &Bound<'_, PyAny>,
+    name: &str,
+    (min, max): (usize, usize),
+) -> PyResult<usize> {
+    value
+        .extract::<i64>()
+        .ok()
+        .and_then(|v| usize::try_from(v).ok())
+        .filter(|v| (min..=max).contains(v))
+        .ok_or_else(|| {
+            let shown = value
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_else(|_| "?".to_string());
+            crate::errors::input_error(
+                py,
+                &format!("{name} must be an integer between {min} and {max}, got {shown}"),
+            )
+        })
+}
+
 /// `report` as the Python form of its JSON.
 pub fn report<'py, T: Serialize + ?Sized>(
     py: Python<'py>,

@@ -89,18 +89,16 @@ pub fn gait_report(scene: &Scene, setup: &Setup, result: &Result<Gait, NewtonErr
 /// Ctrl-C stops it. Raises `walker.SceneError`, `walker.GaitNotFound` or
 /// `walker.StrideFailed` (a stride of the search failed).
 #[pyfunction]
-#[pyo3(signature = (scene, *, max_strides = sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET))]
+#[pyo3(signature = (scene, *, max_strides = None))]
 pub fn gait<'py>(
     py: Python<'py>,
     scene: &PyScene,
-    max_strides: usize,
+    max_strides: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if max_strides == 0 {
-        return Err(errors::input_error(
-            py,
-            "max_strides must be at least 1 (strides one gait search may take)",
-        ));
-    }
+    let max_strides = match max_strides {
+        Some(m) => convert::count_in(py, m, "max_strides", (1, usize::MAX))?,
+        None => sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
+    };
     let budget = Arc::new(SearchBudget::new(max_strides));
     let scene = &scene.inner;
     let report = interrupt::run(py, &[&budget], || report(scene, &budget))?

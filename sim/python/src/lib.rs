@@ -45,5 +45,7 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
         sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
     )?;
     m.add("MAX_WALK_STEPS", sim::stride::walk::MAX_WALK_STEPS)?;
+    m.add("DEFAULT_PATH_SAMPLES", walk::DEFAULT_PATH_SAMPLES)?;
+    m.add("MAX_PATH_SAMPLES", walk::MAX_PATH_SAMPLES)?;
     Ok(())
 }

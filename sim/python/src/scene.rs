@@ -18,10 +18,17 @@ pub struct PyScene {
 
 #[pymethods]
 impl PyScene {
-    /// Loads a built-in scene by name (`walker.scenes()` lists them) or a scene file by path.
-    /// Raises `walker.SceneError` when it cannot be loaded or built.
+    /// Loads a built-in scene by name (`walker.scenes()` lists them) or a scene file by path
+    /// (a `str` or an `os.PathLike`). Raises `walker.SceneError` when it cannot be loaded or
+    /// built, `walker.InputError` for a path that is not UTF-8.
     #[staticmethod]
-    fn load(py: Python<'_>, name_or_path: &str) -> PyResult<Self> {
+    fn load(py: Python<'_>, name_or_path: std::path::PathBuf) -> PyResult<Self> {
+        let name_or_path = name_or_path.to_str().ok_or_else(|| {
+            errors::input_error(
+                py,
+                &format!("scene path {} is not UTF-8", name_or_path.display()),
+            )
+        })?;
         let inner = Scene::load(name_or_path).map_err(|e| errors::scene_error(py, &e))?;
         // Built once, so a scene that cannot be built is refused here, not at first use.
         inner.setup().map_err(|e| errors::scene_error(py, &e))?;

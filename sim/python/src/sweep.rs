@@ -21,33 +21,26 @@ use std::sync::Arc;
 /// GIL; the continuation has no cancel hook, so Ctrl-C raises `KeyboardInterrupt` when the
 /// sweep ends. Raises `walker.SceneError` or `walker.InputError`.
 #[pyfunction]
-#[pyo3(signature = (scene, param, start, end, points, *, max_period = 1))]
+#[pyo3(signature = (scene, param, start, end, points, *, max_period = None))]
 pub fn sweep<'py>(
     py: Python<'py>,
     scene: &PyScene,
     param: &str,
     start: f64,
     end: f64,
-    points: usize,
-    max_period: usize,
+    points: &Bound<'py, PyAny>,
+    max_period: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let points = convert::count_in(py, points, "points", (2, MAX_SWEEP_POINTS))?;
+    let max_period = match max_period {
+        Some(m) => convert::count_in(py, m, "max_period", (1, MAX_SWEEP_PERIOD))?,
+        None => 1,
+    };
     let scene = &scene.inner;
     if !(start.is_finite() && end.is_finite()) || start == end {
         return Err(errors::input_error(
             py,
             &format!("start and end must be two different finite numbers, got {start} and {end}"),
-        ));
-    }
-    if !(2..=MAX_SWEEP_POINTS).contains(&points) {
-        return Err(errors::input_error(
-            py,
-            &format!("points must be between 2 and {MAX_SWEEP_POINTS}, got {points}"),
-        ));
-    }
-    if !(1..=MAX_SWEEP_PERIOD).contains(&max_period) {
-        return Err(errors::input_error(
-            py,
-            &format!("max_period must be between 1 and {MAX_SWEEP_PERIOD}, got {max_period}"),
         ));
     }
     let settings = ContinuationSettings::builder()

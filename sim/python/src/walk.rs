@@ -52,6 +52,16 @@ enum Refused {
     Input(String),
 }
 
+/// Path samples `walker.walk` keeps by default: a million (about 170 MB for the 3D walker's
+/// eight coordinates and rates), past which the path stops and `Walk.path_cut_at_time_s` says
+/// where (the walk goes on). A default-step compass walk of 100,000 steps would keep 2.7
+/// million.
+pub const DEFAULT_PATH_SAMPLES: usize = 1_000_000;
+
+/// Most path samples `walker.walk(max_path_samples=...)` may ask for (about 1.7 GB for the
+/// 3D walker).
+pub const MAX_PATH_SAMPLES: usize = 10_000_000;
+
 /// Walks `steps` strides of `scene` and returns `(report, path)`: `report` is the
 /// `walker walk --json` object as a dict (`steps`, `failure`, `start`, `floor`...), `path`
 /// a dict of numpy arrays: `time_s` (n), `step` (n, 0-based), `q` and `qdot` (n × coordinates,
@@ -64,27 +74,28 @@ enum Refused {
 /// the report's `failure` says how. Raises `walker.InputError`, `walker.SceneError`,
 /// `walker.GaitNotFound` or `walker.StrideFailed` (no gait to start from).
 #[pyfunction]
-#[pyo3(signature = (scene, steps, *, start = None, perturb = None, floor = "plane", path_interval_s = None, max_strides = sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET))]
+#[pyo3(signature = (scene, steps, *, start = None, perturb = None, floor = "plane", path_interval_s = None, max_strides = None, max_path_samples = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn walk<'py>(
     py: Python<'py>,
     scene: &PyScene,
-    steps: i64,
+    steps: &Bound<'py, PyAny>,
     start: Option<&Bound<'py, PyAny>>,
     perturb: Option<&Bound<'py, PyDict>>,
     floor: &str,
     path_interval_s: Option<f64>,
-    max_strides: usize,
+    max_strides: Option<&Bound<'py, PyAny>>,
+    max_path_samples: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
-    let steps = usize::try_from(steps)
-        .ok()
-        .filter(|s| *s <= MAX_WALK_STEPS)
-        .ok_or_else(|| {
-            errors::input_error(
-                py,
-                &format!("steps must be between 0 and {MAX_WALK_STEPS}, got {steps}"),
-            )
-        })?;
+    let steps = convert::count_in(py, steps, "steps", (0, MAX_WALK_STEPS))?;
+    let max_strides = match max_strides {
+        Some(m) => convert::count_in(py, m, "max_strides", (1, usize::MAX))?,
+        None => sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
+    };
+    let max_path_samples = match max_path_samples {
+        Some(m) => convert::count_in(py, m, "max_path_samples", (1, MAX_PATH_SAMPLES))?,
+        None => DEFAULT_PATH_SAMPLES,
+    };
     let floor: Floor = floor
         .parse()
         .map_err(|e: sim::stride::FloorError| errors::input_error(py, &e.to_string()))?;
@@ -95,12 +106,6 @@ pub fn walk<'py>(
                 &format!("path_interval_s must be a positive number of seconds, got {dt}"),
             ));
         }
-    }
-    if max_strides == 0 {
-        return Err(errors::input_error(
-            py,
-            "max_strides must be at least 1 (strides one gait search may take)",
-        ));
     }
     let (kind, state) = start_of(py, start)?;
     let spec = StartSpec {
@@ -118,7 +123,7 @@ pub fn walk<'py>(
             steps,
             spec,
             floor,
-            path_interval_s,
+            (path_interval_s, max_path_samples),
             (&search, &walking),
         )
     })?;
@@ -177,7 +182,7 @@ fn run(
     steps: usize,
     spec: StartSpec,
     floor: Floor,
-    path_interval_s: Option<f64>,
+    (path_interval_s, max_path_samples): (Option<f64>, usize),
     (search, walking): (&Arc<SearchBudget>, &Arc<SearchBudget>),
 ) -> Result<Walked, Refused> {
     let setup = scene.setup().map_err(Refused::Scene)?;
@@ -225,7 +230,8 @@ fn run(
     settings.search_budget = SharedBudget(Some(Arc::clone(walking)));
     let mut request = WalkRequest::new(&settings, steps)
         .floor(floor)
-        .recording(true);
+        .recording(true)
+        .max_path_samples(max_path_samples);
     if let Some(dt) = path_interval_s {
         request = request.path_interval(dt);
     }
@@ -307,5 +313,6 @@ fn path<'py>(py: Python<'py>, walked: &Walked) -> PyResult<Bound<'py, PyDict>> {
         matrix(3, &|s| s.hip_floor_m.iter().copied().collect())?.into_pyarray(py),
     )?;
     d.set_item("coordinates", &walked.coordinates)?;
+    d.set_item("cut_at_time_s", walked.walk.path_cut_t_walk_s)?;
     Ok(d)
 }

@@ -56,7 +56,7 @@ def test_not_a_number_and_not_finite():
 
 @pytest.mark.parametrize("steps", [-1, walker.MAX_WALK_STEPS + 1])
 def test_bad_steps(steps):
-    with pytest.raises(walker.InputError, match="steps must be between 0 and 100000"):
+    with pytest.raises(walker.InputError, match="steps must be an integer between 0 and 100000"):
         walker.walk("compass", steps)
 
 
@@ -120,3 +120,51 @@ def test_ctrl_c_stops_a_long_stability_map():
     finally:
         timer.cancel()
     assert time.monotonic() - started < 30.0
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: walker.gait("compass", max_strides=-1),
+        lambda: walker.gait("compass", max_strides=0),
+        lambda: walker.walk("compass", 10**30),
+        lambda: walker.walk("compass", 2, max_strides=-1),
+        lambda: walker.walk("compass", 2, max_path_samples=0),
+        lambda: walker.walk("compass", 2, max_path_samples=10**12),
+        lambda: walker.sweep("simplest", "slope", 0.01, 0.012, points=-5),
+        lambda: walker.sweep("simplest", "slope", 0.01, 0.012, points=4, max_period=-1),
+        lambda: walker.walk("compass", 2.5),
+    ],
+)
+def test_counts_out_of_range_are_input_errors_naming_the_range(call):
+    # not Python's own OverflowError / TypeError ("can't convert negative int to unsigned")
+    with pytest.raises(walker.InputError, match=r"must be an integer between \d+ and \d+, got"):
+        call()
+
+
+def test_a_path_like_and_start_none_are_accepted(tmp_path):
+    import pathlib
+    import shutil
+
+    import numpy as np
+
+    src = pathlib.Path(__file__).resolve().parents[2] / "scenes" / "compass.toml"
+    copy = tmp_path / "compass.toml"
+    shutil.copy(src, copy)
+    by_path = walker.Scene.load(copy)
+    assert by_path.name == "compass"
+    a = walker.walk(copy, 2, start=None)
+    b = walker.walk("compass", 2)
+    assert np.array_equal(a.q, b.q)
+
+
+def test_a_path_past_its_bound_stops_warns_and_the_walk_goes_on():
+    whole = walker.walk("compass", 3)
+    assert whole.path_cut_at_time_s is None
+    bound = len(whole.time_s) // 3
+    with pytest.warns(RuntimeWarning, match="max_path_samples"):
+        cut = walker.walk("compass", 3, max_path_samples=bound)
+    assert len(cut.time_s) == bound
+    assert cut.path_cut_at_time_s == whole.time_s[bound - 1]
+    assert cut.steps_completed == whole.steps_completed == 3
+    assert (cut.q == whole.q[:bound]).all()

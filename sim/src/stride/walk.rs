@@ -142,6 +142,11 @@ pub struct WalkOptions {
     /// A long walk (a soak) then runs in bounded memory; [`Walk::steps_completed`] still
     /// counts every step and the per-step callback of [`WalkRequest::on_step`] sees each.
     pub keep_steps: Option<usize>,
+    /// Keep at most this many samples in [`Walk::path`] (`None`: no bound). Past them the path
+    /// stops growing and the walk goes on; [`Walk::path_cut_t_walk_s`] says where the path
+    /// stopped. With [`WalkOptions::path_interval_s`] the path still grows with the walk's
+    /// duration: this bounds a long walk's memory whatever its length.
+    pub max_path_samples: Option<usize>,
 }
 
 /// The outcome of a walk.
@@ -155,6 +160,9 @@ pub struct Walk {
     pub failure: Option<WalkFailure>,
     /// Samples, when recording.
     pub path: Vec<PathSample>,
+    /// The walk time of the path's last sample when it reached
+    /// [`WalkOptions::max_path_samples`] before the walk ended \[s\]; `None`: the path is whole.
+    pub path_cut_t_walk_s: Option<f64>,
 }
 
 /// Most steps a caller should ask of one walk (`walker walk --steps`, `walker sil --steps`,
@@ -211,6 +219,15 @@ impl<'a> WalkRequest<'a> {
     pub fn path_interval(self, interval_s: f64) -> Self {
         let options = WalkOptions {
             path_interval_s: Some(interval_s),
+            ..self.options
+        };
+        Self { options, ..self }
+    }
+
+    /// Keeping at most `samples` samples in the path: see [`WalkOptions::max_path_samples`].
+    pub fn max_path_samples(self, samples: usize) -> Self {
+        let options = WalkOptions {
+            max_path_samples: Some(samples),
             ..self.options
         };
         Self { options, ..self }
@@ -273,6 +290,7 @@ pub fn walk(
     let mut floor_heights = floor.heights();
     let (record, keep_steps) = (options.record, options.keep_steps);
     let path_interval_s = options.path_interval_s;
+    let options_max_path = options.max_path_samples;
     let sampling = record || on_sample.is_some();
     let mut last_kept_s = f64::NEG_INFINITY;
     let mut frame = FloorFrame::default();
@@ -285,6 +303,7 @@ pub fn walk(
         steps: Vec::new(),
         failure: None,
         path: Vec::new(),
+        path_cut_t_walk_s: None,
     };
     let mut t0 = 0.0;
     let hip = &walker.model().points[walker.fall().hip.0];
@@ -320,8 +339,14 @@ pub fn walk(
                 f(&p);
             }
             if kept {
-                last_kept_s = t_walk_s;
-                out.path.push(p);
+                if options_max_path.is_some_and(|m| out.path.len() >= m) {
+                    if out.path_cut_t_walk_s.is_none() {
+                        out.path_cut_t_walk_s = out.path.last().map(|p| p.t_walk_s);
+                    }
+                } else {
+                    last_kept_s = t_walk_s;
+                    out.path.push(p);
+                }
             }
         }
         match result {

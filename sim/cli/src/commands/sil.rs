@@ -440,6 +440,7 @@ fn walk_with_firmware(
         record: plan.record,
         path_interval_s: Some(crate::animation::PATH_SAMPLE_INTERVAL_S),
         keep_steps: plan.keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
+        max_path_samples: None,
     };
     let progress = Progress::after(
         PROGRESS_DELAY,

@@ -13,6 +13,8 @@ GIL and stop on Ctrl-C (``KeyboardInterrupt``). Errors are :class:`WalkerError` 
 
 from __future__ import annotations
 
+import os
+import warnings
 from typing import Mapping, Sequence
 
 import pandas as pd
@@ -26,16 +28,20 @@ from ._sweep import Sweep
 from ._walk import Walk
 from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
+    DEFAULT_PATH_SAMPLES,
     MAX_MAP_CELLS,
     MAX_ORBIT_POINTS,
+    MAX_PATH_SAMPLES,
     MAX_WALK_STEPS,
     Scene,
 )
 
 __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
+    "DEFAULT_PATH_SAMPLES",
     "MAX_MAP_CELLS",
     "MAX_ORBIT_POINTS",
+    "MAX_PATH_SAMPLES",
     "MAX_WALK_STEPS",
     "Gait",
     "Gaits",
@@ -59,8 +65,8 @@ __all__ = [
 ]
 
 
-def _scene(scene: Scene | str) -> Scene:
-    return scene if isinstance(scene, Scene) else Scene.load(scene)
+def _scene(scene: Scene | str | os.PathLike[str]) -> Scene:
+    return scene if isinstance(scene, Scene) else Scene.load(os.fspath(scene))
 
 
 def scenes() -> pd.DataFrame:
@@ -72,7 +78,7 @@ def scenes() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("name")
 
 
-def gait(scene: Scene | str, *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -> Gait:
+def gait(scene: Scene | str | os.PathLike[str], *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -> Gait:
     """The gait of ``scene`` (a :class:`Scene` or a scene name or path) as ``walker gait``
     finds it: at the scene's defaults Newton from its guess, elsewhere the defaults' gait
     followed to the scene's values (``Gait.gait_source`` says which), with the scene's
@@ -87,7 +93,7 @@ def gait(scene: Scene | str, *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -
     return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
 
 
-def gaits(scene: Scene | str) -> Gaits:
+def gaits(scene: Scene | str | os.PathLike[str]) -> Gaits:
     """Every distinct period-1 gait of ``scene``, longest step period first, as
     ``walker gaits`` finds them (Newton from many starts, and the gaits followed from the
     scene's defaults). No gait gives an empty list. Raises :class:`SceneError`,
@@ -96,14 +102,15 @@ def gaits(scene: Scene | str) -> Gaits:
 
 
 def walk(
-    scene: Scene | str,
+    scene: Scene | str | os.PathLike[str],
     steps: int,
     *,
-    start: str | Mapping[str, float] = "gait",
+    start: str | Mapping[str, float] | None = "gait",
     perturb: Mapping[str, float] | None = None,
     floor: str = "plane",
     path_interval_s: float | None = None,
     max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    max_path_samples: int = DEFAULT_PATH_SAMPLES,
 ) -> Walk:
     """Walks up to ``steps`` strides of ``scene``, as ``walker walk`` does.
 
@@ -111,8 +118,11 @@ def walk(
     ``"guess"`` (the scene's guess), or a mapping ``{stride-map entry: value}`` that replaces
     entries of the gait's fixed point (``--start-state``). ``perturb``: ``{entry: delta}``
     added to the start (``--perturb``). ``floor``: ``"plane"``, ``"step:at=K,height_m=H"`` or
-    ``"rough:sigma_m=S[,seed=N]"`` (``--floor``). ``path_interval_s``: keep one path sample
-    per interval instead of every integration sample.
+    ``"rough:sigma_m=S[,seed=N]"`` (``--floor``); ``start=None`` is ``"gait"``.
+    ``path_interval_s``: keep one path sample per interval (and every step's first and last)
+    instead of every integration sample. ``max_path_samples`` (at most
+    :data:`MAX_PATH_SAMPLES`) bounds the path's memory: past it the path stops, the walk goes
+    on, :attr:`Walk.path_cut_at_time_s` says where, and a ``RuntimeWarning`` says so.
 
     A fall is not an error: :attr:`Walk.failure` says how the walk ended early (the command's
     exit code 3). Raises :class:`InputError` for bad input (``steps`` outside 0 to
@@ -123,19 +133,29 @@ def walk(
     report, path = _walker.walk(
         _scene(scene),
         steps,
-        start=start if isinstance(start, str) else dict(start),
+        start="gait" if start is None else start if isinstance(start, str) else dict(start),
         perturb=None if perturb is None else dict(perturb),
         floor=floor,
         path_interval_s=path_interval_s,
         max_strides=max_strides,
+        max_path_samples=max_path_samples,
     )
-    return Walk.from_parts(report, path)
+    walked = Walk.from_parts(report, path)
+    if walked.path_cut_at_time_s is not None:
+        warnings.warn(
+            f"walker.walk: the path stopped at {walked.path_cut_at_time_s:.6g} s after "
+            f"max_path_samples={max_path_samples} samples (the walk went on: see "
+            "Walk.steps); a larger path_interval_s or max_path_samples keeps more",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return walked
 
 
 
 
 def stability_map(
-    scene: Scene | str,
+    scene: Scene | str | os.PathLike[str],
     x: tuple[str, Sequence[float]],
     y: tuple[str, Sequence[float]],
 ) -> StabilityMap:
@@ -152,7 +172,7 @@ def stability_map(
     return StabilityMap.from_report(report)
 
 
-def orbit_diagram(scene: Scene | str, param: str, values: Sequence[float]) -> OrbitDiagram:
+def orbit_diagram(scene: Scene | str | os.PathLike[str], param: str, values: Sequence[float]) -> OrbitDiagram:
     """The attractor of the stride map at each of ``values`` of parameter ``param``, each
     value starting from the last one's attractor, as ``walker orbit-diagram`` computes it
     (``values`` as its ``--from``/``--to``/``--points`` give them: ``np.linspace``). Raises
@@ -163,7 +183,7 @@ def orbit_diagram(scene: Scene | str, param: str, values: Sequence[float]) -> Or
 
 
 def sweep(
-    scene: Scene | str,
+    scene: Scene | str | os.PathLike[str],
     param: str,
     start: float,
     end: float,

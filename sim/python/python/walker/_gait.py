@@ -20,8 +20,8 @@ class Gait:
     report: dict[str, Any] = field(repr=False)
     """The ``walker gait --json`` object."""
     names: list[str]
-    """The stride-map entries (coordinates, then rates ``_dot``) sorted, as ``fixed_point``
-    lists them: the order of ``fixed_point``, the Jacobian's rows and columns and the
+    """The stride-map entries sorted by name (each rate ``_dot`` right after its coordinate),
+    as ``fixed_point`` lists them: the order of ``fixed_point``, the Jacobian's rows and columns and the
     eigenvectors' entries."""
     fixed_point: np.ndarray = field(repr=False)
     """The state just after heel strike, in ``names``' order [rad, m, rad/s, m/s]."""

@@ -31,6 +31,9 @@ class Walk:
     """Their rates [rad/s, m/s], shape (n, len(coordinates))."""
     hip_floor_m: np.ndarray = field(repr=False)
     """The hip in the floor frame [m], shape (n, 3): the hip path."""
+    path_cut_at_time_s: float | None = None
+    """``None``: the path covers the whole walk; else the walk time [s] of its last sample,
+    where it reached ``max_path_samples`` (the walk went on: :attr:`steps` has every step)."""
 
     @classmethod
     def from_parts(cls, report: dict[str, Any], path: dict[str, Any]) -> Walk:
@@ -43,6 +46,7 @@ class Walk:
             path["q"],
             path["qdot"],
             path["hip_floor_m"],
+            path["cut_at_time_s"],
         )
 
     @property

@@ -1,5 +1,6 @@
 """Type stubs of the extension module ``walker._walker`` (the Rust side of ``walker``)."""
 
+import os
 from typing import Any, Mapping
 
 import numpy as np
@@ -13,13 +14,17 @@ MAX_ORBIT_POINTS: int
 """Most values of one orbit diagram."""
 MAX_WALK_STEPS: int
 """Most steps of one walk."""
+DEFAULT_PATH_SAMPLES: int
+"""Path samples a walk keeps by default (past them the path stops; the walk goes on)."""
+MAX_PATH_SAMPLES: int
+"""Most steps of one walk."""
 
 class Scene:
     """A scene: a walker described by a scene file (built-in or a path), with parameter
     values. Read-only: :meth:`with_params` returns a new scene."""
 
     @staticmethod
-    def load(name_or_path: str) -> Scene:
+    def load(name_or_path: str | os.PathLike[str]) -> Scene:
         """Loads a built-in scene by name or a scene file by path; raises ``SceneError``."""
     @property
     def name(self) -> str:
@@ -40,7 +45,7 @@ class Scene:
 def scenes() -> dict[str, Any]:
     """The ``walker scenes --json`` object."""
 
-def gait(scene: Scene, *, max_strides: int = ...) -> dict[str, Any]:
+def gait(scene: Scene, *, max_strides: int | None = None) -> dict[str, Any]:
     """The ``walker gait --json`` object of the scene's gait; raises ``GaitNotFound``,
     ``StrideFailed`` or ``SceneError``."""
 
@@ -56,7 +61,7 @@ def stability_map(
     """The ``walker stability-map --json`` object of the grid ``x`` × ``y``."""
 
 def sweep(
-    scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int = 1
+    scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int | None = None
 ) -> dict[str, Any]:
     """The ``walker sweep --json`` object."""
 
@@ -68,7 +73,9 @@ def walk(
     perturb: Mapping[str, float] | None = None,
     floor: str = "plane",
     path_interval_s: float | None = None,
-    max_strides: int = ...,
+    max_strides: int | None = None,
+    max_path_samples: int | None = None,
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """``(report, path)``: the ``walker walk --json`` object and the path's numpy arrays
-    (``time_s``, ``step``, ``q``, ``qdot``, ``hip_floor_m``) with ``coordinates``."""
+    (``time_s``, ``step``, ``q``, ``qdot``, ``hip_floor_m``) with ``coordinates`` and
+    ``cut_at_time_s`` (``None``, or where the path stopped at ``max_path_samples``)."""
