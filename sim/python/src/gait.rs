@@ -62,26 +62,9 @@ pub fn report(scene: &Scene, budget: &Arc<SearchBudget>) -> Result<GaitReport, S
     let sourced = rule_gait(scene, budget)?;
     let setup = scene.setup()?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
-    let mut report = gait_report(scene, &setup, &sourced.map(|(g, _)| g));
+    let (mut report, _) = setup.gait_report(scene, &sourced.map(|(g, _)| g), false);
     report.gait_source = source;
     Ok(report)
-}
-
-/// The report of a gait search `result` at `scene`'s values (built as `setup`), with the
-/// contact figures of a stride from its fixed point, as `walker gait` and `walker gaits`
-/// report each gait.
-pub fn gait_report(scene: &Scene, setup: &Setup, result: &Result<Gait, NewtonError>) -> GaitReport {
-    let stride = result
-        .as_ref()
-        .ok()
-        .and_then(|g| setup.gait_stride(g, false));
-    GaitReport::new(
-        scene,
-        &setup.walker,
-        &setup.settings.integrator,
-        result,
-        stride.as_ref().map(|r| &r.contact),
-    )
 }
 
 /// The gait of `scene`: the `walker gait --json` object as a dict (with `jacobian` and

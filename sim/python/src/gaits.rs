@@ -2,7 +2,7 @@
 
 use crate::convert;
 use crate::errors;
-use crate::gait::{gait_report, setup_for};
+use crate::gait::setup_for;
 use crate::interrupt;
 use crate::scene::PyScene;
 use pyo3::prelude::*;
@@ -29,7 +29,7 @@ fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, Scen
         gaits: found
             .gaits
             .into_iter()
-            .map(|g| gait_report(scene, &setup, &Ok(g)))
+            .map(|g| setup.gait_report(scene, &Ok(g), false).0)
             .collect(),
         searches: found.searches,
     })

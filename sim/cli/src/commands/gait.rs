@@ -15,11 +15,8 @@ use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::homotopy::GaitSource;
-use sim::analysis::limit_cycle::{Gait, NewtonError};
 use sim::report::{AnkleExtension, GaitOutcome, GaitReport};
-use sim::scene::{Scene, Setup};
 use sim::stride::walk::WalkRequest;
-use sim::stride::StrideResult;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -59,7 +56,7 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
-    let (mut report, figures_stride) = report(&scene, &setup, &result, plot.is_some());
+    let (mut report, figures_stride) = setup.gait_report(&scene, &result, plot.is_some());
     report.gait_source = source;
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let eig = figures::eigenvalues(&scene, walker, g);
@@ -101,31 +98,6 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
-}
-
-/// The report of a gait search `result` at `scene`'s values (built as `setup`), with the
-/// stride from its fixed point that gives the contact figures (recorded when `record`, for
-/// the joint-angle figure). `walker gaits` reports each of its gaits so.
-pub fn report(
-    scene: &Scene,
-    setup: &Setup,
-    result: &Result<Gait, NewtonError>,
-    record: bool,
-) -> (GaitReport, Option<StrideResult>) {
-    // One more stride from the fixed point: the report's contact figures and, for the
-    // joint-angle figure, its samples.
-    let figures_stride = result
-        .as_ref()
-        .ok()
-        .and_then(|g| setup.gait_stride(g, record));
-    let report = GaitReport::new(
-        scene,
-        &setup.walker,
-        &setup.settings.integrator,
-        result,
-        figures_stride.as_ref().map(|r| &r.contact),
-    );
-    (report, figures_stride)
 }
 
 fn print_text(out: &mut dyn Write, r: &GaitReport) -> std::io::Result<()> {

@@ -1,7 +1,6 @@
 //! `walker gaits`: the census of a scene's distinct period-1 gaits, longest step period first
 //! ([`sim::analysis::census`]).
 
-use super::gait::report;
 use super::{print_json, shown};
 use crate::options::Common;
 use crate::output;
@@ -43,7 +42,7 @@ pub fn run(args: GaitsArgs) -> Result<ExitCode> {
     let gaits = found
         .gaits
         .into_iter()
-        .map(|g| report(&scene, &setup, &Ok(g), false).0)
+        .map(|g| setup.gait_report(&scene, &Ok(g), false).0)
         .collect::<Vec<_>>();
     let any = !gaits.is_empty();
     let r = GaitsReport {
