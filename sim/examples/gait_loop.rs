@@ -8,6 +8,7 @@
 
 use sim::analysis::homotopy::{GaitRule, HomotopySettings};
 use sim::analysis::limit_cycle::NewtonSettings;
+use sim::report::GaitReport;
 use sim::scene::Scene;
 use std::error::Error;
 use std::time::Instant;
@@ -25,7 +26,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let rule = GaitRule::new(&setup_for, &newton, &homotopy);
         let result = rule.gait(&scene)?.map(|(g, _)| g);
         let setup = scene.setup()?;
-        let (report, _) = setup.gait_report(&scene, &result, false);
+        let (report, _) = GaitReport::of_setup(&setup, &scene, &result, false);
         let json = sim::report::to_json(&report)?;
         max_abs = json["max_abs_eigenvalue"].as_f64().unwrap_or(f64::NAN);
     }

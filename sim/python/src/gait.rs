@@ -62,7 +62,7 @@ pub fn report(scene: &Scene, budget: &Arc<SearchBudget>) -> Result<GaitReport, S
     let sourced = rule_gait(scene, budget)?;
     let setup = scene.setup()?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
-    let (mut report, _) = setup.gait_report(scene, &sourced.map(|(g, _)| g), false);
+    let (mut report, _) = GaitReport::of_setup(&setup, scene, &sourced.map(|(g, _)| g), false);
     report.gait_source = source;
     Ok(report)
 }

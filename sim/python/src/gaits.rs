@@ -8,7 +8,7 @@ use crate::scene::PyScene;
 use pyo3::prelude::*;
 use sim::analysis::census::{census_with_progress, CensusSettings};
 use sim::analysis::limit_cycle::NewtonSettings;
-use sim::report::GaitsReport;
+use sim::report::{GaitReport, GaitsReport};
 use sim::scene::{Scene, SceneError};
 use sim::stride::SearchBudget;
 use std::sync::Arc;
@@ -29,7 +29,7 @@ fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, Scen
         gaits: found
             .gaits
             .into_iter()
-            .map(|g| setup.gait_report(scene, &Ok(g), false).0)
+            .map(|g| GaitReport::of_setup(&setup, scene, &Ok(g), false).0)
             .collect(),
         searches: found.searches,
     })

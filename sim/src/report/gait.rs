@@ -7,8 +7,8 @@ use crate::analysis::limit_cycle::{Gait, JacobianMethod, NewtonError};
 use crate::analysis::stability::{modes, EigenMode};
 use crate::engine::integrators::IntegratorChoice;
 use crate::engine::walker::Walker;
-use crate::scene::Scene;
-use crate::stride::{ContactSummary, StrideEvent, StrideFailure};
+use crate::scene::{Scene, Setup};
+use crate::stride::{ContactSummary, StrideEvent, StrideFailure, StrideResult};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -206,6 +206,30 @@ impl GaitReport {
             gait_source: None,
             outcome,
         }
+    }
+
+    /// The report of a gait search `result` at `scene`'s values (`setup` built from them),
+    /// with the contact figures of [`Setup::gait_stride`] from its fixed point, as `walker gait`
+    /// reports a gait; and that stride (its samples kept when `record`, for a joint-angle
+    /// figure). The report's `gait_source` is left for the caller.
+    pub fn of_setup(
+        setup: &Setup,
+        scene: &Scene,
+        result: &Result<Gait, NewtonError>,
+        record: bool,
+    ) -> (Self, Option<StrideResult>) {
+        let stride = result
+            .as_ref()
+            .ok()
+            .and_then(|g| setup.gait_stride(g, record));
+        let report = Self::new(
+            scene,
+            &setup.walker,
+            &setup.settings.integrator,
+            result,
+            stride.as_ref().map(|r| &r.contact),
+        );
+        (report, stride)
     }
 }
 

@@ -93,33 +93,6 @@ impl Setup {
             )
             .ok()
     }
-
-    /// The report of a gait search `result` at `scene`'s values (this setup built from them),
-    /// with the contact figures of [`Self::gait_stride`] from its fixed point, as `walker gait`
-    /// reports a gait; and that stride (its samples kept when `record`, for a joint-angle
-    /// figure). The report's `gait_source` is left for the caller.
-    pub fn gait_report(
-        &self,
-        scene: &Scene,
-        result: &Result<Gait, NewtonError>,
-        record: bool,
-    ) -> (
-        crate::report::GaitReport,
-        Option<crate::stride::StrideResult>,
-    ) {
-        let stride = result
-            .as_ref()
-            .ok()
-            .and_then(|g| self.gait_stride(g, record));
-        let report = crate::report::GaitReport::new(
-            scene,
-            &self.walker,
-            &self.settings.integrator,
-            result,
-            stride.as_ref().map(|r| &r.contact),
-        );
-        (report, stride)
-    }
 }
 
 /// A scene file with its parameter values.

@@ -56,7 +56,8 @@ pub fn run(args: GaitArgs) -> Result<ExitCode> {
     let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
-    let (mut report, figures_stride) = setup.gait_report(&scene, &result, plot.is_some());
+    let (mut report, figures_stride) =
+        GaitReport::of_setup(&setup, &scene, &result, plot.is_some());
     report.gait_source = source;
     if let (Some(dir), Ok(g)) = (&plot, &result) {
         let eig = figures::eigenvalues(&scene, walker, g);

@@ -8,7 +8,7 @@ use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::census::{census_units, census_with_progress, CensusSettings};
-use sim::report::{GaitOutcome, GaitsReport};
+use sim::report::{GaitOutcome, GaitReport, GaitsReport};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -42,7 +42,7 @@ pub fn run(args: GaitsArgs) -> Result<ExitCode> {
     let gaits = found
         .gaits
         .into_iter()
-        .map(|g| setup.gait_report(&scene, &Ok(g), false).0)
+        .map(|g| GaitReport::of_setup(&setup, &scene, &Ok(g), false).0)
         .collect::<Vec<_>>();
     let any = !gaits.is_empty();
     let r = GaitsReport {

@@ -190,7 +190,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     let best = match &result.best {
         Some(b) => {
             let setup = setup_for(&b.scene)?;
-            let (mut gait, _) = setup.gait_report(&b.scene, &Ok(b.gait.clone()), false);
+            let (mut gait, _) = GaitReport::of_setup(&setup, &b.scene, &Ok(b.gait.clone()), false);
             gait.gait_source = Some(b.source);
             let e = &result.evaluations[b.index];
             Some(Best {

@@ -185,7 +185,7 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
     let source = sourced.as_ref().ok().map(|(_, s)| *s);
     let result = sourced.map(|(g, _)| g);
-    let (mut gait_report, _) = setup.gait_report(&scene, &result, false);
+    let (mut gait_report, _) = GaitReport::of_setup(&setup, &scene, &result, false);
     gait_report.gait_source = source;
     let mut report = RobustnessReport {
         scene: scene.name().to_owned(),
