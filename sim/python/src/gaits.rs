@@ -3,10 +3,10 @@
 use crate::convert;
 use crate::errors;
 use crate::gait::setup_for;
-use crate::interrupt;
+use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
-use sim::analysis::census::{census_with_progress, CensusSettings};
+use sim::analysis::census::{census_units, census_with_progress, CensusSettings};
 use sim::analysis::limit_cycle::NewtonSettings;
 use sim::report::{GaitReport, GaitsReport};
 use sim::scene::{Scene, SceneError};
@@ -15,13 +15,17 @@ use std::sync::Arc;
 
 /// The `walker gaits --json` report of `scene`; every stride of the census taken from
 /// `cancel` (unlimited, there to stop it).
-fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, SceneError> {
+fn report(
+    scene: &Scene,
+    cancel: &Arc<SearchBudget>,
+    counter: &Counter,
+) -> Result<GaitsReport, SceneError> {
     let found = census_with_progress(
         scene,
         &setup_for(cancel),
         &NewtonSettings::default(),
         &CensusSettings::default(),
-        &|| {},
+        &|| counter.tick(),
     )?;
     let setup = scene.setup()?;
     Ok(GaitsReport {
@@ -38,12 +42,21 @@ fn report(scene: &Scene, cancel: &Arc<SearchBudget>) -> Result<GaitsReport, Scen
 /// Every distinct period-1 gait of `scene`, longest step period first: the
 /// `walker gaits --json` object as a dict (`gaits`, each as `walker.gait`'s report but without
 /// `gait_source`; `searches`). No gait gives an empty list (the command's exit code 1). Runs
-/// without the GIL; Ctrl-C stops it. Raises `walker.SceneError`.
+/// without the GIL; Ctrl-C stops it; `progress(done, total)`, if given, hears of the Newton
+/// searches done. Raises `walker.SceneError`.
 #[pyfunction]
-pub fn gaits<'py>(py: Python<'py>, scene: &PyScene) -> PyResult<Bound<'py, PyAny>> {
+#[pyo3(signature = (scene, *, progress = None))]
+pub fn gaits<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
     let cancel = Arc::new(SearchBudget::new(usize::MAX));
     let scene = &scene.inner;
-    let report = interrupt::run(py, &[&cancel], || report(scene, &cancel))?
-        .map_err(|e| errors::scene_error(py, &e))?;
+    let counter = Counter::new(census_units(scene, &CensusSettings::default()), progress);
+    let report = interrupt::run_counted(py, &[&cancel], &counter, || {
+        report(scene, &cancel, &counter)
+    })?
+    .map_err(|e| errors::scene_error(py, &e))?;
     convert::report(py, &report)
 }

@@ -6,17 +6,20 @@
 //! `walker` (python/walker/) wraps these into objects with numpy arrays and pandas tables;
 //! users import `walker`, not this module.
 //!
-//! Long computations run with the GIL released and stop on Ctrl-C (the `interrupt` module).
+//! Long computations run with the GIL released, stop on Ctrl-C and report their progress to a
+//! Python callable (the `interrupt` module).
 
 // pyo3's macros expand to `unsafe` blocks (the CPython ABI); this crate writes none itself.
 #![allow(unsafe_code)]
 
+mod basin;
 mod convert;
 mod errors;
 mod gait;
 mod gaits;
 mod interrupt;
 mod orbit_diagram;
+mod robustness;
 mod scene;
 mod stability_map;
 mod sweep;
@@ -39,6 +42,12 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
         sim::analysis::orbit_diagram::MAX_ORBIT_POINTS,
     )?;
     m.add_function(wrap_pyfunction!(stability_map::stability_map, m)?)?;
+    m.add_function(wrap_pyfunction!(robustness::robustness, m)?)?;
+    m.add_function(wrap_pyfunction!(basin::basin, m)?)?;
+    m.add(
+        "MAX_BASIN_CELL_STRIDES",
+        sim::analysis::robustness::MAX_BASIN_CELL_STRIDES,
+    )?;
     m.add("MAX_MAP_CELLS", sim::analysis::stability_map::MAX_MAP_CELLS)?;
     m.add(
         "DEFAULT_GAIT_STRIDE_BUDGET",

@@ -4,11 +4,12 @@
 use crate::convert;
 use crate::errors;
 use crate::gait::setup_for;
-use crate::interrupt;
+use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
 use sim::analysis::homotopy::HomotopySettings;
 use sim::analysis::limit_cycle::NewtonSettings;
+use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis, MAX_MAP_CELLS};
 use sim::report::StabilityMapReport;
 use sim::stride::SearchBudget;
@@ -18,17 +19,54 @@ use std::sync::Arc;
 /// `(parameter name or alias, values)`: the `walker stability-map --json` object as a dict
 /// (`x`, `y`: name and values; `max_abs_eigenvalue`, `stable`, `step_period_s`,
 /// `gait_source`, `no_gait_reason`: grids indexed `[j][i]` for `y.values[j]`, `x.values[i]`,
-/// `None` where there is no gait). Uses every core, without the GIL; Ctrl-C stops it at the
-/// next gait search. Raises `walker.SceneError` (an unknown parameter, a value out of range)
-/// or `walker.InputError` (the same parameter twice, an empty axis, more than
-/// `MAX_MAP_CELLS` cells).
+/// `None` where there is no gait). `quantity` also maps a robustness measure or another number
+/// of each cell's gait (`walker stability-map --quantity`; `mfpt` with `sigma_m`): the dict's
+/// `quantity`. `progress(done, total)`, if given, hears of the cells done. Uses every core,
+/// without the GIL; Ctrl-C stops it at the next gait search. Raises `walker.SceneError` (an
+/// unknown parameter, a value out of range) or `walker.InputError` (the same parameter twice,
+/// an empty axis, more than `MAX_MAP_CELLS` cells, an unknown quantity, `sigma_m` without
+/// `mfpt`).
 #[pyfunction]
+#[pyo3(signature = (scene, x, y, *, quantity = None, sigma_m = None, progress = None))]
 pub fn stability_map<'py>(
     py: Python<'py>,
     scene: &PyScene,
     x: (String, Vec<f64>),
     y: (String, Vec<f64>),
+    quantity: Option<String>,
+    sigma_m: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let options = QuantityOptions {
+        sigma_m,
+        ..QuantityOptions::default()
+    };
+    let quantity = match quantity.as_deref() {
+        Some(name) => {
+            let q = Quantity::parse(name).ok_or_else(|| {
+                errors::input_error(
+                    py,
+                    &format!("quantity `{name}`: expected one of {}", Quantity::names()),
+                )
+            })?;
+            if q == Quantity::Mfpt && sigma_m.is_none() {
+                return Err(errors::input_error(
+                    py,
+                    "quantity mfpt needs the rough floor's standard deviation: give sigma_m",
+                ));
+            }
+            q.check(&options)
+                .map_err(|e| errors::input_error(py, &format!("quantity {q}: {e}")))?;
+            Some(q)
+        }
+        None => None,
+    };
+    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
+        return Err(errors::input_error(
+            py,
+            "sigma_m is the rough floor of quantity=\"mfpt\": give quantity=\"mfpt\" too",
+        ));
+    }
     let scene = &scene.inner;
     let axis = |(name, values): (String, Vec<f64>)| -> PyResult<Axis> {
         Ok(Axis {
@@ -56,7 +94,8 @@ pub fn stability_map<'py>(
         ));
     }
     let cancel = Arc::new(SearchBudget::new(usize::MAX));
-    let map = interrupt::run(py, &[&cancel], || {
+    let counter = Counter::new(cells, progress);
+    let map = interrupt::run_counted(py, &[&cancel], &counter, || {
         stability_map_of(
             scene,
             &setup_for(&cancel),
@@ -64,10 +103,14 @@ pub fn stability_map<'py>(
             &y,
             &NewtonSettings::default(),
             &HomotopySettings::default(),
-            None,
-            &|| {},
+            quantity.map(|q| (q, &options)),
+            &|| counter.tick(),
         )
     })?
     .map_err(|e| errors::scene_error(py, &e))?;
-    convert::report(py, &StabilityMapReport::new(scene.name(), &x, &y, &map))
+    let report = match quantity {
+        Some(q) => StabilityMapReport::with_quantity(scene.name(), &x, &y, &map, q, &options),
+        None => StabilityMapReport::new(scene.name(), &x, &y, &map),
+    };
+    convert::report(py, &report)
 }

@@ -19,12 +19,14 @@
 //! its lower-case twin `cost_of_transport_j_per_kg_m` (the same number) beside it.
 
 mod ankle_extension;
+mod basin;
 mod cost_of_transport;
 mod fixed_point;
 mod gait;
 mod gaits;
 mod ideal_gait;
 mod orbit_diagram;
+mod robustness;
 mod scenes;
 mod stability_map;
 mod start;
@@ -34,12 +36,18 @@ mod walk;
 mod walk_gait;
 
 pub use ankle_extension::{AnkleExtension, AnkleExtensionError};
+pub use basin::BasinReport;
 pub use cost_of_transport::CostOfTransport;
 pub use fixed_point::FixedPoint;
 pub use gait::{ActuatorFigures, ContactFigures, FoundGait, GaitNotFound, GaitOutcome, GaitReport};
 pub use gaits::GaitsReport;
 pub use ideal_gait::IdealGaitRecord;
 pub use orbit_diagram::{FellRecord, OrbitDiagramReport, OrbitPointRecord};
+pub use robustness::{
+    Again, Measures, RobustnessOptionError, RobustnessOptions, RobustnessReport, Signs,
+    MAX_MFPT_RUNS, MAX_MFPT_STRIDES, MAX_MFPT_TOTAL_STRIDES, MAX_RETURN_STRIDES, MAX_SIGMAS,
+    MIN_RATE_SCAN_STEP,
+};
 pub use scenes::{ParameterEntry, SceneCatalogue, SceneEntry};
 pub use stability_map::{AxisRecord, StabilityMapReport};
 pub use start::{StartKind, StartRecord};

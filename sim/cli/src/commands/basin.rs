@@ -15,9 +15,11 @@ use crate::progress::Progress;
 use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
-use sim::analysis::robustness::{basin_slice, BasinAxis, BasinCell, Outcome, Recovery, ReturnRule};
-use sim::report::GaitReport;
+use sim::analysis::robustness::{
+    basin_axes, basin_slice, BasinAxis, BasinCell, BasinError, Outcome, Recovery, ReturnRule,
+    MAX_BASIN_CELL_STRIDES,
+};
+use sim::report::{BasinReport, GaitReport};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -41,29 +43,6 @@ pub struct BasinArgs {
     pub plot: Option<std::path::PathBuf>,
 }
 
-/// Most strides of a cell.
-const MAX_CELL_STRIDES: usize = 10_000;
-
-/// The report (the contract's fields, then details).
-#[derive(Serialize)]
-struct BasinReport {
-    scene: String,
-    x: BasinAxis,
-    y: BasinAxis,
-    /// One row per y value: `gait`, `periodic`, the failure kind, `not_settled`,
-    /// `off_section`.
-    outcome: Vec<Vec<String>>,
-    /// Strides each cell took (to return, settle or fail).
-    strides: Vec<Vec<usize>>,
-    /// The period of a `periodic` cell, else `null`.
-    period: Vec<Vec<Option<usize>>>,
-    fraction_returning: f64,
-    /// The position coordinate solved to keep the swing foot on the floor.
-    solved_coordinate: Option<String>,
-    return_rule: ReturnRule,
-    gait: GaitReport,
-}
-
 /// Parses `COORD=FROM:TO:N` of option `flag`.
 fn axis(flag: &str, spec: &str) -> Result<BasinAxis, InputError> {
     let (name, values) =
@@ -85,27 +64,20 @@ pub fn run(args: BasinArgs) -> Result<ExitCode> {
     let (x, y) = (axis("--x", &x)?, axis("--y", &y)?);
     let cells = x.values.len() * y.values.len();
     limits::count("--x N × --y N", cells, 1, limits::MAX_MAP_CELLS)?;
-    let strides = limits::count("--strides", strides, 1, MAX_CELL_STRIDES)?;
-    // The names before the gait search: a wrong one fails at once.
-    let names = setup.walker.map_names();
-    for a in [&x, &y] {
-        if !names.contains(&a.name) {
-            return Err(InputError::Other(format!(
-                "`{}` is not a stride-map coordinate of {} (it has: {})",
-                a.name,
-                scene.name(),
-                names.join(", ")
-            ))
-            .into());
-        }
-    }
-    if x.name == y.name {
-        return Err(InputError::Other(format!(
-            "--x and --y both slice `{}`: give two different coordinates",
-            x.name
-        ))
-        .into());
-    }
+    let strides = limits::count("--strides", strides, 1, MAX_BASIN_CELL_STRIDES)?;
+    // The axes before the gait search: a wrong one fails at once.
+    basin_axes(&setup.walker, &x, &y).map_err(|e| {
+        InputError::Other(match e {
+            BasinError::UnknownCoordinate { name, known } => format!(
+                "`{name}` is not a stride-map coordinate of {} (it has: {known})",
+                scene.name()
+            ),
+            BasinError::SameAxis(name) => {
+                format!("--x and --y both slice `{name}`: give two different coordinates")
+            }
+            e @ BasinError::Empty(_) => e.to_string(),
+        })
+    })?;
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }
@@ -133,40 +105,7 @@ pub fn run(args: BasinArgs) -> Result<ExitCode> {
     let slice = basin_slice(&recovery, x, y, &|| progress.tick())
         .map_err(|e| InputError::Other(e.to_string()))?;
     progress.finish();
-    let map = |f: &dyn Fn(&BasinCell) -> String| -> Vec<Vec<String>> {
-        slice
-            .cells
-            .iter()
-            .map(|r| r.iter().map(f).collect())
-            .collect()
-    };
-    let report = BasinReport {
-        scene: scene.name().to_owned(),
-        outcome: map(&BasinCell::name),
-        strides: slice
-            .cells
-            .iter()
-            .map(|r| r.iter().map(BasinCell::strides).collect())
-            .collect(),
-        period: slice
-            .cells
-            .iter()
-            .map(|r| {
-                r.iter()
-                    .map(|c| match c {
-                        BasinCell::Strides(Outcome::Periodic { period, .. }) => Some(*period),
-                        _ => None,
-                    })
-                    .collect()
-            })
-            .collect(),
-        fraction_returning: slice.fraction_returning,
-        solved_coordinate: slice.solved_coordinate.clone(),
-        return_rule: rule,
-        x: slice.x.clone(),
-        y: slice.y.clone(),
-        gait: gait_report,
-    };
+    let report = BasinReport::new(scene.name(), &slice, rule, gait_report);
     if let Some(dir) = &plot {
         let fig = HeatMap {
             title: format!(

@@ -4,21 +4,14 @@
 
 use super::{print_json, shown};
 use crate::input_error::InputError;
-use crate::limits;
 use crate::options::Common;
 use crate::output;
 use crate::progress::Progress;
 use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
-use sim::analysis::gait_sensitivity::{gait_sensitivity_norm, GaitSensitivity};
-use sim::analysis::robustness::{
-    mean_first_passage, step_thresholds, velocity_thresholds, FirstPassage, FirstPassageOptions,
-    Recovery, StepThresholds, ThresholdOptions, VelocityThreshold,
-};
-use sim::report::GaitReport;
-use std::collections::BTreeMap;
+use sim::analysis::robustness::FirstPassageOptions;
+use sim::report::{Measures, RobustnessOptionError, RobustnessOptions, RobustnessReport};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -55,77 +48,6 @@ pub struct RobustnessArgs {
     pub return_strides: usize,
 }
 
-/// The measures `--measures` names.
-#[derive(Clone, Copy, Debug, Default)]
-struct Measures {
-    gsn: bool,
-    steps: bool,
-    rates: bool,
-    mfpt: bool,
-}
-
-impl Measures {
-    fn parse(list: &str) -> Result<Self, InputError> {
-        let mut m = Measures::default();
-        for name in list.split(',').map(str::trim) {
-            let slot = match name {
-                "gsn" => &mut m.gsn,
-                "steps" => &mut m.steps,
-                "rates" => &mut m.rates,
-                "mfpt" => &mut m.mfpt,
-                other => {
-                    return Err(InputError::Other(format!(
-                        "--measures: unknown measure `{other}` (expected gsn, steps, rates, mfpt)"
-                    )))
-                }
-            };
-            *slot = true;
-        }
-        Ok(m)
-    }
-}
-
-/// Most Monte Carlo walks per roughness, and most strides of one.
-const MAX_MFPT_RUNS: usize = 100_000;
-const MAX_MFPT_STRIDES: usize = 1_000_000;
-/// Most Monte Carlo strides per roughness (runs × strides per run).
-const MAX_MFPT_TOTAL_STRIDES: usize = 100_000_000;
-/// Most roughness values.
-const MAX_SIGMAS: usize = 64;
-
-/// A threshold pair as the contract gives it.
-#[derive(Serialize)]
-struct Signs {
-    positive: f64,
-    negative: f64,
-}
-
-/// Where survival starts again past each step threshold (`null`: not up to the limit).
-#[derive(Serialize)]
-struct Again {
-    down: Option<f64>,
-    up: Option<f64>,
-}
-
-/// The report (the contract's fields first; `step_thresholds` and `velocity_thresholds` with
-/// every detail).
-#[derive(Serialize)]
-struct RobustnessReport {
-    scene: String,
-    gait: GaitReport,
-    gait_sensitivity_norm: Option<GaitSensitivity>,
-    step_down_max_m: Option<f64>,
-    step_up_max_m: Option<f64>,
-    survived_again_from_m: Option<Again>,
-    velocity_perturbation_max: Option<BTreeMap<String, Signs>>,
-    mfpt: Vec<FirstPassage>,
-    step_thresholds: Option<StepThresholds>,
-    velocity_thresholds: Option<Vec<VelocityThreshold>>,
-    return_rule: sim::analysis::robustness::ReturnRule,
-    /// A measure that could not be computed, and why.
-    errors: BTreeMap<String, String>,
-}
-
 /// Runs `walker robustness`: exit code 1 when no gait is found or a measure fails.
 pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
     let RobustnessArgs {
@@ -138,180 +60,37 @@ pub fn run(args: RobustnessArgs) -> Result<ExitCode> {
         rate_scan_step,
         return_strides,
     } = args;
-    let return_strides = limits::count("--return-strides", return_strides, 1, 100_000)?;
-    let measures = Measures::parse(&measures)?;
-    if !(rate_scan_step.is_finite()
-        && (1e-6..=ThresholdOptions::rates().limit).contains(&rate_scan_step))
-    {
-        return Err(InputError::Other(format!(
-            "--rate-scan-step must be from 1e-6 to 0.25 natural rates (the scan's limit), got {}",
-            sim::scene::short_number(rate_scan_step)
-        ))
-        .into());
-    }
+    let flag = |field: &str| format!("--{}", field.replace('_', "-"));
+    let option_error = |e: RobustnessOptionError| InputError::Other(e.message(&flag));
+    let options = RobustnessOptions {
+        measures: Measures::from_names(measures.split(',')).map_err(option_error)?,
+        sigma_m,
+        first_passage: FirstPassageOptions {
+            runs: mfpt_runs,
+            strides_per_run: mfpt_strides,
+            seed: mfpt_seed,
+        },
+        rate_scan_step,
+        return_strides,
+        perturbation: common.perturbation,
+    };
+    options.check().map_err(option_error)?;
     let scene = common.scene()?;
     let setup = common.setup(&scene)?;
-    let runs = limits::count("--mfpt-runs", mfpt_runs, 1, MAX_MFPT_RUNS)?;
-    let strides = limits::count("--mfpt-strides", mfpt_strides, 1, MAX_MFPT_STRIDES)?;
-    if runs.saturating_mul(strides) > MAX_MFPT_TOTAL_STRIDES {
-        return Err(InputError::Other(format!(
-            "--mfpt-runs × --mfpt-strides must be at most {MAX_MFPT_TOTAL_STRIDES} strides, got \
-             {runs} × {strides}"
-        ))
-        .into());
-    }
-    if !measures.mfpt && !sigma_m.is_empty() {
-        return Err(InputError::Other(
-            "--sigma-m is the rough floor of the mean first-passage time: add mfpt to --measures"
-                .into(),
-        )
-        .into());
-    }
-    if sigma_m.len() > MAX_SIGMAS {
-        return Err(InputError::Other(format!(
-            "--sigma-m given {} times; at most {MAX_SIGMAS}",
-            sigma_m.len()
-        ))
-        .into());
-    }
-    if let Some(bad) = sigma_m.iter().find(|s| !(s.is_finite() && **s >= 0.0)) {
-        return Err(InputError::Other(format!(
-            "--sigma-m {}: a standard deviation must be a finite number ≥ 0",
-            sim::scene::short_number(*bad)
-        ))
-        .into());
-    }
-    let walker = &setup.walker;
     let sourced = search_progress::rule_gait(&common, &common.setup_for(), &scene)?;
-    let source = sourced.as_ref().ok().map(|(_, s)| *s);
-    let result = sourced.map(|(g, _)| g);
-    let (mut gait_report, _) = GaitReport::of_setup(&setup, &scene, &result, false);
-    gait_report.gait_source = source;
-    let mut report = RobustnessReport {
-        scene: scene.name().to_owned(),
-        gait: gait_report,
-        gait_sensitivity_norm: None,
-        step_down_max_m: None,
-        step_up_max_m: None,
-        survived_again_from_m: None,
-        velocity_perturbation_max: None,
-        mfpt: Vec::new(),
-        step_thresholds: None,
-        velocity_thresholds: None,
-        return_rule: sim::analysis::robustness::ReturnRule::default(),
-        errors: BTreeMap::new(),
-    };
-    let Ok(gait) = &result else {
-        return finish(&common, &report, ExitCode::from(1));
-    };
-    if !gait.stable() {
-        // every measure here asks how a disturbance dies out: at an unstable gait it grows
-        report.errors.insert(
-            "gait".into(),
-            format!(
-                "the gait is unstable (max |λ| = {}): no robustness measure is defined there",
-                gait.max_abs_eigenvalue()
-            ),
-        );
-        return finish(&common, &report, ExitCode::from(1));
-    }
-    let rule = sim::analysis::robustness::ReturnRule {
-        max_strides: return_strides,
-        ..Default::default()
-    };
-    report.return_rule = rule;
-    let recovery = Recovery::new(walker, &setup.settings, gait).with_rule(rule);
-    let leg_m = recovery.leg_length_m();
-    let sigmas = if sigma_m.is_empty() {
-        // rounded to 12 significant digits: a leg length of 0.9999999999999999 m gives 0.001
-        let round = |x: f64| format!("{x:.12e}").parse::<f64>().unwrap_or(x);
-        vec![
-            round(1e-3 * leg_m),
-            round(3e-3 * leg_m),
-            round(1e-2 * leg_m),
-        ]
-    } else {
-        sigma_m
-    };
-    let progress = Progress::new(3 + sigmas.len(), "robustness measures", !common.json);
-    if measures.gsn {
-        match gait_sensitivity_norm(walker, &setup.settings, gait, common.perturbation) {
-            Ok(g) => report.gait_sensitivity_norm = Some(g),
-            Err(e) => {
-                report
-                    .errors
-                    .insert("gait_sensitivity_norm".into(), e.to_string());
-            }
-        }
-    }
-    progress.tick();
-    if measures.steps {
-        steps_into(&mut report, &recovery);
-    }
-    progress.tick();
-    if measures.rates {
-        let options = ThresholdOptions {
-            scan_step: rate_scan_step,
-            ..ThresholdOptions::rates()
-        };
-        rates_into(&mut report, &recovery, &options);
-    }
-    progress.tick();
-    let options = FirstPassageOptions {
-        runs,
-        strides_per_run: strides,
-        seed: mfpt_seed,
-    };
-    for sigma in sigmas.into_iter().filter(|_| measures.mfpt) {
-        match mean_first_passage(&recovery, sigma, &options) {
-            Ok(m) => report.mfpt.push(m),
-            Err(e) => {
-                report
-                    .errors
-                    .insert(format!("mfpt sigma_m={sigma}"), e.to_string());
-            }
-        }
-        progress.tick();
-    }
+    let progress = Progress::new(
+        RobustnessReport::stages(&options),
+        "robustness measures",
+        !common.json,
+    );
+    let report = RobustnessReport::measure(&setup, &scene, sourced, &options, &|| progress.tick());
     progress.finish();
-    let code = if report.errors.is_empty() {
+    let code = if report.complete() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     };
     finish(&common, &report, code)
-}
-
-/// The step thresholds into the report.
-fn steps_into(report: &mut RobustnessReport, recovery: &Recovery<'_>) {
-    let steps = step_thresholds(recovery, &ThresholdOptions::steps());
-    report.step_down_max_m = Some(steps.down.max);
-    report.step_up_max_m = Some(steps.up.max);
-    report.survived_again_from_m = Some(Again {
-        down: steps.down.survived_again_from,
-        up: steps.up.survived_again_from,
-    });
-    report.step_thresholds = Some(steps);
-}
-
-/// The rate thresholds into the report.
-fn rates_into(report: &mut RobustnessReport, recovery: &Recovery<'_>, options: &ThresholdOptions) {
-    let rates = velocity_thresholds(recovery, options);
-    report.velocity_perturbation_max = Some(
-        rates
-            .iter()
-            .map(|v| {
-                (
-                    v.coordinate.clone(),
-                    Signs {
-                        positive: v.positive.max,
-                        negative: v.negative.max,
-                    },
-                )
-            })
-            .collect(),
-    );
-    report.velocity_thresholds = Some(rates);
 }
 
 fn finish(common: &Common, report: &RobustnessReport, code: ExitCode) -> Result<ExitCode> {

@@ -20,15 +20,19 @@ from typing import Mapping, Sequence
 import pandas as pd
 
 from . import _walker
+from ._basin import Basin
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
 from ._gait import Gait, Gaits
 from ._orbit_diagram import OrbitDiagram
+from ._progress import ProgressArg, callback as _progress_callback
+from ._robustness import Robustness
 from ._stability_map import StabilityMap
 from ._sweep import Sweep
 from ._walk import Walk
 from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
     DEFAULT_PATH_SAMPLES,
+    MAX_BASIN_CELL_STRIDES,
     MAX_MAP_CELLS,
     MAX_ORBIT_POINTS,
     MAX_PATH_SAMPLES,
@@ -37,8 +41,13 @@ from ._walker import (
 )
 
 __all__ = [
+    "Basin",
+    "Robustness",
+    "basin",
+    "robustness",
     "DEFAULT_GAIT_STRIDE_BUDGET",
     "DEFAULT_PATH_SAMPLES",
+    "MAX_BASIN_CELL_STRIDES",
     "MAX_MAP_CELLS",
     "MAX_ORBIT_POINTS",
     "MAX_PATH_SAMPLES",
@@ -93,12 +102,25 @@ def gait(scene: Scene | str | os.PathLike[str], *, max_strides: int = DEFAULT_GA
     return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
 
 
-def gaits(scene: Scene | str | os.PathLike[str]) -> Gaits:
+def _with_progress(progress: ProgressArg, desc: str, unit: str, run):
+    f, bar = _progress_callback(progress, desc, unit)
+    try:
+        return run(f)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def gaits(scene: Scene | str | os.PathLike[str], *, progress: ProgressArg = True) -> Gaits:
     """Every distinct period-1 gait of ``scene``, longest step period first, as
     ``walker gaits`` finds them (Newton from many starts, and the gaits followed from the
-    scene's defaults). No gait gives an empty list. Raises :class:`SceneError`,
-    ``KeyboardInterrupt`` on Ctrl-C."""
-    return Gaits.from_report(_walker.gaits(_scene(scene)))
+    scene's defaults). No gait gives an empty list. ``progress``: ``True`` shows a tqdm bar of
+    the Newton searches once the census has lasted a second, ``False`` none, a callable is
+    called as ``progress(done, total)``. Raises :class:`SceneError`, ``KeyboardInterrupt``
+    on Ctrl-C."""
+    s = _scene(scene)
+    report = _with_progress(progress, "gaits", "search", lambda f: _walker.gaits(s, progress=f))
+    return Gaits.from_report(report)
 
 
 def walk(
@@ -158,18 +180,115 @@ def stability_map(
     scene: Scene | str | os.PathLike[str],
     x: tuple[str, Sequence[float]],
     y: tuple[str, Sequence[float]],
+    *,
+    quantity: str | None = None,
+    sigma_m: float | None = None,
+    progress: ProgressArg = True,
 ) -> StabilityMap:
     """The gait of ``scene`` (as :func:`gait` finds it) at every cell of the grid of two
     parameters ``x`` and ``y``, each ``(name or alias, values)``, e.g.
     ``x=("slope_rad", np.linspace(0.01, 0.08, 29))``, as ``walker stability-map`` computes it
-    (every core). Raises :class:`SceneError` (unknown parameter, value out of range),
-    :class:`InputError` (one parameter twice, no cells, more than :data:`MAX_MAP_CELLS`),
+    (every core). ``quantity`` also maps a number of each cell's gait (``gsn``,
+    ``step_down``, ``step_up``, ``mfpt`` with ``sigma_m``, ``max_abs_eigenvalue``,
+    ``cost_of_transport``, ``speed_m_s``, ``step_period_s``, ``step_length_m``:
+    ``--quantity``): :attr:`StabilityMap.quantity`. ``progress``: a tqdm bar of the cells
+    (``True``, shown after a second), none (``False``) or ``progress(done, total)``. Raises
+    :class:`SceneError` (unknown parameter, value out of range), :class:`InputError` (one
+    parameter twice, no cells, more than :data:`MAX_MAP_CELLS`, an unknown quantity),
     ``KeyboardInterrupt`` on Ctrl-C (at the next gait search)."""
     (xn, xv), (yn, yv) = x, y
-    report = _walker.stability_map(
-        _scene(scene), (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    s = _scene(scene)
+    axes = (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    report = _with_progress(
+        progress,
+        "stability map",
+        "cell",
+        lambda f: _walker.stability_map(s, *axes, quantity=quantity, sigma_m=sigma_m, progress=f),
     )
     return StabilityMap.from_report(report)
+
+
+def robustness(
+    scene: Scene | str | os.PathLike[str],
+    *,
+    measures: Sequence[str] = ("gsn", "steps", "rates", "mfpt"),
+    sigma_m: Sequence[float] | None = None,
+    mfpt_runs: int = 100,
+    mfpt_strides: int = 200,
+    mfpt_seed: int = 0,
+    rate_scan_step: float = 1e-2,
+    return_strides: int = 100,
+    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    progress: ProgressArg = True,
+) -> Robustness:
+    """How much disturbance the gait of ``scene`` (as :func:`gait` finds it) survives, as
+    ``walker robustness`` measures it (docs/robustness.md): the gait sensitivity norm
+    (``gsn``), the largest step down and up (``steps``), the largest change of each rate
+    (``rates``), the mean first-passage time on rough floors of standard deviation
+    ``sigma_m`` (``mfpt``; default 0.001, 0.003 and 0.01 leg lengths; ``mfpt_runs`` walks of
+    at most ``mfpt_strides`` strides, floor seeds from ``mfpt_seed``). A disturbed walker must
+    come back within 1e-6 of the gait in ``return_strides`` strides. ``progress``: a tqdm bar
+    of the measures (``True``), none (``False``) or ``progress(done, total)``.
+
+    An unstable gait has no measure: the result's ``errors["gait"]`` says so (and a
+    ``RuntimeWarning``), as does any measure that failed. Raises :class:`InputError` (an
+    option out of its range), :class:`SceneError`, :class:`GaitNotFound` /
+    :class:`StrideFailed` (no gait), ``KeyboardInterrupt`` on Ctrl-C.
+    """
+    s = _scene(scene)
+    report = _with_progress(
+        progress,
+        "robustness",
+        "measure",
+        lambda f: _walker.robustness(
+            s,
+            measures=list(measures),
+            sigma_m=None if sigma_m is None else [float(v) for v in sigma_m],
+            mfpt_runs=mfpt_runs,
+            mfpt_strides=mfpt_strides,
+            mfpt_seed=mfpt_seed,
+            rate_scan_step=float(rate_scan_step),
+            return_strides=return_strides,
+            max_strides=max_strides,
+            progress=f,
+        ),
+    )
+    result = Robustness.from_report(report)
+    if result.errors:
+        shown = "; ".join(f"{k}: {v}" for k, v in result.errors.items())
+        warnings.warn(f"walker.robustness: {shown}", RuntimeWarning, stacklevel=2)
+    return result
+
+
+def basin(
+    scene: Scene | str | os.PathLike[str],
+    x: tuple[str, Sequence[float]],
+    y: tuple[str, Sequence[float]],
+    *,
+    strides: int = 100,
+    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    progress: ProgressArg = True,
+) -> Basin:
+    """A slice of the basin of attraction of the gait of ``scene`` (as :func:`gait` finds it)
+    through its fixed point, over two stride-map coordinates ``x`` and ``y`` (each ``(name,
+    values)``; :attr:`Gait.names` lists them), as ``walker basin`` computes it (every core):
+    each cell starts from the fixed point with the two coordinates set, a third position
+    solved to keep the swing foot on the floor, and walks until it is back within 1e-6 of the
+    gait in at most ``strides`` strides (at most :data:`MAX_BASIN_CELL_STRIDES`), falls, or
+    settles elsewhere. ``progress``: a tqdm bar of the cells (``True``), none (``False``) or
+    ``progress(done, total)``. Raises :class:`InputError` (an unknown or repeated coordinate,
+    an empty axis, too many cells), :class:`SceneError`, :class:`GaitNotFound` /
+    :class:`StrideFailed` (no gait), ``KeyboardInterrupt`` on Ctrl-C."""
+    (xn, xv), (yn, yv) = x, y
+    s = _scene(scene)
+    axes = (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    report = _with_progress(
+        progress,
+        "basin",
+        "cell",
+        lambda f: _walker.basin(s, *axes, strides=strides, max_strides=max_strides, progress=f),
+    )
+    return Basin.from_report(report)
 
 
 def orbit_diagram(scene: Scene | str | os.PathLike[str], param: str, values: Sequence[float]) -> OrbitDiagram:

@@ -47,13 +47,33 @@ class StabilityMap:
         )
 
     @property
+    def quantity_name(self) -> str | None:
+        """The other quantity mapped (``quantity=``), or ``None``."""
+        q = self.report.get("quantity")
+        return None if q is None else q["name"]
+
+    @property
+    def quantity(self) -> np.ndarray | None:
+        """The other quantity of each cell's gait (``quantity=``; NaN: no gait, or it could not
+        be had: ``quantity_errors`` says why), or ``None``."""
+        q = self.report.get("quantity")
+        return None if q is None else _grid(q["values"])
+
+    @property
+    def quantity_errors(self) -> np.ndarray | None:
+        """Why the quantity could not be had at a cell with a gait (``None`` elsewhere)."""
+        q = self.report.get("quantity")
+        return None if q is None else np.array(q["errors"], dtype=object)
+
+    @property
     def stable(self) -> np.ndarray:
         """Whether each cell's gait is stable (``False`` also where there is no gait)."""
         return np.array([[v is True for v in row] for row in self.report["stable"]])
 
     def to_frame(self) -> pd.DataFrame:
         """One row per cell: the two parameters, ``max_abs_eigenvalue``, ``stable``,
-        ``step_period_s``, ``gait_source`` and ``no_gait_reason``."""
+        ``step_period_s``, ``gait_source``, ``no_gait_reason`` and the other quantity, if
+        mapped, under its name."""
         r = self.report
         rows = [
             {
@@ -68,4 +88,8 @@ class StabilityMap:
             for j, y in enumerate(self.y)
             for i, x in enumerate(self.x)
         ]
+        q = r.get("quantity")
+        if q is not None:
+            for row, value in zip(rows, (v for line in q["values"] for v in line)):
+                row[q["name"]] = value
         return pd.DataFrame(rows)

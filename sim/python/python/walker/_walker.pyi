@@ -1,13 +1,15 @@
 """Type stubs of the extension module ``walker._walker`` (the Rust side of ``walker``)."""
 
 import os
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import pandas as pd
 
 DEFAULT_GAIT_STRIDE_BUDGET: int
 """Strides one gait search may take by default (``--max-strides``)."""
+MAX_BASIN_CELL_STRIDES: int
+"""Most strides a basin cell may take (``basin(strides=)``)."""
 MAX_MAP_CELLS: int
 """Most cells of one stability map."""
 MAX_ORBIT_POINTS: int
@@ -49,16 +51,51 @@ def gait(scene: Scene, *, max_strides: int | None = None) -> dict[str, Any]:
     """The ``walker gait --json`` object of the scene's gait; raises ``GaitNotFound``,
     ``StrideFailed`` or ``SceneError``."""
 
-def gaits(scene: Scene) -> dict[str, Any]:
+def gaits(scene: Scene, *, progress: Callable[[int, int], None] | None = None) -> dict[str, Any]:
     """The ``walker gaits --json`` object: every period-1 gait, longest step period first."""
 
 def orbit_diagram(scene: Scene, param: str, values: list[float]) -> dict[str, Any]:
     """The ``walker orbit-diagram --json`` object of ``param`` over ``values``."""
 
 def stability_map(
-    scene: Scene, x: tuple[str, list[float]], y: tuple[str, list[float]]
+    scene: Scene,
+    x: tuple[str, list[float]],
+    y: tuple[str, list[float]],
+    *,
+    quantity: str | None = None,
+    sigma_m: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
-    """The ``walker stability-map --json`` object of the grid ``x`` × ``y``."""
+    """The ``walker stability-map --json`` object of the grid ``x`` × ``y`` (with
+    ``quantity`` mapped too)."""
+
+def robustness(
+    scene: Scene,
+    *,
+    measures: list[str] | None = None,
+    sigma_m: list[float] | None = None,
+    mfpt_runs: int | None = None,
+    mfpt_strides: int | None = None,
+    mfpt_seed: int | None = None,
+    rate_scan_step: float = 1e-2,
+    return_strides: int | None = None,
+    max_strides: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Any]:
+    """The ``walker robustness --json`` object of the scene's gait; raises ``InputError``,
+    ``SceneError``, ``GaitNotFound`` or ``StrideFailed``."""
+
+def basin(
+    scene: Scene,
+    x: tuple[str, list[float]],
+    y: tuple[str, list[float]],
+    *,
+    strides: int | None = None,
+    max_strides: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Any]:
+    """The ``walker basin --json`` object of the slice ``x`` × ``y`` through the scene's
+    gait; raises ``InputError``, ``SceneError``, ``GaitNotFound`` or ``StrideFailed``."""
 
 def sweep(
     scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int | None = None

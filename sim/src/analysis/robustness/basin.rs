@@ -19,6 +19,7 @@
 use super::recovery::{Outcome, Recovery, Until};
 use crate::engine::kinematics::Kinematics;
 use crate::engine::model::PointIndex;
+use crate::engine::walker::Walker;
 use crate::stride::StrideWorkspace;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -82,6 +83,9 @@ pub struct BasinSlice {
     pub fraction_returning: f64,
 }
 
+/// Most strides a cell may take to return to the gait.
+pub const MAX_BASIN_CELL_STRIDES: usize = 10_000;
+
 /// Why a slice was refused.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum BasinError {
@@ -121,17 +125,16 @@ impl FootHeight<'_> {
     }
 }
 
-/// The slice of `recovery`'s gait over the `x` and `y` axes (module documentation).
+/// The stride-map indices of the axes `x` and `y` of a slice of `walker`'s basin, checked before
+/// anything is computed.
 ///
 /// # Errors
 /// An axis that is not a stride-map coordinate, both axes the same, an empty axis.
-pub fn basin_slice(
-    recovery: &Recovery<'_>,
-    x: BasinAxis,
-    y: BasinAxis,
-    progress: &(dyn Fn() + Sync),
-) -> Result<BasinSlice, BasinError> {
-    let walker = recovery.walker;
+pub fn basin_axes(
+    walker: &Walker,
+    x: &BasinAxis,
+    y: &BasinAxis,
+) -> Result<(usize, usize), BasinError> {
     let names = walker.map_names();
     let index = |a: &BasinAxis| {
         if a.values.is_empty() {
@@ -145,10 +148,26 @@ pub fn basin_slice(
                 known: names.join(", "),
             })
     };
-    let (ix, iy) = (index(&x)?, index(&y)?);
+    let (ix, iy) = (index(x)?, index(y)?);
     if ix == iy {
         return Err(BasinError::SameAxis(x.name.clone()));
     }
+    Ok((ix, iy))
+}
+
+/// The slice of `recovery`'s gait over the `x` and `y` axes (module documentation).
+///
+/// # Errors
+/// An axis that is not a stride-map coordinate, both axes the same, an empty axis.
+pub fn basin_slice(
+    recovery: &Recovery<'_>,
+    x: BasinAxis,
+    y: BasinAxis,
+    progress: &(dyn Fn() + Sync),
+) -> Result<BasinSlice, BasinError> {
+    let walker = recovery.walker;
+    let names = walker.map_names();
+    let (ix, iy) = basin_axes(walker, &x, &y)?;
     let n = names.len() / 2;
     let coords = walker.map_coordinates();
     let model = walker.model();

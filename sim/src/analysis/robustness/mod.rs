@@ -20,7 +20,9 @@ pub mod first_passage;
 pub mod recovery;
 pub mod threshold;
 
-pub use basin::{basin_slice, BasinAxis, BasinCell, BasinSlice};
+pub use basin::{
+    basin_axes, basin_slice, BasinAxis, BasinCell, BasinError, BasinSlice, MAX_BASIN_CELL_STRIDES,
+};
 pub use first_passage::{mean_first_passage, FirstPassage, FirstPassageOptions};
 pub use recovery::{Outcome, Recovery, ReturnRule};
 pub use threshold::{
