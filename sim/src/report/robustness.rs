@@ -90,12 +90,12 @@ impl Measures {
 pub struct RobustnessOptions {
     /// The measures to take.
     pub measures: Measures,
-    /// The rough floors' standard deviations for the mean first-passage time [m]; empty: 0.001,
+    /// The rough floors' standard deviations for the mean first-passage time \[m\]; empty: 0.001,
     /// 0.003 and 0.01 leg lengths.
     pub sigma_m: Vec<f64>,
     /// The Monte Carlo walks per roughness, their strides and seeds.
     pub first_passage: FirstPassageOptions,
-    /// The scan's grid step of the rate thresholds [natural rates sqrt(g/L)].
+    /// The scan's grid step of the rate thresholds \[natural rates sqrt(g/L)\].
     pub rate_scan_step: f64,
     /// Strides a disturbed walker may take to come back within the return rule's tolerance.
     pub return_strides: usize,
@@ -288,9 +288,9 @@ pub struct Signs {
 /// Where survival starts again past each step threshold (`null`: not up to the limit).
 #[derive(Clone, Debug, Serialize)]
 pub struct Again {
-    /// Past the step-down threshold [m].
+    /// Past the step-down threshold \[m\].
     pub down: Option<f64>,
-    /// Past the step-up threshold [m].
+    /// Past the step-up threshold \[m\].
     pub up: Option<f64>,
 }
 
@@ -304,13 +304,13 @@ pub struct RobustnessReport {
     pub gait: GaitReport,
     /// The gait sensitivity norm (`null`: not measured or failed).
     pub gait_sensitivity_norm: Option<GaitSensitivity>,
-    /// Largest step down survived [m].
+    /// Largest step down survived \[m\].
     pub step_down_max_m: Option<f64>,
-    /// Largest step up survived [m].
+    /// Largest step up survived \[m\].
     pub step_up_max_m: Option<f64>,
     /// Where survival starts again past the step thresholds.
     pub survived_again_from_m: Option<Again>,
-    /// Largest change of each rate survived, by coordinate [rad/s or m/s].
+    /// Largest change of each rate survived, by coordinate \[rad/s or m/s\].
     pub velocity_perturbation_max: Option<BTreeMap<String, Signs>>,
     /// The mean first-passage time at each roughness.
     pub mfpt: Vec<FirstPassage>,
