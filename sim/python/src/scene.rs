@@ -14,6 +14,8 @@ use sim::scene::Scene;
 pub struct PyScene {
     /// The library's scene.
     pub inner: Scene,
+    /// What `Scene.load` was given (a built-in name or a path), for `repr`.
+    source: String,
 }
 
 #[pymethods]
@@ -32,7 +34,10 @@ impl PyScene {
         let inner = Scene::load(name_or_path).map_err(|e| errors::scene_error(py, &e))?;
         // Built once, so a scene that cannot be built is refused here, not at first use.
         inner.setup().map_err(|e| errors::scene_error(py, &e))?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            source: name_or_path.to_owned(),
+        })
     }
 
     /// The scene's name.
@@ -114,11 +119,33 @@ impl PyScene {
             given.push((name, key));
         }
         inner.setup().map_err(|e| errors::scene_error(py, &e))?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            source: self.source.clone(),
+        })
     }
 
+    /// `Scene.load("NAME")`, then `.with_params(k=v, ...)` with every value that is not the
+    /// scene file's default: an expression that builds the same scene.
     fn __repr__(&self) -> String {
-        format!("Scene.load({:?})", self.inner.name())
+        let changed: Vec<String> = SceneEntry::of(&self.inner)
+            .map(|entry| {
+                entry
+                    .parameters
+                    .iter()
+                    .filter_map(|p| {
+                        let v = *self.inner.values.get(&p.name)?;
+                        (v.to_bits() != p.default.to_bits()).then(|| format!("{}={v:?}", p.name))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let load = format!("Scene.load({:?})", self.source);
+        if changed.is_empty() {
+            load
+        } else {
+            format!("{load}.with_params({})", changed.join(", "))
+        }
     }
 }
 

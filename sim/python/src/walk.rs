@@ -12,7 +12,7 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use sim::analysis::limit_cycle::NewtonError;
-use sim::analysis::walk_start::other_scene_gait;
+use sim::analysis::walk_start::{self as walk_start, GaitStart};
 use sim::engine::walker::Walker;
 use sim::report::{GaitReport, StartRecord, WalkReport};
 use sim::scene::Scene;
@@ -252,31 +252,27 @@ fn run(
     })
 }
 
-/// The start from the scene's gait as `walker walk` takes it: its own gait, or when it has none
-/// that of the scene it names to start from (`walk_start_scene`; the report's `start` names
-/// it); the scene's own search error when neither has one.
+/// The start from the scene's gait as `walker walk` takes it
+/// ([`sim::analysis::walk_start::gait_start`]): its own gait, or when it has none that of the
+/// scene it names to start from (the report's `start` names it). When neither has one, the
+/// error is the scene's own search's (the `GaitNotFound` report is this scene's).
 fn gait_start(
     scene: &Scene,
     walker: &Walker,
     budget: &Arc<SearchBudget>,
 ) -> Result<Result<(DVector<f64>, StartRecord), NewtonError>, SceneError> {
     with_rule(budget, |rule| {
-        let own = match rule.gait(scene)? {
-            Ok((g, source)) => {
-                let record = StartRecord::gait(scene.name(), &g, source);
-                return Ok(Ok((g.fixed_point, record)));
+        Ok(match walk_start::gait_start(scene, walker, rule)? {
+            GaitStart::Own { gait, source } => {
+                let record = StartRecord::gait(scene.name(), &gait, source);
+                Ok((gait.fixed_point, record))
             }
-            Err(e) => e,
-        };
-        let Some(other) = &scene.file.walk_start_scene else {
-            return Ok(Err(own));
-        };
-        Ok(other_scene_gait(other, scene, walker, rule)?
-            .map(|s| {
-                let record = StartRecord::gait(s.scene.name(), &s.gait, s.source);
-                (s.state, record)
-            })
-            .map_err(|_| own))
+            GaitStart::Other { start, .. } => {
+                let record = StartRecord::gait(start.scene.name(), &start.gait, start.source);
+                Ok((start.state, record))
+            }
+            GaitStart::None { own, .. } => Err(own),
+        })
     })
 }
 

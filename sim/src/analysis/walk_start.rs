@@ -59,3 +59,65 @@ pub fn other_scene_gait(
         source,
     }))
 }
+
+/// Where a walk "from the gait" starts ([`gait_start`]).
+#[derive(Clone, Debug)]
+pub enum GaitStart {
+    /// The scene's own gait.
+    Own {
+        /// The gait.
+        gait: Box<Gait>,
+        /// Where it came from.
+        source: GaitSource,
+    },
+    /// The scene has no gait of its own; the scene it names to start from
+    /// (`walk_start_scene`) has one.
+    Other {
+        /// The scene's own search error.
+        own: NewtonError,
+        /// The other scene's gait and the start it gives.
+        start: Box<OtherSceneStart>,
+    },
+    /// Neither the scene nor the scene it names (if any) has a gait.
+    None {
+        /// The scene's own search error.
+        own: NewtonError,
+        /// The scene it names to start from, and that scene's search error.
+        other: Option<(String, NewtonError)>,
+    },
+}
+
+/// The one rule of a walk from the gait, for `walker walk`, `walker sil` and the Python
+/// package: the scene's own gait by `rule`; when it has none and names a scene to start from
+/// (`walk_start_scene`), that scene's gait ([`other_scene_gait`]).
+///
+/// # Errors
+/// A scene cannot be loaded or built at the values the rule visits.
+pub fn gait_start(
+    scene: &Scene,
+    walker: &Walker,
+    rule: &GaitRule<'_>,
+) -> Result<GaitStart, SceneError> {
+    let own = match rule.gait(scene)? {
+        Ok((gait, source)) => {
+            return Ok(GaitStart::Own {
+                gait: Box::new(gait),
+                source,
+            })
+        }
+        Err(e) => e,
+    };
+    let Some(other) = &scene.file.walk_start_scene else {
+        return Ok(GaitStart::None { own, other: None });
+    };
+    Ok(match other_scene_gait(other, scene, walker, rule)? {
+        Ok(start) => GaitStart::Other {
+            own,
+            start: Box::new(start),
+        },
+        Err(e) => GaitStart::None {
+            own,
+            other: Some((other.clone(), e)),
+        },
+    })
+}

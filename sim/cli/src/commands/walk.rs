@@ -18,6 +18,7 @@ use crate::search_progress::SearchProgress;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::homotopy::GaitRule;
+use sim::analysis::walk_start::{gait_start, GaitStart};
 use sim::report::{StartRecord, WalkGaitRecord, WalkReport};
 use sim::scene::Scene;
 use sim::stride::walk::WalkRequest;
@@ -127,26 +128,39 @@ pub fn run(args: WalkArgs) -> Result<ExitCode> {
     let started = match (start_from_scene, start.as_str()) {
         (Some(other), _) => from_other(&other)?,
         (None, "guess") => Some((v0, StartRecord::guess(scene.name()))),
-        (None, "gait") => match rule.gait(&scene)? {
-            Ok((g, source)) => {
-                let record = StartRecord::gait(scene.name(), &g, source);
-                Some((g.fixed_point, record))
+        (None, "gait") => match gait_start(&scene, walker, &rule)? {
+            GaitStart::Own { gait, source } => {
+                let record = StartRecord::gait(scene.name(), &gait, source);
+                Some((gait.fixed_point, record))
             }
-            Err(e) => match &scene.file.walk_start_scene {
-                Some(other) => {
-                    output::note(format_args!(
-                        "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
-                        scene.name()
-                    ));
-                    from_other(other)?
-                }
-                None => {
-                    output::note(format_args!(
-                        "error: no gait to start from: {e} (use --start guess)"
-                    ));
-                    None
-                }
-            },
+            GaitStart::Other { start, .. } => {
+                output::note(format_args!(
+                    "note: scene `{}` has no gait of its own; starting from the gait of `{}`",
+                    scene.name(),
+                    start.scene.name()
+                ));
+                let record = StartRecord::gait(start.scene.name(), &start.gait, start.source);
+                Some((start.state, record))
+            }
+            GaitStart::None {
+                other: Some((other, e)),
+                ..
+            } => {
+                output::note(format_args!(
+                    "note: scene `{}` has no gait of its own; starting from the gait of `{other}`",
+                    scene.name()
+                ));
+                output::note(format_args!(
+                    "error: scene `{other}` has no gait to start from: {e}"
+                ));
+                None
+            }
+            GaitStart::None { own, other: None } => {
+                output::note(format_args!(
+                    "error: no gait to start from: {own} (use --start guess)"
+                ));
+                None
+            }
         },
         (None, other) => {
             return Err(
