@@ -2,8 +2,8 @@
 
 use crate::input_error::InputError;
 use clap::Args;
-use sim::analysis::limit_cycle::{JacobianMethod, NewtonSettings};
-use sim::engine::integrators::IntegratorChoice;
+use sim::analysis::limit_cycle::NewtonSettings;
+use sim::analysis::solver_options::{jacobian_method, SolverOptionError, SolverOptions};
 use sim::scene::{Scene, SceneError, Setup};
 use sim::stride::StrideSettings;
 
@@ -101,97 +101,40 @@ impl Common {
         }
     }
 
+    /// The numerical options as the library takes them (`jacobian` read later, by
+    /// [`Self::configure`]).
+    fn solver(&self) -> SolverOptions {
+        SolverOptions {
+            integrator: self.integrator.clone(),
+            step_s: self.step_s,
+            rtol: self.rtol,
+            newton_tol: self.newton_tol,
+            newton_max_iter: self.newton_max_iter,
+            max_strides: self.max_strides,
+            perturbation: self.perturbation,
+            frozen_steps: self.frozen_steps,
+            jacobian: jacobian_method(&self.jacobian).unwrap_or_default(),
+        }
+    }
+
     /// Applies the integrator options to a scene's stride settings; checks every numeric
-    /// option.
+    /// option ([`SolverOptions::configure`]).
     fn configure(&self, settings: &mut StrideSettings) -> Result<(), InputError> {
-        let positive = |name: &str, v: Option<f64>| match v {
-            Some(x) if !(x.is_finite() && x > 0.0) => Err(InputError::Other(format!(
-                "--{name} must be a positive number, got {}",
-                sim::scene::short_number(x)
-            ))),
-            _ => Ok(()),
-        };
-        positive("step-s", self.step_s)?;
-        positive("rtol", self.rtol)?;
-        positive("newton-tol", Some(self.newton_tol))?;
-        if self.max_strides == 0 {
-            return Err(InputError::Other(
-                "--max-strides must be at least 1 (strides one gait search may take)".to_owned(),
-            ));
-        }
-        if self.newton_max_iter == 0 {
-            return Err(InputError::Other(
-                "--newton-max-iter must be at least 1 (Newton iterations allowed)".to_owned(),
-            ));
-        }
-        positive("perturbation", Some(self.perturbation))?;
-        if !matches!(self.jacobian.as_str(), "central" | "variational") {
-            return Err(InputError::Other(format!(
-                "--jacobian `{}`: expected central or variational",
-                self.jacobian
-            )));
-        }
-        if let Some(kind) = &self.integrator {
-            settings.integrator =
-                IntegratorChoice::from_kind(kind, self.step_s, self.rtol, None, None).ok_or_else(
-                    || {
-                        InputError::Other(format!(
-                            "--integrator `{kind}`: expected meijaard, rk4, dopri5 or dop853"
-                        ))
-                    },
-                )?;
-        } else {
-            settings.integrator = settings
-                .integrator
-                .with_tolerance_or_step(self.rtol, self.step_s);
-        }
-        // A flag the chosen integrator would ignore is refused, not dropped in silence.
-        let adaptive = matches!(
-            settings.integrator,
-            IntegratorChoice::Dopri5 { .. } | IntegratorChoice::Dop853 { .. }
-        );
-        let kind = settings.integrator.kind();
-        if adaptive && self.step_s.is_some() {
-            return Err(InputError::Other(format!(
-                "--step-s sets the fixed step of meijaard and rk4; the integrator here is {kind}, which chooses its own steps (use --rtol, or --integrator rk4)"
-            )));
-        }
-        if !adaptive && self.rtol.is_some() {
-            return Err(InputError::Other(format!(
-                "--rtol sets the tolerance of dopri5 and dop853; the integrator here is {kind}, with a fixed step (use --step-s, or --integrator dop853)"
-            )));
-        }
-        // A step too small for the stride's budgets would only run out of them, slowly.
-        settings
-            .validate()
-            .map_err(|e| InputError::Other(e.to_string()))
+        let flag = |field: &str| format!("--{}", field.replace('_', "-"));
+        let refused = |e: SolverOptionError| InputError::Other(e.message(&flag));
+        jacobian_method(&self.jacobian).map_err(refused)?;
+        self.solver().configure(settings).map_err(refused)
     }
 
     /// How a gait is followed from the scene's defaults, with the gait's budget of strides
     /// (`--max-strides`).
     pub fn homotopy(&self) -> sim::analysis::homotopy::HomotopySettings {
-        sim::analysis::homotopy::HomotopySettings {
-            gait_stride_budget: self.max_strides,
-            ..Default::default()
-        }
+        self.solver().homotopy()
     }
 
     /// The gait search's settings.
     pub fn newton(&self) -> NewtonSettings {
-        NewtonSettings {
-            tolerance: self.newton_tol,
-            max_iterations: self.newton_max_iter,
-            perturbation: self.perturbation,
-            central: true,
-            forward_stepping: true,
-            max_halvings: 8,
-            frozen_steps: self.frozen_steps,
-            jacobian: match self.jacobian.as_str() {
-                "variational" => JacobianMethod::Variational,
-                _ => JacobianMethod::CentralDifferences,
-            },
-            ..NewtonSettings::default()
-        }
+        self.solver().newton()
     }
 }
 

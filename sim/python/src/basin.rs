@@ -3,7 +3,7 @@
 
 use crate::convert;
 use crate::errors;
-use crate::gait::{rule_gait, setup_for};
+use crate::gait::{rule_gait, search_budget, setup_for};
 use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
@@ -44,10 +44,6 @@ pub fn basin<'py>(
         Some(v) => convert::count_in(py, v, "strides", (1, MAX_BASIN_CELL_STRIDES))?,
         None => ReturnRule::default().max_strides,
     };
-    let max_strides = match max_strides {
-        Some(v) => convert::count_in(py, v, "max_strides", (1, usize::MAX))?,
-        None => sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
-    };
     let (x, y) = (
         BasinAxis {
             name: x.0,
@@ -71,16 +67,16 @@ pub fn basin<'py>(
             &format!("an axis value must be a finite number, got {bad}"),
         ));
     }
-    let scene = &scene.inner;
+    let search = search_budget(py, max_strides, &scene.solver)?;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     // The axes before the gait search: a wrong one fails at once.
     let setup = scene.setup().map_err(|e| errors::scene_error(py, &e))?;
     basin_axes(&setup.walker, &x, &y).map_err(|e| basin_error(py, scene.name(), e))?;
-    let search = Arc::new(SearchBudget::new(max_strides));
     let measuring = Arc::new(SearchBudget::new(usize::MAX));
     let counter = Counter::new(cells, progress);
     let report = interrupt::run_counted(py, &[&search, &measuring], &counter, || {
-        let sourced = rule_gait(scene, &search).map_err(Refused::Scene)?;
-        let setup = setup_for(&measuring)(scene).map_err(Refused::Scene)?;
+        let sourced = rule_gait(scene, solver, &search).map_err(Refused::Scene)?;
+        let setup = setup_for(solver, &measuring)(scene).map_err(Refused::Scene)?;
         let source = sourced.as_ref().ok().map(|(_, s)| *s);
         let result = sourced.map(|(g, _)| g);
         let (mut gait_report, _) = GaitReport::of_setup(&setup, scene, &result, false);

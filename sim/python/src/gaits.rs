@@ -7,7 +7,7 @@ use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
 use sim::analysis::census::{census_units, census_with_progress, CensusSettings};
-use sim::analysis::limit_cycle::NewtonSettings;
+use sim::analysis::solver_options::SolverOptions;
 use sim::report::{GaitReport, GaitsReport};
 use sim::scene::{Scene, SceneError};
 use sim::stride::SearchBudget;
@@ -17,17 +17,18 @@ use std::sync::Arc;
 /// `cancel` (unlimited, there to stop it).
 fn report(
     scene: &Scene,
+    solver: &SolverOptions,
     cancel: &Arc<SearchBudget>,
     counter: &Counter,
 ) -> Result<GaitsReport, SceneError> {
     let found = census_with_progress(
         scene,
-        &setup_for(cancel),
-        &NewtonSettings::default(),
+        &setup_for(solver, cancel),
+        &solver.newton(),
         &CensusSettings::default(),
         &|| counter.tick(),
     )?;
-    let setup = scene.setup()?;
+    let setup = setup_for(solver, cancel)(scene)?;
     Ok(GaitsReport {
         scene: scene.name().to_string(),
         gaits: found
@@ -52,10 +53,10 @@ pub fn gaits<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let cancel = Arc::new(SearchBudget::new(usize::MAX));
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     let counter = Counter::new(census_units(scene, &CensusSettings::default()), progress);
     let report = interrupt::run_counted(py, &[&cancel], &counter, || {
-        report(scene, &cancel, &counter)
+        report(scene, solver, &cancel, &counter)
     })?
     .map_err(|e| errors::scene_error(py, &e))?;
     convert::report(py, &report)

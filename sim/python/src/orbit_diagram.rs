@@ -7,7 +7,6 @@ use crate::gait::setup_for;
 use crate::interrupt;
 use crate::scene::PyScene;
 use pyo3::prelude::*;
-use sim::analysis::limit_cycle::NewtonSettings;
 use sim::analysis::orbit_diagram::{
     orbit_diagram as diagram, OrbitError, OrbitSettings, MAX_ORBIT_POINTS,
 };
@@ -28,7 +27,7 @@ pub fn orbit_diagram<'py>(
     param: &str,
     values: Vec<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     let param = scene
         .parameter_name(param)
         .map_err(|e| errors::scene_error(py, &e))?;
@@ -55,10 +54,10 @@ pub fn orbit_diagram<'py>(
     let found = interrupt::run(py, &[&cancel], || {
         diagram(
             scene,
-            &setup_for(&cancel),
+            &setup_for(solver, &cancel),
             &param,
             &values,
-            &NewtonSettings::default(),
+            &solver.newton(),
             &settings,
             &|| {},
         )
@@ -67,7 +66,7 @@ pub fn orbit_diagram<'py>(
         OrbitError::Scene(s) => errors::scene_error(py, &s),
         other => errors::input_error(py, &other.to_string()),
     })?;
-    let setup = scene.setup().map_err(|e| errors::scene_error(py, &e))?;
+    let setup = setup_for(solver, &cancel)(scene).map_err(|e| errors::scene_error(py, &e))?;
     convert::report(
         py,
         &OrbitDiagramReport::new(scene, &setup.walker, &param, &found, &settings),

@@ -4,7 +4,7 @@
 
 use crate::convert;
 use crate::errors;
-use crate::gait::{rule_gait, setup_for};
+use crate::gait::{rule_gait, search_budget, setup_for};
 use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
@@ -86,22 +86,16 @@ pub fn robustness<'py>(
             MAX_RETURN_STRIDES,
             defaults.return_strides,
         )?,
-        perturbation: defaults.perturbation,
+        perturbation: scene.solver.perturbation,
     };
     options.check().map_err(option_error)?;
-    let max_strides = count(
-        max_strides,
-        "max_strides",
-        usize::MAX,
-        sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
-    )?;
-    let search = Arc::new(SearchBudget::new(max_strides));
+    let search = search_budget(py, max_strides, &scene.solver)?;
     let measuring = Arc::new(SearchBudget::new(usize::MAX));
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     let counter = Counter::new(RobustnessReport::stages(&options), progress);
     let report = interrupt::run_counted(py, &[&search, &measuring], &counter, || {
-        let sourced = rule_gait(scene, &search)?;
-        let setup = setup_for(&measuring)(scene)?;
+        let sourced = rule_gait(scene, solver, &search)?;
+        let setup = setup_for(solver, &measuring)(scene)?;
         Ok(RobustnessReport::measure(
             &setup,
             scene,

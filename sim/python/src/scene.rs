@@ -5,6 +5,9 @@ use crate::convert;
 use crate::errors;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use sim::analysis::solver_options::{
+    jacobian_method, jacobian_name, SolverOptionError, SolverOptions,
+};
 use sim::report::{SceneCatalogue, SceneEntry};
 use sim::scene::Scene;
 
@@ -16,6 +19,8 @@ pub struct PyScene {
     pub inner: Scene,
     /// What `Scene.load` was given (a built-in name or a path), for `repr`.
     source: String,
+    /// The numerical options of every study of this scene (`with_solver`).
+    pub solver: SolverOptions,
 }
 
 #[pymethods]
@@ -37,6 +42,7 @@ impl PyScene {
         Ok(Self {
             inner,
             source: name_or_path.to_owned(),
+            solver: SolverOptions::default(),
         })
     }
 
@@ -122,11 +128,97 @@ impl PyScene {
         Ok(Self {
             inner,
             source: self.source.clone(),
+            solver: self.solver.clone(),
         })
     }
 
+    /// A new scene whose studies use these numerical options (each `None` keeps this scene's):
+    /// `integrator` (`meijaard`, `rk4`, `dopri5`, `dop853`), its fixed `step_s` [s] or its
+    /// tolerance `rtol`, Newton's `newton_tol` and `newton_max_iter`, the gait search's
+    /// `max_strides`, the Jacobian's `perturbation`, `frozen_steps` and `jacobian`
+    /// (`central`, `variational`): the `walker` command's `--integrator`, `--step-s`, `--rtol`,
+    /// `--newton-tol`, ... Raises `walker.InputError` for an option out of its range, an
+    /// unknown name, or one the integrator would ignore (a step for an adaptive one).
+    #[pyo3(signature = (
+        *, integrator = None, step_s = None, rtol = None, newton_tol = None,
+        newton_max_iter = None, max_strides = None, perturbation = None, frozen_steps = None,
+        jacobian = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn with_solver(
+        &self,
+        py: Python<'_>,
+        integrator: Option<String>,
+        step_s: Option<f64>,
+        rtol: Option<f64>,
+        newton_tol: Option<f64>,
+        newton_max_iter: Option<&Bound<'_, PyAny>>,
+        max_strides: Option<&Bound<'_, PyAny>>,
+        perturbation: Option<f64>,
+        frozen_steps: Option<bool>,
+        jacobian: Option<String>,
+    ) -> PyResult<Self> {
+        let refused = |e: SolverOptionError| errors::input_error(py, &e.message(&|n| n.to_owned()));
+        let old = &self.solver;
+        let count = |v: Option<&Bound<'_, PyAny>>, name: &str, default: usize| match v {
+            Some(v) => convert::count_in(py, v, name, (1, usize::MAX)),
+            None => Ok(default),
+        };
+        let solver = SolverOptions {
+            integrator: integrator.or_else(|| old.integrator.clone()),
+            step_s: step_s.or(old.step_s),
+            rtol: rtol.or(old.rtol),
+            newton_tol: newton_tol.unwrap_or(old.newton_tol),
+            newton_max_iter: count(newton_max_iter, "newton_max_iter", old.newton_max_iter)?,
+            max_strides: count(max_strides, "max_strides", old.max_strides)?,
+            perturbation: perturbation.unwrap_or(old.perturbation),
+            frozen_steps: frozen_steps.unwrap_or(old.frozen_steps),
+            jacobian: match jacobian {
+                Some(name) => jacobian_method(&name).map_err(refused)?,
+                None => old.jacobian,
+            },
+        };
+        let mut setup = self
+            .inner
+            .setup()
+            .map_err(|e| errors::scene_error(py, &e))?;
+        solver.configure(&mut setup.settings).map_err(refused)?;
+        Ok(Self {
+            inner: self.inner.clone(),
+            source: self.source.clone(),
+            solver,
+        })
+    }
+
+    /// The numerical options of this scene's studies (`with_solver`): `integrator` (the
+    /// integrator the scene's stride runs with, and its settings), `newton_tol`,
+    /// `newton_max_iter`, `max_strides`, `perturbation`, `frozen_steps`, `jacobian`.
+    #[getter]
+    fn solver<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let mut setup = self
+            .inner
+            .setup()
+            .map_err(|e| errors::scene_error(py, &e))?;
+        self.solver
+            .configure(&mut setup.settings)
+            .map_err(|e| errors::input_error(py, &e.to_string()))?;
+        let d = PyDict::new(py);
+        d.set_item(
+            "integrator",
+            convert::report(py, &setup.settings.integrator)?,
+        )?;
+        d.set_item("newton_tol", self.solver.newton_tol)?;
+        d.set_item("newton_max_iter", self.solver.newton_max_iter)?;
+        d.set_item("max_strides", self.solver.max_strides)?;
+        d.set_item("perturbation", self.solver.perturbation)?;
+        d.set_item("frozen_steps", self.solver.frozen_steps)?;
+        d.set_item("jacobian", jacobian_name(self.solver.jacobian))?;
+        Ok(d)
+    }
+
     /// `Scene.load("NAME")`, then `.with_params(k=v, ...)` with every value that is not the
-    /// scene file's default: an expression that builds the same scene.
+    /// scene file's default and `.with_solver(...)` with every option set: an expression that
+    /// builds the same scene.
     fn __repr__(&self) -> String {
         let changed: Vec<String> = SceneEntry::of(&self.inner)
             .map(|entry| {
@@ -140,12 +232,43 @@ impl PyScene {
                     .collect()
             })
             .unwrap_or_default();
-        let load = format!("Scene.load({:?})", self.source);
-        if changed.is_empty() {
-            load
-        } else {
-            format!("{load}.with_params({})", changed.join(", "))
+        let mut shown = format!("Scene.load({:?})", self.source);
+        if !changed.is_empty() {
+            shown += &format!(".with_params({})", changed.join(", "));
         }
+        let (o, d) = (&self.solver, SolverOptions::default());
+        let mut set: Vec<String> = Vec::new();
+        if let Some(k) = &o.integrator {
+            set.push(format!("integrator={k:?}"));
+        }
+        if let Some(h) = o.step_s {
+            set.push(format!("step_s={h:?}"));
+        }
+        if let Some(r) = o.rtol {
+            set.push(format!("rtol={r:?}"));
+        }
+        if o.newton_tol.to_bits() != d.newton_tol.to_bits() {
+            set.push(format!("newton_tol={:?}", o.newton_tol));
+        }
+        if o.newton_max_iter != d.newton_max_iter {
+            set.push(format!("newton_max_iter={}", o.newton_max_iter));
+        }
+        if o.max_strides != d.max_strides {
+            set.push(format!("max_strides={}", o.max_strides));
+        }
+        if o.perturbation.to_bits() != d.perturbation.to_bits() {
+            set.push(format!("perturbation={:?}", o.perturbation));
+        }
+        if o.frozen_steps {
+            set.push("frozen_steps=True".to_owned());
+        }
+        if o.jacobian != d.jacobian {
+            set.push(format!("jacobian={:?}", jacobian_name(o.jacobian)));
+        }
+        if !set.is_empty() {
+            shown += &format!(".with_solver({})", set.join(", "));
+        }
+        shown
     }
 }
 

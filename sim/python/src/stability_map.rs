@@ -7,8 +7,6 @@ use crate::gait::setup_for;
 use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
-use sim::analysis::homotopy::HomotopySettings;
-use sim::analysis::limit_cycle::NewtonSettings;
 use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis, MAX_MAP_CELLS};
 use sim::report::StabilityMapReport;
@@ -67,7 +65,7 @@ pub fn stability_map<'py>(
             "sigma_m is the rough floor of quantity=\"mfpt\": give quantity=\"mfpt\" too",
         ));
     }
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     let axis = |(name, values): (String, Vec<f64>)| -> PyResult<Axis> {
         Ok(Axis {
             name: scene
@@ -98,11 +96,11 @@ pub fn stability_map<'py>(
     let map = interrupt::run_counted(py, &[&cancel], &counter, || {
         stability_map_of(
             scene,
-            &setup_for(&cancel),
+            &setup_for(solver, &cancel),
             &x,
             &y,
-            &NewtonSettings::default(),
-            &HomotopySettings::default(),
+            &solver.newton(),
+            &solver.homotopy(),
             quantity.map(|q| (q, &options)),
             &|| counter.tick(),
         )

@@ -9,7 +9,6 @@ use pyo3::prelude::*;
 use sim::analysis::continuation::{
     continuation, ContinuationSettings, SweepError, MAX_SWEEP_PERIOD, MAX_SWEEP_POINTS,
 };
-use sim::analysis::limit_cycle::NewtonSettings;
 use sim::report::SweepReport;
 use sim::stride::SearchBudget;
 use std::sync::Arc;
@@ -36,17 +35,29 @@ pub fn sweep<'py>(
         Some(m) => convert::count_in(py, m, "max_period", (1, MAX_SWEEP_PERIOD))?,
         None => 1,
     };
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     if !(start.is_finite() && end.is_finite()) || start == end {
         return Err(errors::input_error(
             py,
             &format!("start and end must be two different finite numbers, got {start} and {end}"),
         ));
     }
+    // The scene's integrator options apply at every parameter value, as the command's do.
+    let overridden =
+        solver.integrator.is_some() || solver.rtol.is_some() || solver.step_s.is_some();
+    let stride_settings = if overridden {
+        let mut setup = scene.setup().map_err(|e| errors::scene_error(py, &e))?;
+        solver
+            .configure(&mut setup.settings)
+            .map_err(|e| errors::input_error(py, &e.to_string()))?;
+        Some(setup.settings)
+    } else {
+        None
+    };
     let settings = ContinuationSettings::builder()
-        .newton(NewtonSettings::default())
+        .newton(solver.newton())
         .max_period(max_period)
-        .stride_settings(None)
+        .stride_settings(stride_settings)
         .build()
         .map_err(|e| errors::input_error(py, &e.to_string()))?;
     let nothing_to_cancel = Arc::new(SearchBudget::new(usize::MAX));

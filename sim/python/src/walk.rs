@@ -3,7 +3,7 @@
 
 use crate::convert;
 use crate::errors;
-use crate::gait::with_rule;
+use crate::gait::{search_budget, setup_for, with_rule};
 use crate::interrupt;
 use crate::scene::PyScene;
 use nalgebra::DVector;
@@ -12,6 +12,7 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use sim::analysis::limit_cycle::NewtonError;
+use sim::analysis::solver_options::SolverOptions;
 use sim::analysis::walk_start::{self as walk_start, GaitStart};
 use sim::engine::walker::Walker;
 use sim::report::{GaitReport, StartRecord, WalkReport};
@@ -88,10 +89,6 @@ pub fn walk<'py>(
     max_path_samples: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
     let steps = convert::count_in(py, steps, "steps", (0, MAX_WALK_STEPS))?;
-    let max_strides = match max_strides {
-        Some(m) => convert::count_in(py, m, "max_strides", (1, usize::MAX))?,
-        None => sim::analysis::homotopy::DEFAULT_GAIT_STRIDE_BUDGET,
-    };
     let max_path_samples = match max_path_samples {
         Some(m) => convert::count_in(py, m, "max_path_samples", (1, MAX_PATH_SAMPLES))?,
         None => DEFAULT_PATH_SAMPLES,
@@ -113,13 +110,14 @@ pub fn walk<'py>(
         state,
         perturb: entries(perturb)?,
     };
-    let search = Arc::new(SearchBudget::new(max_strides));
+    let search = search_budget(py, max_strides, &scene.solver)?;
     // The walk's own strides are not limited; this budget only stops them on Ctrl-C.
     let walking = Arc::new(SearchBudget::new(usize::MAX));
-    let scene = &scene.inner;
+    let (solver, scene) = (&scene.solver, &scene.inner);
     let walked = interrupt::run(py, &[&search, &walking], || {
         run(
             scene,
+            solver,
             steps,
             spec,
             floor,
@@ -179,20 +177,21 @@ fn entries(d: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, f64)>> {
 /// The walk, without the GIL.
 fn run(
     scene: &Scene,
+    solver: &SolverOptions,
     steps: usize,
     spec: StartSpec,
     floor: Floor,
     (path_interval_s, max_path_samples): (Option<f64>, usize),
     (search, walking): (&Arc<SearchBudget>, &Arc<SearchBudget>),
 ) -> Result<Walked, Refused> {
-    let setup = scene.setup().map_err(Refused::Scene)?;
+    let setup = setup_for(solver, walking)(scene).map_err(Refused::Scene)?;
     let walker = &setup.walker;
     let (mut v, record) = match spec.kind {
         Start::Guess => (
             walker.pack(&setup.guess.q, &setup.guess.qd),
             StartRecord::guess(scene.name()),
         ),
-        Start::Gait => gait_start(scene, walker, search)
+        Start::Gait => gait_start(scene, solver, walker, search)
             .map_err(Refused::Scene)?
             .map_err(|e| {
                 let report =
@@ -258,10 +257,11 @@ fn run(
 /// error is the scene's own search's (the `GaitNotFound` report is this scene's).
 fn gait_start(
     scene: &Scene,
+    solver: &SolverOptions,
     walker: &Walker,
     budget: &Arc<SearchBudget>,
 ) -> Result<Result<(DVector<f64>, StartRecord), NewtonError>, SceneError> {
-    with_rule(budget, |rule| {
+    with_rule(solver, budget, |rule| {
         Ok(match walk_start::gait_start(scene, walker, rule)? {
             GaitStart::Own { gait, source } => {
                 let record = StartRecord::gait(scene.name(), &gait, source);

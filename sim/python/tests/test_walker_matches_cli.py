@@ -195,3 +195,58 @@ def test_sweep_equals_the_cli_json(cli):
         walker.sweep("simplest", "slope", 0.012, 0.0155, 1)
     with pytest.raises(walker.InputError, match="different"):
         walker.sweep("simplest", "slope", 0.012, 0.012, 5)
+
+
+def test_solver_options_are_the_commands(cli):
+    scene = walker.Scene.load("compass").with_solver(integrator="dop853", rtol=1e-8, newton_tol=1e-10)
+    assert scene.solver["integrator"]["kind"] == "dop853" and scene.solver["newton_tol"] == 1e-10
+    code, expected, err = cli(
+        "gait", "--scene", "compass", "--integrator", "dop853", "--rtol", "1e-8", "--newton-tol", "1e-10", "--json"
+    )
+    assert code == 0, err
+    g = walker.gait(scene)
+    assert g.report == expected
+    assert g.report["integrator"] != walker.gait("compass").report["integrator"]
+    # the options travel with the scene through with_params, into every study
+    code, expected, err = cli(
+        "stability-map", "--scene", "compass", "--x", "slope_rad=0.04:0.06:2", "--y", "leg_mass_kg=4:6:2",
+        "--jacobian", "variational", "--json",
+    )
+    assert code == 0, err
+    m = walker.stability_map(
+        walker.Scene.load("compass").with_solver(jacobian="variational"),
+        x=("slope_rad", expected["x"]["values"]),
+        y=("leg_mass_kg", expected["y"]["values"]),
+        progress=False,
+    )
+    assert m.report == expected
+    code, expected, err = cli("walk", "--scene", "compass", "--steps", "3", "--integrator", "rk4", "--step-s", "0.002", "--json")
+    assert code == 0, err
+    w = walker.walk(walker.Scene.load("compass").with_solver(integrator="rk4", step_s=0.002), 3)
+    assert w.report == expected
+
+
+@pytest.mark.parametrize(
+    "options, match",
+    [
+        ({"step_s": -1.0}, "step_s must be a positive number"),
+        ({"rtol": float("nan")}, "rtol must be a positive number"),
+        ({"integrator": "euler"}, "integrator `euler`: expected meijaard, rk4, dopri5 or dop853"),
+        ({"integrator": "dop853", "step_s": 0.01}, "step_s sets the fixed step of meijaard and rk4"),
+        ({"integrator": "rk4", "rtol": 1e-6}, "rtol sets the tolerance of dopri5 and dop853"),
+        ({"jacobian": "forward"}, "jacobian `forward`: expected central or variational"),
+        ({"newton_max_iter": 0}, "newton_max_iter must be"),
+        ({"max_strides": -5}, "max_strides must be"),
+    ],
+)
+def test_solver_options_bad_input(options, match):
+    with pytest.raises(walker.InputError, match=match):
+        walker.Scene.load("compass").with_solver(**options)
+
+
+def test_a_scene_with_solver_options_repr_builds_it_again():
+    scene = walker.Scene.load("compass").with_params(slope=0.05).with_solver(integrator="rk4", step_s=0.002, jacobian="variational")
+    shown = repr(scene)
+    assert ".with_solver(" in shown and 'integrator="rk4"' in shown
+    again = eval(shown, {"Scene": walker.Scene})
+    assert again.solver == scene.solver and again.values == scene.values

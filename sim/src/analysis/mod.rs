@@ -13,6 +13,7 @@ pub mod optimize;
 pub mod orbit_diagram;
 pub mod quantity;
 pub mod robustness;
+pub mod solver_options;
 pub mod stability;
 pub mod stability_map;
 pub mod tune;

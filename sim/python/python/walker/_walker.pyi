@@ -40,6 +40,28 @@ class Scene:
     def describe(self) -> dict[str, Any]:
         """The ``walker scenes NAME --json`` object: summary, reference, degrees of freedom,
         coordinates, parameters."""
+    def with_solver(
+        self,
+        *,
+        integrator: str | None = None,
+        step_s: float | None = None,
+        rtol: float | None = None,
+        newton_tol: float | None = None,
+        newton_max_iter: int | None = None,
+        max_strides: int | None = None,
+        perturbation: float | None = None,
+        frozen_steps: bool | None = None,
+        jacobian: str | None = None,
+    ) -> Scene:
+        """A new scene whose studies use these numerical options (``None`` keeps this scene's):
+        the command's ``--integrator``, ``--step-s``, ``--rtol``, ``--newton-tol``,
+        ``--newton-max-iter``, ``--max-strides``, ``--perturbation``, ``--frozen-steps``,
+        ``--jacobian``; raises ``InputError``."""
+    @property
+    def solver(self) -> dict[str, Any]:
+        """The numerical options of this scene's studies: ``integrator`` (as the reports give
+        it), ``newton_tol``, ``newton_max_iter``, ``max_strides``, ``perturbation``,
+        ``frozen_steps``, ``jacobian``."""
     def with_params(self, **params: float) -> Scene:
         """A new scene with these parameters (by name or alias) set; raises ``SceneError``
         (unknown parameter, not a finite number, out of range) or ``InputError``."""
