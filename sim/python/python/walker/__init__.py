@@ -1,4 +1,5 @@
-"""The walker simulator from Python: scenes, gaits and walks as numpy arrays and pandas tables.
+"""The walker simulator from Python: scenes, gaits, walks and walks with the ankle firmware in
+the loop as numpy arrays and pandas tables.
 
 >>> import walker
 >>> scene = walker.Scene.load("compass").with_params(slope_rad=0.05)
@@ -23,25 +24,31 @@ from . import _walker
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
 from ._gait import Gait, Gaits
 from ._orbit_diagram import OrbitDiagram
+from ._sil import Sil
 from ._stability_map import StabilityMap
 from ._sweep import Sweep
 from ._walk import Walk
 from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
     DEFAULT_PATH_SAMPLES,
+    DEFAULT_SIL_FRAMES,
     MAX_MAP_CELLS,
     MAX_ORBIT_POINTS,
     MAX_PATH_SAMPLES,
+    MAX_SIL_FRAMES,
     MAX_WALK_STEPS,
     Scene,
+    dbc,
 )
 
 __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
     "DEFAULT_PATH_SAMPLES",
+    "DEFAULT_SIL_FRAMES",
     "MAX_MAP_CELLS",
     "MAX_ORBIT_POINTS",
     "MAX_PATH_SAMPLES",
+    "MAX_SIL_FRAMES",
     "MAX_WALK_STEPS",
     "Gait",
     "Gaits",
@@ -50,15 +57,18 @@ __all__ = [
     "OrbitDiagram",
     "Scene",
     "SceneError",
+    "Sil",
     "StabilityMap",
     "StrideFailed",
     "Sweep",
     "Walk",
     "WalkerError",
+    "dbc",
     "gait",
     "gaits",
     "orbit_diagram",
     "scenes",
+    "sil",
     "stability_map",
     "sweep",
     "walk",
@@ -152,6 +162,74 @@ def walk(
     return walked
 
 
+def sil(
+    scene: Scene | str | os.PathLike[str],
+    steps: int,
+    *,
+    faults: Sequence[str] = (),
+    sensor_faults: Sequence[str] = (),
+    firmware_params: Mapping[str, float] | Sequence[str] | None = None,
+    actuator: str = "servo",
+    estop_at_s: float | None = None,
+    floor: str = "plane",
+    keep_steps: int | None = None,
+    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    max_frames: int = DEFAULT_SIL_FRAMES,
+) -> Sil:
+    """Walks up to ``steps`` strides of ``scene`` with the ankle firmware in the loop (two
+    nodes on the simulated CAN bus actuating the ankles), as ``walker sil`` does: from the
+    ideal-actuator gait (found as :func:`gait` finds it), with the SIL integrator.
+
+    ``faults``: bus faults (``--fault``, e.g. ``"drop:id=0x022,count=5"``); ``sensor_faults``:
+    encoder faults (``--sensor-fault``, e.g. ``"stuck:side=left,from_ms=500"``);
+    ``firmware_params``: written to both ankles at start-up (``--firmware-param``), a mapping
+    ``{"taut_angle_rad": -0.07}`` or strings ``"taut_angle_rad=-0.07"``, in order;
+    ``actuator``: ``"servo"`` or ``"motor"``; ``estop_at_s``: the host's emergency stop at
+    this walk time (``--estop-at``); ``floor`` as :func:`walk`'s; ``keep_steps``: keep only
+    the last N step summaries (``--keep-steps``). ``max_frames`` (at most
+    :data:`MAX_SIL_FRAMES`) bounds the bus frames kept: past it the first ``max_frames`` are
+    kept, :attr:`Sil.frames_cut_at_time_s` says where, and a ``RuntimeWarning`` says so (0
+    keeps none, silently).
+
+    :attr:`Sil.report` is the ``walker sil --json`` object; :attr:`Sil.frames` the bus
+    frames (what ``--candump`` logs) decoded with the project's DBC (:func:`dbc`, cantools).
+    A fall is not an error (:attr:`Sil.failure`). Raises :class:`InputError` with the
+    command's message (an unknown fault, a bad firmware parameter, ``steps`` outside 0 to
+    :data:`MAX_WALK_STEPS`, a scene without actuated ankles), :class:`SceneError`,
+    :class:`GaitNotFound` / :class:`StrideFailed` (no ideal-actuator gait to start from),
+    ``KeyboardInterrupt`` on Ctrl-C (at the next step).
+    """
+    if firmware_params is None:
+        params: list[str] = []
+    elif isinstance(firmware_params, Mapping):
+        params = [f"{k}={v}" for k, v in firmware_params.items()]
+    elif isinstance(firmware_params, str):
+        params = [firmware_params]
+    else:
+        params = [str(p) for p in firmware_params]
+    report, frames = _walker.sil(
+        _scene(scene),
+        steps,
+        faults=[faults] if isinstance(faults, str) else list(faults),
+        sensor_faults=[sensor_faults] if isinstance(sensor_faults, str) else list(sensor_faults),
+        firmware_params=params,
+        actuator=actuator,
+        estop_at=estop_at_s,
+        floor=floor,
+        keep_steps=keep_steps,
+        max_strides=max_strides,
+        max_frames=max_frames,
+    )
+    ran = Sil.from_parts(report, frames)
+    if ran.frames_not_kept and max_frames > 0:
+        warnings.warn(
+            f"walker.sil: the bus frames stopped at {ran.frames_cut_at_time_s:.6g} s after "
+            f"max_frames={max_frames} frames ({ran.frames_not_kept} more not kept; the walk "
+            "went on: see Sil.report); a larger max_frames keeps more",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return ran
 
 
 def stability_map(
