@@ -7,12 +7,12 @@ use crate::errors;
 use crate::gait::rule_gait;
 use crate::interrupt;
 use crate::scene::PyScene;
+use ::sil::walk::{SilRun, Specs, WalkPlan};
+use ::sil::FrameLog;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sil::walk::{Specs, SilRun, WalkPlan};
-use sil::FrameLog;
 use sim::report::GaitReport;
 use sim::scene::Scene;
 use sim::stride::walk::MAX_WALK_STEPS;
@@ -33,8 +33,8 @@ enum Refused {
     Input(String),
 }
 
-impl From<sil::walk::SilInputError> for Refused {
-    fn from(e: sil::walk::SilInputError) -> Self {
+impl From<::sil::walk::SilInputError> for Refused {
+    fn from(e: ::sil::walk::SilInputError) -> Self {
         Refused::Input(e.0)
     }
 }
@@ -42,7 +42,7 @@ impl From<sil::walk::SilInputError> for Refused {
 /// The arguments of one SIL walk.
 struct Request {
     steps: usize,
-    actuator: sil::ActuatorChoice,
+    actuator: ::sil::ActuatorChoice,
     faults: Vec<String>,
     sensor_faults: Vec<String>,
     firmware_params: Vec<String>,
@@ -85,7 +85,11 @@ pub fn sil<'py>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
     // A count too large is refused by the library's check (the command's message); one that
     // is negative or not an integer, which the command cannot be given, here.
-    let steps = match steps.extract::<i64>().ok().and_then(|v| usize::try_from(v).ok()) {
+    let steps = match steps
+        .extract::<i64>()
+        .ok()
+        .and_then(|v| usize::try_from(v).ok())
+    {
         Some(n) => n,
         None => convert::count_in(py, steps, "steps", (0, MAX_WALK_STEPS))?,
     };
@@ -100,7 +104,7 @@ pub fn sil<'py>(
         Some(m) => convert::count_in(py, m, "max_frames", (0, MAX_SIL_FRAMES))?,
         None => DEFAULT_SIL_FRAMES,
     };
-    let (actuator, steps) = sil::walk::check_options(actuator, steps, estop_at)
+    let (actuator, steps) = ::sil::walk::check_options(actuator, steps, estop_at)
         .map_err(|e| errors::input_error(py, &e.0))?;
     let floor: Floor = floor
         .parse()
@@ -149,13 +153,13 @@ fn run(
     let actuator_choice = r.actuator;
     let setup = scene.setup().map_err(Refused::Scene)?;
     let walker = &setup.walker;
-    let reflex = sil::walk::require_ankle(walker, scene.name())?;
+    let reflex = ::sil::walk::require_ankle(walker, scene.name())?;
     let specs = Specs {
         firmware_params: &r.firmware_params,
         faults: &r.faults,
         sensor_faults: &r.sensor_faults,
     };
-    let (config, firmware_params_written) = sil::walk::config_from_specs(actuator_choice, specs)?;
+    let (config, firmware_params_written) = ::sil::walk::config_from_specs(actuator_choice, specs)?;
     let ideal_setup = scene.setup().map_err(Refused::Scene)?;
     let (ideal, source) = match rule_gait(scene, search).map_err(Refused::Scene)? {
         Ok(found) => found,
@@ -164,10 +168,10 @@ fn run(
             return Err(Refused::NoGait(Box::new(report)));
         }
     };
-    let mut settings = sil::walk::walk_settings(&setup.settings, false);
+    let mut settings = ::sil::walk::walk_settings(&setup.settings, false);
     settings.search_budget = SharedBudget(Some(Arc::clone(walking)));
     let mut ctl =
-        sil::FirmwareInTheLoop::new(config).map_err(|e| sil::walk::setup_error(&e))?;
+        ::sil::FirmwareInTheLoop::new(config).map_err(|e| ::sil::walk::setup_error(&e))?;
     if let Some(t) = r.estop_at {
         ctl.emergency_stop_at(t);
     }
@@ -180,11 +184,11 @@ fn run(
         floor: r.floor,
     };
     let (q, qd) = walker.unpack(&ideal.fixed_point);
-    let walk = sil::walk::walk_with_firmware(walker, (&q, &qd), &settings, &mut ctl, &plan, None);
+    let walk = ::sil::walk::walk_with_firmware(walker, (&q, &qd), &settings, &mut ctl, &plan, None);
     let frames = ctl.take_frame_log().unwrap_or_default();
     // No candump log to flush, no server to stop: finishing cannot fail.
     let firmware = ctl.finish().map_err(|e| Refused::Input(e.to_string()))?;
-    let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
+    let warnings = ::sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
     let report = SilRun {
         scene: scene.name(),
         walker,
@@ -212,8 +216,14 @@ fn frames<'py>(py: Python<'py>, log: &FrameLog) -> PyResult<Bound<'py, PyDict>> 
         "time_ns",
         PyArray1::from_vec(py, f.iter().map(|x| x.t_ns).collect()),
     )?;
-    d.set_item("id", PyArray1::from_vec(py, f.iter().map(|x| x.id).collect()))?;
-    d.set_item("dlc", PyArray1::from_vec(py, f.iter().map(|x| x.dlc).collect()))?;
+    d.set_item(
+        "id",
+        PyArray1::from_vec(py, f.iter().map(|x| x.id).collect()),
+    )?;
+    d.set_item(
+        "dlc",
+        PyArray1::from_vec(py, f.iter().map(|x| x.dlc).collect()),
+    )?;
     d.set_item(
         "error",
         PyArray1::from_vec(py, f.iter().map(|x| x.error).collect()),

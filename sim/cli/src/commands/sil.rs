@@ -340,7 +340,12 @@ fn walk_with_firmware(
     plan: &WalkPlan,
     (realtime, show_progress): (Option<f64>, bool),
 ) -> Walk {
-    let progress = Progress::after(PROGRESS_DELAY, plan.steps, "sil walk (steps)", show_progress);
+    let progress = Progress::after(
+        PROGRESS_DELAY,
+        plan.steps,
+        "sil walk (steps)",
+        show_progress,
+    );
     let mut tick = |_: &StepSummary| progress.tick();
     let walk = match realtime {
         None => sil::walk::walk_with_firmware(
@@ -370,11 +375,7 @@ fn walk_with_firmware(
 }
 
 /// The report as JSON or as text.
-fn write_report(
-    report: &SilWalkReport<'_>,
-    json: bool,
-    steps: usize,
-) -> Result<()> {
+fn write_report(report: &SilWalkReport<'_>, json: bool, steps: usize) -> Result<()> {
     if json {
         print_json(report)?;
     } else {
@@ -394,11 +395,7 @@ fn candump_error(candump: &Option<std::path::PathBuf>, e: sil::SilError) -> Inpu
     }
 }
 
-fn print_text(
-    out: &mut dyn Write,
-    r: &SilWalkReport<'_>,
-    steps: usize,
-) -> std::io::Result<()> {
+fn print_text(out: &mut dyn Write, r: &SilWalkReport<'_>, steps: usize) -> std::io::Result<()> {
     match r.emergency_stop_sent_s {
         None => writeln!(
             out,
