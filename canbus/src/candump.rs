@@ -491,7 +491,7 @@ pub enum WriteError {
     Timestamp(#[from] TimestampOverflow),
 }
 
-/// What a candump log records of a bus event, and when on the bus clock [ns]: a delivered
+/// What a candump log records of a bus event, and when on the bus clock \[ns\]: a delivered
 /// frame (stamped at the end of its interframe space), an error frame (`CAN_ERR_PROT |
 /// CAN_ERR_BUSERROR`, data byte 2 = `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF |
 /// CAN_ERR_BUSERROR`). [`CandumpWriter`] writes these; a run that keeps its frames in memory
