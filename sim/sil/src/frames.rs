@@ -74,3 +74,43 @@ impl FrameLog {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use canbus::candump::{CAN_ERR_BUSERROR, CAN_ERR_BUSOFF};
+    use canbus::{Frame, NodeHandle};
+
+    #[test]
+    fn the_first_events_are_kept_as_the_log_records_them_and_the_rest_counted() {
+        let frame = Frame::new(0x062, &[1, 2, 3]).unwrap();
+        let mut bus = canbus::Bus::new(canbus::BusConfig::default()).unwrap();
+        let node: NodeHandle = bus.attach("n", Some(2));
+        let delivered = BusEvent::Delivered(canbus::Delivered {
+            frame,
+            t_start_ns: 10,
+            t_end_ns: 250,
+            from: node,
+        });
+        let off = BusEvent::BusOff { node, t_ns: 900 };
+        let mut log = FrameLog::new(2);
+        for ev in [&delivered, &off, &delivered] {
+            log.push(ev);
+        }
+        assert_eq!(log.not_kept, 1);
+        assert_eq!(
+            log.frames[0],
+            BusFrame {
+                t_ns: 250,
+                id: 0x062,
+                dlc: 3,
+                data: [1, 2, 3, 0, 0, 0, 0, 0],
+                error: false
+            }
+        );
+        let b = log.frames[1];
+        assert!(b.error && b.t_ns == 900 && b.dlc == 8);
+        assert_eq!(b.id, CAN_ERR_FLAG | CAN_ERR_BUSOFF | CAN_ERR_BUSERROR);
+    }
+}

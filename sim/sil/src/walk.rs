@@ -318,3 +318,66 @@ impl<'a> SilRun<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+
+    #[test]
+    fn options_are_checked_in_order_with_the_commands_messages() {
+        let (choice, steps) = check_options("motor", 12, Some(0.0)).unwrap();
+        assert_eq!((choice, steps), (ActuatorChoice::SpoolMotor, 12));
+        let e = check_options("piston", MAX_WALK_STEPS + 1, Some(-1.0)).unwrap_err();
+        assert_eq!(e.0, "--actuator `piston`: expected `motor` or `servo`");
+        let e = check_options("servo", MAX_WALK_STEPS + 1, Some(-1.0)).unwrap_err();
+        assert_eq!(e.0, "--steps must be between 0 and 100000, got 100001");
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let e = check_options("servo", 1, Some(bad)).unwrap_err();
+            assert!(
+                e.0.starts_with("--estop-at must be a finite walk time"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn specs_configure_the_firmware_or_name_the_one_refused() {
+        let params = ["taut_angle_rad=-0.07".to_owned()];
+        let faults = ["drop:id=0x022,count=5".to_owned()];
+        let sensor_faults = ["stuck:side=left,from_ms=500".to_owned()];
+        let (config, written) = config_from_specs(
+            ActuatorChoice::Servo,
+            Specs {
+                firmware_params: &params,
+                faults: &faults,
+                sensor_faults: &sensor_faults,
+            },
+        )
+        .unwrap();
+        assert_eq!(written.get("taut_angle_rad"), Some(&-0.07));
+        assert_eq!(
+            (config.bus_faults.len(), config.sensor_faults.len()),
+            (1, 1)
+        );
+        let bogus = ["bogus".to_owned()];
+        let e = config_from_specs(
+            ActuatorChoice::Servo,
+            Specs {
+                faults: &bogus,
+                ..Specs::default()
+            },
+        )
+        .unwrap_err();
+        assert!(e.0.starts_with("--fault `bogus`: "), "{e}");
+        let e = config_from_specs(
+            ActuatorChoice::Servo,
+            Specs {
+                firmware_params: &bogus,
+                ..Specs::default()
+            },
+        )
+        .unwrap_err();
+        assert!(e.0.starts_with("--firmware-param `bogus`: "), "{e}");
+    }
+}
