@@ -491,6 +491,31 @@ pub enum WriteError {
     Timestamp(#[from] TimestampOverflow),
 }
 
+/// What a candump log records of a bus event, and when on the bus clock \[ns\]: a delivered
+/// frame (stamped at the end of its interframe space), an error frame (`CAN_ERR_PROT |
+/// CAN_ERR_BUSERROR`, data byte 2 = `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF |
+/// CAN_ERR_BUSERROR`). [`CandumpWriter`] writes these; a run that keeps its frames in memory
+/// (the Python package's `walker.sil`) keeps the same.
+pub fn event_frame(ev: &BusEvent) -> (u64, LogFrame) {
+    match ev {
+        BusEvent::Delivered(d) => (d.t_end_ns, LogFrame::Standard(d.frame)),
+        BusEvent::ErrorFrame { t_end_ns, .. } => (
+            *t_end_ns,
+            LogFrame::Error {
+                class: CAN_ERR_PROT | CAN_ERR_BUSERROR,
+                data: vec![0, 0, 0x01, 0, 0, 0, 0, 0],
+            },
+        ),
+        BusEvent::BusOff { t_ns, .. } => (
+            *t_ns,
+            LogFrame::Error {
+                class: CAN_ERR_BUSOFF | CAN_ERR_BUSERROR,
+                data: vec![0; 8],
+            },
+        ),
+    }
+}
+
 /// Writes bus events as a candump log.
 #[derive(Debug)]
 pub struct CandumpWriter<W: Write> {
@@ -517,30 +542,12 @@ impl<W: Write> CandumpWriter<W> {
         writeln!(self.out, "{}", format_record(r))
     }
 
-    /// The record for a bus event: a delivered frame (stamped at the end of its interframe
-    /// space), an error frame (`CAN_ERR_PROT | CAN_ERR_BUSERROR`, data byte 2 =
-    /// `CAN_ERR_PROT_BIT`) or a bus-off (`CAN_ERR_BUSOFF | CAN_ERR_BUSERROR`).
+    /// The record for a bus event ([`event_frame`]).
     ///
     /// # Errors
     /// [`TimestampOverflow`] when the origin plus the event's time does not fit.
     pub fn record_for(&self, ev: &BusEvent) -> Result<LogRecord, TimestampOverflow> {
-        let (t, frame) = match ev {
-            BusEvent::Delivered(d) => (d.t_end_ns, LogFrame::Standard(d.frame)),
-            BusEvent::ErrorFrame { t_end_ns, .. } => (
-                *t_end_ns,
-                LogFrame::Error {
-                    class: CAN_ERR_PROT | CAN_ERR_BUSERROR,
-                    data: vec![0, 0, 0x01, 0, 0, 0, 0, 0],
-                },
-            ),
-            BusEvent::BusOff { t_ns, .. } => (
-                *t_ns,
-                LogFrame::Error {
-                    class: CAN_ERR_BUSOFF | CAN_ERR_BUSERROR,
-                    data: vec![0; 8],
-                },
-            ),
-        };
+        let (t, frame) = event_frame(ev);
         Ok(LogRecord {
             timestamp_ns: stamp_ns(self.origin_ns, t)?,
             channel: self.channel.clone(),

@@ -1,4 +1,5 @@
-//! The `walker._walker` extension module: the simulator's scenes, gaits and walks for Python.
+//! The `walker._walker` extension module: the simulator's scenes, gaits, walks and walks with
+//! the firmware in the loop for Python.
 //!
 //! Each function runs the same library calls as the `walker` command and hands back the same
 //! report (`sim::report`), converted from its JSON form into Python dicts and lists, plus numpy
@@ -21,6 +22,7 @@ mod interrupt;
 mod orbit_diagram;
 mod robustness;
 mod scene;
+mod sil_walk;
 mod stability_map;
 mod sweep;
 mod walk;
@@ -56,5 +58,9 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_WALK_STEPS", sim::stride::walk::MAX_WALK_STEPS)?;
     m.add("DEFAULT_PATH_SAMPLES", walk::DEFAULT_PATH_SAMPLES)?;
     m.add("MAX_PATH_SAMPLES", walk::MAX_PATH_SAMPLES)?;
+    m.add_function(wrap_pyfunction!(sil_walk::sil, m)?)?;
+    m.add_function(wrap_pyfunction!(sil_walk::dbc, m)?)?;
+    m.add("DEFAULT_SIL_FRAMES", sil_walk::DEFAULT_SIL_FRAMES)?;
+    m.add("MAX_SIL_FRAMES", sil_walk::MAX_SIL_FRAMES)?;
     Ok(())
 }

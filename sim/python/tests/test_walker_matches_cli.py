@@ -250,3 +250,13 @@ def test_a_scene_with_solver_options_repr_builds_it_again():
     assert ".with_solver(" in shown and 'integrator="rk4"' in shown
     again = eval(shown, {"Scene": walker.Scene})
     assert again.solver == scene.solver and again.values == scene.values
+
+
+def test_the_scenes_stride_budget_applies_unless_a_call_gives_one(cli):
+    tight = walker.Scene.load("compass").with_solver(max_strides=2)
+    code, expected, _ = cli("gait", "--scene", "compass", "--max-strides", "2", "--json")
+    assert code == 1
+    with pytest.raises(walker.GaitNotFound) as e:
+        walker.gait(tight)
+    assert e.value.report == expected
+    assert walker.gait(tight, max_strides=10_000).max_abs_eigenvalue < 1

@@ -14,6 +14,7 @@ use canbus::{
 use protocol::NodeId;
 
 use crate::error::{SilError, TickError};
+use crate::frames::FrameLog;
 use crate::history::BoundedLog;
 use crate::report::SocketcandReport;
 use crate::side::Side;
@@ -31,6 +32,8 @@ pub(crate) struct BusSide {
     frames_delivered: u64,
     /// Bus-off events: (time [s], node name).
     bus_off: BoundedLog<(f64, String)>,
+    /// The events kept in memory, when asked ([`BusSide::keep_frames`]).
+    frame_log: Option<FrameLog>,
 }
 
 impl BusSide {
@@ -48,7 +51,19 @@ impl BusSide {
             server: None,
             frames_delivered: 0,
             bus_off: BoundedLog::new(history_capacity),
+            frame_log: None,
         })
+    }
+
+    /// Keep the first `max_frames` bus events from now on in memory, as a candump log would
+    /// record them.
+    pub fn keep_frames(&mut self, max_frames: usize) {
+        self.frame_log = Some(FrameLog::new(max_frames));
+    }
+
+    /// The events kept ([`BusSide::keep_frames`]), taken out (`None` if none were asked for).
+    pub fn take_frame_log(&mut self) -> Option<FrameLog> {
+        self.frame_log.take()
     }
 
     /// Attach one ankle's node, named and numbered as the protocol's.
@@ -106,6 +121,9 @@ impl BusSide {
         for ev in &events {
             if let Some(w) = self.candump.as_mut() {
                 w.write_event(ev)?;
+            }
+            if let Some(log) = self.frame_log.as_mut() {
+                log.push(ev);
             }
             match ev {
                 BusEvent::Delivered(d) => {

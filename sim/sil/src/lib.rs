@@ -32,6 +32,7 @@ mod bus_side;
 pub mod config;
 mod error;
 pub mod firmware_param;
+pub mod frames;
 mod gait;
 pub mod hal;
 pub mod history;
@@ -46,6 +47,7 @@ pub mod side;
 pub mod spool_plant;
 pub mod swing;
 mod tick;
+pub mod walk;
 
 #[cfg(test)]
 mod tests;
@@ -57,6 +59,7 @@ pub use error::{SilError, TickError};
 /// What the firmware's spool-motor driver set the power stage to.
 pub use firmware::drivers::spool_motor::StageOutput;
 pub use firmware_param::{FirmwareParam, FirmwareParamError};
+pub use frames::{BusFrame, FrameLog};
 pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;

@@ -119,6 +119,19 @@ impl FirmwareInTheLoop {
         self.ankles[side.index()].spool_counts()
     }
 
+    /// Keep the first `max_frames` bus events from now on in memory (delivered frames, error
+    /// frames, bus-off events: what `SilConfig::candump`'s log records);
+    /// [`FirmwareInTheLoop::take_frame_log`] hands them over. Call it before the walk.
+    pub fn keep_frames(&mut self, max_frames: usize) {
+        self.bus.keep_frames(max_frames);
+    }
+
+    /// The bus events kept ([`FirmwareInTheLoop::keep_frames`]), taken out: `None` if none
+    /// were asked for (or they were taken already).
+    pub fn take_frame_log(&mut self) -> Option<crate::frames::FrameLog> {
+        self.bus.take_frame_log()
+    }
+
     /// The report so far.
     pub fn report(&self) -> SilReport {
         let nodes = Side::BOTH

@@ -138,16 +138,6 @@ pub fn firmware_events(r: &sil::SilReport) -> Vec<Event> {
     sorted(out)
 }
 
-/// The walk time the host sent its first emergency stop \[s\], from the run's report (`None`
-/// if it sent none).
-pub fn emergency_stop_sent_s(r: &sil::SilReport) -> Option<f64> {
-    r.host
-        .commands_sent
-        .iter()
-        .find(|(_, command)| command.contains("EmergencyStop"))
-        .map(|(t_s, _)| *t_s)
-}
-
 /// A host command as the run's report writes it (`Command(Command { target: Broadcast, kind:
 /// EmergencyStop })`) shortened to `EmergencyStop to Broadcast`; any other form as it is.
 fn command_words(debug: &str) -> String {

@@ -14,14 +14,11 @@ use crate::progress::Progress;
 use crate::search_progress;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
+use sil::walk::{SilRun, SilWalkReport, WalkPlan};
 use sim::analysis::homotopy::GaitSource;
 use sim::analysis::limit_cycle::Gait;
-use sim::engine::integrators::IntegratorChoice;
-use sim::report::{IdealGaitRecord, StartRecord, WalkGaitRecord};
 use sim::scene::Setup;
-use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkRequest};
-use sim::stride::Floor;
+use sim::stride::walk::{StepSummary, Walk};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
@@ -110,56 +107,6 @@ pub struct SilArgs {
     pub floor: String,
 }
 
-/// The `walker sil --json` object. `Bus` is the bus statistics' type (the `canbus` crate's,
-/// which this crate does not name).
-#[derive(Serialize)]
-struct SilWalkReport<'a, Bus: Serialize> {
-    /// Scene name.
-    scene: &'a str,
-    /// The integrator of the walk with the firmware.
-    integrator: &'a IntegratorChoice,
-    /// Steps completed.
-    steps_completed: usize,
-    /// The first failure (`null` if none).
-    failure: Option<&'a WalkFailure>,
-    /// The firmware's gait over the last 10 steps that ended by the emergency stop (all
-    /// steps without one; `null` if there is no such step).
-    gait: Option<WalkGaitRecord>,
-    /// Walk time the host sent the emergency stop (`--estop-at`) \[s\]; `null` if none was sent.
-    emergency_stop_sent_s: Option<f64>,
-    /// Steps completed that ended by the emergency stop (all of them without one).
-    steps_before_emergency_stop: usize,
-    /// The ideal-actuator gait.
-    ideal_gait: IdealGaitRecord,
-    /// What the walk started from: the ideal-actuator gait, as `walker gait` finds it
-    /// (`gait_source`, its step period).
-    start: StartRecord,
-    /// Faults the nodes raised or cleared.
-    node_faults: &'a [sil::FaultRecord],
-    /// The left and the right node; `nodes.<side>.parameters`: the extension profile's
-    /// parameters in force as the node reported them over the bus.
-    nodes: &'a BTreeMap<sil::Side, sil::NodeReport>,
-    /// Firmware parameters written at start-up (`--firmware-param`), by name [SI units].
-    firmware_params_written: BTreeMap<&'static str, f64>,
-    /// Differences between the scene's extension profile (the plant's string geometry and
-    /// the ideal gait) and the one the nodes report; empty when they agree.
-    warnings: &'a [String],
-    /// Bus load [-].
-    bus_load: f64,
-    /// Bus statistics.
-    bus: &'a Bus,
-    /// Frames delivered on the bus.
-    frames: u64,
-    /// The step summaries kept (`--keep-steps`).
-    steps: &'a [StepSummary],
-    /// Injected encoder faults that took effect: `[{side, kind, t_s}]`.
-    sensor_faults_applied: &'a [sil::AppliedSensorFault],
-    /// The ankles' actuator (`motor`, `servo`).
-    actuator: &'static str,
-    /// The floor walked over (`{kind, ...}`, as `walker walk` reports it).
-    floor: Floor,
-}
-
 /// Runs `walker sil`: exit code 1 if there is no ideal-actuator gait to start from, 3 if the
 /// walker fell (the report's `failure`). The stages: the options checked, the firmware's
 /// configuration, the ideal-actuator gait, the firmware started, the walk, the report.
@@ -173,41 +120,38 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
     let candump = &args.candump;
     let scene = common.scene()?;
     let Setup {
-        walker,
-        settings: mut stride_settings,
-        ..
+        walker, settings, ..
     } = common.setup(&scene)?;
-    let Some(reflex) = walker.ankle().cloned() else {
-        return Err(InputError::Other(format!(
-            "scene `{}` has no actuated ankles (ankle_reflex)",
-            scene.name()
-        ))
-        .into());
-    };
+    let reflex = sil::walk::require_ankle(&walker, scene.name()).map_err(input)?;
     let (config, firmware_params_written) = sil_config(actuator_choice, &args)?;
     let Some((ideal_setup, ideal, source)) = ideal_gait(&scene, common)? else {
         return Ok(ExitCode::from(1));
     };
-    if common.integrator.is_none() && common.rtol.is_none() && common.step_s.is_none() {
-        stride_settings.integrator = sil::SIL_INTEGRATOR;
-    }
+    let integrator_chosen =
+        common.integrator.is_some() || common.rtol.is_some() || common.step_s.is_some();
+    let stride_settings = sil::walk::walk_settings(&settings, integrator_chosen);
     let mut ctl = start_firmware(config, candump, args.estop_at, wait_client)?;
     let plan = WalkPlan {
         steps,
         keep_steps: args.keep_steps,
         record: animation.is_some(),
-        realtime: args.realtime,
-        show_progress: !common.json,
+        path_interval_s: Some(crate::animation::PATH_SAMPLE_INTERVAL_S),
         floor,
     };
     let (q, qd) = walker.unpack(&ideal.fixed_point);
-    let walk = walk_with_firmware(&walker, (&q, &qd), &stride_settings, &mut ctl, &plan);
+    let walk = walk_with_firmware(
+        &walker,
+        (&q, &qd),
+        &stride_settings,
+        &mut ctl,
+        &plan,
+        (args.realtime, !common.json),
+    );
     let firmware = ctl.finish().map_err(|e| match candump_error(candump, e) {
         // Only the log's flush can fail here: not bad input.
         InputError::Other(m) => anyhow::anyhow!(m),
         other => anyhow::Error::from(other),
     })?;
-    let emergency_stop_sent_s = timeline::emergency_stop_sent_s(&firmware);
     if let Some(file) = animation {
         file.write(&Animation {
             scene: &scene,
@@ -216,30 +160,34 @@ pub fn run(args: SilArgs) -> Result<ExitCode> {
             command: "sil",
             events: walk_and_firmware_events(&walk, &firmware),
             firmware: true,
-            emergency_stop_sent_s,
+            emergency_stop_sent_s: sil::walk::emergency_stop_sent_s(&firmware),
         })?;
     }
     let warnings = sil::scene_profile::profile_mismatches(&reflex, &firmware.nodes);
     for w in &warnings {
         output::note(format_args!("warning: {w}"));
     }
-    let ran = WalkRun {
+    let ran = SilRun {
         scene: scene.name(),
         walker: &walker,
         integrator: &stride_settings.integrator,
-        ideal: IdealGaitRecord::of(&ideal_setup.walker, &ideal),
-        start: StartRecord::gait(scene.name(), &ideal, source),
+        ideal_walker: &ideal_setup.walker,
+        ideal: (&ideal, source),
         walk: &walk,
         keep_steps: args.keep_steps,
         firmware: &firmware,
-        emergency_stop_sent_s,
         firmware_params_written,
         warnings: &warnings,
-        actuator: actuator_choice.name(),
+        actuator: actuator_choice,
         floor,
     };
     write_report(&ran.report(), common.json, steps)?;
     Ok(walk_exit_code(&walk))
+}
+
+/// The library's bad input as the command's.
+fn input(e: sil::walk::SilInputError) -> InputError {
+    InputError::Other(e.0)
 }
 
 /// The walk's and the firmware's events in time order, for the animation.
@@ -251,24 +199,19 @@ fn walk_and_firmware_events(walk: &Walk, firmware: &sil::SilReport) -> Vec<timel
 }
 
 /// The options checked in order: the actuator's name, the number of steps, the emergency
-/// stop's time, the pace against real time. The actuator and the steps.
+/// stop's time (the library's checks, `sil::walk::check_options`), the pace against real
+/// time. The actuator and the steps.
 fn check_options(
     actuator: &str,
     steps: usize,
     estop_at: Option<f64>,
     realtime: Option<f64>,
 ) -> Result<(sil::ActuatorChoice, usize), InputError> {
-    let Some(actuator_choice) = sil::ActuatorChoice::from_name(actuator) else {
-        return Err(InputError::Other(format!(
-            "--actuator `{actuator}`: expected `motor` or `servo`"
-        )));
-    };
-    let steps = limits::count("--steps", steps, 0, limits::MAX_WALK_STEPS)?;
-    check_estop_at(estop_at)?;
+    let checked = sil::walk::check_options(actuator, steps, estop_at).map_err(input)?;
     if let Some(r) = realtime {
         limits::within("--realtime", r, &limits::REALTIME_RANGE)?;
     }
-    Ok((actuator_choice, steps))
+    Ok(checked)
 }
 
 /// The ideal-actuator gait with the scene's own (accurate) integrator (the walk with the
@@ -291,16 +234,6 @@ fn ideal_gait(
             ));
             Ok(None)
         }
-    }
-}
-
-/// The host's emergency stop time: a finite walk time of 0 s or more.
-fn check_estop_at(estop_at: Option<f64>) -> Result<(), InputError> {
-    match estop_at {
-        Some(t) if !(t.is_finite() && t >= 0.0) => Err(InputError::Other(format!(
-            "--estop-at must be a finite walk time of 0 s or more, got {t}"
-        ))),
-        _ => Ok(()),
     }
 }
 
@@ -327,30 +260,13 @@ fn sil_config(
     actuator_choice: sil::ActuatorChoice,
     args: &SilArgs,
 ) -> Result<(sil::config::SilConfig, BTreeMap<&'static str, f64>), InputError> {
-    let mut config = sil::config::SilConfig {
-        actuator_choice,
-        ..sil::config::SilConfig::default()
+    let specs = sil::walk::Specs {
+        firmware_params: &args.firmware_params,
+        faults: &args.faults,
+        sensor_faults: &args.sensor_faults,
     };
-    for p in &args.firmware_params {
-        config = config
-            .with_firmware_param_str(p)
-            .map_err(|e| InputError::Other(format!("--firmware-param `{p}`: {e}")))?;
-    }
-    let firmware_params_written = config
-        .firmware_param_writes()
-        .iter()
-        .map(|w| (sil::firmware_param::param_name(w.id), w.wire_value_f64()))
-        .collect();
-    for f in &args.faults {
-        config = config
-            .with_fault_str(f)
-            .map_err(|e| InputError::Other(format!("--fault `{f}`: {e}")))?;
-    }
-    for f in &args.sensor_faults {
-        config = config
-            .with_sensor_fault_str(f)
-            .map_err(|e| InputError::Other(format!("--sensor-fault `{f}`: {e}")))?;
-    }
+    let (mut config, firmware_params_written) =
+        sil::walk::config_from_specs(actuator_choice, specs).map_err(input)?;
     if args.socketcand_allow_send && args.socketcand.is_none() {
         return Err(InputError::Other(
             "--socketcand-allow-send needs --socketcand ADDR".to_owned(),
@@ -414,65 +330,43 @@ fn start_firmware(
     Ok(ctl)
 }
 
-/// How the walk with the firmware runs: its steps, the summaries kept, whether it records
-/// the path (for the animation), its pace against real time, a progress bar.
-struct WalkPlan {
-    steps: usize,
-    keep_steps: Option<usize>,
-    record: bool,
-    realtime: Option<f64>,
-    show_progress: bool,
-    floor: Floor,
-}
-
-/// The walk from the ideal gait's start state `(q, qd)` with the firmware actuating the
-/// ankles (paced to real time when the plan says so).
+/// The walk with the firmware (`sil::walk::walk_with_firmware`), paced to real time when
+/// `realtime` says so, with a progress bar when `show_progress`.
 fn walk_with_firmware(
     walker: &sim::engine::walker::Walker,
-    (q, qd): (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
+    start: (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
     stride_settings: &sim::stride::StrideSettings,
     ctl: &mut sil::FirmwareInTheLoop,
     plan: &WalkPlan,
+    (realtime, show_progress): (Option<f64>, bool),
 ) -> Walk {
-    // The gait figures average the last 10 steps: keep at least those; keeping more than
-    // the walk's steps keeps them all (and a huge N never reaches the walk's arithmetic).
-    let options = sim::stride::walk::WalkOptions {
-        record: plan.record,
-        path_interval_s: Some(crate::animation::PATH_SAMPLE_INTERVAL_S),
-        keep_steps: plan.keep_steps.map(|n| n.clamp(10, limits::MAX_WALK_STEPS)),
-        max_path_samples: None,
-    };
     let progress = Progress::after(
         PROGRESS_DELAY,
         plan.steps,
         "sil walk (steps)",
-        plan.show_progress,
+        show_progress,
     );
     let mut tick = |_: &StepSummary| progress.tick();
-    let walk = match plan.realtime {
-        None => sim::stride::walk::walk(
+    let walk = match realtime {
+        None => sil::walk::walk_with_firmware(
             walker,
-            q,
-            qd,
-            WalkRequest::new(stride_settings, plan.steps)
-                .options(options)
-                .floor(plan.floor)
-                .controlled(ctl)
-                .on_step(&mut tick),
+            start,
+            stride_settings,
+            ctl,
+            plan,
+            Some(&mut tick),
         ),
         Some(factor) => {
             // Step by step, sleeping so that walk time keeps pace with wall time.
-            let start = std::time::Instant::now();
-            let mut paced = sim::engine::control::Paced::new(ctl, factor, start);
-            sim::stride::walk::walk(
+            let started = std::time::Instant::now();
+            let mut paced = sim::engine::control::Paced::new(ctl, factor, started);
+            sil::walk::walk_with_firmware(
                 walker,
-                q,
-                qd,
-                WalkRequest::new(stride_settings, plan.steps)
-                    .options(options)
-                    .floor(plan.floor)
-                    .controlled(&mut paced)
-                    .on_step(&mut tick),
+                start,
+                stride_settings,
+                &mut paced,
+                plan,
+                Some(&mut tick),
             )
         }
     };
@@ -480,71 +374,8 @@ fn walk_with_firmware(
     walk
 }
 
-/// What the walk with the firmware gave, for its report.
-struct WalkRun<'a> {
-    scene: &'a str,
-    walker: &'a sim::engine::walker::Walker,
-    integrator: &'a IntegratorChoice,
-    ideal: IdealGaitRecord,
-    start: StartRecord,
-    walk: &'a Walk,
-    keep_steps: Option<usize>,
-    firmware: &'a sil::SilReport,
-    emergency_stop_sent_s: Option<f64>,
-    firmware_params_written: BTreeMap<&'static str, f64>,
-    warnings: &'a [String],
-    actuator: &'static str,
-    floor: Floor,
-}
-
-impl<'a> WalkRun<'a> {
-    /// The `walker sil` report. The firmware's gait: the steps that ended by the emergency
-    /// stop (one under way at the stop, or begun after it, is not walked with the ankles
-    /// actuating throughout).
-    fn report(self) -> SilWalkReport<'a, impl Serialize + 'a> {
-        let walk = self.walk;
-        let kept = self.keep_steps.unwrap_or(usize::MAX).min(walk.steps.len());
-        let emergency_stop_sent_s = self.emergency_stop_sent_s;
-        let actuated_steps = match emergency_stop_sent_s {
-            Some(t_stop) => {
-                let before = walk
-                    .steps
-                    .partition_point(|s| s.start_t_walk_s + s.duration_s <= t_stop);
-                &walk.steps[..before]
-            }
-            None => &walk.steps[..],
-        };
-        SilWalkReport {
-            scene: self.scene,
-            integrator: self.integrator,
-            steps_completed: walk.steps_completed,
-            failure: walk.failure.as_ref(),
-            gait: WalkGaitRecord::of_steps(self.walker, actuated_steps, 10),
-            emergency_stop_sent_s,
-            steps_before_emergency_stop: actuated_steps.len(),
-            ideal_gait: self.ideal,
-            start: self.start,
-            node_faults: &self.firmware.faults,
-            nodes: &self.firmware.nodes,
-            firmware_params_written: self.firmware_params_written,
-            warnings: self.warnings,
-            bus_load: self.firmware.bus.load,
-            bus: &self.firmware.bus,
-            frames: self.firmware.frames_delivered,
-            steps: &walk.steps[walk.steps.len() - kept..],
-            sensor_faults_applied: &self.firmware.sensor_faults_applied,
-            actuator: self.actuator,
-            floor: self.floor,
-        }
-    }
-}
-
 /// The report as JSON or as text.
-fn write_report<Bus: Serialize>(
-    report: &SilWalkReport<'_, Bus>,
-    json: bool,
-    steps: usize,
-) -> Result<()> {
+fn write_report(report: &SilWalkReport<'_>, json: bool, steps: usize) -> Result<()> {
     if json {
         print_json(report)?;
     } else {
@@ -560,15 +391,11 @@ fn candump_error(candump: &Option<std::path::PathBuf>, e: sil::SilError) -> Inpu
         (sil::SilError::Candump(io), Some(path)) => {
             InputError::Other(PathError::new("--candump", path, io).to_string())
         }
-        (e, _) => InputError::Other(format!("software in the loop: {e}")),
+        (e, _) => input(sil::walk::setup_error(&e)),
     }
 }
 
-fn print_text<Bus: Serialize>(
-    out: &mut dyn Write,
-    r: &SilWalkReport<'_, Bus>,
-    steps: usize,
-) -> std::io::Result<()> {
+fn print_text(out: &mut dyn Write, r: &SilWalkReport<'_>, steps: usize) -> std::io::Result<()> {
     match r.emergency_stop_sent_s {
         None => writeln!(
             out,

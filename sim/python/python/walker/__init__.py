@@ -1,4 +1,5 @@
-"""The walker simulator from Python: scenes, gaits and walks as numpy arrays and pandas tables.
+"""The walker simulator from Python: scenes, gaits, walks and walks with the ankle firmware in
+the loop as numpy arrays and pandas tables.
 
 >>> import walker
 >>> scene = walker.Scene.load("compass").with_params(slope_rad=0.05)
@@ -26,6 +27,7 @@ from ._gait import Gait, Gaits
 from ._orbit_diagram import OrbitDiagram
 from ._progress import ProgressArg, callback as _progress_callback
 from ._robustness import Robustness
+from ._sil import Sil
 from ._stability_map import StabilityMap
 from ._sweep import Sweep
 from ._walk import Walk
@@ -33,11 +35,14 @@ from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
     DEFAULT_PATH_SAMPLES,
     MAX_BASIN_CELL_STRIDES,
+    DEFAULT_SIL_FRAMES,
     MAX_MAP_CELLS,
     MAX_ORBIT_POINTS,
     MAX_PATH_SAMPLES,
+    MAX_SIL_FRAMES,
     MAX_WALK_STEPS,
     Scene,
+    dbc,
 )
 
 __all__ = [
@@ -48,9 +53,11 @@ __all__ = [
     "DEFAULT_GAIT_STRIDE_BUDGET",
     "DEFAULT_PATH_SAMPLES",
     "MAX_BASIN_CELL_STRIDES",
+    "DEFAULT_SIL_FRAMES",
     "MAX_MAP_CELLS",
     "MAX_ORBIT_POINTS",
     "MAX_PATH_SAMPLES",
+    "MAX_SIL_FRAMES",
     "MAX_WALK_STEPS",
     "Gait",
     "Gaits",
@@ -59,15 +66,18 @@ __all__ = [
     "OrbitDiagram",
     "Scene",
     "SceneError",
+    "Sil",
     "StabilityMap",
     "StrideFailed",
     "Sweep",
     "Walk",
     "WalkerError",
+    "dbc",
     "gait",
     "gaits",
     "orbit_diagram",
     "scenes",
+    "sil",
     "stability_map",
     "sweep",
     "walk",
@@ -87,13 +97,15 @@ def scenes() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("name")
 
 
-def gait(scene: Scene | str | os.PathLike[str], *, max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET) -> Gait:
+def gait(scene: Scene | str | os.PathLike[str], *, max_strides: int | None = None) -> Gait:
     """The gait of ``scene`` (a :class:`Scene` or a scene name or path) as ``walker gait``
     finds it: at the scene's defaults Newton from its guess, elsewhere the defaults' gait
-    followed to the scene's values (``Gait.gait_source`` says which), with the scene's
-    integrator and the command's default Newton settings.
+    followed to the scene's values (``Gait.gait_source`` says which), with the scene's solver
+    options (:meth:`Scene.with_solver`; by default the scene's integrator and the command's
+    default Newton settings).
 
-    ``max_strides`` bounds the strides the search may take (``--max-strides``).
+    ``max_strides`` bounds the strides the search may take (``--max-strides``; ``None``: the
+    scene's solver options', by default :data:`DEFAULT_GAIT_STRIDE_BUDGET`).
 
     Raises :class:`GaitNotFound` (or :class:`StrideFailed`, a subclass, when a stride of the
     search failed) if there is none, :class:`SceneError` if the scene cannot be built,
@@ -131,7 +143,7 @@ def walk(
     perturb: Mapping[str, float] | None = None,
     floor: str = "plane",
     path_interval_s: float | None = None,
-    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    max_strides: int | None = None,
     max_path_samples: int = DEFAULT_PATH_SAMPLES,
 ) -> Walk:
     """Walks up to ``steps`` strides of ``scene``, as ``walker walk`` does.
@@ -174,6 +186,75 @@ def walk(
     return walked
 
 
+def sil(
+    scene: Scene | str | os.PathLike[str],
+    steps: int,
+    *,
+    faults: Sequence[str] = (),
+    sensor_faults: Sequence[str] = (),
+    firmware_params: Mapping[str, float] | Sequence[str] | None = None,
+    actuator: str = "servo",
+    estop_at_s: float | None = None,
+    floor: str = "plane",
+    keep_steps: int | None = None,
+    max_strides: int | None = None,
+    max_frames: int = DEFAULT_SIL_FRAMES,
+) -> Sil:
+    """Walks up to ``steps`` strides of ``scene`` with the ankle firmware in the loop (two
+    nodes on the simulated CAN bus actuating the ankles), as ``walker sil`` does: from the
+    ideal-actuator gait (found as :func:`gait` finds it), with the SIL integrator unless the
+    scene's solver options (:meth:`Scene.with_solver`) choose one.
+
+    ``faults``: bus faults (``--fault``, e.g. ``"drop:id=0x022,count=5"``); ``sensor_faults``:
+    encoder faults (``--sensor-fault``, e.g. ``"stuck:side=left,from_ms=500"``);
+    ``firmware_params``: written to both ankles at start-up (``--firmware-param``), a mapping
+    ``{"taut_angle_rad": -0.07}`` or strings ``"taut_angle_rad=-0.07"``, in order;
+    ``actuator``: ``"servo"`` or ``"motor"``; ``estop_at_s``: the host's emergency stop at
+    this walk time (``--estop-at``); ``floor`` as :func:`walk`'s; ``keep_steps``: keep only
+    the last N step summaries (``--keep-steps``). ``max_frames`` (at most
+    :data:`MAX_SIL_FRAMES`) bounds the bus frames kept: past it the first ``max_frames`` are
+    kept, :attr:`Sil.frames_cut_at_time_s` says where, and a ``RuntimeWarning`` says so (0
+    keeps none, silently).
+
+    :attr:`Sil.report` is the ``walker sil --json`` object; :attr:`Sil.frames` the bus
+    frames (what ``--candump`` logs) decoded with the project's DBC (:func:`dbc`, cantools).
+    A fall is not an error (:attr:`Sil.failure`). Raises :class:`InputError` with the
+    command's message (an unknown fault, a bad firmware parameter, ``steps`` outside 0 to
+    :data:`MAX_WALK_STEPS`, a scene without actuated ankles), :class:`SceneError`,
+    :class:`GaitNotFound` / :class:`StrideFailed` (no ideal-actuator gait to start from),
+    ``KeyboardInterrupt`` on Ctrl-C (at the next step).
+    """
+    if firmware_params is None:
+        params: list[str] = []
+    elif isinstance(firmware_params, Mapping):
+        params = [f"{k}={v}" for k, v in firmware_params.items()]
+    elif isinstance(firmware_params, str):
+        params = [firmware_params]
+    else:
+        params = [str(p) for p in firmware_params]
+    report, frames = _walker.sil(
+        _scene(scene),
+        steps,
+        faults=[faults] if isinstance(faults, str) else list(faults),
+        sensor_faults=[sensor_faults] if isinstance(sensor_faults, str) else list(sensor_faults),
+        firmware_params=params,
+        actuator=actuator,
+        estop_at=estop_at_s,
+        floor=floor,
+        keep_steps=keep_steps,
+        max_strides=max_strides,
+        max_frames=max_frames,
+    )
+    ran = Sil.from_parts(report, frames)
+    if ran.frames_not_kept and max_frames > 0:
+        warnings.warn(
+            f"walker.sil: the bus frames stopped at {ran.frames_cut_at_time_s:.6g} s after "
+            f"max_frames={max_frames} frames ({ran.frames_not_kept} more not kept; the walk "
+            "went on: see Sil.report); a larger max_frames keeps more",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return ran
 
 
 def stability_map(
@@ -218,7 +299,7 @@ def robustness(
     mfpt_seed: int = 0,
     rate_scan_step: float = 1e-2,
     return_strides: int = 100,
-    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    max_strides: int | None = None,
     progress: ProgressArg = True,
 ) -> Robustness:
     """How much disturbance the gait of ``scene`` (as :func:`gait` finds it) survives, as
@@ -266,7 +347,7 @@ def basin(
     y: tuple[str, Sequence[float]],
     *,
     strides: int = 100,
-    max_strides: int = DEFAULT_GAIT_STRIDE_BUDGET,
+    max_strides: int | None = None,
     progress: ProgressArg = True,
 ) -> Basin:
     """A slice of the basin of attraction of the gait of ``scene`` (as :func:`gait` finds it)

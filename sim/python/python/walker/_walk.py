@@ -9,6 +9,22 @@ import numpy as np
 import pandas as pd
 
 
+def steps_frame(steps: list[dict[str, Any]]) -> pd.DataFrame:
+    """The step summaries of a walk's JSON (``walker walk``, ``walker sil``) as a table: one row
+    per step, its fields but ``events`` and ``state``, ``hip_floor_m`` as ``hip_x_m``,
+    ``hip_y_m``, ``hip_z_m``."""
+    rows = [
+        {k: v for k, v in s.items() if k not in ("events", "state", "hip_floor_m")}
+        | {
+            "hip_x_m": s["hip_floor_m"][0],
+            "hip_y_m": s["hip_floor_m"][1],
+            "hip_z_m": s["hip_floor_m"][2],
+        }
+        for s in steps
+    ]
+    return pd.DataFrame(rows)
+
+
 @dataclass(frozen=True)
 class Walk:
     """A walk: the path sampled by the integrator, the per-step table and the failure.
@@ -66,16 +82,7 @@ class Walk:
         ``start_time_s``, ``duration_s``, ``step_length_m``, ``state_deviation``,
         ``impact_energy_loss_j``, ``actuator_work_j``... (``events`` and ``state`` left to
         :attr:`events` and :attr:`states`)."""
-        rows = [
-            {k: v for k, v in s.items() if k not in ("events", "state", "hip_floor_m")}
-            | {
-                "hip_x_m": s["hip_floor_m"][0],
-                "hip_y_m": s["hip_floor_m"][1],
-                "hip_z_m": s["hip_floor_m"][2],
-            }
-            for s in self.report["steps"]
-        ]
-        return pd.DataFrame(rows)
+        return steps_frame(self.report["steps"])
 
     @property
     def events(self) -> pd.DataFrame:

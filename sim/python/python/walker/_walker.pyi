@@ -19,7 +19,11 @@ MAX_WALK_STEPS: int
 DEFAULT_PATH_SAMPLES: int
 """Path samples a walk keeps by default (past them the path stops; the walk goes on)."""
 MAX_PATH_SAMPLES: int
-"""Most steps of one walk."""
+"""Most path samples one walk may keep (``max_path_samples``)."""
+DEFAULT_SIL_FRAMES: int
+"""Bus frames a SIL walk keeps by default (past them the first are kept; the walk goes on)."""
+MAX_SIL_FRAMES: int
+"""Most bus frames one SIL walk may keep (``max_frames``)."""
 
 class Scene:
     """A scene: a walker described by a scene file (built-in or a path), with parameter
@@ -138,3 +142,27 @@ def walk(
     """``(report, path)``: the ``walker walk --json`` object and the path's numpy arrays
     (``time_s``, ``step``, ``q``, ``qdot``, ``hip_floor_m``) with ``coordinates`` and
     ``cut_at_time_s`` (``None``, or where the path stopped at ``max_path_samples``)."""
+
+def sil(
+    scene: Scene,
+    steps: int,
+    *,
+    faults: list[str] = ...,
+    sensor_faults: list[str] = ...,
+    firmware_params: list[str] = ...,
+    actuator: str = "servo",
+    estop_at: float | None = None,
+    floor: str = "plane",
+    keep_steps: int | None = None,
+    max_strides: int | None = None,
+    max_frames: int | None = None,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``(report, frames)``: the ``walker sil --json`` object and the run's bus events as
+    ``--candump`` logs them, numpy arrays ``time_ns`` (bus clock), ``id``, ``dlc``, ``data``
+    (n × 8 bytes), ``error``, with ``not_kept`` (events past ``max_frames``) and
+    ``max_frames``; raises ``InputError`` (the command's message), ``SceneError``,
+    ``GaitNotFound`` or ``StrideFailed``."""
+
+def dbc() -> str:
+    """The project's DBC file (the bus's messages and signals, as ``protocol/walker.dbc``),
+    for ``cantools.database.load_string``."""
