@@ -5,6 +5,7 @@ use crate::convert;
 use crate::errors;
 use crate::gait::{rule_gait, search_budget, setup_for};
 use crate::interrupt::{self, Counter};
+use crate::refused::Refused;
 use crate::scene::PyScene;
 use pyo3::prelude::*;
 use sim::analysis::robustness::{
@@ -12,16 +13,8 @@ use sim::analysis::robustness::{
 };
 use sim::analysis::stability_map::MAX_MAP_CELLS;
 use sim::report::{BasinReport, GaitReport};
-use sim::scene::SceneError;
 use sim::stride::SearchBudget;
 use std::sync::Arc;
-
-/// What the work returns besides a report: no gait (its report), or a scene or slice error.
-enum Refused {
-    Scene(SceneError),
-    Slice(BasinError),
-    NoGait(Box<GaitReport>),
-}
 
 /// The basin slice of `scene`'s gait over the stride-map coordinates `x` and `y`, each
 /// `(name, values)`: the `walker basin --json` object as a dict. Each cell may take `strides`
@@ -71,7 +64,8 @@ pub fn basin<'py>(
     let (solver, scene) = (&scene.solver, &scene.inner);
     // The axes before the gait search: a wrong one fails at once.
     let setup = scene.setup().map_err(|e| errors::scene_error(py, &e))?;
-    basin_axes(&setup.walker, &x, &y).map_err(|e| basin_error(py, scene.name(), e))?;
+    basin_axes(&setup.walker, &x, &y)
+        .map_err(|e| errors::input_error(py, &basin_message(scene.name(), e)))?;
     let measuring = Arc::new(SearchBudget::new(usize::MAX));
     let counter = Counter::new(cells, progress);
     let report = interrupt::run_counted(py, &[&search, &measuring], &counter, || {
@@ -89,29 +83,22 @@ pub fn basin<'py>(
             ..ReturnRule::default()
         };
         let recovery = Recovery::new(&setup.walker, &setup.settings, gait).with_rule(rule);
-        let slice = basin_slice(&recovery, x, y, &|| counter.tick()).map_err(Refused::Slice)?;
+        let slice = basin_slice(&recovery, x, y, &|| counter.tick())
+            .map_err(|e| Refused::Input(basin_message(scene.name(), e)))?;
         Ok(BasinReport::new(scene.name(), &slice, rule, gait_report))
     })?;
-    match report {
-        Ok(report) => convert::report(py, &report),
-        Err(Refused::Scene(e)) => Err(errors::scene_error(py, &e)),
-        Err(Refused::Slice(e)) => Err(basin_error(py, scene.name(), e)),
-        Err(Refused::NoGait(gait)) => Err(errors::gait_not_found(py, &convert::report(py, &gait)?)),
-    }
+    convert::report(py, &report.map_err(|r| r.into_py_err(py))?)
 }
 
-/// An axis refused, as `walker.InputError`.
-fn basin_error(py: Python<'_>, scene: &str, e: BasinError) -> PyErr {
-    errors::input_error(
-        py,
-        &match e {
-            BasinError::UnknownCoordinate { name, known } => {
-                format!("`{name}` is not a stride-map coordinate of {scene} (it has: {known})")
-            }
-            BasinError::SameAxis(name) => {
-                format!("x and y both slice `{name}`: give two different coordinates")
-            }
-            e @ BasinError::Empty(_) => e.to_string(),
-        },
-    )
+/// An axis refused, in words.
+fn basin_message(scene: &str, e: BasinError) -> String {
+    match e {
+        BasinError::UnknownCoordinate { name, known } => {
+            format!("`{name}` is not a stride-map coordinate of {scene} (it has: {known})")
+        }
+        BasinError::SameAxis(name) => {
+            format!("x and y both slice `{name}`: give two different coordinates")
+        }
+        e @ BasinError::Empty(_) => e.to_string(),
+    }
 }

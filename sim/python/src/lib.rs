@@ -20,6 +20,7 @@ mod gait;
 mod gaits;
 mod interrupt;
 mod orbit_diagram;
+mod refused;
 mod robustness;
 mod scene;
 mod sil_walk;

@@ -6,6 +6,7 @@ use crate::convert;
 use crate::errors;
 use crate::gait::{rule_gait, search_budget, setup_for};
 use crate::interrupt;
+use crate::refused::Refused;
 use crate::scene::PyScene;
 use ::sil::walk::{SilRun, Specs, WalkPlan};
 use ::sil::FrameLog;
@@ -26,13 +27,6 @@ pub const DEFAULT_SIL_FRAMES: usize = 1_000_000;
 
 /// Most bus frames `walker.sil(max_frames=...)` may ask for.
 pub const MAX_SIL_FRAMES: usize = 10_000_000;
-
-/// What went wrong before the walk.
-enum Refused {
-    Scene(sim::scene::SceneError),
-    NoGait(Box<GaitReport>),
-    Input(String),
-}
 
 impl From<::sil::walk::SilInputError> for Refused {
     fn from(e: ::sil::walk::SilInputError) -> Self {
@@ -124,15 +118,7 @@ pub fn sil<'py>(
     let ran = interrupt::run(py, &[&search, &walking], || {
         run(scene, solver, &request, (&search, &walking))
     })?;
-    let ran = match ran {
-        Ok(r) => r,
-        Err(Refused::Scene(e)) => return Err(errors::scene_error(py, &e)),
-        Err(Refused::Input(m)) => return Err(errors::input_error(py, &m)),
-        Err(Refused::NoGait(report)) => {
-            let dict = convert::report(py, &*report)?;
-            return Err(errors::gait_not_found(py, &dict));
-        }
-    };
+    let ran = ran.map_err(|r| r.into_py_err(py))?;
     Ok((
         convert::value_to_py(py, &ran.report)?,
         frames(py, &ran.frames)?,

@@ -5,6 +5,7 @@ use crate::convert;
 use crate::errors;
 use crate::gait::{search_budget, setup_for, with_rule};
 use crate::interrupt;
+use crate::refused::Refused;
 use crate::scene::PyScene;
 use nalgebra::DVector;
 use numpy::ndarray::Array2;
@@ -44,13 +45,6 @@ struct Walked {
     report: WalkReport,
     walk: Walk,
     coordinates: Vec<String>,
-}
-
-/// What went wrong before the walk.
-enum Refused {
-    Scene(sim::scene::SceneError),
-    NoGait(Box<GaitReport>),
-    Input(String),
 }
 
 /// Path samples `walker.walk` keeps by default: a million (about 170 MB for the 3D walker's
@@ -125,15 +119,7 @@ pub fn walk<'py>(
             (&search, &walking),
         )
     })?;
-    let walked = match walked {
-        Ok(w) => w,
-        Err(Refused::Scene(e)) => return Err(errors::scene_error(py, &e)),
-        Err(Refused::Input(m)) => return Err(errors::input_error(py, &m)),
-        Err(Refused::NoGait(report)) => {
-            let dict = convert::report(py, &*report)?;
-            return Err(errors::gait_not_found(py, &dict));
-        }
-    };
+    let walked = walked.map_err(|r| r.into_py_err(py))?;
     Ok((convert::report(py, &walked.report)?, path(py, &walked)?))
 }
 

@@ -114,6 +114,11 @@ def gait(scene: Scene | str | os.PathLike[str], *, max_strides: int | None = Non
     return Gait.from_report(_walker.gait(_scene(scene), max_strides=max_strides))
 
 
+def _axes(x: tuple[str, Sequence[float]], y: tuple[str, Sequence[float]]):
+    """Two grid axes ``(name, values)`` with the values as floats."""
+    return tuple((name, [float(v) for v in values]) for name, values in (x, y))
+
+
 def _with_progress(progress: ProgressArg, desc: str, unit: str, run):
     f, bar = _progress_callback(progress, desc, unit)
     try:
@@ -277,9 +282,7 @@ def stability_map(
     :class:`SceneError` (unknown parameter, value out of range), :class:`InputError` (one
     parameter twice, no cells, more than :data:`MAX_MAP_CELLS`, an unknown quantity),
     ``KeyboardInterrupt`` on Ctrl-C (at the next gait search)."""
-    (xn, xv), (yn, yv) = x, y
-    s = _scene(scene)
-    axes = (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    s, axes = _scene(scene), _axes(x, y)
     report = _with_progress(
         progress,
         "stability map",
@@ -360,9 +363,7 @@ def basin(
     ``progress(done, total)``. Raises :class:`InputError` (an unknown or repeated coordinate,
     an empty axis, too many cells), :class:`SceneError`, :class:`GaitNotFound` /
     :class:`StrideFailed` (no gait), ``KeyboardInterrupt`` on Ctrl-C."""
-    (xn, xv), (yn, yv) = x, y
-    s = _scene(scene)
-    axes = (xn, [float(v) for v in xv]), (yn, [float(v) for v in yv])
+    s, axes = _scene(scene), _axes(x, y)
     report = _with_progress(
         progress,
         "basin",
