@@ -63,7 +63,16 @@ pub fn robustness<'py>(
             }
             None => Measures::default(),
         },
-        sigma_m: sigma_m.unwrap_or_default(),
+        sigma_m: match sigma_m {
+            Some(v) if v.is_empty() => {
+                return Err(errors::input_error(
+                    py,
+                    "sigma_m: give at least one roughness [m], or None for 0.001, 0.003 and \
+                     0.01 leg lengths",
+                ))
+            }
+            v => v.unwrap_or_default(),
+        },
         first_passage: FirstPassageOptions {
             runs: count(
                 mfpt_runs,

@@ -144,8 +144,16 @@ fn run(
         sensor_faults: &r.sensor_faults,
     };
     let (config, firmware_params_written) = ::sil::walk::config_from_specs(actuator_choice, specs)?;
-    let ideal_setup = setup_for(solver, search)(scene).map_err(Refused::Scene)?;
-    let (ideal, source) = match rule_gait(scene, solver, search).map_err(Refused::Scene)? {
+    // The ideal-actuator gait with the scene's own (accurate) integrator and the options'
+    // Newton settings, as `walker sil` finds it whatever its integrator options.
+    let own_integrator = SolverOptions {
+        integrator: None,
+        step_s: None,
+        rtol: None,
+        ..solver.clone()
+    };
+    let ideal_setup = setup_for(&own_integrator, search)(scene).map_err(Refused::Scene)?;
+    let (ideal, source) = match rule_gait(scene, &own_integrator, search).map_err(Refused::Scene)? {
         Ok(found) => found,
         Err(e) => {
             let report = GaitReport::new(scene, walker, &setup.settings.integrator, &Err(e), None);

@@ -53,6 +53,12 @@ pub fn stability_map<'py>(
                     "quantity mfpt needs the rough floor's standard deviation: give sigma_m",
                 ));
             }
+            if let Some(bad) = sigma_m.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+                return Err(errors::input_error(
+                    py,
+                    &format!("sigma_m {bad}: a standard deviation must be a finite number ≥ 0"),
+                ));
+            }
             q.check(&options)
                 .map_err(|e| errors::input_error(py, &format!("quantity {q}: {e}")))?;
             Some(q)

@@ -118,6 +118,8 @@ def test_stability_map_of_a_quantity_equals_the_cli_json(cli):
         ({"return_strides": 10**30}, "return_strides must be"),
         ({"mfpt_seed": -1}, "mfpt_seed"),
         ({"progress": "yes"}, "progress must be"),
+        ({"measures": []}, "measures: name at least one measure"),
+        ({"sigma_m": []}, "sigma_m: give at least one roughness"),
     ],
 )
 def test_robustness_bad_input_is_an_input_error(kwargs, match):
@@ -149,6 +151,14 @@ def test_stability_map_quantity_bad_input():
         walker.stability_map("compass", *axes, quantity="mfpt")
     with pytest.raises(walker.InputError, match="sigma_m is the rough floor"):
         walker.stability_map("compass", *axes, sigma_m=0.001)
+    with pytest.raises(walker.InputError, match="^sigma_m NaN: a standard deviation") as e:
+        walker.stability_map("compass", *axes, quantity="mfpt", sigma_m=float("nan"))
+    assert "--" not in str(e.value)
+
+
+def test_one_measure_by_name():
+    r = walker.robustness("compass", measures="gsn", progress=False)
+    assert r.gait_sensitivity_norm is not None and r.step_down_max_m is None
 
 
 def test_a_progress_callable_that_raises_stops_the_study():

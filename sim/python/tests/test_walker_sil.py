@@ -234,3 +234,13 @@ def test_ctrl_c_stops_a_long_sil_walk():
     finally:
         timer.cancel()
     assert time.monotonic() - started < 30.0
+
+
+def test_solver_options_as_the_clis_integrator_flags(cli):
+    # the walk with the firmware takes the options; the ideal-actuator gait it starts from is
+    # found with the scene's own integrator, as the command does
+    code, expected, err = cli("sil", "--scene", "wisse3d", "--steps", "2", "--rtol", "1e-8", "--newton-tol", "1e-10", "--json")
+    assert code in (0, 3), err
+    ran = walker.sil(walker.Scene.load("wisse3d").with_solver(rtol=1e-8, newton_tol=1e-10), 2)
+    assert ran.report == expected
+    assert ran.report["integrator"] != walker.sil("wisse3d", 2).report["integrator"]

@@ -57,20 +57,25 @@ impl Measures {
     /// The measures' names, as a list names them.
     pub const NAMES: [&'static str; 4] = ["gsn", "steps", "rates", "mfpt"];
 
-    /// The measures `names` lists (`gsn`, `steps`, `rates`, `mfpt`; whitespace around each
-    /// ignored).
-    ///
-    /// # Errors
-    /// A name that is not a measure.
-    pub fn from_names<'a>(
-        names: impl IntoIterator<Item = &'a str>,
-    ) -> Result<Self, RobustnessOptionError> {
-        let mut m = Self {
+    /// No measure.
+    const fn none() -> Self {
+        Self {
             gsn: false,
             steps: false,
             rates: false,
             mfpt: false,
-        };
+        }
+    }
+
+    /// The measures `names` lists (`gsn`, `steps`, `rates`, `mfpt`; whitespace around each
+    /// ignored).
+    ///
+    /// # Errors
+    /// A name that is not a measure, or no name.
+    pub fn from_names<'a>(
+        names: impl IntoIterator<Item = &'a str>,
+    ) -> Result<Self, RobustnessOptionError> {
+        let mut m = Self::none();
         for name in names.into_iter().map(str::trim) {
             let slot = match name {
                 "gsn" => &mut m.gsn,
@@ -80,6 +85,9 @@ impl Measures {
                 other => return Err(RobustnessOptionError::UnknownMeasure(other.to_owned())),
             };
             *slot = true;
+        }
+        if m == Self::none() {
+            return Err(RobustnessOptionError::NoMeasure);
         }
         Ok(m)
     }
@@ -124,6 +132,8 @@ impl Default for RobustnessOptions {
 pub enum RobustnessOptionError {
     /// A measure name that is not one of [`Measures::NAMES`].
     UnknownMeasure(String),
+    /// No measure named.
+    NoMeasure,
     /// A count outside `min..=max`.
     Count {
         /// The option.
@@ -161,6 +171,11 @@ impl RobustnessOptionError {
         match self {
             Self::UnknownMeasure(name) => format!(
                 "{}: unknown measure `{name}` (expected {})",
+                spell("measures"),
+                Measures::NAMES.join(", ")
+            ),
+            Self::NoMeasure => format!(
+                "{}: name at least one measure of {}",
                 spell("measures"),
                 Measures::NAMES.join(", ")
             ),

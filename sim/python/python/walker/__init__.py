@@ -326,7 +326,7 @@ def robustness(
         "measure",
         lambda f: _walker.robustness(
             s,
-            measures=list(measures),
+            measures=[measures] if isinstance(measures, str) else list(measures),
             sigma_m=None if sigma_m is None else [float(v) for v in sigma_m],
             mfpt_runs=mfpt_runs,
             mfpt_strides=mfpt_strides,
