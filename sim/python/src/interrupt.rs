@@ -41,6 +41,11 @@ impl Counter {
         self.done.fetch_add(1, Ordering::Relaxed);
     }
 
+    /// `done` units done (a study that reports a fraction, scaled to `total`).
+    pub fn set(&self, done: usize) {
+        self.done.store(done.min(self.total), Ordering::Relaxed);
+    }
+
     /// Tells the callable the count (with the GIL).
     fn report(&self, py: Python<'_>) -> PyResult<()> {
         match &self.callback {

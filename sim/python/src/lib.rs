@@ -20,6 +20,7 @@ mod gait;
 mod gaits;
 mod interrupt;
 mod orbit_diagram;
+mod quantity;
 mod refused;
 mod robustness;
 mod scene;

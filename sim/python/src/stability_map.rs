@@ -5,9 +5,9 @@ use crate::convert;
 use crate::errors;
 use crate::gait::setup_for;
 use crate::interrupt::{self, Counter};
+use crate::quantity;
 use crate::scene::PyScene;
 use pyo3::prelude::*;
-use sim::analysis::quantity::{Quantity, QuantityOptions};
 use sim::analysis::stability_map::{stability_map_of, Axis, MAX_MAP_CELLS};
 use sim::report::StabilityMapReport;
 use sim::stride::SearchBudget;
@@ -35,42 +35,7 @@ pub fn stability_map<'py>(
     sigma_m: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let options = QuantityOptions {
-        sigma_m,
-        ..QuantityOptions::default()
-    };
-    let quantity = match quantity.as_deref() {
-        Some(name) => {
-            let q = Quantity::parse(name).ok_or_else(|| {
-                errors::input_error(
-                    py,
-                    &format!("quantity `{name}`: expected one of {}", Quantity::names()),
-                )
-            })?;
-            if q == Quantity::Mfpt && sigma_m.is_none() {
-                return Err(errors::input_error(
-                    py,
-                    "quantity mfpt needs the rough floor's standard deviation: give sigma_m",
-                ));
-            }
-            if let Some(bad) = sigma_m.filter(|s| !(s.is_finite() && *s >= 0.0)) {
-                return Err(errors::input_error(
-                    py,
-                    &format!("sigma_m {bad}: a standard deviation must be a finite number ≥ 0"),
-                ));
-            }
-            q.check(&options)
-                .map_err(|e| errors::input_error(py, &format!("quantity {q}: {e}")))?;
-            Some(q)
-        }
-        None => None,
-    };
-    if sigma_m.is_some() && quantity != Some(Quantity::Mfpt) {
-        return Err(errors::input_error(
-            py,
-            "sigma_m is the rough floor of quantity=\"mfpt\": give quantity=\"mfpt\" too",
-        ));
-    }
+    let (quantity, options) = quantity::choose(py, quantity.as_deref(), sigma_m)?;
     let (solver, scene) = (&scene.solver, &scene.inner);
     let axis = |(name, values): (String, Vec<f64>)| -> PyResult<Axis> {
         Ok(Axis {

@@ -54,6 +54,22 @@ def test_not_a_number_and_not_finite():
         walker.Scene.load("compass").with_params(slope_rad=0.05, slope=0.05)
 
 
+def test_ctrl_c_stops_a_long_sweep():
+    import time
+
+    # A wisse3d sweep of 200 points takes minutes (the review measured 16 s to a Ctrl-C when
+    # the continuation had no cancel hook); its budget stops it at the next stride.
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+    started = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            walker.sweep("wisse3d", "slope_rad", 0.001, 0.05, 200, progress=False)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - started < 5.0
+
+
 @pytest.mark.parametrize("steps", [-1, walker.MAX_WALK_STEPS + 1])
 def test_bad_steps(steps):
     with pytest.raises(walker.InputError, match="steps must be an integer between 0 and 100000"):

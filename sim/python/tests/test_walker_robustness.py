@@ -178,3 +178,21 @@ def test_gaits_reports_progress():
     assert found.gaits and seen
     done, total = seen[-1]
     assert 0 < done <= total
+
+
+def test_sweep_of_a_quantity_equals_the_cli_json(cli):
+    code, expected, err = cli(
+        "sweep", "--scene", "compass", "--param", "slope_rad", "--from", "0.01", "--to", "0.02",
+        "--points", "4", "--quantity", "step_down", "--json",
+    )
+    assert code == 0, err
+    seen = []
+    s = walker.sweep("compass", "slope_rad", 0.01, 0.02, 4, quantity="step_down", progress=lambda d, t: seen.append((d, t)))
+    assert s.report == expected
+    points = s.points()
+    assert "step_down" in points and points["step_down"].notna().all()
+    assert seen[-1] == (4, 4)  # the measuring stage, after the continuation's thousandths
+    assert any(t == 1000 for _, t in seen)
+    # the sweep's value at a point is the robustness measure there
+    at = walker.robustness(walker.Scene.load("compass").with_params(slope_rad=float(points["value"][0])), measures="steps", progress=False)
+    assert at.step_down_max_m == pytest.approx(points["step_down"][0], rel=1e-6)

@@ -5,6 +5,9 @@
 
 use super::{eigenvalue_pairs, FixedPoint};
 use crate::analysis::continuation::{Bifurcation, BranchPoint, Continuation, Family};
+use crate::analysis::homotopy::SetupFor;
+use crate::analysis::limit_cycle::NewtonSettings;
+use crate::analysis::quantity::{at_fixed_point, Quantity, QuantityError, QuantityOptions};
 use serde::Serialize;
 
 /// The `walker sweep --json` object.
@@ -234,6 +237,77 @@ impl FailedPoint {
 }
 
 impl SweepReport {
+    /// `quantity` at every period-1 point of the sweep `result` (this report's continuation),
+    /// in parallel, into the report's points (which list the branches' grid points in the same
+    /// order): each gait re-found by Newton (`newton`) from its fixed point at its value, with
+    /// setups from `setup_for`; `progress` called once per point (`walker sweep --quantity`).
+    pub fn measure(
+        &mut self,
+        result: &Continuation,
+        (quantity, options): (Quantity, &QuantityOptions),
+        setup_for: &SetupFor<'_>,
+        newton: &NewtonSettings,
+        progress: &(dyn Fn() + Sync),
+    ) {
+        use rayon::prelude::*;
+        let family = &result.family;
+        let points: Vec<&BranchPoint> = result
+            .branches
+            .iter()
+            .flat_map(|b| b.grid.iter().map(|g| &g.point))
+            .collect();
+        let values: Vec<Result<f64, QuantityError>> = points
+            .par_iter()
+            .map(|p| {
+                let value = if p.period_strides() > 1 {
+                    Err(QuantityError::Undefined {
+                        quantity,
+                        why: format!(
+                            "defined for period-1 gaits; this one repeats every {} strides",
+                            p.period_strides()
+                        ),
+                    })
+                } else {
+                    family
+                        .scene_at(p.value)
+                        .map_err(|e| QuantityError::Undefined {
+                            quantity,
+                            why: e.to_string(),
+                        })
+                        .and_then(|scene| {
+                            at_fixed_point(
+                                quantity,
+                                options,
+                                &scene,
+                                setup_for,
+                                newton,
+                                &p.orbit[0],
+                            )
+                        })
+                };
+                progress();
+                value
+            })
+            .collect();
+        let converged = self.points.iter_mut().filter_map(|r| match r {
+            SweepPointRecord::Converged(c) => Some(c),
+            SweepPointRecord::Failed(_) => None,
+        });
+        for (c, v) in converged.zip(values) {
+            c.quantity = Some(QuantityValue {
+                name: quantity,
+                sigma_m: options.sigma_m.filter(|_| quantity == Quantity::Mfpt),
+                value: v.as_ref().ok().copied(),
+                error: v.err().map(|e| e.to_string()),
+            });
+        }
+    }
+
+    /// The period-1 points [`Self::measure`] visits (its progress's total).
+    pub fn measured_points(result: &Continuation) -> usize {
+        result.branches.iter().map(|b| b.grid.len()).sum()
+    }
+
     /// The report of a pseudo-arclength continuation (of its family's parameter): each branch's
     /// points at the grid values in arclength order (branch 0 first, then the grid values it
     /// did not reach, with the reason; then the period-doubled branches), every located

@@ -14,69 +14,9 @@ use crate::sweep_figures::sweep_figures;
 use anyhow::Result;
 use clap::Args;
 use sim::analysis::continuation::{continuation, ContinuationSettings, SweepError};
-use sim::analysis::quantity::{at_fixed_point, Quantity, QuantityError, QuantityOptions};
-use sim::report::{QuantityValue, SweepPointRecord, SweepReport};
+use sim::report::{SweepPointRecord, SweepReport};
 use std::io::Write;
 use std::process::ExitCode;
-
-/// `quantity` at every period-1 point of the sweep, in parallel, into the report's points
-/// (which list the branches' grid points in the same order).
-fn measure(
-    report: &mut SweepReport,
-    result: &sim::analysis::continuation::Continuation,
-    quantity: Quantity,
-    options: &QuantityOptions,
-    common: &Common,
-) {
-    use rayon::prelude::*;
-    let family = &result.family;
-    let points: Vec<&sim::analysis::continuation::BranchPoint> = result
-        .branches
-        .iter()
-        .flat_map(|b| b.grid.iter().map(|g| &g.point))
-        .collect();
-    let progress = Progress::new(points.len(), "sweep: measuring", !common.json);
-    let (setup_for, newton) = (common.setup_for(), common.newton());
-    let values: Vec<Result<f64, QuantityError>> = points
-        .par_iter()
-        .map(|p| {
-            let value = if p.period_strides() > 1 {
-                Err(QuantityError::Undefined {
-                    quantity,
-                    why: format!(
-                        "defined for period-1 gaits; this one repeats every {} strides",
-                        p.period_strides()
-                    ),
-                })
-            } else {
-                family
-                    .scene_at(p.value)
-                    .map_err(|e| QuantityError::Undefined {
-                        quantity,
-                        why: e.to_string(),
-                    })
-                    .and_then(|scene| {
-                        at_fixed_point(quantity, options, &scene, &setup_for, &newton, &p.orbit[0])
-                    })
-            };
-            progress.tick();
-            value
-        })
-        .collect();
-    progress.finish();
-    let converged = report.points.iter_mut().filter_map(|r| match r {
-        SweepPointRecord::Converged(c) => Some(c),
-        SweepPointRecord::Failed(_) => None,
-    });
-    for (c, v) in converged.zip(values) {
-        c.quantity = Some(QuantityValue {
-            name: quantity,
-            sigma_m: options.sigma_m.filter(|_| quantity == Quantity::Mfpt),
-            value: v.as_ref().ok().copied(),
-            error: v.err().map(|e| e.to_string()),
-        });
-    }
-}
 
 /// Resolution of the sweep's progress bar (the continuation reports a fraction done).
 const PROGRESS_STEPS: usize = 1000;
@@ -184,7 +124,19 @@ pub fn run(args: SweepArgs) -> Result<ExitCode> {
     }
     let mut report = SweepReport::from_continuation(&result);
     if let Some(q) = quantity {
-        measure(&mut report, &result, q, &quantity_options, &common);
+        let progress = Progress::new(
+            SweepReport::measured_points(&result),
+            "sweep: measuring",
+            !common.json,
+        );
+        report.measure(
+            &result,
+            (q, &quantity_options),
+            &common.setup_for(),
+            &common.newton(),
+            &|| progress.tick(),
+        );
+        progress.finish();
     }
     if common.json {
         print_json(&report)?;

@@ -391,12 +391,26 @@ def sweep(
     points: int,
     *,
     max_period: int = 1,
+    quantity: str | None = None,
+    sigma_m: float | None = None,
+    progress: ProgressArg = True,
 ) -> Sweep:
     """The gait of ``scene`` followed as ``param`` goes from ``start`` to ``end`` at
     ``points`` points, as ``walker sweep --param P --from START --to END --points N
     --max-period K`` follows it (pseudo-arclength continuation through folds, bifurcations
-    located, period-doubled branches up to ``max_period`` strides per cycle). Raises
-    :class:`SceneError`, :class:`InputError`; Ctrl-C raises ``KeyboardInterrupt`` when the
-    sweep ends (the continuation has no cancel hook)."""
-    report = _walker.sweep(_scene(scene), param, start, end, points, max_period=max_period)
+    located, period-doubled branches up to ``max_period`` strides per cycle). ``quantity``
+    also measures a number of every period-1 gait (as :func:`stability_map`'s; ``mfpt`` with
+    ``sigma_m``): the ``quantity`` column of :meth:`Sweep.points`. ``progress``: a tqdm bar
+    (``True``, after a second), none (``False``) or ``progress(done, total)``. Raises
+    :class:`SceneError`, :class:`InputError`, ``KeyboardInterrupt`` on Ctrl-C (at the next
+    stride)."""
+    s = _scene(scene)
+    report = _with_progress(
+        progress,
+        "sweep",
+        "‰",
+        lambda f: _walker.sweep(
+            s, param, start, end, points, max_period=max_period, quantity=quantity, sigma_m=sigma_m, progress=f
+        ),
+    )
     return Sweep.from_report(report)

@@ -22,6 +22,8 @@ class _Bar:
             from tqdm.auto import tqdm
 
             self._bar = tqdm(total=total, desc=self._desc, unit=self._unit, delay=1.0)
+        if total != self._bar.total:  # the next stage of the study (e.g. a sweep's measuring)
+            self._bar.reset(total=total)
         self._bar.update(done - self._bar.n)
 
     def close(self) -> None:

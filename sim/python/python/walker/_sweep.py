@@ -26,7 +26,8 @@ class Sweep:
     def points(self) -> pd.DataFrame:
         """One row per point along the branches: ``value``, ``converged``, ``branch``,
         ``period_strides``, ``max_abs_eigenvalue``, ``stable``, ``step_period_s``,
-        ``step_length_m`` (NaN where no gait was found)."""
+        ``step_length_m`` (NaN where no gait was found), and with ``quantity=`` its value
+        under its name (NaN where it has none: :meth:`quantity_errors` says why)."""
         keys = [
             "value",
             "converged",
@@ -37,9 +38,23 @@ class Sweep:
             "step_period_s",
             "step_length_m",
         ]
-        return pd.DataFrame(
-            [{k: p.get(k) for k in keys} for p in self.report["points"]], columns=keys
-        )
+        rows = [{k: p.get(k) for k in keys} for p in self.report["points"]]
+        names = {p["quantity"]["name"] for p in self.report["points"] if p.get("quantity")}
+        for name in names:
+            keys.append(name)
+            for row, p in zip(rows, self.report["points"]):
+                q = p.get("quantity")
+                row[name] = q["value"] if q and q["value"] is not None else float("nan")
+        return pd.DataFrame(rows, columns=keys)
+
+    def quantity_errors(self) -> pd.DataFrame:
+        """Why a point's ``quantity`` has no value: ``value``, ``branch``, ``error``."""
+        rows = [
+            {"value": p["value"], "branch": p.get("branch"), "error": p["quantity"]["error"]}
+            for p in self.report["points"]
+            if p.get("quantity") and p["quantity"].get("error")
+        ]
+        return pd.DataFrame(rows, columns=["value", "branch", "error"])
 
     def stability_boundaries(self) -> pd.DataFrame:
         """The located bifurcations (folds, period doublings, Neimark–Sacker), one row each,

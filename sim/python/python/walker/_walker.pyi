@@ -124,7 +124,16 @@ def basin(
     gait; raises ``InputError``, ``SceneError``, ``GaitNotFound`` or ``StrideFailed``."""
 
 def sweep(
-    scene: Scene, param: str, start: float, end: float, points: int, *, max_period: int | None = None
+    scene: Scene,
+    param: str,
+    start: float,
+    end: float,
+    points: int,
+    *,
+    max_period: int | None = None,
+    quantity: str | None = None,
+    sigma_m: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """The ``walker sweep --json`` object."""
 

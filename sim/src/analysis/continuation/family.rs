@@ -7,7 +7,7 @@
 
 use crate::analysis::limit_cycle::{GaitSearch, JacobianMethod, NewtonSettings};
 use crate::scene::{Scene, SceneError, Setup};
-use crate::stride::{StrideFailure, StrideResult, StrideSettings};
+use crate::stride::{SharedBudget, StrideFailure, StrideResult, StrideSettings};
 use nalgebra::{DMatrix, DVector};
 
 /// Why a stride map of the family could not be evaluated.
@@ -87,6 +87,8 @@ pub struct Family {
     /// command line's `--integrator`, `--rtol`, `--step-s`); `None`: the scene's own at each
     /// value.
     pub stride_settings: Option<StrideSettings>,
+    /// The budget the strides take from (none: the scene's settings' own).
+    pub search_budget: SharedBudget,
 }
 
 impl Family {
@@ -109,6 +111,7 @@ impl Family {
             newton: *newton,
             dp: newton.perturbation,
             stride_settings: None,
+            search_budget: SharedBudget::default(),
         })
     }
 
@@ -128,6 +131,9 @@ impl Family {
         let mut setup = scene.setup()?;
         if let Some(settings) = &self.stride_settings {
             setup.settings = settings.clone();
+        }
+        if self.search_budget.0.is_some() {
+            setup.settings.search_budget = self.search_budget.clone();
         }
         Ok(setup)
     }

@@ -174,6 +174,7 @@ pub fn continuation(
     }
     let mut family = Family::new(scene, param, settings.newton())?;
     family.stride_settings = settings.stride_settings().cloned();
+    family.search_budget = settings.search_budget().clone();
     family.scene_at(from)?;
     family.scene_at(to)?;
     let grid = Grid::new(from, to, points);

@@ -7,7 +7,7 @@
 
 use crate::analysis::homotopy::HomotopySettings;
 use crate::analysis::limit_cycle::NewtonSettings;
-use crate::stride::StrideSettings;
+use crate::stride::{SharedBudget, StrideSettings};
 
 /// Which bifurcations a continuation locates (all by default;
 /// [`super::BifurcationKind::detected_by`]). A kind not detected is neither
@@ -75,6 +75,7 @@ pub struct ContinuationSettings {
     max_turn_deg: f64,
     detect: Detection,
     stride_settings: Option<StrideSettings>,
+    search_budget: SharedBudget,
     start_attempts: usize,
     homotopy: HomotopySettings,
 }
@@ -92,6 +93,7 @@ impl Default for ContinuationSettings {
             max_turn_deg: 60.0,
             detect: Detection::default(),
             stride_settings: None,
+            search_budget: SharedBudget::default(),
             start_attempts: 64,
             homotopy: HomotopySettings::default(),
         }
@@ -160,6 +162,12 @@ impl ContinuationSettings {
     /// default: the scene's own at each value).
     pub fn stride_settings(&self) -> Option<&StrideSettings> {
         self.stride_settings.as_ref()
+    }
+
+    /// The budget every stride of the continuation's branches takes from (none by default): a
+    /// caller cancels it to stop the sweep at its next stride (Ctrl-C in the Python package).
+    pub fn search_budget(&self) -> &SharedBudget {
+        &self.search_budget
     }
 
     /// Grid values tried for a first gait ([`crate::analysis::homotopy::long_period_gait`]):
@@ -327,6 +335,12 @@ impl ContinuationSettingsBuilder {
     /// See [`ContinuationSettings::stride_settings`].
     pub fn stride_settings(mut self, settings: Option<StrideSettings>) -> Self {
         self.0.stride_settings = settings;
+        self
+    }
+
+    /// See [`ContinuationSettings::search_budget`].
+    pub fn search_budget(mut self, budget: SharedBudget) -> Self {
+        self.0.search_budget = budget;
         self
     }
 
