@@ -103,6 +103,7 @@ pub fn optimize<'py>(
             &solver.homotopy(),
             &|| counter.tick(),
         )
+        .map_err(Box::new)
     })?
     .map_err(|e| option_error(py, &e))?;
     convert::report(py, &report)

@@ -415,7 +415,7 @@ impl OptimizeReport {
             setup_for,
             newton,
             homotopy,
-            quantity_options: request.quantity_options.clone(),
+            quantity_options: request.quantity_options,
         };
         check(scene, &settings)?;
         let result = optimize(scene, &settings, on_evaluation)?;
