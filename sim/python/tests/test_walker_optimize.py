@@ -140,3 +140,14 @@ def test_a_range_outside_the_parameters_is_a_scene_error_with_its_fields():
     assert raised.value.kind == "out_of_range"
     assert raised.value.name == "leg_com_from_hip_m"
     assert str(raised.value).startswith("vary `leg_com_from_hip_m=-1.0:0.5`: ")
+
+
+def test_a_progress_callable_that_raises_stops_the_search():
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        raise Stop()
+
+    with pytest.raises(Stop):
+        walker.optimize("compass", {"leg_mass_kg": (4.0, 6.0), "leg_com_from_hip_m": (0.3, 0.7)}, "gsn", budget=10_000, progress=stop)

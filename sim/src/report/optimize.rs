@@ -463,3 +463,69 @@ impl OptimizeReport {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    fn flag(field: &str) -> String {
+        format!("--{}", field.replace('_', "-"))
+    }
+
+    fn refusal(options: OptimizeOptions) -> OptimizeOptionError {
+        let scene = Scene::load("compass").unwrap();
+        options.request(&scene).err().expect("refused")
+    }
+
+    #[test]
+    fn options_are_read_and_refusals_name_the_option_per_front_end() {
+        let scene = Scene::load("compass").unwrap();
+        let options = OptimizeOptions {
+            vary: vec!["leg_mass_kg=4:6".into()],
+            objective: " max_abs_eigenvalue ".into(),
+            constraints: vec!["step_period_s<=0.8".into()],
+            ..OptimizeOptions::default()
+        };
+        let request = options.request(&scene).unwrap();
+        assert_eq!(request.params[0].min, 4.0);
+        assert_eq!(request.objective, Objective::MaxAbsEigenvalue);
+        assert_eq!(request.constraints[0].bound, 0.8);
+        let e = refusal(OptimizeOptions {
+            budget: 0,
+            ..OptimizeOptions::default()
+        });
+        assert_eq!(
+            e.message(&flag),
+            "--budget must be between 1 and 10000, got 0"
+        );
+        assert_eq!(e.to_string(), "budget must be between 1 and 10000, got 0");
+        let e = refusal(OptimizeOptions {
+            vary: vec!["leg_mass_kg=4:6".into()],
+            sigma_m: Some(0.001),
+            ..OptimizeOptions::default()
+        });
+        assert_eq!(
+            e.message(&flag),
+            "--sigma-m is the rough floor of mfpt: give --objective mfpt or an mfpt constraint"
+        );
+        let e = refusal(OptimizeOptions {
+            vary: vec!["leg_mass_kg=6:4".into()],
+            ..OptimizeOptions::default()
+        });
+        assert_eq!(
+            e.to_string(),
+            "vary `leg_mass_kg=6:4`: MIN 6 must be below MAX 4"
+        );
+        let e = refusal(OptimizeOptions {
+            vary: vec!["leg_com_from_hip_m=-1:0.5".into()],
+            ..OptimizeOptions::default()
+        });
+        assert!(e.scene_error().is_some(), "{e}");
+        let e = refusal(OptimizeOptions {
+            vary: vec!["nope=0:1".into()],
+            ..OptimizeOptions::default()
+        });
+        assert!(matches!(e, OptimizeOptionError::UnknownParameter(_)), "{e}");
+    }
+}
