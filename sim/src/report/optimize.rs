@@ -475,7 +475,7 @@ mod tests {
 
     fn refusal(options: OptimizeOptions) -> OptimizeOptionError {
         let scene = Scene::load("compass").unwrap();
-        options.request(&scene).err().expect("refused")
+        options.request(&scene).expect_err("refused")
     }
 
     #[test]
