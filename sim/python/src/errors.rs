@@ -46,6 +46,15 @@ pub fn scene_error(py: Python<'_>, e: &SceneError) -> PyErr {
     raise(py, "SceneError", &message, &fields)
 }
 
+/// [`scene_error`] with another message (the option that gave the value, then the scene's
+/// refusal).
+pub fn scene_error_with_message(py: Python<'_>, message: &str, e: &SceneError) -> PyErr {
+    match scene_error_fields(py, e) {
+        Ok(fields) => raise(py, "SceneError", message, &fields),
+        Err(err) => err,
+    }
+}
+
 fn scene_error_fields<'py>(py: Python<'py>, e: &SceneError) -> PyResult<Fields<'py>> {
     let s = |x: &str| x.into_pyobject(py).map(|o| o.into_any());
     let f = |x: f64| x.into_pyobject(py).map(|o| o.into_any());

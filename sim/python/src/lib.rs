@@ -19,6 +19,7 @@ mod errors;
 mod gait;
 mod gaits;
 mod interrupt;
+mod optimize;
 mod orbit_diagram;
 mod quantity;
 mod refused;
@@ -48,6 +49,15 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability_map::stability_map, m)?)?;
     m.add_function(wrap_pyfunction!(robustness::robustness, m)?)?;
     m.add_function(wrap_pyfunction!(basin::basin, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
+    m.add(
+        "MAX_OPTIMIZE_EVALUATIONS",
+        sim::report::MAX_OPTIMIZE_EVALUATIONS,
+    )?;
+    m.add(
+        "DEFAULT_INITIAL_STEP",
+        sim::analysis::optimize::INITIAL_STEP,
+    )?;
     m.add(
         "MAX_BASIN_CELL_STRIDES",
         sim::analysis::robustness::MAX_BASIN_CELL_STRIDES,

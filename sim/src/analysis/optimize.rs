@@ -431,6 +431,9 @@ pub enum OptimizeError {
         /// Why.
         why: QuantityError,
     },
+    /// The initial step size is not above 0 and at most 1.
+    #[error("the initial step must be above 0 and at most 1 (normalised), got {0}")]
+    InitialStep(f64),
     /// Anything else wrong with the request.
     #[error("{0}")]
     Invalid(String),
@@ -456,10 +459,7 @@ pub fn check(scene: &Scene, settings: &OptimizeSettings<'_>) -> Result<(), Optim
         ));
     }
     if !(settings.initial_step > 0.0 && settings.initial_step <= 1.0) {
-        return Err(OptimizeError::Invalid(format!(
-            "the initial step must be above 0 and at most 1 (normalised), got {}",
-            settings.initial_step
-        )));
+        return Err(OptimizeError::InitialStep(settings.initial_step));
     }
     if settings.budget == 0 {
         return Err(OptimizeError::Invalid(
@@ -776,7 +776,9 @@ impl Progress {
 }
 
 /// Optimises `settings.objective` over `settings.params` from `scene`'s design (see the
-/// [module docs](self)), calling `on_evaluation` after each candidate (from any thread).
+/// [module docs](self)), calling `on_evaluation` after each evaluation (from any thread): the
+/// scene's own design first, then every candidate, `budget + 1` calls in all. The calls have
+/// no effect on the search.
 ///
 /// # Errors
 /// A request [`check`] refuses, or a scene that cannot be built at a design.
@@ -810,6 +812,7 @@ pub fn optimize(
     let default = evaluator
         .evaluate(scene.clone(), given, 0.0, 0.0)?
         .evaluation;
+    on_evaluation();
     let evaluator = Evaluator {
         on_evaluation,
         ..evaluator

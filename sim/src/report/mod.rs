@@ -25,6 +25,7 @@ mod fixed_point;
 mod gait;
 mod gaits;
 mod ideal_gait;
+mod optimize;
 mod orbit_diagram;
 mod robustness;
 mod scenes;
@@ -42,6 +43,10 @@ pub use fixed_point::FixedPoint;
 pub use gait::{ActuatorFigures, ContactFigures, FoundGait, GaitNotFound, GaitOutcome, GaitReport};
 pub use gaits::GaitsReport;
 pub use ideal_gait::IdealGaitRecord;
+pub use optimize::{
+    parse_vary, Best, Method, OptimizeOptionError, OptimizeOptions, OptimizeReport,
+    OptimizeRequest, MAX_OPTIMIZE_EVALUATIONS,
+};
 pub use orbit_diagram::{FellRecord, OrbitDiagramReport, OrbitPointRecord};
 pub use robustness::{
     Again, Measures, RobustnessOptionError, RobustnessOptions, RobustnessReport, Signs,

@@ -9,21 +9,15 @@ use super::{print_json, shown};
 use crate::export;
 use crate::input_error::InputError;
 use crate::labels;
-use crate::limits;
 use crate::options::Common;
 use crate::output;
 use crate::plot::{Marker, Plot, Series, Style, PALETTE};
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
-use sim::analysis::optimize::{
-    optimize, Constraint, Evaluation, Generation, Objective, OptimizeError, OptimizeResult,
-    OptimizeSettings, Sense, VariedParameter, BOUND_PENALTY, INITIAL_STEP,
-};
-use sim::report::GaitReport;
+use sim::analysis::optimize::{Generation, Objective, OptimizeError, Sense, INITIAL_STEP};
+use sim::report::{OptimizeOptionError, OptimizeOptions, OptimizeReport};
 use sim::scene::Scene;
-use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -78,51 +72,6 @@ pub struct OptimizeArgs {
     pub plot: Option<std::path::PathBuf>,
 }
 
-/// The `walker optimize --json` object.
-#[derive(Serialize)]
-struct OptimizeReport<'a> {
-    scene: &'a str,
-    objective: Objective,
-    sense: Sense,
-    parameters: &'a [VariedParameter],
-    constraints: &'a [Constraint],
-    seed: u64,
-    budget: usize,
-    /// How the search ran (its fixed rules), for a reader of the JSON.
-    method: Method,
-    /// The scene's own design (its values with `--set`), evaluated outside the budget.
-    default: &'a Evaluation,
-    /// The best feasible design (`null`: none was feasible).
-    best: Option<Best<'a>>,
-    /// The best feasible value after each generation (`null` before the first feasible one).
-    history: Vec<Option<f64>>,
-    generations: &'a [Generation],
-    runs: usize,
-    evaluations: &'a [Evaluation],
-}
-
-/// The search's fixed rules.
-#[derive(Serialize)]
-struct Method {
-    algorithm: &'static str,
-    coordinates: &'static str,
-    initial_step: f64,
-    bounds: &'static str,
-    bound_penalty: f64,
-    restarts: &'static str,
-}
-
-/// The best design.
-#[derive(Serialize)]
-struct Best<'a> {
-    /// Its index in `evaluations`.
-    index: usize,
-    parameters: &'a BTreeMap<String, f64>,
-    value: Option<f64>,
-    /// Its gait, as `walker gait --json` reports it at these values (with its `gait_source`).
-    gait: GaitReport,
-}
-
 /// Runs `walker optimize`.
 pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     let OptimizeArgs {
@@ -134,100 +83,33 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         seed,
         initial_step,
         plot,
-        sigma_m: args_sigma_m,
+        sigma_m,
     } = args;
     let scene = common.scene()?;
     common.setup(&scene)?;
-    let budget = limits::count("--budget", budget, 1, limits::MAX_TUNE_EVALUATIONS)?;
-    let objective = Objective::parse(objective.trim()).ok_or_else(|| {
-        InputError::Other(format!(
-            "--objective `{objective}`: expected one of {}",
-            Objective::ALL.map(Objective::name).join(", ")
-        ))
-    })?;
-    let params = vary
-        .iter()
-        .map(|v| parse_vary(v, &scene))
-        .collect::<Result<Vec<_>, _>>()?;
-    let constraints = constraint
-        .iter()
-        .map(|c| Constraint::parse(c).map_err(|e| InputError::Other(format!("--{e}"))))
-        .collect::<Result<Vec<_>, _>>()?;
-    let uses_mfpt = objective.quantity() == sim::analysis::quantity::Quantity::Mfpt
-        || constraints
-            .iter()
-            .any(|c| c.quantity == sim::analysis::quantity::Quantity::Mfpt);
-    if args_sigma_m.is_some() && !uses_mfpt {
-        return Err(InputError::Other(
-            "--sigma-m is the rough floor of mfpt: give --objective mfpt or an mfpt constraint"
-                .into(),
-        )
-        .into());
-    }
+    let options = OptimizeOptions {
+        vary,
+        objective,
+        constraints: constraint,
+        budget,
+        seed,
+        initial_step,
+        sigma_m,
+    };
+    let request = options.request(&scene).map_err(input_error)?;
     if let Some(dir) = &plot {
         output::create_dir("--plot", dir)?;
     }
     let (setup_for, newton, homotopy) = (common.setup_for(), common.newton(), common.homotopy());
-    let settings = OptimizeSettings {
-        params: &params,
-        objective,
-        constraints: &constraints,
-        budget,
-        seed,
-        initial_step,
-        setup_for: &setup_for,
-        newton: &newton,
-        homotopy: &homotopy,
-        quantity_options: sim::analysis::quantity::QuantityOptions {
-            sigma_m: args_sigma_m,
-            ..Default::default()
-        },
-    };
-    sim::analysis::optimize::check(&scene, &settings).map_err(input_error)?;
-    let progress = Progress::new(budget, "optimize (gait searches)", !common.json);
-    let result = optimize(&scene, &settings, &|| progress.tick()).map_err(input_error)?;
+    // The scene's own design and every candidate.
+    let progress = Progress::new(request.budget + 1, "optimize (gait searches)", !common.json);
+    let report = OptimizeReport::run(&scene, &request, &setup_for, &newton, &homotopy, &|| {
+        progress.tick()
+    })
+    .map_err(input_error)?;
     progress.finish();
-    let best = match &result.best {
-        Some(b) => {
-            let setup = setup_for(&b.scene)?;
-            let (mut gait, _) = GaitReport::of_setup(&setup, &b.scene, &Ok(b.gait.clone()), false);
-            gait.gait_source = Some(b.source);
-            let e = &result.evaluations[b.index];
-            Some(Best {
-                index: b.index,
-                parameters: &e.parameters,
-                value: e.value,
-                gait,
-            })
-        }
-        None => None,
-    };
-    let report = OptimizeReport {
-        scene: scene.name(),
-        objective,
-        sense: objective.sense(),
-        parameters: &result.parameters,
-        constraints: &constraints,
-        seed,
-        budget,
-        method: Method {
-            algorithm: "CMA-ES (cmaes crate), IPOP restarts",
-            coordinates: "normalised: (value - MIN) / (MAX - MIN)",
-            initial_step,
-            bounds: "clipped to the box, ranked with a penalty on the squared distance outside",
-            bound_penalty: BOUND_PENALTY,
-            restarts: "a run that stops by itself restarts with twice the population from \
-                       the best feasible design",
-        },
-        default: &result.default,
-        best,
-        history: result.generations.iter().map(|g| g.best_so_far).collect(),
-        generations: &result.generations,
-        runs: result.runs,
-        evaluations: &result.evaluations,
-    };
     if let Some(dir) = &plot {
-        let figure = history_plot(&scene, objective, &result);
+        let figure = history_plot(&scene, &report);
         export::write_figure("--plot", dir, "history", &figure.to_svg(760.0, 480.0))?;
     }
     if common.json {
@@ -242,48 +124,25 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     })
 }
 
-/// A request the search refuses is bad input (exit 2).
-fn input_error(e: OptimizeError) -> anyhow::Error {
-    match e {
-        OptimizeError::Scene(s) => InputError::Scene(s).into(),
-        other => InputError::Other(other.to_string()).into(),
-    }
-}
-
-/// A `--vary NAME=MIN:MAX` option (the parameter by its canonical name).
-fn parse_vary(v: &str, scene: &Scene) -> Result<VariedParameter, InputError> {
-    let bad = |why: &str| InputError::Other(format!("--vary `{v}`: {why} (expected NAME=MIN:MAX)"));
-    let (name, range) = v.split_once('=').ok_or_else(|| bad("no `=`"))?;
-    let name = scene.parameter_name(name.trim())?;
-    let (lo, hi) = range
-        .split_once(':')
-        .ok_or_else(|| bad("no `:` between MIN and MAX"))?;
-    let number = |what: &str, s: &str| -> Result<f64, InputError> {
-        s.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| bad(&format!("{what} `{}` is not a finite number", s.trim())))
+/// An option the search refuses is bad input (exit 2), each option spelled as its flag.
+fn input_error(e: OptimizeOptionError) -> anyhow::Error {
+    let flag = |field: &str| match field {
+        "constraints" => "--constraint".to_owned(),
+        // The command's message for it predates the spelling of options as flags.
+        "initial_step" => "the initial step".to_owned(),
+        other => format!("--{}", other.replace('_', "-")),
     };
-    let (min, max) = (number("MIN", lo)?, number("MAX", hi)?);
-    if min >= max {
-        return Err(InputError::Other(format!(
-            "--vary `{v}`: MIN {min} must be below MAX {max}"
-        )));
+    match e {
+        OptimizeOptionError::UnknownParameter(s)
+        | OptimizeOptionError::Search(OptimizeError::Scene(s)) => InputError::Scene(s).into(),
+        other => InputError::Other(other.message(&flag)).into(),
     }
-    // Both ends inside the scene's own range (`walker scenes S`).
-    let mut check = scene.clone();
-    for end in [min, max] {
-        check
-            .set(&name, end)
-            .map_err(|e| InputError::Other(format!("--vary `{v}`: {e}")))?;
-    }
-    Ok(VariedParameter { name, min, max })
 }
 
 /// The history figure: each generation's best feasible value and the best so far, against
 /// the evaluations spent, with the scene's own design's value as a dashed line.
-fn history_plot(scene: &Scene, objective: Objective, r: &OptimizeResult) -> Plot {
+fn history_plot(scene: &Scene, r: &OptimizeReport) -> Plot {
+    let objective = r.objective;
     let point = |g: &Generation, v: Option<f64>| (g.evaluations as f64, v.unwrap_or(f64::NAN));
     let mut series = vec![
         Series {
@@ -348,7 +207,7 @@ fn objective_label(o: Objective) -> &'static str {
     }
 }
 
-fn print_text(out: &mut dyn Write, r: &OptimizeReport<'_>) -> std::io::Result<()> {
+fn print_text(out: &mut dyn Write, r: &OptimizeReport) -> std::io::Result<()> {
     writeln!(out, "scene: {}", r.scene)?;
     let sense = match r.sense {
         Sense::Minimise => "minimise",
@@ -365,7 +224,7 @@ fn print_text(out: &mut dyn Write, r: &OptimizeReport<'_>) -> std::io::Result<()
         r.runs,
         if r.runs == 1 { "" } else { "s" },
     )?;
-    for c in r.constraints {
+    for c in &r.constraints {
         writeln!(out, "constraint: {c}")?;
     }
     let feasible = r.evaluations.iter().filter(|e| e.feasible).count();
@@ -390,7 +249,7 @@ fn print_text(out: &mut dyn Write, r: &OptimizeReport<'_>) -> std::io::Result<()
         "{:<36} {:>14} {:>14}   bounds",
         "parameter", "scene's design", "best design"
     )?;
-    for p in r.parameters {
+    for p in &r.parameters {
         let d = r
             .default
             .parameters

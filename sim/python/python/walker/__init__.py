@@ -24,6 +24,7 @@ from . import _walker
 from ._basin import Basin
 from ._errors import GaitNotFound, InputError, SceneError, StrideFailed, WalkerError
 from ._gait import Gait, Gaits
+from ._optimize import Best, Optimize
 from ._orbit_diagram import OrbitDiagram
 from ._progress import ProgressArg, callback as _progress_callback
 from ._robustness import Robustness
@@ -33,10 +34,12 @@ from ._sweep import Sweep
 from ._walk import Walk
 from ._walker import (
     DEFAULT_GAIT_STRIDE_BUDGET,
+    DEFAULT_INITIAL_STEP,
     DEFAULT_PATH_SAMPLES,
     MAX_BASIN_CELL_STRIDES,
     DEFAULT_SIL_FRAMES,
     MAX_MAP_CELLS,
+    MAX_OPTIMIZE_EVALUATIONS,
     MAX_ORBIT_POINTS,
     MAX_PATH_SAMPLES,
     MAX_SIL_FRAMES,
@@ -47,6 +50,11 @@ from ._walker import (
 
 __all__ = [
     "Basin",
+    "Best",
+    "Optimize",
+    "optimize",
+    "DEFAULT_INITIAL_STEP",
+    "MAX_OPTIMIZE_EVALUATIONS",
     "Robustness",
     "basin",
     "robustness",
@@ -414,3 +422,107 @@ def sweep(
         ),
     )
     return Sweep.from_report(report)
+
+
+def _ranges(vary: Mapping[str, tuple[float, float]] | Sequence[str] | str) -> list[str]:
+    """``vary`` as ``NAME=MIN:MAX`` texts (floats written as Python writes them, which the
+    library reads back to the same numbers)."""
+    if isinstance(vary, str):
+        return [vary]
+    if isinstance(vary, Mapping):
+        ranges = []
+        for name, bounds in vary.items():
+            try:
+                lo, hi = bounds
+                lo, hi = float(lo), float(hi)
+            except (TypeError, ValueError):
+                raise InputError(f"vary `{name}`: expected a pair (min, max) of numbers, got {bounds!r}") from None
+            ranges.append(f"{name}={lo!r}:{hi!r}")
+        return ranges
+    return [str(v) for v in vary]
+
+
+def _constraints(constraints: Sequence[str | tuple[str, str, float]] | str) -> list[str]:
+    """``constraints`` as ``NAME<=V`` / ``NAME>=V`` texts."""
+    if isinstance(constraints, str):
+        return [constraints]
+    texts = []
+    for c in constraints:
+        if isinstance(c, str):
+            texts.append(c)
+            continue
+        try:
+            name, relation, bound = c
+            bound = float(bound)
+        except (TypeError, ValueError):
+            raise InputError(f"constraints: expected \"NAME<=V\" or (name, \"<=\", value), got {c!r}") from None
+        if relation not in ("<=", ">="):
+            raise InputError(f"constraints: relation {relation!r} of {c!r}: expected \"<=\" or \">=\"")
+        texts.append(f"{name}{relation}{bound!r}")
+    return texts
+
+
+def optimize(
+    scene: Scene | str | os.PathLike[str],
+    vary: Mapping[str, tuple[float, float]] | Sequence[str],
+    objective: str,
+    *,
+    constraints: Sequence[str | tuple[str, str, float]] = (),
+    budget: int = 200,
+    seed: int = 0,
+    initial_step: float = DEFAULT_INITIAL_STEP,
+    sigma_m: float | None = None,
+    progress: ProgressArg = True,
+) -> Optimize:
+    """Searches ``scene``'s parameters for the design whose gait (as :func:`gait` finds it)
+    is best by ``objective``, by CMA-ES, as ``walker optimize`` does (docs/robustness.md): the
+    same arguments give the same search, bit for bit, and :attr:`Optimize.report` equals the
+    command's ``--json`` object.
+
+    ``vary``: the parameters and their ranges, ``{"leg_mass_kg": (4.0, 6.0)}`` (or texts
+    ``"leg_mass_kg=4:6"``, ``--vary``), each inside the parameter's own range.
+    ``objective``: ``gsn``, ``max_abs_eigenvalue``, ``cost_of_transport`` (actuated walkers;
+    these three minimised), ``step_down`` or ``mfpt`` (on the rough floor of ``sigma_m``
+    metres; maximised). ``constraints``: each ``"NAME<=V"`` / ``"NAME>=V"`` or a tuple
+    ``(name, "<=", value)`` on ``gsn``, ``step_down``, ``step_up``, ``max_abs_eigenvalue``,
+    ``mfpt``, ``cost_of_transport``, ``speed_m_s``, ``step_period_s``, ``step_length_m``.
+    ``budget``: candidates evaluated, exactly (1 to :data:`MAX_OPTIMIZE_EVALUATIONS`; the
+    scene's own design is evaluated once more, :attr:`Optimize.default`). ``seed``: of
+    CMA-ES's draws. ``initial_step``: CMA-ES's first step size in normalised coordinates
+    (each range 0 to 1; above 0, at most 1). The scene's solver options
+    (:meth:`Scene.with_solver`) apply as the command's ``--integrator``, ``--rtol``, ...
+    ``progress``: a tqdm bar of the ``budget + 1`` evaluations (``True``), none (``False``)
+    or ``progress(done, total)``.
+
+    No feasible design is not an error (the command's exit code 1): :attr:`Optimize.best` is
+    ``None`` and a ``RuntimeWarning`` says so. Raises :class:`InputError` (an option out of
+    its range, an unknown objective, a range or constraint that cannot be read),
+    :class:`SceneError` (an unknown parameter, a range outside the parameter's),
+    ``KeyboardInterrupt`` on Ctrl-C (at the next gait search).
+    """
+    s = _scene(scene)
+    ranges, texts = _ranges(vary), _constraints(constraints)
+    report = _with_progress(
+        progress,
+        "optimize",
+        "gait search",
+        lambda f: _walker.optimize(
+            s,
+            ranges,
+            objective,
+            constraints=texts,
+            budget=budget,
+            seed=seed,
+            initial_step=float(initial_step),
+            sigma_m=None if sigma_m is None else float(sigma_m),
+            progress=f,
+        ),
+    )
+    result = Optimize.from_report(report)
+    if result.best is None:
+        warnings.warn(
+            f"walker.optimize: no feasible design among {len(report['evaluations'])} evaluations",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return result

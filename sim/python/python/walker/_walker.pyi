@@ -12,6 +12,10 @@ MAX_BASIN_CELL_STRIDES: int
 """Most strides a basin cell may take (``basin(strides=)``)."""
 MAX_MAP_CELLS: int
 """Most cells of one stability map."""
+MAX_OPTIMIZE_EVALUATIONS: int
+"""Most candidates one search may evaluate (``optimize(budget=)``)."""
+DEFAULT_INITIAL_STEP: float
+"""CMA-ES's initial step size by default, normalised (``optimize(initial_step=)``)."""
 MAX_ORBIT_POINTS: int
 """Most values of one orbit diagram."""
 MAX_WALK_STEPS: int
@@ -175,3 +179,19 @@ def sil(
 def dbc() -> str:
     """The project's DBC file (the bus's messages and signals, as ``protocol/walker.dbc``),
     for ``cantools.database.load_string``."""
+
+def optimize(
+    scene: Scene,
+    vary: list[str],
+    objective: str,
+    *,
+    constraints: list[str] = ...,
+    budget: int | None = None,
+    seed: int | None = None,
+    initial_step: float = ...,
+    sigma_m: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Any]:
+    """The ``walker optimize --json`` object of CMA-ES over the ranges ``vary``
+    (``NAME=MIN:MAX``) for ``objective`` under ``constraints`` (``NAME<=V``); raises
+    ``InputError`` or ``SceneError``."""
