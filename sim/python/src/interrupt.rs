@@ -10,11 +10,16 @@
 //! `progress(done, total)` at each poll (the package passes a tqdm bar's update).
 
 use pyo3::prelude::*;
+#[cfg(unix)]
 use pyo3::types::PyDict;
 use sim::stride::SearchBudget;
+#[cfg(unix)]
 use std::io::Read;
+#[cfg(unix)]
 use std::net::Shutdown;
+#[cfg(unix)]
 use std::os::fd::AsRawFd;
+#[cfg(unix)]
 use std::os::unix::net::UnixStream;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
@@ -92,12 +97,14 @@ fn panicked() -> PyErr {
 }
 
 /// The signal number of SIGINT (Ctrl-C) on the platforms CPython's wake-up fd serves.
+#[cfg(unix)]
 const SIGINT: u8 = 2;
 
 /// A watcher of Ctrl-C while the calling thread works: Python's signal handler writes each
 /// signal's number to the wake-up fd (`signal.set_wakeup_fd`), here one end of a socket pair
 /// whose other end a thread reads; on SIGINT it cancels the budgets. Python's own handler has
 /// tripped meanwhile, so `check_signals` raises `KeyboardInterrupt` once the work returns.
+#[cfg(unix)]
 struct CtrlCWatch {
     /// The `signal` module.
     signal: Py<PyAny>,
@@ -107,6 +114,7 @@ struct CtrlCWatch {
     _writer: UnixStream,
 }
 
+#[cfg(unix)]
 impl CtrlCWatch {
     /// Starts watching; `None` when the wake-up fd cannot be taken (not the main thread, or
     /// already set by someone else: theirs is put back).
@@ -164,6 +172,21 @@ impl CtrlCWatch {
         let _ = self.reader.shutdown(Shutdown::Both);
         restored?;
         py.check_signals()
+    }
+}
+
+/// Elsewhere the work always runs on a thread of its own ([`run_counted`]).
+#[cfg(not(unix))]
+struct CtrlCWatch;
+
+#[cfg(not(unix))]
+impl CtrlCWatch {
+    fn start(_: Python<'_>, _: &[&Arc<SearchBudget>]) -> Option<Self> {
+        None
+    }
+
+    fn stop(self, _: Python<'_>) -> PyResult<()> {
+        Ok(())
     }
 }
 
