@@ -1,9 +1,11 @@
 //! Long computations with the GIL released, stopped by Ctrl-C.
 //!
-//! The work runs on a thread of its own while the calling (Python main) thread, without the
-//! GIL, polls for signals every [`POLL`]: on Ctrl-C it cancels the work's
+//! [`run_counted`]: the work runs on a thread of its own while the calling (Python main)
+//! thread, without the GIL, polls for signals every [`POLL`]: on Ctrl-C it cancels the work's
 //! [`SearchBudget`] (every later stride fails at once, so a gait search or a walk ends at its
-//! next stride), waits for the work to return and raises `KeyboardInterrupt`.
+//! next stride), waits for the work to return and raises `KeyboardInterrupt`. [`run`] runs the
+//! work on the calling thread instead where a watcher of Python's signal wake-up fd can stand
+//! in for the poll (no Python handler but SIGINT's default), else as [`run_counted`].
 //!
 //! [`run_counted`] also reports a study's progress: the work ticks a [`Counter`] (an atomic
 //! count, no GIL), and the waiting thread hands the count to a Python callable
@@ -84,6 +86,11 @@ where
     let Some(watch) = CtrlCWatch::start(py, budgets) else {
         return run_counted(py, budgets, &Counter::new(0, None), work);
     };
+    // A signal that arrived before the wake-up fd was ours wrote nothing to it.
+    if let Err(e) = py.check_signals() {
+        watch.stop(py)?;
+        return Err(e);
+    }
     let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| py.detach(work)));
     watch.stop(py)?;
     out.map_err(|_| panicked())
@@ -94,6 +101,48 @@ fn panicked() -> PyErr {
     pyo3::exceptions::PyRuntimeError::new_err(
         "the computation panicked (a bug: please report it with the call that caused it)",
     )
+}
+
+/// Signals whose Python handlers commonly raise (timeouts, termination, user signals): with one
+/// of them handled, the poll stands in for the watcher. Others (SIGCHLD, SIGWINCH, ...) are
+/// handled when the call returns. Checking every valid signal cost ~100 µs a call.
+#[cfg(unix)]
+const RAISING_SIGNALS: [&str; 8] = [
+    "SIGALRM",
+    "SIGVTALRM",
+    "SIGPROF",
+    "SIGTERM",
+    "SIGHUP",
+    "SIGQUIT",
+    "SIGUSR1",
+    "SIGUSR2",
+];
+
+/// Whether this is the main thread, SIGINT's handler is Python's default
+/// (`signal.default_int_handler`, which raises `KeyboardInterrupt`) and none of
+/// [`RAISING_SIGNALS`] has a Python handler.
+#[cfg(unix)]
+fn only_default_ctrl_c(py: Python<'_>, signal: &Bound<'_, PyModule>) -> PyResult<bool> {
+    let threading = py.import("threading")?;
+    if !threading
+        .call_method0("current_thread")?
+        .is(&threading.call_method0("main_thread")?)
+    {
+        return Ok(false);
+    }
+    let sigint = signal.call_method1("getsignal", (signal.getattr("SIGINT")?,))?;
+    if !sigint.is(&signal.getattr("default_int_handler")?) {
+        return Ok(false);
+    }
+    for name in RAISING_SIGNALS {
+        let Ok(number) = signal.getattr(name) else {
+            continue;
+        };
+        if signal.call_method1("getsignal", (number,))?.is_callable() {
+            return Ok(false);
+        }
+    }
+    Ok(true)
 }
 
 /// The signal number of SIGINT (Ctrl-C) on the platforms CPython's wake-up fd serves.
@@ -116,10 +165,16 @@ struct CtrlCWatch {
 
 #[cfg(unix)]
 impl CtrlCWatch {
-    /// Starts watching; `None` when the wake-up fd cannot be taken (not the main thread, or
-    /// already set by someone else: theirs is put back).
+    /// Starts watching; `None` when this thread is not the main thread, when a signal has a
+    /// Python handler other than SIGINT's default (whose effect the watcher cannot know: a
+    /// handler that does not raise must not stop the work, one that raises must stop it at
+    /// once, as the poll does), or when the wake-up fd is already set by someone else (theirs
+    /// is put back).
     fn start(py: Python<'_>, budgets: &[&Arc<SearchBudget>]) -> Option<Self> {
         let signal = py.import("signal").ok()?;
+        if !only_default_ctrl_c(py, &signal).unwrap_or(false) {
+            return None;
+        }
         let (reader, writer) = UnixStream::pair().ok()?;
         writer.set_nonblocking(true).ok()?;
         let watched = reader.try_clone().ok()?;

@@ -70,6 +70,56 @@ def test_ctrl_c_stops_a_long_sweep():
     assert time.monotonic() - started < 5.0
 
 
+def test_ctrl_c_stops_a_sweep_still_looking_for_its_first_gait():
+    import time
+
+    # At these slopes the first gait's search tries many starts (24 s to a Ctrl-C when the
+    # cancelled budget did not reach it): the family refuses every setup once cancelled.
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+    started = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            walker.sweep("wisse3d", "slope_rad", 0.3, 0.35, 40, progress=False)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - started < 5.0
+
+
+def test_a_raising_alarm_handler_stops_a_walk_promptly():
+    import signal
+    import time
+
+    def on_alarm(signum, frame):
+        raise TimeoutError("alarm")
+
+    old = signal.signal(signal.SIGALRM, on_alarm)
+    started = time.monotonic()
+    signal.setitimer(signal.ITIMER_REAL, 0.3)
+    try:
+        with pytest.raises(TimeoutError):
+            walker.walk("wisse3d", 1000)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert time.monotonic() - started < 1.5
+
+
+def test_a_sigint_handler_that_does_not_raise_does_not_cut_a_walk_short():
+    import signal
+
+    heard = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: heard.append(signum))
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    timer.start()
+    try:
+        walked = walker.walk("wisse3d", 300)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, old)
+    assert heard and walked.failure is None and walked.steps_completed == 300
+
+
 @pytest.mark.parametrize("steps", [-1, walker.MAX_WALK_STEPS + 1])
 def test_bad_steps(steps):
     with pytest.raises(walker.InputError, match="steps must be an integer between 0 and 100000"):

@@ -303,7 +303,8 @@ impl SweepReport {
         }
     }
 
-    /// The period-1 points [`Self::measure`] visits (its progress's total).
+    /// The points [`Self::measure`] visits: every grid point of every branch (a period-doubled
+    /// one gets its reason for no value), its progress's total.
     pub fn measured_points(result: &Continuation) -> usize {
         result.branches.iter().map(|b| b.grid.len()).sum()
     }

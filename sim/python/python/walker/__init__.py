@@ -416,7 +416,7 @@ def sweep(
     report = _with_progress(
         progress,
         "sweep",
-        "‰",
+        "step",
         lambda f: _walker.sweep(
             s, param, start, end, points, max_period=max_period, quantity=quantity, sigma_m=sigma_m, progress=f
         ),

@@ -22,7 +22,8 @@ class _Bar:
             from tqdm.auto import tqdm
 
             self._bar = tqdm(total=total, desc=self._desc, unit=self._unit, delay=1.0)
-        if total != self._bar.total:  # the next stage of the study (e.g. a sweep's measuring)
+        if total != self._bar.total or done < self._bar.n:
+            # the next stage of the study (a sweep's measuring after its continuation)
             self._bar.reset(total=total)
         self._bar.update(done - self._bar.n)
 

@@ -128,6 +128,18 @@ impl Family {
     /// # Errors
     /// A scene that cannot be built.
     pub fn setup_of(&self, scene: &Scene) -> Result<Setup, SceneError> {
+        // A cancelled sweep builds nothing more: its first gait's search (which strides on a
+        // budget of its own) stops at its next setup.
+        if self
+            .search_budget
+            .0
+            .as_ref()
+            .is_some_and(|b| b.is_cancelled())
+        {
+            return Err(SceneError::Invalid(
+                "interrupted: the sweep's budget was cancelled".to_owned(),
+            ));
+        }
         let mut setup = scene.setup()?;
         if let Some(settings) = &self.stride_settings {
             setup.settings = settings.clone();
