@@ -54,36 +54,34 @@ def test_not_a_number_and_not_finite():
         walker.Scene.load("compass").with_params(slope_rad=0.05, slope=0.05)
 
 
-def test_ctrl_c_stops_a_long_sweep():
+def interrupted_after(seconds: float, call) -> float:
+    """Runs ``call()`` with a Ctrl-C (``_thread.interrupt_main``) delivered after ``seconds``;
+    asserts it raised ``KeyboardInterrupt`` and returns the seconds it took."""
     import time
 
-    # A wisse3d sweep of 200 points takes minutes (the review measured 16 s to a Ctrl-C when
-    # the continuation had no cancel hook); its budget stops it at the next stride.
-    timer = threading.Timer(1.0, _thread.interrupt_main)
+    timer = threading.Timer(seconds, _thread.interrupt_main)
     started = time.monotonic()
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            walker.sweep("wisse3d", "slope_rad", 0.001, 0.05, 200, progress=False)
+            call()
     finally:
         timer.cancel()
-    assert time.monotonic() - started < 5.0
+    return time.monotonic() - started
+
+
+def test_ctrl_c_stops_a_long_sweep():
+    # A wisse3d sweep of 200 points takes minutes (the review measured 16 s to a Ctrl-C when
+    # the continuation had no cancel hook); its budget stops it at the next stride.
+    took = interrupted_after(1.0, lambda: walker.sweep("wisse3d", "slope_rad", 0.001, 0.05, 200, progress=False))
+    assert took < 5.0
 
 
 def test_ctrl_c_stops_a_sweep_still_looking_for_its_first_gait():
-    import time
-
     # At these slopes the first gait's search tries many starts (24 s to a Ctrl-C when the
     # cancelled budget did not reach it): the family refuses every setup once cancelled.
-    timer = threading.Timer(1.0, _thread.interrupt_main)
-    started = time.monotonic()
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            walker.sweep("wisse3d", "slope_rad", 0.3, 0.35, 40, progress=False)
-    finally:
-        timer.cancel()
-    assert time.monotonic() - started < 5.0
+    took = interrupted_after(1.0, lambda: walker.sweep("wisse3d", "slope_rad", 0.3, 0.35, 40, progress=False))
+    assert took < 5.0
 
 
 def test_a_raising_alarm_handler_stops_a_walk_promptly():
@@ -158,34 +156,22 @@ def test_gait_not_found_carries_the_cli_report(cli):
 
 def test_ctrl_c_stops_a_long_walk():
     # Delivered while the walk runs without the GIL: the walk stops at its next stride.
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            walker.walk("compass", walker.MAX_WALK_STEPS, path_interval_s=10.0)
-    finally:
-        timer.cancel()
+    interrupted_after(0.5, lambda: walker.walk("compass", walker.MAX_WALK_STEPS, path_interval_s=10.0))
 
 
 def test_ctrl_c_stops_a_long_stability_map():
-    import time
-
     import numpy as np
 
     # 400 gait searches of the 3D walker take minutes; Ctrl-C ends the map at the next search.
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    started = time.monotonic()
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            walker.stability_map(
-                "wisse3d",
-                x=("slope_rad", np.linspace(0.04, 0.06, 20)),
-                y=("pelvic_ring_radius_m", np.linspace(0.40, 0.44, 20)),
-            )
-    finally:
-        timer.cancel()
-    assert time.monotonic() - started < 30.0
+    took = interrupted_after(
+        0.5,
+        lambda: walker.stability_map(
+            "wisse3d",
+            x=("slope_rad", np.linspace(0.04, 0.06, 20)),
+            y=("pelvic_ring_radius_m", np.linspace(0.40, 0.44, 20)),
+        ),
+    )
+    assert took < 30.0
 
 
 @pytest.mark.parametrize(
