@@ -139,9 +139,16 @@ fn matched<'a>(
     pa: &[&'a Complex<f64>],
     pb: &[&'a Complex<f64>],
 ) -> Option<Vec<(&'a Complex<f64>, &'a Complex<f64>)>> {
-    if pa.len() != pb.len() {
-        return None;
-    }
+    (pa.len() == pb.len()).then(|| matched_nearest(pa, pb))
+}
+
+/// As many pairs as the shorter of `pa` and `pb` has, matched one to one greedily by
+/// distance; where pairs formed or split in between, the pairs without a partner are left
+/// out.
+fn matched_nearest<'a>(
+    pa: &[&'a Complex<f64>],
+    pb: &[&'a Complex<f64>],
+) -> Vec<(&'a Complex<f64>, &'a Complex<f64>)> {
     let mut candidates: Vec<(f64, usize, usize)> = Vec::with_capacity(pa.len() * pb.len());
     for (i, za) in pa.iter().enumerate() {
         for (j, zb) in pb.iter().enumerate() {
@@ -158,21 +165,35 @@ fn matched<'a>(
             out.push((pa[i], pb[j]));
         }
     }
-    Some(out)
+    out
 }
 
-/// The matched pairs of `ma` and `mb` (upper members) whose `|λ| − 1` changed sign.
+/// The matched pairs of `ma` and `mb` (upper members) whose `|λ| − 1` changed sign; `None`
+/// when the numbers of pairs differ.
 fn crossing_pairs(
     ma: &[Complex<f64>],
     mb: &[Complex<f64>],
 ) -> Option<Vec<(Complex<f64>, Complex<f64>)>> {
     let (pa, pb): (Vec<_>, Vec<_>) = (pairs(ma).collect(), pairs(mb).collect());
-    matched(&pa, &pb).map(|m| {
-        m.into_iter()
-            .filter(|(za, zb)| (za.norm() > 1.0) != (zb.norm() > 1.0))
-            .map(|(za, zb)| (*za, *zb))
-            .collect()
-    })
+    matched(&pa, &pb).map(crossed)
+}
+
+/// [`crossing_pairs`] among the pairs that have a partner when the numbers of pairs differ
+/// (two real multipliers merged into a pair, or a pair split, in the same step).
+fn crossing_pairs_of_partners(
+    ma: &[Complex<f64>],
+    mb: &[Complex<f64>],
+) -> Vec<(Complex<f64>, Complex<f64>)> {
+    let (pa, pb): (Vec<_>, Vec<_>) = (pairs(ma).collect(), pairs(mb).collect());
+    crossed(matched_nearest(&pa, &pb))
+}
+
+/// The matched pairs whose `|λ| − 1` changed sign.
+fn crossed(m: Vec<(&Complex<f64>, &Complex<f64>)>) -> Vec<(Complex<f64>, Complex<f64>)> {
+    m.into_iter()
+        .filter(|(za, zb)| (za.norm() > 1.0) != (zb.norm() > 1.0))
+        .map(|(za, zb)| (*za, *zb))
+        .collect()
 }
 
 /// How many complex pairs crossed the unit circle between multipliers `ma` and `mb`: the
@@ -259,10 +280,16 @@ pub fn locate(
     let s_b = a.tangent.dot(&(b.x() - a.x()));
     // A Neimark–Sacker point is located on the crossing pair itself, followed from trial to
     // trial (the product over all pairs also changes sign where a pair forms or splits).
+    // Where a pair formed or split in the same step, the pair that crossed is the one
+    // crossing pair among those with a partner.
     let crossing = match kind {
         BifurcationKind::NeimarkSacker => {
-            match crossing_pairs(&a.multipliers, &b.multipliers).as_deref() {
-                Some([(za, zb)]) => Some((*za, *zb)),
+            let (ma, mb) = (&a.multipliers, &b.multipliers);
+            match crossing_pairs(ma, mb)
+                .unwrap_or_else(|| crossing_pairs_of_partners(ma, mb))
+                .as_slice()
+            {
+                [(za, zb)] => Some((*za, *zb)),
                 _ => return Err(CorrectorError::NoSignChange),
             }
         }
@@ -441,6 +468,18 @@ mod tests {
         .concat();
         let e = [polar(0.99, 2.0).as_slice(), polar(1.25, 0.05).as_slice()].concat();
         assert!(neimark_sacker_crossed(&d, &e));
+        // ... and the location follows the crossing pair, the one with a partner (the pair
+        // that formed has none): wisse3d's first Neimark–Sacker point was reported
+        // unlocated where the step also made a real pair complex.
+        assert_eq!(crossing_pairs(&d, &e), None);
+        assert_eq!(
+            crossing_pairs_of_partners(&d, &e),
+            vec![(polar(1.01, 2.0)[0], polar(0.99, 2.0)[0])]
+        );
+        assert_eq!(
+            crossing_pairs_of_partners(&e, &d),
+            vec![(polar(0.99, 2.0)[0], polar(1.01, 2.0)[0])]
+        );
         // Two pairs crossing in opposite directions in one step: two crossings, though the
         // product of the pairs' `|λ| − 1` keeps its sign (the branch halves such a step).
         let f = [polar(1.01, 2.0).as_slice(), polar(0.99, 0.5).as_slice()].concat();
