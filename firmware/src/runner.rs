@@ -99,6 +99,7 @@ where
         };
         self.health.actuator_error = result.is_err();
         self.health.string_moving = self.actuator.string_moving();
+        self.health.spool_sensor = self.actuator.has_spool_sensor();
         self.health.can_error = self.can.transmit(&out.transmit);
         out
     }

@@ -245,9 +245,13 @@ fn full_reflex_cycle_through_the_node() {
         (ReflexPhase::Swing, ActuatorCommand::Released)
     );
     assert!(fault_events(&o.transmit, FaultCode::PeerHeelStrikeLate).is_empty());
-    // Our own heel strike echoed back (or the host's) does not release.
+    // Our own heel strike echoed back (or the host's) does not release. (A swing back to
+    // the landing angle first: a heel strike sooner than 0.2 s after the lift-off is a
+    // stuck contact switch.)
     b.contact = false;
     b.tick();
+    b.move_to(0.1);
+    b.run(250);
     b.drive_to_push();
     let own = Message::HeelStrike(HeelStrike {
         node: ME,
@@ -273,6 +277,7 @@ fn late_peer_message_falls_back_to_lift_off_and_clears_next_stride() {
     );
     assert_eq!(o.state, NodeState::Enabled, "not safety-relevant");
     b.move_to(0.1);
+    b.run(250);
     b.drive_to_push();
     let peer_hs = Message::HeelStrike(HeelStrike {
         node: PEER,

@@ -174,6 +174,17 @@ wire_enum!(
         /// them, saturated at 32767. Reported, not safety-relevant (the loop that would let
         /// the buffer fill is the watchdog's).
         CanRxOverflow = 11,
+        /// The contact switch contradicts the stride: `detail` 1 = still closed
+        /// `StuckTimeout` after the other foot's heel strike released this one (the foot
+        /// must lift), or closed again too soon after the lift-off (a swing shorter than the
+        /// walker can swing), or a stance in which the ankle does not rotate; 2 = open while
+        /// the ankle turns as only a loaded foot turns it (away from the swing's rest angle),
+        /// or the other foot's heel strike arriving again before this foot landed.
+        ContactStuck = 12,
+        /// The spool encoder stood still while the ankle, held by the taut string (push or
+        /// hold), moved: `detail` = the ankle's displacement since the spool last turned, in
+        /// ankle-encoder counts (saturated at 32767).
+        SpoolStuck = 13,
     }
 );
 
@@ -187,7 +198,7 @@ impl FaultCode {
     }
     /// The bit of this fault in [`FaultFlags`].
     pub const fn flag(self) -> u16 {
-        // Codes are 1..=11 (bits 0..=10); a code past bit 15 would have no bit (0).
+        // Codes are 1..=13 (bits 0..=12); a code past bit 15 would have no bit (0).
         match 1u16.checked_shl((self as u8).saturating_sub(1) as u32) {
             Some(bit) => bit,
             None => 0,

@@ -51,6 +51,12 @@ pub trait Actuator {
         false
     }
 
+    /// True when the actuator has a spool sensor behind [`Actuator::string_moving`] (the node
+    /// then cross-checks it against the ankle reading: `SpoolStuck`). The default: false.
+    fn has_spool_sensor(&self) -> bool {
+        false
+    }
+
     /// Emergency stop: the actuator off at once, without a release sequence. The default
     /// applies `Released` (for actuators whose release is already immediate).
     ///
@@ -70,6 +76,9 @@ impl<T: Actuator + ?Sized> Actuator for &mut T {
     }
     fn string_moving(&self) -> bool {
         T::string_moving(self)
+    }
+    fn has_spool_sensor(&self) -> bool {
+        T::has_spool_sensor(self)
     }
 }
 

@@ -125,6 +125,10 @@ impl Actuator for SimActuator {
     fn string_moving(&self) -> bool {
         self.0.borrow().moving
     }
+
+    fn has_spool_sensor(&self) -> bool {
+        true
+    }
 }
 
 /// The actuator of a simulated ankle: the firmware's spool-motor driver over the motor
@@ -153,6 +157,13 @@ impl Actuator for AnkleActuator {
         match self {
             AnkleActuator::SpoolMotor(m) => m.string_moving(),
             AnkleActuator::Servo(s) => s.string_moving(),
+        }
+    }
+
+    fn has_spool_sensor(&self) -> bool {
+        match self {
+            AnkleActuator::SpoolMotor(m) => m.has_spool_sensor(),
+            AnkleActuator::Servo(s) => s.has_spool_sensor(),
         }
     }
 
