@@ -22,11 +22,9 @@
 //!   swinging foot; only the floor turns the ankle away), or the other foot's heel strike
 //!   arriving again while this ankle is still in the swing its previous one began.
 //!
-//! The spool encoder (`SpoolStuck`): in `Push` and `Hold` the string is taut and the ankle
-//! moves only with the spool, so an ankle reading that moves more than
-//! [`SPOOL_SILENT_ANKLE_COUNTS`] while the spool reports no motion means the spool encoder
-//! stopped (the nominal walk's largest such motion is 5.5 counts with the motor, 0.9 with the
-//! servo model; docs/firmware.md).
+//! The spool encoder (`SpoolStuck`): in `Push` and `Hold` only the string winding in extends
+//! the ankle, so an ankle reading that rises more than [`SPOOL_SILENT_ANKLE_COUNTS`] while the
+//! spool reports no motion means the spool encoder stopped.
 //!
 //! Each finding stays until its sensor shows the contradiction is gone (the switch changes,
 //! the spool turns), also after the node left `Enabled`. Constant work per tick.
@@ -48,10 +46,13 @@ pub const SWING_REST_BAND_RAD: f32 = 0.03;
 /// 0.8 s stride.
 pub const MIN_SWING_S: f32 = 0.2;
 
-/// Ankle motion \[counts\] while the spool reports none, in push or hold, above which the
-/// spool encoder is taken as stopped. 16 counts (6.1 mrad): three times the nominal walk's
-/// largest (5.5 counts with the motor: the string catching the ankle at the push's start).
+/// Ankle extension \[counts\] while the spool reports no motion, in push or hold, above
+/// which the spool encoder is taken as stopped. 16 counts (6.1 mrad); the nominal walks'
+/// largest is 0.4 counts (docs/firmware.md).
 pub const SPOOL_SILENT_ANKLE_COUNTS: u16 = 16;
+
+/// One count of the ankle encoder \[rad\].
+const COUNT_RAD: f32 = core::f32::consts::TAU / crate::sensors::ENCODER_COUNTS_PER_REV as f32;
 
 /// `ContactStuck` detail: the switch reads closed where the foot must be in the air.
 pub const CONTACT_STUCK_CLOSED: i16 = 1;
@@ -103,8 +104,8 @@ pub struct StrideCheck {
     swing_after_release: bool,
     /// Closest the reading came to the rest angle in this swing \[rad\].
     swing_closest_rad: Option<f32>,
-    /// The ankle counts when the spool last turned (push and hold).
-    spool_ref_counts: Option<u16>,
+    /// The ankle angle when the spool last turned (push and hold) \[rad\].
+    spool_ref_rad: Option<f32>,
     contact: Option<(i16, bool)>,
     spool: Option<i16>,
 }
@@ -178,15 +179,17 @@ impl StrideCheck {
             return;
         };
         if !taut || i.string_moving {
-            self.spool_ref_counts = taut.then_some(s.counts);
+            self.spool_ref_rad = taut.then_some(s.angle_rad);
             return;
         }
-        let reference = *self.spool_ref_counts.get_or_insert(s.counts);
-        // Counts on the encoder's circle: the shorter way round.
-        let d = s.counts.abs_diff(reference);
-        let d = d.min(crate::sensors::ENCODER_COUNTS_PER_REV.saturating_sub(d));
-        if d > SPOOL_SILENT_ANKLE_COUNTS {
-            self.spool = Some(i16::try_from(d).unwrap_or(i16::MAX));
+        let reference = *self.spool_ref_rad.get_or_insert(s.angle_rad);
+        // Only the extension: the ankle sinking onto a string that took up its slack (at the
+        // push's start: up to 15 counts in the nominal walks) or a servo that stalls is no
+        // evidence; the ankle rising is the string winding it up (or a slack string lifted by
+        // the walker: 0.4 counts at most in the nominal walks).
+        let rise_counts = libm::roundf((s.angle_rad - reference) / COUNT_RAD);
+        if rise_counts > f32::from(SPOOL_SILENT_ANKLE_COUNTS) {
+            self.spool = Some(crate::convert::saturating_i16(rise_counts));
         }
     }
 

@@ -64,7 +64,8 @@ pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;
 pub use report::{
-    FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport, PhaseChange,
+    FallCause, FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport,
+    PhaseChange,
     SilReport, SocketcandReport, StateChange,
 };
 pub use sensors::{
