@@ -122,6 +122,8 @@ pub enum ConfigError {
 pub struct DriverHealth {
     /// The actuator driver failed to apply the last command.
     pub actuator_error: bool,
+    /// Why, as the `Actuator` fault's detail (`ActuatorError::detail`; 0 when not known).
+    pub actuator_error_detail: i16,
     /// A frame could not be queued for transmission (the queue was full).
     pub can_error: bool,
     /// The CAN controller is bus-off (from its status register; error frames and
@@ -675,6 +677,7 @@ impl AnkleNode {
                 ..stride_inputs
             },
             self.params.stuck_timeout_s(),
+            self.params.taut_angle_rad(),
         );
         self.set_fault(out, now, FaultCode::ContactStuck, stride.contact);
         self.set_fault(out, now, FaultCode::SpoolStuck, stride.spool);
@@ -725,7 +728,10 @@ impl AnkleNode {
             out,
             now,
             FaultCode::Actuator,
-            inputs.drivers.actuator_error.then_some(0),
+            inputs
+                .drivers
+                .actuator_error
+                .then_some(inputs.drivers.actuator_error_detail),
         );
         self.set_fault(
             out,

@@ -15,12 +15,15 @@
 //!
 //! The contact switch (`ContactStuck`, detail 1 closed, 2 open):
 //! * closed: still closed `StuckTimeout` after the other foot's heel strike released this
-//!   ankle (the trailing foot must lift), or closed again less than [`MIN_SWING_S`] after the
-//!   own lift-off (no swing is that short);
+//!   ankle (the trailing foot must lift) while the ankle does not turn as a loaded one, or
+//!   closed again less than [`MIN_SWING_S`] after the own lift-off (no swing is that short),
+//!   or a walking stance whose reading changes but turns less than
+//!   [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout (a foot in the air);
 //! * open: in a swing, the reading moving *away* from the foot's rest angle by more than
-//!   [`SWING_REST_BAND_RAD`] beyond the closest it came in that swing (the spring returns a
-//!   swinging foot; only the floor turns the ankle away), or the other foot's heel strike
-//!   arriving again while this ankle is still in the swing its previous one began.
+//!   [`SWING_TURN_AWAY_RAD`] beyond the closest it came in that swing (the spring returns a
+//!   swinging foot; only the floor turns the ankle away), or down through the taut angle, or
+//!   the other foot's heel strike arriving again while this ankle is still in the swing its
+//!   previous one began.
 //!
 //! The spool encoder (`SpoolStuck`): in `Push` and `Hold` only the string winding in extends
 //! the ankle, so an ankle reading that rises more than [`SPOOL_SILENT_ANKLE_COUNTS`] while the
@@ -40,6 +43,20 @@ use crate::time::Instant;
 /// walk's swing readings stay within 0.02 rad of the landing angle once returned
 /// (docs/firmware.md).
 pub const SWING_REST_BAND_RAD: f32 = 0.03;
+
+/// Net turn of the ankle over one stuck timeout of a walking stance below which the foot is
+/// taken as not loaded \[rad\]: 8 counts (3.1 mrad). The nominal walks turn it by at least 30
+/// counts per 50 ms in `Free` (docs/firmware.md).
+pub const STANCE_MIN_ROTATION_RAD: f32 = 8.0 * COUNT_RAD;
+
+/// A swing ankle that turned away from its rest angle by no more than this \[rad\] is not
+/// loaded: 4 counts (1.5 mrad), twice a healthy encoder's ±1-count noise.
+pub const SWING_STILL_RAD: f32 = 4.0 * COUNT_RAD;
+
+/// A swing ankle turned away from its rest angle by more than this, beyond the closest it
+/// came in that swing, is turned by the floor \[rad\]: 0.015 rad (39 counts; the nominal
+/// walks' swings only approach the rest angle).
+pub const SWING_TURN_AWAY_RAD: f32 = 0.015;
 
 /// Shortest swing the walker can make \[s\]: an own heel strike sooner than this after the
 /// own lift-off is a contact switch that closed by itself. 0.2 s, a quarter of the nominal
@@ -104,10 +121,25 @@ pub struct StrideCheck {
     swing_after_release: bool,
     /// Closest the reading came to the rest angle in this swing \[rad\].
     swing_closest_rad: Option<f32>,
+    /// The reading was above the taut angle in this swing (switch open).
+    swing_above_taut: bool,
+    /// The switch at the previous check.
+    last_contact_closed: Option<bool>,
     /// The ankle angle when the spool last turned (push and hold) \[rad\].
     spool_ref_rad: Option<f32>,
+    /// The stance rotation's window (`Free`, walking, switch closed).
+    stance_window: Option<StanceWindow>,
     contact: Option<(i16, bool)>,
     spool: Option<i16>,
+}
+
+/// One stuck timeout of a walking stance: where the reading started and whether it changed.
+#[derive(Clone, Copy, Debug)]
+struct StanceWindow {
+    since: Instant,
+    from_rad: f32,
+    last_counts: u16,
+    changed: bool,
 }
 
 impl StrideCheck {
@@ -126,8 +158,13 @@ impl StrideCheck {
     }
 
     /// The contact and spool checks of one tick, before the reflex steps.
-    pub fn check(&mut self, i: &StrideInputs, stuck_timeout_s: f32) -> StrideFindings {
-        self.check_contact(i, stuck_timeout_s);
+    pub fn check(
+        &mut self,
+        i: &StrideInputs,
+        stuck_timeout_s: f32,
+        taut_angle_rad: f32,
+    ) -> StrideFindings {
+        self.check_contact(i, stuck_timeout_s, taut_angle_rad);
         self.check_spool(i);
         StrideFindings {
             contact: self.contact.map(|(d, _)| d),
@@ -141,33 +178,96 @@ impl StrideCheck {
         }
     }
 
-    fn check_contact(&mut self, i: &StrideInputs, stuck_timeout_s: f32) {
+    fn check_contact(&mut self, i: &StrideInputs, stuck_timeout_s: f32, taut_angle_rad: f32) {
         // A finding stays until the switch changes.
         if let Some((_, closed)) = self.contact {
             if closed != i.contact_closed {
                 self.contact = None;
             }
         }
-        if i.phase == ReflexPhase::Swing && i.contact_closed {
-            if let Some(t) = self.released_by_peer_at {
-                if i.now.secs_since(t) >= stuck_timeout_s {
-                    self.raise_contact(CONTACT_STUCK_CLOSED, true);
-                }
-            }
+        self.check_stance_rotation(i, stuck_timeout_s);
+        // The switch opening starts the swing proper (the foot in the air from here): the
+        // swing's closest approach to rest is counted from it.
+        if self.last_contact_closed.replace(i.contact_closed) == Some(true) && !i.contact_closed {
+            self.swing_closest_rad = None;
+            self.swing_above_taut = false;
         }
-        if i.phase == ReflexPhase::Swing && !i.contact_closed {
-            if i.peer_heel_strike && self.swing_after_release {
-                self.raise_contact(CONTACT_STUCK_OPEN, false);
-            }
-            if let (Some(rest), Some(s)) = (self.landing_rad, i.sample) {
+        if i.phase != ReflexPhase::Swing {
+            return;
+        }
+        // How far the swing turned the ankle away from its rest angle, beyond the closest it
+        // came in this swing [rad] (0 before the first landing).
+        let turned_away_rad = match (self.landing_rad, i.sample) {
+            (Some(rest), Some(s)) => {
                 let d = (s.angle_rad - rest).abs();
                 let closest = self.swing_closest_rad.map_or(d, |c| c.min(d));
                 self.swing_closest_rad = Some(closest);
-                if d - closest > SWING_REST_BAND_RAD {
-                    self.raise_contact(CONTACT_STUCK_OPEN, false);
-                }
+                d - closest
+            }
+            _ => 0.0,
+        };
+        if i.contact_closed {
+            // Released by the other foot's heel strike, this foot must lift: a switch still
+            // closed over the stuck timeout while the ankle does not turn as a loaded foot's
+            // (a stance rotation here says the other foot's heel strike was the wrong one).
+            let due = self
+                .released_by_peer_at
+                .is_some_and(|t| i.now.secs_since(t) >= stuck_timeout_s);
+            if due && turned_away_rad <= SWING_STILL_RAD {
+                self.raise_contact(CONTACT_STUCK_CLOSED, true);
+            }
+        } else {
+            if i.peer_heel_strike && self.swing_after_release {
+                self.raise_contact(CONTACT_STUCK_OPEN, false);
+            }
+            // Only the floor turns a swinging ankle away from its rest angle, or down through
+            // the taut angle (a swing foot hangs near its landing angle, far above it).
+            let above_taut = i.sample.map(|s| s.angle_rad > taut_angle_rad);
+            let crossed_down = self.swing_above_taut && above_taut == Some(false);
+            self.swing_above_taut |= above_taut == Some(true);
+            if turned_away_rad > SWING_TURN_AWAY_RAD || crossed_down {
+                self.raise_contact(CONTACT_STUCK_OPEN, false);
             }
         }
+    }
+
+    /// A walking stance (`Free` after an own heel strike, switch closed) turns the ankle: a
+    /// reading that changes (so the encoder works) but moves less than
+    /// [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout is a foot in the air on a switch
+    /// that reads closed. A reading that does not change at all is the encoder's fault
+    /// (`EncoderStuck`), not this one.
+    fn check_stance_rotation(&mut self, i: &StrideInputs, stuck_timeout_s: f32) {
+        let stance = i.phase == ReflexPhase::Free && self.walking && i.contact_closed;
+        let (Some(s), true) = (i.sample, stance) else {
+            self.stance_window = None;
+            return;
+        };
+        let Some(mut w) = self.stance_window else {
+            self.stance_window = Some(StanceWindow {
+                since: i.now,
+                from_rad: s.angle_rad,
+                last_counts: s.counts,
+                changed: false,
+            });
+            return;
+        };
+        // A change in the window's second half: a reading frozen early in the window is the
+        // encoder's (`EncoderStuck`), not a foot in the air.
+        let late = i.now.secs_since(w.since) >= 0.5 * stuck_timeout_s;
+        w.changed |= late && s.counts != w.last_counts;
+        w.last_counts = s.counts;
+        if i.now.secs_since(w.since) >= stuck_timeout_s {
+            if w.changed && (s.angle_rad - w.from_rad).abs() < STANCE_MIN_ROTATION_RAD {
+                self.raise_contact(CONTACT_STUCK_CLOSED, true);
+            }
+            w = StanceWindow {
+                since: i.now,
+                from_rad: s.angle_rad,
+                last_counts: s.counts,
+                changed: false,
+            };
+        }
+        self.stance_window = Some(w);
     }
 
     fn check_spool(&mut self, i: &StrideInputs) {
@@ -217,6 +317,7 @@ impl StrideCheck {
                 self.walking = true;
                 self.swing_after_release = false;
                 self.swing_closest_rad = None;
+                self.swing_above_taut = false;
                 if let Some(s) = sample {
                     self.landing_rad = Some(s.angle_rad);
                 }
@@ -224,6 +325,7 @@ impl StrideCheck {
             Some(ReflexEvent::Released(cause)) => {
                 self.swing_after_release = true;
                 self.swing_closest_rad = None;
+                self.swing_above_taut = false;
                 if cause == ReleaseCause::PeerHeelStrike && !lift_off {
                     self.released_by_peer_at = Some(now);
                 }
@@ -308,19 +410,19 @@ mod tests {
             Some(ReflexEvent::Released(ReleaseCause::PeerHeelStrike)),
         );
         for ms in 801..850 {
-            let f = c.check(&inputs(ms, ReflexPhase::Swing, 0.15, true), 0.05);
+            let f = c.check(&inputs(ms, ReflexPhase::Swing, 0.15, true), 0.05, -0.08);
             assert_eq!(f.contact, None, "{ms}");
         }
-        let f = c.check(&inputs(850, ReflexPhase::Swing, 0.15, true), 0.05);
+        let f = c.check(&inputs(850, ReflexPhase::Swing, 0.15, true), 0.05, -0.08);
         assert_eq!(f.contact, Some(CONTACT_STUCK_CLOSED));
         // It stays while the switch stays, and goes when the switch changes.
         assert_eq!(
-            c.check(&inputs(900, ReflexPhase::Swing, 0.15, true), 0.05)
+            c.check(&inputs(900, ReflexPhase::Swing, 0.15, true), 0.05, -0.08)
                 .contact,
             Some(CONTACT_STUCK_CLOSED)
         );
         assert_eq!(
-            c.check(&inputs(901, ReflexPhase::Swing, 0.15, false), 0.05)
+            c.check(&inputs(901, ReflexPhase::Swing, 0.15, false), 0.05, -0.08)
                 .contact,
             None
         );
@@ -334,7 +436,7 @@ mod tests {
         );
         c.observe(Instant::from_millis(810), sample(0.15), true, None);
         for ms in 811..1500 {
-            let f = c.check(&inputs(ms, ReflexPhase::Swing, 0.16, false), 0.05);
+            let f = c.check(&inputs(ms, ReflexPhase::Swing, 0.16, false), 0.05, -0.08);
             assert_eq!(f.contact, None);
         }
         // A heel strike 100 ms after the lift-off: no swing is that short.
@@ -344,7 +446,7 @@ mod tests {
             false,
             Some(ReflexEvent::HeelStrike),
         );
-        let f = c.check(&inputs(911, ReflexPhase::Free, 0.16, true), 0.05);
+        let f = c.check(&inputs(911, ReflexPhase::Free, 0.16, true), 0.05, -0.08);
         assert_eq!(f.contact, Some(CONTACT_STUCK_CLOSED));
     }
 
@@ -368,7 +470,7 @@ mod tests {
         for ms in 801..1000 {
             a = f32::max(a - 0.002, 0.16);
             assert_eq!(
-                c.check(&inputs(ms, ReflexPhase::Swing, a, false), 0.05)
+                c.check(&inputs(ms, ReflexPhase::Swing, a, false), 0.05, -0.08)
                     .contact,
                 None
             );
@@ -377,14 +479,14 @@ mod tests {
         let mut found = None;
         for ms in 1000..1200 {
             a -= 0.0005;
-            let f = c.check(&inputs(ms, ReflexPhase::Swing, a, false), 0.05);
+            let f = c.check(&inputs(ms, ReflexPhase::Swing, a, false), 0.05, -0.08);
             if f.contact.is_some() {
                 found = Some((ms, f.contact));
                 break;
             }
         }
         assert!(
-            matches!(found, Some((ms, Some(CONTACT_STUCK_OPEN))) if (1060..1064).contains(&ms)),
+            matches!(found, Some((ms, Some(CONTACT_STUCK_OPEN))) if (1030..1034).contains(&ms)),
             "{found:?}"
         );
         // The other foot's heel strike again while this one still swings.
@@ -396,9 +498,9 @@ mod tests {
             Some(ReflexEvent::Released(ReleaseCause::PeerHeelStrike)),
         );
         let mut i = inputs(1600, ReflexPhase::Swing, 0.16, false);
-        assert_eq!(c.check(&i, 0.05).contact, None);
+        assert_eq!(c.check(&i, 0.05, -0.08).contact, None);
         i.peer_heel_strike = true;
-        assert_eq!(c.check(&i, 0.05).contact, Some(CONTACT_STUCK_OPEN));
+        assert_eq!(c.check(&i, 0.05, -0.08).contact, Some(CONTACT_STUCK_OPEN));
     }
 
     #[test]
@@ -406,13 +508,13 @@ mod tests {
         let mut c = StrideCheck::default();
         let mut i = inputs(0, ReflexPhase::Push, -0.08, true);
         i.string_moving = true;
-        assert_eq!(c.check(&i, 0.05).spool, None);
+        assert_eq!(c.check(&i, 0.05, -0.08).spool, None);
         let per_count = core::f32::consts::TAU / 16384.0;
         let mut found = None;
         for k in 1..40u16 {
             let mut i = inputs(u64::from(k), ReflexPhase::Push, -0.08 + f32::from(k) * per_count, true);
             i.string_moving = false;
-            if let Some(d) = c.check(&i, 0.05).spool {
+            if let Some(d) = c.check(&i, 0.05, -0.08).spool {
                 found = Some((k, d));
                 break;
             }
@@ -421,9 +523,9 @@ mod tests {
         // The spool turning again clears it; outside push and hold nothing is checked.
         let mut i = inputs(40, ReflexPhase::Push, 0.0, true);
         i.string_moving = true;
-        assert_eq!(c.check(&i, 0.05).spool, None);
+        assert_eq!(c.check(&i, 0.05, -0.08).spool, None);
         assert_eq!(
-            c.check(&inputs(41, ReflexPhase::Free, -0.5, true), 0.05).spool,
+            c.check(&inputs(41, ReflexPhase::Free, -0.5, true), 0.05, -0.08).spool,
             None
         );
     }

@@ -31,6 +31,26 @@ pub enum ActuatorError {
     ReleaseStalled,
 }
 
+impl ActuatorError {
+    /// A small code for the `Actuator` fault event's `detail`: 1 PWM, 2 pin, 3 no feedback,
+    /// 4 over-current, 5 current sense, 6 spool sensor, 7 bridge, 8 release timeout,
+    /// 9 release stalled (the spool made no progress paying out: jammed, reversed, or a
+    /// spool encoder that stopped).
+    pub fn detail(&self) -> i16 {
+        match self {
+            ActuatorError::Pwm(_) => 1,
+            ActuatorError::Pin(_) => 2,
+            ActuatorError::NoFeedback => 3,
+            ActuatorError::OverCurrent => 4,
+            ActuatorError::CurrentSense => 5,
+            ActuatorError::SpoolSensor => 6,
+            ActuatorError::Bridge => 7,
+            ActuatorError::ReleaseTimeout => 8,
+            ActuatorError::ReleaseStalled => 9,
+        }
+    }
+}
+
 /// Anything that can hold the string at an ankle angle or release it.
 pub trait Actuator {
     /// Apply `command`; `measured_angle_rad` is the current ankle angle estimate, `None` when
