@@ -58,6 +58,10 @@ pub const SWING_STILL_RAD: f32 = 4.0 * COUNT_RAD;
 /// walks' swings only approach the rest angle).
 pub const SWING_TURN_AWAY_RAD: f32 = 0.015;
 
+/// How long a swing must stay turned away from rest before the switch is taken as stuck
+/// open \[s\]: 10 ms, over the debouncer's 3 samples that a real landing takes to close it.
+pub const SWING_AWAY_HELD_S: f32 = 0.01;
+
 /// Shortest swing the walker can make \[s\]: an own heel strike sooner than this after the
 /// own lift-off is a contact switch that closed by itself. 0.2 s, a quarter of the nominal
 /// 0.8 s stride.
@@ -71,10 +75,20 @@ pub const SPOOL_SILENT_ANKLE_COUNTS: u16 = 16;
 /// One count of the ankle encoder \[rad\].
 const COUNT_RAD: f32 = core::f32::consts::TAU / crate::sensors::ENCODER_COUNTS_PER_REV as f32;
 
-/// `ContactStuck` detail: the switch reads closed where the foot must be in the air.
+/// `ContactStuck` detail: closed `StuckTimeout` after the other foot's heel strike released
+/// this ankle, the ankle not turning as a loaded one (the foot must have lifted).
 pub const CONTACT_STUCK_CLOSED: i16 = 1;
-/// `ContactStuck` detail: the switch reads open where the foot must be on the floor.
+/// `ContactStuck` detail: open while the swing turns the ankle away from its rest angle or
+/// down through the taut angle (only the floor does).
 pub const CONTACT_STUCK_OPEN: i16 = 2;
+/// `ContactStuck` detail: closed again less than [`MIN_SWING_S`] after the lift-off.
+pub const CONTACT_CLOSED_TOO_SOON: i16 = 3;
+/// `ContactStuck` detail: closed in a walking stance whose ankle does not turn (a foot in
+/// the air).
+pub const CONTACT_CLOSED_NO_STANCE: i16 = 4;
+/// `ContactStuck` detail: open when the other foot's heel strike came again during this
+/// foot's swing (it must have landed in between).
+pub const CONTACT_OPEN_PEER_AGAIN: i16 = 5;
 
 /// What one tick of the node tells the stride check (the phase is the one the tick started
 /// in: the reflex has not stepped yet).
@@ -98,9 +112,12 @@ pub struct StrideInputs {
 }
 
 /// What the stride check found in one tick: `Some(detail)` per fault.
+///
+/// `ContactStuck`'s details: [`CONTACT_STUCK_CLOSED`] 1, [`CONTACT_STUCK_OPEN`] 2,
+/// [`CONTACT_CLOSED_TOO_SOON`] 3, [`CONTACT_CLOSED_NO_STANCE`] 4, [`CONTACT_OPEN_PEER_AGAIN`] 5.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StrideFindings {
-    /// `ContactStuck` ([`CONTACT_STUCK_CLOSED`] or [`CONTACT_STUCK_OPEN`]).
+    /// `ContactStuck` (its evidence: 1–5, see above).
     pub contact: Option<i16>,
     /// `SpoolStuck` (ankle counts moved while the spool stood still).
     pub spool: Option<i16>,
@@ -123,6 +140,9 @@ pub struct StrideCheck {
     swing_closest_rad: Option<f32>,
     /// The reading was above the taut angle in this swing (switch open).
     swing_above_taut: bool,
+    /// Since when the swing has turned away from rest (or is below the taut angle after
+    /// being above it).
+    swing_away_since: Option<Instant>,
     /// The switch at the previous check.
     last_contact_closed: Option<bool>,
     /// The ankle angle when the spool last turned (push and hold) \[rad\].
@@ -191,6 +211,7 @@ impl StrideCheck {
         if self.last_contact_closed.replace(i.contact_closed) == Some(true) && !i.contact_closed {
             self.swing_closest_rad = None;
             self.swing_above_taut = false;
+            self.swing_away_since = None;
         }
         if i.phase != ReflexPhase::Swing {
             return;
@@ -218,15 +239,22 @@ impl StrideCheck {
             }
         } else {
             if i.peer_heel_strike && self.swing_after_release {
-                self.raise_contact(CONTACT_STUCK_OPEN, false);
+                self.raise_contact(CONTACT_OPEN_PEER_AGAIN, false);
             }
             // Only the floor turns a swinging ankle away from its rest angle, or down through
             // the taut angle (a swing foot hangs near its landing angle, far above it).
             let above_taut = i.sample.map(|s| s.angle_rad > taut_angle_rad);
             let crossed_down = self.swing_above_taut && above_taut == Some(false);
             self.swing_above_taut |= above_taut == Some(true);
+            // Held for a while: a foot that just landed turns away too, for the few ticks
+            // the switch's debouncer takes to close.
             if turned_away_rad > SWING_TURN_AWAY_RAD || crossed_down {
-                self.raise_contact(CONTACT_STUCK_OPEN, false);
+                let since = *self.swing_away_since.get_or_insert(i.now);
+                if i.now.secs_since(since) >= SWING_AWAY_HELD_S {
+                    self.raise_contact(CONTACT_STUCK_OPEN, false);
+                }
+            } else {
+                self.swing_away_since = None;
             }
         }
     }
@@ -258,7 +286,7 @@ impl StrideCheck {
         w.last_counts = s.counts;
         if i.now.secs_since(w.since) >= stuck_timeout_s {
             if w.changed && (s.angle_rad - w.from_rad).abs() < STANCE_MIN_ROTATION_RAD {
-                self.raise_contact(CONTACT_STUCK_CLOSED, true);
+                self.raise_contact(CONTACT_CLOSED_NO_STANCE, true);
             }
             w = StanceWindow {
                 since: i.now,
@@ -312,12 +340,13 @@ impl StrideCheck {
                     .lift_off_at
                     .is_some_and(|t| now.secs_since(t) < MIN_SWING_S)
                 {
-                    self.raise_contact(CONTACT_STUCK_CLOSED, true);
+                    self.raise_contact(CONTACT_CLOSED_TOO_SOON, true);
                 }
                 self.walking = true;
                 self.swing_after_release = false;
                 self.swing_closest_rad = None;
                 self.swing_above_taut = false;
+                self.swing_away_since = None;
                 if let Some(s) = sample {
                     self.landing_rad = Some(s.angle_rad);
                 }
@@ -326,6 +355,7 @@ impl StrideCheck {
                 self.swing_after_release = true;
                 self.swing_closest_rad = None;
                 self.swing_above_taut = false;
+                self.swing_away_since = None;
                 if cause == ReleaseCause::PeerHeelStrike && !lift_off {
                     self.released_by_peer_at = Some(now);
                 }
@@ -447,7 +477,7 @@ mod tests {
             Some(ReflexEvent::HeelStrike),
         );
         let f = c.check(&inputs(911, ReflexPhase::Free, 0.16, true), 0.05, -0.08);
-        assert_eq!(f.contact, Some(CONTACT_STUCK_CLOSED));
+        assert_eq!(f.contact, Some(CONTACT_CLOSED_TOO_SOON));
     }
 
     #[test]
@@ -486,7 +516,7 @@ mod tests {
             }
         }
         assert!(
-            matches!(found, Some((ms, Some(CONTACT_STUCK_OPEN))) if (1030..1034).contains(&ms)),
+            matches!(found, Some((ms, Some(CONTACT_STUCK_OPEN))) if (1040..1044).contains(&ms)),
             "{found:?}"
         );
         // The other foot's heel strike again while this one still swings.
@@ -500,7 +530,7 @@ mod tests {
         let mut i = inputs(1600, ReflexPhase::Swing, 0.16, false);
         assert_eq!(c.check(&i, 0.05, -0.08).contact, None);
         i.peer_heel_strike = true;
-        assert_eq!(c.check(&i, 0.05, -0.08).contact, Some(CONTACT_STUCK_OPEN));
+        assert_eq!(c.check(&i, 0.05, -0.08).contact, Some(CONTACT_OPEN_PEER_AGAIN));
     }
 
     #[test]

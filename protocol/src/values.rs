@@ -174,12 +174,13 @@ wire_enum!(
         /// them, saturated at 32767. Reported, not safety-relevant (the loop that would let
         /// the buffer fill is the watchdog's).
         CanRxOverflow = 11,
-        /// The contact switch contradicts the stride: `detail` 1 = still closed
+        /// The contact switch contradicts the stride. `detail`, the evidence: 1 = closed
         /// `StuckTimeout` after the other foot's heel strike released this one (the foot
-        /// must lift), or closed again too soon after the lift-off (a swing shorter than the
-        /// walker can swing), or a stance in which the ankle does not rotate; 2 = open while
-        /// the ankle turns as only a loaded foot turns it (away from the swing's rest angle),
-        /// or the other foot's heel strike arriving again before this foot landed.
+        /// must lift); 2 = open while the ankle turns as only a loaded foot turns it (away
+        /// from the swing's rest angle, or down through the taut angle); 3 = closed again
+        /// too soon after the lift-off (a swing shorter than the walker can swing); 4 =
+        /// closed in a walking stance whose ankle does not turn; 5 = open when the other
+        /// foot's heel strike came again before this foot landed.
         ContactStuck = 12,
         /// The spool encoder stood still while the ankle, held by the taut string (push or
         /// hold), moved: `detail` = the ankle's displacement since the spool last turned, in
