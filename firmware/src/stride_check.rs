@@ -530,7 +530,10 @@ mod tests {
         let mut i = inputs(1600, ReflexPhase::Swing, 0.16, false);
         assert_eq!(c.check(&i, 0.05, -0.08).contact, None);
         i.peer_heel_strike = true;
-        assert_eq!(c.check(&i, 0.05, -0.08).contact, Some(CONTACT_OPEN_PEER_AGAIN));
+        assert_eq!(
+            c.check(&i, 0.05, -0.08).contact,
+            Some(CONTACT_OPEN_PEER_AGAIN)
+        );
     }
 
     #[test]
@@ -542,7 +545,12 @@ mod tests {
         let per_count = core::f32::consts::TAU / 16384.0;
         let mut found = None;
         for k in 1..40u16 {
-            let mut i = inputs(u64::from(k), ReflexPhase::Push, -0.08 + f32::from(k) * per_count, true);
+            let mut i = inputs(
+                u64::from(k),
+                ReflexPhase::Push,
+                -0.08 + f32::from(k) * per_count,
+                true,
+            );
             i.string_moving = false;
             if let Some(d) = c.check(&i, 0.05, -0.08).spool {
                 found = Some((k, d));
@@ -555,7 +563,8 @@ mod tests {
         i.string_moving = true;
         assert_eq!(c.check(&i, 0.05, -0.08).spool, None);
         assert_eq!(
-            c.check(&inputs(41, ReflexPhase::Free, -0.5, true), 0.05, -0.08).spool,
+            c.check(&inputs(41, ReflexPhase::Free, -0.5, true), 0.05, -0.08)
+                .spool,
             None
         );
     }

@@ -50,8 +50,7 @@ fn draws(seed: u64) -> Vec<(f64, Side)> {
 fn phase_at(r: &SilReport, side: Side, t_s: f64) -> String {
     r.phase_history
         .iter()
-        .filter(|p| p.side == side && p.t_s <= t_s)
-        .last()
+        .rfind(|p| p.side == side && p.t_s <= t_s)
         .map_or_else(|| "Inactive".to_owned(), |p| p.phase.clone())
 }
 
@@ -137,10 +136,14 @@ fn run_draws(
         .collect();
     // At most one draw may end before any check could: a contact switch closing late in
     // a swing announces a heel strike the other ankle releases on at once.
-    let ended = outcomes
+    let ended: Vec<f64> = outcomes
         .iter()
-        .filter(|(o, _)| matches!(o, Outcome::EndedFirst { .. }))
-        .count();
+        .filter_map(|(o, _)| match o {
+            Outcome::EndedFirst { after_s } => Some(*after_s),
+            Outcome::Named { .. } => None,
+        })
+        .collect();
+    let ended = ended.len();
     assert!(ended <= 1, "{ended} walks ended before a check could");
     outcomes
 }
@@ -278,7 +281,9 @@ fn frozen_in_hold(actuator: ActuatorChoice) -> (f64, sil::FallCause) {
         });
     let (walk, r) = walk(config, 12);
     let applied = r.sensor_faults_applied[0].t_s;
-    let f = walk.failure.expect("still falls: the left never pushes again");
+    let f = walk
+        .failure
+        .expect("still falls: the left never pushes again");
     let cause = r.fall_cause(f.t_walk_s).expect("named");
     assert_eq!(
         (cause.side, cause.code.as_str()),

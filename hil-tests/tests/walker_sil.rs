@@ -332,11 +332,17 @@ fn an_encoder_stuck_before_the_push_is_caught_in_the_stance_and_names_the_fall()
         stuck >= from_s + timeout - 0.0011 && stuck <= from_s + timeout + 0.0021,
         "{stuck} vs {from_s}"
     );
-    assert_eq!(r.first_state_at_or_after(Side::Left, "Safe", from_s), Some(stuck));
+    assert_eq!(
+        r.first_state_at_or_after(Side::Left, "Safe", from_s),
+        Some(stuck)
+    );
     let f = walk.failure.expect("typed failure");
     assert!(f.t_walk_s > stuck, "{f:?}");
     let cause = r.fall_cause(f.t_walk_s).expect("a cause");
-    assert_eq!((cause.side, cause.code.as_str()), (Side::Left, "EncoderStuck"));
+    assert_eq!(
+        (cause.side, cause.code.as_str()),
+        (Side::Left, "EncoderStuck")
+    );
 }
 
 #[test]

@@ -82,7 +82,9 @@ fn sil_names_the_fault_that_ended_the_walk() {
     assert_eq!(cause["code"], "EncoderStuck", "{cause}");
     let t = cause["t_s"].as_f64().expect("t_s");
     assert!(t < fail_t, "{t} vs {fail_t}");
-    let before = cause["before_failure_s"].as_f64().expect("before_failure_s");
+    let before = cause["before_failure_s"]
+        .as_f64()
+        .expect("before_failure_s");
     assert!((before - (fail_t - t)).abs() < 1e-9);
     let text = walker(&args);
     let text = String::from_utf8_lossy(&text.stdout);

@@ -258,9 +258,8 @@ impl Ankle {
         let w = &mut self.wiring;
         for (f, fired) in &mut w.other_faults {
             let from_s = match *f {
-                SensorFault::ContactStuck { from_s, .. } | SensorFault::SpoolStuck { from_s, .. } => {
-                    from_s
-                }
+                SensorFault::ContactStuck { from_s, .. }
+                | SensorFault::SpoolStuck { from_s, .. } => from_s,
                 _ => continue,
             };
             if *fired || t_s < from_s {

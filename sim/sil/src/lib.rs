@@ -65,8 +65,7 @@ pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;
 pub use report::{
     FallCause, FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport,
-    PhaseChange,
-    SilReport, SocketcandReport, StateChange,
+    PhaseChange, SilReport, SocketcandReport, StateChange,
 };
 pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,

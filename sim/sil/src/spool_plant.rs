@@ -220,7 +220,8 @@ impl SpoolPlant {
 
     /// What the spool encoder reads: [`Self::spool_counts`], or the count it froze at.
     pub fn encoder_counts(&self) -> i32 {
-        self.encoder_frozen_at.unwrap_or_else(|| self.spool_counts())
+        self.encoder_frozen_at
+            .unwrap_or_else(|| self.spool_counts())
     }
 
     /// The spool encoder freezes at the count it reads now (an injected fault; the spool

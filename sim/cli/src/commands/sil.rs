@@ -422,7 +422,10 @@ fn print_text(out: &mut dyn Write, r: &SilWalkReport<'_>, steps: usize) -> std::
                 "cause: {:?} node raised {} (detail {}) at t = {:.4} s, {:.4} s before the failure",
                 c.side, c.code, c.detail, c.t_s, c.before_failure_s
             )?,
-            None => writeln!(out, "cause: no node raised a safety-relevant fault before it")?,
+            None => writeln!(
+                out,
+                "cause: no node raised a safety-relevant fault before it"
+            )?,
         }
     }
     let before_stop = if r.emergency_stop_sent_s.is_some() {
