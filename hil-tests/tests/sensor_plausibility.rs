@@ -345,3 +345,28 @@ fn a_glitch_of_a_million_radians_is_a_rate_fault_in_its_tick() {
         );
     }
 }
+
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "minutes unoptimised: cargo test --release -p hil-tests"
+)]
+fn no_fault_is_raised_on_200_healthy_steps_with_either_actuator() {
+    // No false alarm of the stride-wide checks: the nominal walk, nothing injected, 200 steps
+    // with each actuator, not one fault event (the soak's 1,000 and 10,000 servo steps assert
+    // the same, `soak.rs`).
+    for actuator in [ActuatorChoice::Servo, ActuatorChoice::SpoolMotor] {
+        let (walk, r) = walk(config(actuator), 200);
+        assert!(walk.failure.is_none(), "{actuator:?}: {:?}", walk.failure);
+        assert_eq!(walk.steps.len(), 200);
+        assert!(r.faults.is_empty(), "{actuator:?}: {:?}", r.faults);
+        for (side, n) in &r.nodes {
+            assert_eq!(n.state, "Enabled", "{actuator:?} {side:?}");
+            assert!(
+                n.engagements >= 99,
+                "{actuator:?} {side:?}: {}",
+                n.engagements
+            );
+        }
+    }
+}
