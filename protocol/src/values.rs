@@ -147,8 +147,9 @@ wire_enum!(
         EncoderRange = 2,
         /// The angle changed faster than the ankle can move.
         EncoderRate = 3,
-        /// The angle did not change at all for too long while the actuator was driving (push
-        /// or hold; a working magnetic encoder's output always moves by its noise).
+        /// The angle did not change at all for too long while the stride says the ankle
+        /// moves (a walking stance, a swing returning to rest, the push, a hold while the
+        /// spool turns). `detail`: the frozen counts.
         EncoderStuck = 4,
         /// No heartbeat from the other ankle within the timeout.
         PeerHeartbeatLost = 5,
