@@ -44,6 +44,7 @@ pub mod reflex;
 pub mod runner;
 pub mod scenarios;
 pub mod sensors;
+pub mod stride_check;
 pub mod supervisor;
 pub mod time;
 

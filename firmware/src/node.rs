@@ -19,6 +19,7 @@ use crate::following::FollowingErrorMonitor;
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
 use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
+use crate::stride_check::{StrideCheck, StrideInputs};
 use crate::time::Instant;
 
 /// Messages the node reads per tick at most (bounded work); callers keep the rest queued.
@@ -33,8 +34,8 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 pub const MAX_TX_PER_TICK: usize =
     1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
 
-// docs/firmware.md states the value: 34 with 11 fault codes, 8 answers and 8 history records.
-const _: () = assert!(MAX_TX_PER_TICK == 34);
+// docs/firmware.md states the value: 36 with 13 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 36);
 
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
@@ -121,6 +122,8 @@ pub enum ConfigError {
 pub struct DriverHealth {
     /// The actuator driver failed to apply the last command.
     pub actuator_error: bool,
+    /// Why, as the `Actuator` fault's detail (`ActuatorError::detail`; 0 when not known).
+    pub actuator_error_detail: i16,
     /// A frame could not be queued for transmission (the queue was full).
     pub can_error: bool,
     /// The CAN controller is bus-off (from its status register; error frames and
@@ -129,6 +132,9 @@ pub struct DriverHealth {
     /// The actuator moved the string in the last tick (`Actuator::string_moving`: the spool
     /// encoder turned); cross-checked against the ankle angle by the stuck check in hold.
     pub string_moving: bool,
+    /// The actuator has a spool sensor (`Actuator::has_spool_sensor`): without one,
+    /// `string_moving` is always false and says nothing about the spool.
+    pub spool_sensor: bool,
     /// Received frames the controller lost to a full receive buffer since the last tick.
     pub rx_lost: u32,
 }
@@ -171,6 +177,9 @@ pub struct AnkleNode {
     reflex: Reflex,
     faults: FaultFlags,
     plausibility: Plausibility,
+    stride: StrideCheck,
+    /// This tick's good reading (for the stride check after the reflex).
+    sample: Option<AngleSample>,
     estimator: AngleEstimator,
     last_sample_at: Option<Instant>,
     contact: Option<bool>,
@@ -266,6 +275,8 @@ impl AnkleNode {
             reflex: Reflex::default(),
             faults: FaultFlags::NONE,
             plausibility: Plausibility::default(),
+            stride: StrideCheck::default(),
+            sample: None,
             estimator: AngleEstimator::new(config.estimator),
             last_sample_at: None,
             contact: None,
@@ -468,6 +479,7 @@ impl AnkleNode {
             self.reflex.start(contact_closed);
         } else {
             self.reflex.stop();
+            self.stride.stop();
         }
     }
 
@@ -570,7 +582,7 @@ impl AnkleNode {
             out.push(Message::CommandAck(a));
         }
         let peer_heel_strike = self.read_messages(&mut out, now, inputs);
-        self.check_sensors(&mut out, now, inputs);
+        self.check_sensors(&mut out, now, inputs, peer_heel_strike);
         self.check_peer_liveness_and_drivers(&mut out, now, started, inputs);
         let edges = self.contact_edges(&mut out, now, contact);
         self.check_peer_state_and_receive(&mut out, now, inputs);
@@ -626,17 +638,30 @@ impl AnkleNode {
         peer_heel_strike
     }
 
-    /// Tick stage 2, sensors: plausibility, then the estimator on good samples. The stuck check
-    /// counts ticks where the actuator moves the ankle: the whole push (the setpoint profile
-    /// moves it), and hold ticks in which the spool turned (`DriverHealth::string_moving`). A
-    /// still ankle with a still spool in hold is no fault: a healthy encoder may sit on one
-    /// code then.
-    fn check_sensors(&mut self, out: &mut Outbox, now: Instant, inputs: &TickInputs) {
-        let driving = match self.reflex.phase() {
-            ReflexPhase::Push => true,
-            ReflexPhase::Hold => inputs.drivers.string_moving,
-            _ => false,
+    /// Tick stage 2, sensors: plausibility, then the estimator on good samples. The stuck
+    /// check counts ticks where the stride says the ankle must move
+    /// ([`StrideCheck::ankle_expected_to_move`]: a walking stance, a swing away from its rest
+    /// angle, the push, a hold while the spool turns); the stride check also checks the
+    /// contact switch and the spool encoder against the reading (`ContactStuck`,
+    /// `SpoolStuck`). A still ankle where nothing says it moves is no fault: a healthy
+    /// encoder may sit on one code then.
+    fn check_sensors(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        inputs: &TickInputs,
+        peer_heel_strike: bool,
+    ) {
+        let stride_inputs = StrideInputs {
+            now,
+            phase: self.reflex.phase(),
+            sample: inputs.angle.ok(),
+            contact_closed: inputs.contact_closed,
+            string_moving: inputs.drivers.string_moving,
+            spool_sensor: inputs.drivers.spool_sensor,
+            peer_heel_strike,
         };
+        let driving = self.stride.ankle_expected_to_move(&stride_inputs);
         let found: SensorFindings =
             self.plausibility
                 .check(now, &inputs.angle, driving, &self.params);
@@ -644,9 +669,21 @@ impl AnkleNode {
         self.set_fault(out, now, FaultCode::EncoderRange, found.range);
         self.set_fault(out, now, FaultCode::EncoderRate, found.rate);
         self.set_fault(out, now, FaultCode::EncoderStuck, found.stuck);
+        let plausible = found.range.is_none() && found.rate.is_none();
+        self.sample = inputs.angle.ok().filter(|_| plausible);
+        let stride = self.stride.check(
+            &StrideInputs {
+                sample: self.sample,
+                ..stride_inputs
+            },
+            self.params.stuck_timeout_s(),
+            self.params.taut_angle_rad(),
+        );
+        self.set_fault(out, now, FaultCode::ContactStuck, stride.contact);
+        self.set_fault(out, now, FaultCode::SpoolStuck, stride.spool);
         // Following error against the previous tick's setpoint, on a plausible reading.
         let measured = match inputs.angle {
-            Ok(s) if found.range.is_none() && found.rate.is_none() => Some(s.angle_rad),
+            Ok(s) if plausible => Some(s.angle_rad),
             _ => None,
         };
         let following = self.following.check(now, self.driven_setpoint, measured);
@@ -691,7 +728,10 @@ impl AnkleNode {
             out,
             now,
             FaultCode::Actuator,
-            inputs.drivers.actuator_error.then_some(0),
+            inputs
+                .drivers
+                .actuator_error
+                .then_some(inputs.drivers.actuator_error_detail),
         );
         self.set_fault(
             out,
@@ -773,6 +813,7 @@ impl AnkleNode {
             },
             &self.params,
         );
+        self.stride.observe(now, self.sample, edges.lift_off, event);
         match event {
             Some(ReflexEvent::Released(ReleaseCause::OwnLiftOff)) => {
                 self.set_fault(out, now, FaultCode::PeerHeelStrikeLate, Some(0));

@@ -98,7 +98,9 @@ where
             self.actuator.apply(out.actuator, measured)
         };
         self.health.actuator_error = result.is_err();
+        self.health.actuator_error_detail = result.err().map_or(0, |e| e.detail());
         self.health.string_moving = self.actuator.string_moving();
+        self.health.spool_sensor = self.actuator.has_spool_sensor();
         self.health.can_error = self.can.transmit(&out.transmit);
         out
     }

@@ -119,7 +119,7 @@ proptest! {
                     angle,
                     contact_closed: s.contact,
                     received: &received,
-                    drivers: DriverHealth { actuator_error: s.drivers.0, can_error: s.drivers.1, can_bus_off: false, string_moving: false, rx_lost: 0 },
+                    drivers: DriverHealth { actuator_error: s.drivers.0, actuator_error_detail: 0, can_error: s.drivers.1, can_bus_off: false, string_moving: false, spool_sensor: false, rx_lost: 0 },
                 },
             );
             prop_assert_eq!(node.dropped_tx(), 0);

@@ -245,9 +245,13 @@ fn full_reflex_cycle_through_the_node() {
         (ReflexPhase::Swing, ActuatorCommand::Released)
     );
     assert!(fault_events(&o.transmit, FaultCode::PeerHeelStrikeLate).is_empty());
-    // Our own heel strike echoed back (or the host's) does not release.
+    // Our own heel strike echoed back (or the host's) does not release. (A swing back to
+    // the landing angle first: a heel strike sooner than 0.2 s after the lift-off is a
+    // stuck contact switch.)
     b.contact = false;
     b.tick();
+    b.move_to(0.1);
+    b.run(250);
     b.drive_to_push();
     let own = Message::HeelStrike(HeelStrike {
         node: ME,
@@ -273,6 +277,7 @@ fn late_peer_message_falls_back_to_lift_off_and_clears_next_stride() {
     );
     assert_eq!(o.state, NodeState::Enabled, "not safety-relevant");
     b.move_to(0.1);
+    b.run(250);
     b.drive_to_push();
     let peer_hs = Message::HeelStrike(HeelStrike {
         node: PEER,
@@ -914,4 +919,128 @@ fn every_lost_frame_is_counted_and_reported_without_a_safe_state() {
         !b.node.faults().contains(FaultCode::CanRxOverflow),
         "cleared"
     );
+}
+
+/// The fault events of `code` in `msgs`, with their details.
+fn fault_details(msgs: &[Message], code: FaultCode) -> Vec<(FaultTransition, i16)> {
+    msgs.iter()
+        .filter_map(|m| match m {
+            Message::Fault(f) if f.code == code => Some((f.transition, f.detail)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn a_reading_frozen_in_a_walking_stance_is_stuck_within_50_ms() {
+    // After an own heel strike the stance turns the ankle: a reading that stops changing
+    // there (no push, no spool) is `EncoderStuck` 50 ms later, sent with the frozen counts,
+    // and the node goes `Safe`. Before the first heel strike (enabled with the foot down)
+    // nothing says the walker walks: the same frozen reading raises nothing.
+    let mut b = Bench::new();
+    b.contact = true;
+    b.tick();
+    b.tick_with(&[cmd(CommandKind::Enable)]);
+    assert_eq!(b.node.phase(), ReflexPhase::Free);
+    b.frozen = Some(CALIBRATION.counts(b.angle));
+    for _ in 0..500 {
+        assert_eq!(b.tick().state, NodeState::Enabled);
+    }
+    // A walking stance: swing, heel strike, the ankle turning down toward the taut angle.
+    b.frozen = None;
+    b.contact = false;
+    b.run(250);
+    b.contact = true;
+    b.tick();
+    assert_eq!(b.node.phase(), ReflexPhase::Free);
+    for _ in 0..5 {
+        b.angle -= 0.0005;
+        b.tick();
+    }
+    let counts = CALIBRATION.counts(b.angle);
+    b.frozen = Some(counts);
+    let mut msgs = Vec::new();
+    let mut safe_after = None;
+    for k in 0..=60 {
+        b.angle -= 0.0005;
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.state == NodeState::Safe {
+            safe_after = Some(k);
+            break;
+        }
+    }
+    let k = safe_after.expect("safe");
+    assert!((48..=50).contains(&k), "{k} ms");
+    assert_eq!(
+        fault_details(&msgs, FaultCode::EncoderStuck),
+        [(FaultTransition::Raised, counts as i16)]
+    );
+}
+
+#[test]
+fn a_switch_still_closed_after_the_release_is_stuck_closed_and_goes_safe() {
+    let mut b = Bench::enabled();
+    b.drive_to_push();
+    let peer_hs = Message::HeelStrike(HeelStrike {
+        node: PEER,
+        step_count: 1,
+        time_us: 0,
+    });
+    let o = b.tick_with(&[peer_hs]);
+    assert_eq!(o.phase, ReflexPhase::Swing);
+    // The foot never lifts (the switch stays closed) and the ankle does not turn as a
+    // loaded one (it stays where the string left it).
+    let mut msgs = Vec::new();
+    let mut safe_after = None;
+    for k in 1..=60 {
+        let o = b.tick();
+        msgs.extend(o.transmit.iter().copied());
+        if o.state == NodeState::Safe {
+            safe_after = Some(k);
+            break;
+        }
+    }
+    assert_eq!(safe_after, Some(50));
+    assert_eq!(
+        fault_details(&msgs, FaultCode::ContactStuck),
+        [(
+            FaultTransition::Raised,
+            firmware::stride_check::CONTACT_STUCK_CLOSED
+        )]
+    );
+    // It stays until the switch changes, so the node cannot be enabled on it.
+    b.tick_with(&[cmd(CommandKind::Enable)]);
+    assert_eq!(b.node.state(), NodeState::Safe);
+    b.contact = false;
+    b.tick();
+    assert!(!b.node.faults().contains(FaultCode::ContactStuck));
+}
+
+#[test]
+fn an_ankle_extending_under_a_silent_spool_is_a_stuck_spool() {
+    // With a spool sensor, a push that extends the ankle while the spool reports no motion:
+    // `SpoolStuck` with the ankle's extension in counts; without one, nothing is checked.
+    for spool_sensor in [true, false] {
+        let mut b = Bench::enabled();
+        b.drivers.spool_sensor = spool_sensor;
+        b.drivers.string_moving = false;
+        b.drive_to_push();
+        let mut msgs = Vec::new();
+        for _ in 0..300 {
+            msgs.extend(b.tick().transmit.iter().copied());
+        }
+        let found = fault_details(&msgs, FaultCode::SpoolStuck);
+        if spool_sensor {
+            assert!(
+                // Over 16 counts (the threshold), by the encoder noise at most.
+                matches!(found.first(), Some((FaultTransition::Raised, d)) if (17..=19).contains(d)),
+                "{found:?}"
+            );
+            assert_eq!(b.node.state(), NodeState::Safe);
+        } else {
+            assert!(found.is_empty(), "{found:?}");
+            assert_eq!(b.node.phase(), ReflexPhase::Hold);
+        }
+    }
 }

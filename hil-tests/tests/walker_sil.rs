@@ -313,26 +313,36 @@ fn released_in(walk: &sim::stride::walk::Walk, k: usize) -> Option<f64> {
     debug_assertions,
     ignore = "minutes unoptimised: cargo test --release -p hil-tests"
 )]
-fn an_encoder_stuck_before_the_push_is_not_detected_and_the_robot_falls() {
-    // Frozen at 30 % of stride 10, above the taut angle: the firmware never sees the ankle
-    // reach it, never pushes, and its stuck check (which runs only while pushing) never
-    // fires. The walk ends in a typed failure with the node still enabled.
+fn an_encoder_stuck_before_the_push_is_caught_in_the_stance_and_names_the_fall() {
+    // Frozen at 30 % of stride 10, above the taut angle, in the left's walking stance
+    // (`Free` after its heel strike): the stance must turn the ankle (the stride check), so
+    // the reading that stopped is `EncoderStuck` 50 ms later (it used to go unseen: the
+    // firmware never pushed, the stuck check ran only while pushing, and the walk fell with
+    // the node enabled). The node goes `Safe`, and the fall is put down to that fault.
     let from_s = in_stride(10, 0.3);
     let config = matched().with_sensor_fault(SensorFault::Stuck {
         side: Side::Left,
         from_s,
     });
     let (walk, r) = walk(config, 40);
-    assert_eq!(r.first_raise(Side::Left, "EncoderStuck"), None);
-    assert!(r.faults.is_empty(), "{:?}", r.faults);
-    assert_eq!(r.node(Side::Left).unwrap().state, "Enabled");
+    let stuck = r.first_raise(Side::Left, "EncoderStuck").expect("caught");
+    let timeout = f64::from(protocol::ParamId::StuckTimeout.default_si());
+    assert!(
+        // The frozen counts repeat the last reading before the freeze: up to a tick early.
+        stuck >= from_s + timeout - 0.0011 && stuck <= from_s + timeout + 0.0021,
+        "{stuck} vs {from_s}"
+    );
     assert_eq!(
-        r.node(Side::Left).unwrap().engagements,
-        5,
-        "strides 0, 2, .., 8"
+        r.first_state_at_or_after(Side::Left, "Safe", from_s),
+        Some(stuck)
     );
     let f = walk.failure.expect("typed failure");
-    assert!(f.step <= 11 && f.t_walk_s > from_s, "{f:?}");
+    assert!(f.t_walk_s > stuck, "{f:?}");
+    let cause = r.fall_cause(f.t_walk_s).expect("a cause");
+    assert_eq!(
+        (cause.side, cause.code.as_str()),
+        (Side::Left, "EncoderStuck")
+    );
 }
 
 #[test]

@@ -147,8 +147,9 @@ wire_enum!(
         EncoderRange = 2,
         /// The angle changed faster than the ankle can move.
         EncoderRate = 3,
-        /// The angle did not change at all for too long while the actuator was driving (push
-        /// or hold; a working magnetic encoder's output always moves by its noise).
+        /// The angle did not change at all for too long while the stride says the ankle
+        /// moves (a walking stance, a swing returning to rest, the push, a hold while the
+        /// spool turns). `detail`: the frozen counts.
         EncoderStuck = 4,
         /// No heartbeat from the other ankle within the timeout.
         PeerHeartbeatLost = 5,
@@ -174,6 +175,18 @@ wire_enum!(
         /// them, saturated at 32767. Reported, not safety-relevant (the loop that would let
         /// the buffer fill is the watchdog's).
         CanRxOverflow = 11,
+        /// The contact switch contradicts the stride. `detail`, the evidence: 1 = closed
+        /// `StuckTimeout` after the other foot's heel strike released this one (the foot
+        /// must lift); 2 = open while the ankle turns as only a loaded foot turns it (away
+        /// from the swing's rest angle, or down through the taut angle); 3 = closed again
+        /// too soon after the lift-off (a swing shorter than the walker can swing); 4 =
+        /// closed in a walking stance whose ankle does not turn; 5 = open when the other
+        /// foot's heel strike came again before this foot landed.
+        ContactStuck = 12,
+        /// The spool encoder stood still while the ankle, held by the taut string (push or
+        /// hold), moved: `detail` = the ankle's displacement since the spool last turned, in
+        /// ankle-encoder counts (saturated at 32767).
+        SpoolStuck = 13,
     }
 );
 
@@ -187,7 +200,7 @@ impl FaultCode {
     }
     /// The bit of this fault in [`FaultFlags`].
     pub const fn flag(self) -> u16 {
-        // Codes are 1..=11 (bits 0..=10); a code past bit 15 would have no bit (0).
+        // Codes are 1..=13 (bits 0..=12); a code past bit 15 would have no bit (0).
         match 1u16.checked_shl((self as u8).saturating_sub(1) as u32) {
             Some(bit) => bit,
             None => 0,

@@ -31,6 +31,26 @@ pub enum ActuatorError {
     ReleaseStalled,
 }
 
+impl ActuatorError {
+    /// A small code for the `Actuator` fault event's `detail`: 1 PWM, 2 pin, 3 no feedback,
+    /// 4 over-current, 5 current sense, 6 spool sensor, 7 bridge, 8 release timeout,
+    /// 9 release stalled (the spool made no progress paying out: jammed, reversed, or a
+    /// spool encoder that stopped).
+    pub fn detail(&self) -> i16 {
+        match self {
+            ActuatorError::Pwm(_) => 1,
+            ActuatorError::Pin(_) => 2,
+            ActuatorError::NoFeedback => 3,
+            ActuatorError::OverCurrent => 4,
+            ActuatorError::CurrentSense => 5,
+            ActuatorError::SpoolSensor => 6,
+            ActuatorError::Bridge => 7,
+            ActuatorError::ReleaseTimeout => 8,
+            ActuatorError::ReleaseStalled => 9,
+        }
+    }
+}
+
 /// Anything that can hold the string at an ankle angle or release it.
 pub trait Actuator {
     /// Apply `command`; `measured_angle_rad` is the current ankle angle estimate, `None` when
@@ -48,6 +68,12 @@ pub trait Actuator {
     /// sensor saw it turn). The default, for actuators without such a sensor: false (the
     /// node then has no evidence that a hold moves the ankle).
     fn string_moving(&self) -> bool {
+        false
+    }
+
+    /// True when the actuator has a spool sensor behind [`Actuator::string_moving`] (the node
+    /// then cross-checks it against the ankle reading: `SpoolStuck`). The default: false.
+    fn has_spool_sensor(&self) -> bool {
         false
     }
 
@@ -70,6 +96,9 @@ impl<T: Actuator + ?Sized> Actuator for &mut T {
     }
     fn string_moving(&self) -> bool {
         T::string_moving(self)
+    }
+    fn has_spool_sensor(&self) -> bool {
+        T::has_spool_sensor(self)
     }
 }
 

@@ -368,6 +368,10 @@ impl<B: HalfBridges, E: SpoolEncoder, I: CurrentSense> Actuator for SpoolMotor<B
         self.moving
     }
 
+    fn has_spool_sensor(&self) -> bool {
+        true
+    }
+
     fn stop(&mut self) -> Result<(), ActuatorError> {
         self.stop_now();
         Ok(())

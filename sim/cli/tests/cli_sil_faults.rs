@@ -41,15 +41,56 @@ fn sil_stuck_in_hold_lists_the_fault_applied() {
     let t = a["t_s"].as_f64().expect("t_s a number");
     assert!((0.5..1.0).contains(&t), "{t}");
     // Outcome: the servo holds still in Hold, so the frozen reading equals the held angle and
-    // the stuck check (hold ticks count only while the spool turns) has no evidence: no node
-    // fault, both nodes still enabled, the walk completes.
-    assert_eq!(
-        v["node_faults"],
-        Value::Array(vec![]),
-        "{}",
-        v["node_faults"]
-    );
-    assert_eq!(v["nodes"]["Left"]["state"], "Enabled");
-    assert_eq!(v["nodes"]["Left"]["fault_raises"], serde_json::json!({}));
+    // the hold gives no evidence (hold ticks count only while the spool turns). The left's
+    // next walking stance must turn the ankle: 50 ms after its heel strike the node raises
+    // `EncoderStuck` (detail: the frozen counts) and goes `Safe`; the right follows
+    // (`PeerSafe`). The 3 steps complete (the fall, without the left's pushes, comes later:
+    // step 4 of `--steps 12`, whose `fall_cause` names this fault).
+    let faults = v["node_faults"].as_array().expect("a list");
+    let first = &faults[0];
+    assert_eq!(first["side"], "Left", "{faults:?}");
+    assert_eq!(first["code"], "EncoderStuck", "{faults:?}");
+    assert_eq!(first["raised"], true);
+    let stuck_at = first["t_s"].as_f64().expect("t_s");
+    assert!(stuck_at > t + 0.5 && stuck_at < t + 1.0, "{stuck_at}");
+    assert_eq!(v["nodes"]["Left"]["state"], "Safe");
     assert_eq!(v["steps_completed"], 3);
+    assert_eq!(v["failure"], Value::Null);
+    assert_eq!(v["fall_cause"], Value::Null, "no failure, no cause");
+}
+
+#[test]
+fn sil_names_the_fault_that_ended_the_walk() {
+    // The same fault over 12 steps: the walk falls, and both the JSON and the text name the
+    // left's `EncoderStuck` as the cause.
+    let args = [
+        "sil",
+        "--scene",
+        "wisse3d",
+        "--steps",
+        "12",
+        "--sensor-fault",
+        "stuck:side=left,state=hold",
+        "--firmware-param",
+        "push_duration_s=0.15",
+    ];
+    let out = walker(&[&args[..], &["--json"]].concat());
+    let v: Value = serde_json::from_slice(&out.stdout).expect("valid json");
+    let fail_t = v["failure"]["time_s"].as_f64().expect("the walk falls");
+    let cause = &v["fall_cause"];
+    assert_eq!(cause["side"], "Left", "{cause}");
+    assert_eq!(cause["code"], "EncoderStuck", "{cause}");
+    let t = cause["t_s"].as_f64().expect("t_s");
+    assert!(t < fail_t, "{t} vs {fail_t}");
+    let before = cause["before_failure_s"]
+        .as_f64()
+        .expect("before_failure_s");
+    assert!((before - (fail_t - t)).abs() < 1e-9);
+    let text = walker(&args);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("cause: Left node raised EncoderStuck (detail ")),
+        "{text}"
+    );
 }

@@ -145,6 +145,10 @@ def test_an_encoder_fault_is_a_node_fault(cli):
     assert comms["raised"].iloc[0] and comms["time_s"].iloc[0] == pytest.approx(0.5)
     assert ran.sensor_faults_applied["kind"].tolist() == ["spi"]
     assert ran.nodes.loc["Right", "fault_raises.EncoderComms"] >= 1
+    # A fall is put down to the first safety-relevant fault before it (none without a fall).
+    assert ran.fall_cause == expected["fall_cause"]
+    if ran.failure is not None:
+        assert ran.fall_cause["code"] == "EncoderComms" and ran.fall_cause["side"] == "Right"
 
 
 def test_firmware_params_estop_and_keep_steps_as_the_cli(cli):

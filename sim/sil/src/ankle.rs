@@ -27,7 +27,7 @@ use crate::hal::{
     SimClock, SimContactPin, SimCurrentSense, SimSpi, SimSpoolEncoder,
 };
 use crate::report::NodeReport;
-use crate::sensors::SimEncoder;
+use crate::sensors::{AppliedSensorFault, SensorFault, SimEncoder};
 use crate::side::Side;
 use crate::spool_plant::{PlantTick, SpoolPlant};
 use crate::tick::TickTime;
@@ -48,6 +48,13 @@ struct Wiring {
     plant: Option<PlantLink>,
     /// A supply drop still to apply at the first tick in `Hold` [V].
     supply_drop_v: Option<f64>,
+    /// The contact switch's and the spool encoder's injected faults, and whether each took
+    /// effect yet.
+    other_faults: Vec<(SensorFault, bool)>,
+    /// Those that took effect.
+    other_applied: Vec<AppliedSensorFault>,
+    /// The raw contact switch is stuck at this (closed: true).
+    contact_stuck: Option<bool>,
 }
 
 /// What the ankle's bus node allows at a tick.
@@ -102,12 +109,17 @@ impl Ankle {
                 node: side.node(),
                 reason: e,
             })?;
-        let faults = config
+        let (other_faults, faults): (Vec<_>, Vec<_>) = config
             .sensor_faults
             .iter()
             .filter(|f| f.side() == side)
             .copied()
-            .collect();
+            .partition(|f| {
+                matches!(
+                    f,
+                    SensorFault::ContactStuck { .. } | SensorFault::SpoolStuck { .. }
+                )
+            });
         let calibration = config.calibration[side.index()];
         let wiring = Wiring {
             shaft: Shaft::new(),
@@ -128,6 +140,9 @@ impl Ankle {
                 .iter()
                 .find(|d| d.side == side)
                 .map(|d| d.supply_v),
+            other_faults: other_faults.into_iter().map(|f| (f, false)).collect(),
+            other_applied: Vec::new(),
+            contact_stuck: None,
         };
         let actuator = match &wiring.plant {
             Some(plant) => AnkleActuator::SpoolMotor(Box::new(SpoolMotor::new(
@@ -183,10 +198,12 @@ impl Ankle {
     /// the bus node's state, the actuator's tick interval), run one driver step, and see
     /// what the firmware read.
     pub fn step(&mut self, t: TickTime, scene: &AnkleScene, access: BusAccess) -> AnkleStep {
+        self.apply_other_faults(t.t_s);
         let w = &self.wiring;
         w.shaft.set(t.t_s, scene.angle_rad);
         w.shaft.set_phase(self.drivers.node.phase());
-        w.contact.set_closed(scene.contact_closed);
+        w.contact
+            .set_closed(w.contact_stuck.unwrap_or(scene.contact_closed));
         w.clock.set(Instant::from_micros(t.t_ns / 1000));
         {
             let mut can = w.can.borrow_mut();
@@ -233,6 +250,34 @@ impl Ankle {
             outputs,
             peer_heel_strike,
             rx_backlog: can.rx_backlog(),
+        }
+    }
+
+    /// The contact switch's and the spool encoder's faults due at `t_s` take effect.
+    fn apply_other_faults(&mut self, t_s: f64) {
+        let w = &mut self.wiring;
+        for (f, fired) in &mut w.other_faults {
+            let from_s = match *f {
+                SensorFault::ContactStuck { from_s, .. }
+                | SensorFault::SpoolStuck { from_s, .. } => from_s,
+                _ => continue,
+            };
+            if *fired || t_s < from_s {
+                continue;
+            }
+            *fired = true;
+            match *f {
+                SensorFault::ContactStuck { closed, .. } => w.contact_stuck = Some(closed),
+                _ => match &w.plant {
+                    Some(plant) => plant.borrow_mut().freeze_encoder(),
+                    None => w.actuator.borrow_mut().freeze_spool_sensor(),
+                },
+            }
+            w.other_applied.push(AppliedSensorFault {
+                side: f.side(),
+                kind: f.kind(),
+                t_s,
+            });
         }
     }
 
@@ -286,9 +331,16 @@ impl Ankle {
             .map(|p| p.borrow().spool_counts())
     }
 
-    /// The injected encoder faults that took effect at this ankle.
-    pub fn sensor_faults_applied(&self) -> &[crate::sensors::AppliedSensorFault] {
-        self.drivers.encoder.device().encoder().applied()
+    /// The injected sensor faults that took effect at this ankle: the encoder's, then the
+    /// contact switch's and the spool encoder's.
+    pub fn sensor_faults_applied(&self) -> impl Iterator<Item = &AppliedSensorFault> {
+        self.drivers
+            .encoder
+            .device()
+            .encoder()
+            .applied()
+            .iter()
+            .chain(self.wiring.other_applied.iter())
     }
 
     /// Fill in what the firmware, its CAN port, the controller and the actuator counted.

@@ -64,8 +64,8 @@ pub use history::BoundedLog;
 pub use integrator::SIL_INTEGRATOR;
 pub use orchestrator::FirmwareInTheLoop;
 pub use report::{
-    FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport, PhaseChange,
-    SilReport, SocketcandReport, StateChange,
+    FallCause, FaultRecord, HistoryElided, HostReport, Landing, NodeParameters, NodeReport,
+    PhaseChange, SilReport, SocketcandReport, StateChange,
 };
 pub use sensors::{
     AppliedSensorFault, DrivenPhase, SensorFault, SensorFaultParseError, SimEncoder,

@@ -171,7 +171,7 @@ impl FirmwareInTheLoop {
             sensor_faults_applied: self
                 .ankles
                 .iter()
-                .flat_map(|a| a.sensor_faults_applied().iter().cloned())
+                .flat_map(|a| a.sensor_faults_applied().cloned())
                 .collect(),
         }
     }

@@ -25,6 +25,23 @@ pub struct FaultRecord {
     pub detail: i16,
 }
 
+/// The fault that ended a walk: the first safety-relevant fault a node raised (its own
+/// `Fault` event) at or before the walk's failure (`walker sil --json`'s `fall_cause`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FallCause {
+    /// The node that raised it.
+    pub side: Side,
+    /// Fault code (`EncoderStuck`, `ContactStuck`, `SpoolStuck`, ...).
+    pub code: String,
+    /// The event's evidence (`detail`: the stuck counts, the switch's state, the ankle's
+    /// motion under a silent spool, ...).
+    pub detail: i16,
+    /// When it was raised \[s\].
+    pub t_s: f64,
+    /// How long before the failure \[s\].
+    pub before_failure_s: f64,
+}
+
 /// A node-state change.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StateChange {
@@ -304,6 +321,26 @@ impl SilReport {
     /// The report of one node.
     pub fn node(&self, side: Side) -> Option<&NodeReport> {
         self.nodes.get(&side)
+    }
+
+    /// The first safety-relevant fault raised at or before `failure_s` \[s\], as the cause of
+    /// a failure then; `None` when no node raised one by then.
+    pub fn fall_cause(&self, failure_s: f64) -> Option<FallCause> {
+        let safety_relevant = |code: &str| {
+            protocol::FaultCode::ALL
+                .iter()
+                .any(|c| format!("{c:?}") == code && c.is_safety_relevant())
+        };
+        self.faults
+            .iter()
+            .find(|f| f.raised && f.t_s <= failure_s && safety_relevant(&f.code))
+            .map(|f| FallCause {
+                side: f.side,
+                code: f.code.clone(),
+                detail: f.detail,
+                t_s: f.t_s,
+                before_failure_s: failure_s - f.t_s,
+            })
     }
 }
 

@@ -163,6 +163,8 @@ pub struct SpoolPlant {
     stage: StageOutput,
     /// The supply now, when it differs from `params.supply_v` (a supply drop) [V].
     supply_override_v: Option<f64>,
+    /// The count the encoder reads while it is frozen (an injected `SpoolStuck`).
+    encoder_frozen_at: Option<i32>,
     tick: PlantTick,
     last: Option<ActuatorSegment>,
     last_coupled: Option<(f64, f64)>,
@@ -179,6 +181,7 @@ impl SpoolPlant {
             current_a: 0.0,
             stage: StageOutput::Off,
             supply_override_v: None,
+            encoder_frozen_at: None,
             tick: PlantTick {
                 t0_s: 0.0,
                 t1_s: 0.0,
@@ -213,6 +216,18 @@ impl SpoolPlant {
         let c = self.motor_rad * self.params.counts_per_motor_turn / (2.0 * std::f64::consts::PI);
         // Saturating conversion; the firmware's soft limits keep it far from i32's range.
         c.floor() as i32
+    }
+
+    /// What the spool encoder reads: [`Self::spool_counts`], or the count it froze at.
+    pub fn encoder_counts(&self) -> i32 {
+        self.encoder_frozen_at
+            .unwrap_or_else(|| self.spool_counts())
+    }
+
+    /// The spool encoder freezes at the count it reads now (an injected fault; the spool
+    /// itself turns on).
+    pub fn freeze_encoder(&mut self) {
+        self.encoder_frozen_at.get_or_insert(self.spool_counts());
     }
 
     /// The current-sense reading now: |i|, quantised \[A\].

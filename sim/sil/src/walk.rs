@@ -19,7 +19,7 @@ use sim::stride::walk::{StepSummary, Walk, WalkFailure, WalkOptions, WalkRequest
 use sim::stride::{Floor, StrideSettings};
 
 use crate::config::{ActuatorChoice, SilConfig};
-use crate::report::{FaultRecord, NodeReport, SilReport};
+use crate::report::{FallCause, FaultRecord, NodeReport, SilReport};
 use crate::sensors::AppliedSensorFault;
 use crate::side::Side;
 
@@ -209,6 +209,10 @@ pub struct SilWalkReport<'a> {
     pub steps_completed: usize,
     /// The first failure (`null` if none).
     pub failure: Option<&'a WalkFailure>,
+    /// The fault that ended the walk: the first safety-relevant fault a node raised at or
+    /// before the failure (`null` without a failure, or when no node raised one: a fall the
+    /// nodes did not see coming).
+    pub fall_cause: Option<FallCause>,
     /// The firmware's gait over the last 10 steps that ended by the emergency stop (all
     /// steps without one; `null` if there is no such step).
     pub gait: Option<WalkGaitRecord>,
@@ -299,6 +303,10 @@ impl<'a> SilRun<'a> {
             integrator: self.integrator,
             steps_completed: walk.steps_completed,
             failure: walk.failure.as_ref(),
+            fall_cause: walk
+                .failure
+                .as_ref()
+                .and_then(|f| self.firmware.fall_cause(f.t_walk_s)),
             gait: WalkGaitRecord::of_steps(self.walker, actuated_steps, GAIT_STEPS_AVERAGED),
             emergency_stop_sent_s,
             steps_before_emergency_stop: actuated_steps.len(),

@@ -36,10 +36,12 @@ pub struct SilArgs {
     /// sends (heel strike 0x022/0x023, heartbeat 0x061-0x063, ankle state 0x072/0x073, ...).
     #[arg(long = "fault", value_name = "SPEC")]
     pub faults: Vec<String>,
-    /// An encoder fault (repeatable; docs/sil.md):
+    /// A sensor fault (repeatable; docs/sil.md): the ankle encoder's
     /// `glitch:side=left,at_ms=500[,delta_rad=0.1]`, `stuck:side=left,from_ms=500`,
     /// `stuck:side=left,state=hold` (frozen from the first tick that node is in Hold),
-    /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`.
+    /// `spi:side=right,from_ms=500[,until_ms=700]`, `parity:side=right,at_ms=500`; the contact
+    /// switch's `contact:side=left,from_ms=500,state=closed|open`; the spool encoder's
+    /// `spool:side=left,from_ms=500`.
     #[arg(long = "sensor-fault", value_name = "SPEC")]
     pub sensor_faults: Vec<String>,
     /// Host emergency stop to every ankle at this walk time, in seconds (finite, not negative).
@@ -416,6 +418,17 @@ fn print_text(out: &mut dyn Write, r: &SilWalkReport<'_>, steps: usize) -> std::
     }
     if let Some(f) = r.failure {
         writeln!(out, "failure: {}", failure_text(f))?;
+        match &r.fall_cause {
+            Some(c) => writeln!(
+                out,
+                "cause: {:?} node raised {} (detail {}) at t = {:.4} s, {:.4} s before the failure",
+                c.side, c.code, c.detail, c.t_s, c.before_failure_s
+            )?,
+            None => writeln!(
+                out,
+                "cause: no node raised a safety-relevant fault before it"
+            )?,
+        }
     }
     let before_stop = if r.emergency_stop_sent_s.is_some() {
         " before the emergency stop"

@@ -71,6 +71,13 @@ class Sil:
         return self.report["failure"]
 
     @property
+    def fall_cause(self) -> dict[str, Any] | None:
+        """The fault that ended the walk: the first safety-relevant fault a node raised at or
+        before the failure (``side``, ``code``, ``detail``, ``t_s``, ``before_failure_s``), or
+        ``None`` (no failure, or a fall no node saw coming)."""
+        return self.report["fall_cause"]
+
+    @property
     def gait(self) -> dict[str, Any] | None:
         """The firmware's gait over the last 10 steps before any emergency stop (speed, step
         length, period, ...), or ``None`` if no step completed."""

@@ -40,6 +40,8 @@ pub struct ActuatorLink {
     last_measured_rad: Option<f32>,
     commands: u64,
     moving: bool,
+    /// The spool sensor reports no motion from now on (an injected `SpoolStuck`).
+    spool_sensor_frozen: bool,
 }
 
 impl ActuatorLink {
@@ -56,6 +58,7 @@ impl ActuatorLink {
             last_measured_rad: None,
             commands: 0,
             moving: false,
+            spool_sensor_frozen: false,
         }
     }
 
@@ -88,6 +91,11 @@ impl ActuatorLink {
     pub fn commands(&self) -> u64 {
         self.commands
     }
+
+    /// The servo's spool sensor reports no motion from now on (an injected fault).
+    pub fn freeze_spool_sensor(&mut self) {
+        self.spool_sensor_frozen = true;
+    }
 }
 
 /// The actuator; it shares its [`ActuatorLink`] with the orchestrator.
@@ -114,7 +122,9 @@ impl Actuator for SimActuator {
         };
         let (t0, t1, take_up, load) = (l.t0_s, l.t1_s, l.take_up_rad, l.load_n_m);
         let seg = l.model.tick(t0, t1, setpoint, take_up, load);
-        l.moving = !seg.released && (seg.p1_rad - seg.p0_rad).abs() >= SPOOL_RESOLUTION_RAD;
+        l.moving = !seg.released
+            && !l.spool_sensor_frozen
+            && (seg.p1_rad - seg.p0_rad).abs() >= SPOOL_RESOLUTION_RAD;
         l.segment = Some(seg);
         l.last_command = Some(command);
         l.last_measured_rad = measured_angle_rad;
@@ -124,6 +134,10 @@ impl Actuator for SimActuator {
 
     fn string_moving(&self) -> bool {
         self.0.borrow().moving
+    }
+
+    fn has_spool_sensor(&self) -> bool {
+        true
     }
 }
 
@@ -153,6 +167,13 @@ impl Actuator for AnkleActuator {
         match self {
             AnkleActuator::SpoolMotor(m) => m.string_moving(),
             AnkleActuator::Servo(s) => s.string_moving(),
+        }
+    }
+
+    fn has_spool_sensor(&self) -> bool {
+        match self {
+            AnkleActuator::SpoolMotor(m) => m.has_spool_sensor(),
+            AnkleActuator::Servo(s) => s.has_spool_sensor(),
         }
     }
 

@@ -42,7 +42,7 @@ pub struct SimSpoolEncoder(pub PlantLink);
 
 impl SpoolEncoder for SimSpoolEncoder {
     fn spool_counts(&mut self) -> Result<i32, HardwareError> {
-        Ok(self.0.borrow().spool_counts())
+        Ok(self.0.borrow().encoder_counts())
     }
 }
 

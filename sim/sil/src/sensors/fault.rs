@@ -1,5 +1,6 @@
-//! Encoder faults injected for tests, and their text form
-//! (`stuck:side=left,from_ms=500`, parsed by [`canbus::spec`]).
+//! Sensor faults injected for tests — the ankle encoder's, the contact switch's and the spool
+//! encoder's — and their text form (`stuck:side=left,from_ms=500`, parsed by
+//! [`canbus::spec`]).
 
 use canbus::spec::{parse_ms, Spec, SpecError};
 use serde::Serialize;
@@ -50,6 +51,25 @@ pub enum SensorFault {
         /// When \[s\].
         at_s: f64,
     },
+    /// From `from_s` on, the foot's contact switch reads `closed` (or open) whatever the
+    /// foot does (before the firmware's debouncer).
+    ContactStuck {
+        /// Which ankle.
+        side: Side,
+        /// From when \[s\].
+        from_s: f64,
+        /// Stuck closed (true) or open.
+        closed: bool,
+    },
+    /// From `from_s` on, the spool encoder reads its last count: with the motor plant the
+    /// quadrature count the driver reads stays frozen, with the servo model its spool sensor
+    /// reports no motion (`Actuator::string_moving` false).
+    SpoolStuck {
+        /// Which ankle.
+        side: Side,
+        /// From when \[s\].
+        from_s: f64,
+    },
 }
 
 /// A reflex phase in which the actuator drives, as a trigger of [`SensorFault::StuckInPhase`].
@@ -73,9 +93,12 @@ impl DrivenPhase {
 }
 
 impl SensorFault {
-    /// The kind's name in the text form (`glitch`, `stuck`, `spi`, `parity`).
+    /// The kind's name in the text form (`glitch`, `stuck`, `spi`, `parity`, `contact`,
+    /// `spool`).
     pub fn kind(&self) -> &'static str {
         match self {
+            SensorFault::ContactStuck { .. } => "contact",
+            SensorFault::SpoolStuck { .. } => "spool",
             SensorFault::Glitch { .. } => "glitch",
             SensorFault::Stuck { .. } | SensorFault::StuckInPhase { .. } => "stuck",
             SensorFault::SpiFailure { .. } => "spi",
@@ -90,7 +113,9 @@ impl SensorFault {
             | SensorFault::Stuck { side, .. }
             | SensorFault::StuckInPhase { side, .. }
             | SensorFault::SpiFailure { side, .. }
-            | SensorFault::Parity { side, .. } => *side,
+            | SensorFault::Parity { side, .. }
+            | SensorFault::ContactStuck { side, .. }
+            | SensorFault::SpoolStuck { side, .. } => *side,
         }
     }
 }
@@ -100,7 +125,9 @@ impl SensorFault {
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum SensorFaultParseError {
     /// The text before `:` is not a fault kind.
-    #[error("unknown encoder fault `{kind}` (expected glitch, stuck, spi or parity)")]
+    #[error(
+        "unknown sensor fault `{kind}` (expected glitch, stuck, spi, parity, contact or spool)"
+    )]
     UnknownKind {
         /// The offending kind.
         kind: String,
@@ -166,7 +193,10 @@ impl std::str::FromStr for SensorFault {
     ///   from the first tick that node is in that reflex phase;
     /// * `spi:side=right,from_ms=500[,until_ms=700]` — [`SensorFault::SpiFailure`] (until the
     ///   end of the run without `until_ms`);
-    /// * `parity:side=right,at_ms=500` — [`SensorFault::Parity`].
+    /// * `parity:side=right,at_ms=500` — [`SensorFault::Parity`];
+    /// * `contact:side=left,from_ms=500,state=closed` (or `state=open`) —
+    ///   [`SensorFault::ContactStuck`];
+    /// * `spool:side=left,from_ms=500` — [`SensorFault::SpoolStuck`].
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let spec = Spec::parse(s, allowed_keys)?;
         let side = spec.required("side", "left or right", |v| match v {
@@ -223,6 +253,19 @@ impl std::str::FromStr for SensorFault {
                     until_s,
                 }
             }
+            "contact" => SensorFault::ContactStuck {
+                side,
+                from_s: spec.required("from_ms", ms, seconds)?,
+                closed: spec.required("state", "closed or open", |v| match v {
+                    "closed" => Some(true),
+                    "open" => Some(false),
+                    _ => None,
+                })?,
+            },
+            "spool" => SensorFault::SpoolStuck {
+                side,
+                from_s: spec.required("from_ms", ms, seconds)?,
+            },
             _ => SensorFault::Parity {
                 side,
                 at_s: spec.required("at_ms", ms, seconds)?,
@@ -238,6 +281,8 @@ fn allowed_keys(kind: &str) -> Option<&'static str> {
         "stuck" => "side, from_ms, state",
         "spi" => "side, from_ms, until_ms",
         "parity" => "side, at_ms",
+        "contact" => "side, from_ms, state",
+        "spool" => "side, from_ms",
         _ => return None,
     })
 }
@@ -285,6 +330,24 @@ mod tests {
         assert!(bad("stuck:side=left,state=swing").contains("push or hold"));
         assert!(bad("stuck:side=left,state=hold,from_ms=5").contains("not both"));
         assert!(bad("stuck:side=left").contains("from_ms"));
+        assert_eq!(
+            ok("contact:side=right,from_ms=1500,state=open"),
+            SensorFault::ContactStuck {
+                side: Side::Right,
+                from_s: 1.5,
+                closed: false
+            }
+        );
+        assert_eq!(
+            ok("spool:side=left,from_ms=20"),
+            SensorFault::SpoolStuck {
+                side: Side::Left,
+                from_s: 0.02
+            }
+        );
+        assert!(bad("contact:side=left,from_ms=5,state=half").contains("closed or open"));
+        assert!(bad("contact:side=left,from_ms=5").contains("state"));
+        assert!(bad("spool:side=left,at_ms=5").contains("at_ms"));
     }
 
     #[test]
