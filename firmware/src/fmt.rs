@@ -9,9 +9,9 @@ macro_rules! log_info {
 }
 #[cfg(not(feature = "defmt"))]
 macro_rules! log_info {
-    ($($t:tt)*) => {{
+    ($fmt:literal $(, $arg:expr)* $(,)?) => {{
         if false {
-            let _ = ($crate::fmt::Ignore);
+            let _ = ($crate::fmt::Ignore, $(&$arg),*);
         }
     }};
 }
@@ -22,9 +22,33 @@ macro_rules! log_warn {
 }
 #[cfg(not(feature = "defmt"))]
 macro_rules! log_warn {
-    ($($t:tt)*) => {{
+    ($fmt:literal $(, $arg:expr)* $(,)?) => {{
         if false {
-            let _ = ($crate::fmt::Ignore);
+            let _ = ($crate::fmt::Ignore, $(&$arg),*);
+        }
+    }};
+}
+
+/// A bench-log line through a [`crate::log_limit::LogLimiter`]: `log_limited!(limiter, kind,
+/// now, "format", args...)`. Logged while the kind's bucket has a token; the first line
+/// after a suppression is followed by the count left out. Without the `defmt` feature
+/// nothing is evaluated but the arguments' types (the limiter is not consulted).
+#[cfg(feature = "defmt")]
+macro_rules! log_limited {
+    ($limiter:expr, $kind:expr, $now:expr, $($t:tt)*) => {{
+        if let $crate::log_limit::Allowance::Log { suppressed } = $limiter.allow($kind, $now) {
+            defmt::info!($($t)*);
+            if suppressed > 0 {
+                defmt::warn!("{} earlier {} lines left out (rate limit)", suppressed, $kind);
+            }
+        }
+    }};
+}
+#[cfg(not(feature = "defmt"))]
+macro_rules! log_limited {
+    ($limiter:expr, $kind:expr, $now:expr, $fmt:literal $(, $arg:expr)* $(,)?) => {{
+        if false {
+            let _ = (&$limiter, $kind, $now, $(&$arg),*);
         }
     }};
 }
@@ -34,4 +58,5 @@ macro_rules! log_warn {
 pub(crate) struct Ignore;
 
 pub(crate) use log_info;
+pub(crate) use log_limited;
 pub(crate) use log_warn;

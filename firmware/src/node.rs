@@ -5,17 +5,19 @@
 
 use heapless::Vec;
 use protocol::{
-    Angle, AngularRate, AnkleState, BootInfo, Command, CommandAck, CommandKind, CommandResult,
-    ConfigSource, FaultCode, FaultEvent, FaultFlags, FaultHistoryEntry, FaultTransition, Heartbeat,
-    HeelStrike, Identity, Message, NodeId, NodeState, Opcode, ParamAck, ParamStatus, ReflexPhase,
-    ResetCause, Version, PROTOCOL_VERSION,
+    Angle, AngularRate, AnkleState, BootInfo, ClockInfo, Command, CommandAck, CommandKind,
+    CommandResult, ConfigSource, FaultCode, FaultEvent, FaultFlags, FaultHistoryEntry,
+    FaultTransition, Heartbeat, HeelStrike, Identity, Message, NodeId, NodeState, Opcode, ParamAck,
+    ParamStatus, ReflexPhase, ResetCause, Version, PROTOCOL_VERSION,
 };
 
+use crate::clock_choice::ClockChoice;
 use crate::convert::saturating_i16;
 use crate::estimator::{AngleEstimator, EstimatorGains};
 use crate::fault_report::FaultReporter;
-use crate::fmt::{log_info, log_warn};
+use crate::fmt::{log_info, log_limited, log_warn};
 use crate::following::FollowingErrorMonitor;
+use crate::log_limit::{LogKind, LogLimiter};
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
 use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
@@ -29,12 +31,12 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 /// Capacity of the per-tick transmit list: heel strike, every fault code changing at once,
 /// one acknowledgement per received message, state, heartbeat and version, one fault-history
 /// dump and one identity (each answered once per tick however often asked), a deferred
-/// acknowledgement.
+/// acknowledgement, the identity's `ClockInfo`.
 pub const MAX_TX_PER_TICK: usize =
-    1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
+    1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1 + 1;
 
-// docs/firmware.md states the value: 34 with 11 fault codes, 8 answers and 8 history records.
-const _: () = assert!(MAX_TX_PER_TICK == 34);
+// docs/firmware.md states the value: 36 with 12 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 36);
 
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
@@ -86,6 +88,9 @@ pub struct NodeConfig {
     pub calibration_source: ConfigSource,
     /// Estimator gains.
     pub estimator: EstimatorGains,
+    /// The clock chosen at start-up ([`crate::clock_choice::choose`]; sent in `ClockInfo`; a
+    /// refused power stage raises `ClockTolerance` and keeps the node from being enabled).
+    pub clock: ClockChoice,
 }
 
 impl NodeConfig {
@@ -102,6 +107,7 @@ impl NodeConfig {
             params_source: ConfigSource::Defaults,
             calibration_source: ConfigSource::Defaults,
             estimator: EstimatorGains::default(),
+            clock: ClockChoice::SIMULATED,
         }
     }
 }
@@ -196,6 +202,7 @@ pub struct AnkleNode {
     pending_ack: Option<CommandAck>,
     request: Option<NodeRequest>,
     save_in_progress: bool,
+    log_limiter: LogLimiter,
 }
 
 /// Accumulates one tick's transmissions, counting what does not fit.
@@ -290,6 +297,7 @@ impl AnkleNode {
             pending_ack: None,
             request: None,
             save_in_progress: false,
+            log_limiter: LogLimiter::default(),
         })
     }
 
@@ -385,6 +393,7 @@ impl AnkleNode {
     pub fn storage_done(&mut self, ok: bool) {
         if self.save_in_progress {
             self.save_in_progress = false;
+            log_info!("parameters saved: {}", ok);
             self.pending_ack = Some(self.ack(
                 Opcode::SaveParams,
                 if ok {
@@ -436,6 +445,17 @@ impl AnkleNode {
             fault_history_len: u8::try_from(self.history.len()).unwrap_or(u8::MAX),
             calibration_source: c.calibration_source,
         }));
+        let clock = &c.clock;
+        out.push(Message::ClockInfo(ClockInfo {
+            node: c.node,
+            source: clock.source,
+            crystal: clock.crystal,
+            // 100 ppm counts, saturated at 2.55 % (the signal's width).
+            oscillator_error_centi_pct: u8::try_from(clock.oscillator_ppm / 100).unwrap_or(u8::MAX),
+            tolerated_error_ppm: u16::try_from(clock.tolerated_ppm).unwrap_or(u16::MAX),
+            // 10 Hz counts within the signal's 24 bits (167 MHz), saturated past them.
+            crystal_freq_10hz: (clock.crystal_measured_hz / 10).min(0xFF_FFFF),
+        }));
     }
 
     fn send_history(&self, out: &mut Outbox) {
@@ -471,7 +491,13 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, inputs: &TickInputs) {
+    fn handle_command(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        cmd: &Command,
+        inputs: &TickInputs,
+    ) {
         let contact_closed = inputs.contact_closed;
         if !cmd.target.addresses(self.config.node) {
             return;
@@ -496,6 +522,15 @@ impl AnkleNode {
                         Err(s) => s,
                     }
                 };
+                log_limited!(
+                    self.log_limiter,
+                    LogKind::Param,
+                    now,
+                    "SetParam {} = {} µ-units: {}",
+                    param,
+                    value.0,
+                    status
+                );
                 out.push(Message::ParamAck(ParamAck {
                     node: self.config.node,
                     param,
@@ -563,8 +598,20 @@ impl AnkleNode {
             list: Vec::new(),
             dropped: &mut dropped,
         };
+        if self.started_at.is_none() {
+            self.log_boot();
+        }
         let started = *self.started_at.get_or_insert(now);
         let contact = inputs.contact_closed;
+        let phase_before = self.reflex.phase();
+        let driven_before = self.driven_setpoint;
+        // The clock chosen at start-up, before any command: a refused power stage is a
+        // standing fault, so that not even the first tick's `Enable` passes.
+        let clock = self.config.clock;
+        let clock_detail = clock
+            .refusal
+            .map(|_| i16::try_from(clock.tolerated_ppm).unwrap_or(i16::MAX));
+        self.set_fault(&mut out, now, FaultCode::ClockTolerance, clock_detail);
         self.raised_this_tick = 0;
         if let Some(a) = self.pending_ack.take() {
             out.push(Message::CommandAck(a));
@@ -579,6 +626,7 @@ impl AnkleNode {
             self.enter(NodeState::Safe, contact);
         }
         let actuator = self.run_reflex(&mut out, now, edges, peer_heel_strike);
+        self.log_reflex(now, phase_before, driven_before, edges, peer_heel_strike);
         self.send_due_reports(&mut out, now);
         self.send_periodic(&mut out, now);
         sort_by_priority(&mut out.list);
@@ -593,13 +641,107 @@ impl AnkleNode {
         outputs
     }
 
+    /// The bench log's start-up lines: why the chip reset (a watchdog reset as a warning),
+    /// the clock and what its CAN timing tolerates.
+    fn log_boot(&self) {
+        let c = &self.config;
+        if matches!(
+            c.reset_cause,
+            ResetCause::IndependentWatchdog | ResetCause::WindowWatchdog
+        ) {
+            log_warn!("boot after a watchdog reset: {}", c.reset_cause);
+        } else {
+            log_info!("boot, reset cause {}", c.reset_cause);
+        }
+        let clock = &c.clock;
+        log_info!(
+            "clock {} (crystal {}, {} Hz measured), oscillator error {} ppm, CAN tolerates {} ppm",
+            clock.source,
+            clock.crystal,
+            clock.crystal_measured_hz,
+            clock.oscillator_ppm,
+            clock.tolerated_ppm
+        );
+        if let Some(r) = clock.refusal {
+            log_warn!("power stage refused on this clock: {}", r);
+        }
+    }
+
+    /// The bench log of one tick's reflex events, each kind rate-limited: heel strikes (own
+    /// and peer), phase changes, the string engaged (a setpoint appears) and released, with
+    /// the estimated angle and the node's uptime.
+    fn log_reflex(
+        &mut self,
+        now: Instant,
+        phase_before: ReflexPhase,
+        driven_before: Option<f32>,
+        edges: ContactEdges,
+        peer_heel_strike: bool,
+    ) {
+        let angle_rad = self.estimator.angle_rad().unwrap_or(f32::NAN);
+        let ms = now.uptime_ms();
+        if edges.heel_strike {
+            log_limited!(
+                self.log_limiter,
+                LogKind::HeelStrike,
+                now,
+                "heel strike (own, step {}) at {} ms",
+                self.step_count,
+                ms
+            );
+        }
+        if peer_heel_strike {
+            log_limited!(
+                self.log_limiter,
+                LogKind::HeelStrike,
+                now,
+                "heel strike (peer) at {} ms",
+                ms
+            );
+        }
+        let phase = self.reflex.phase();
+        if phase != phase_before {
+            log_limited!(
+                self.log_limiter,
+                LogKind::ReflexPhase,
+                now,
+                "reflex {} -> {} at {} ms, angle {} rad",
+                phase_before,
+                phase,
+                ms,
+                angle_rad
+            );
+        }
+        match (driven_before, self.driven_setpoint) {
+            (None, Some(setpoint)) => log_limited!(
+                self.log_limiter,
+                LogKind::String,
+                now,
+                "string engaged at {} ms, angle {} rad, setpoint {} rad",
+                ms,
+                angle_rad,
+                setpoint
+            ),
+            (Some(last), None) => log_limited!(
+                self.log_limiter,
+                LogKind::String,
+                now,
+                "string released at {} ms, angle {} rad (last setpoint {} rad)",
+                ms,
+                angle_rad,
+                last
+            ),
+            _ => {}
+        }
+    }
+
     /// Tick stage 1, messages: commands to this node, the peer's heartbeat and heel strike
     /// (at most [`MAX_RX_PER_TICK`]). Whether the peer announced its heel strike.
     fn read_messages(&mut self, out: &mut Outbox, now: Instant, inputs: &TickInputs) -> bool {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(out, c, inputs),
+                Message::Command(c) => self.handle_command(out, now, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
                     let before = self.peer_state.map(|(_, st)| st);

@@ -10,6 +10,8 @@ use crate::drivers::actuator::Actuator;
 use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
+use crate::fmt::log_limited;
+use crate::log_limit::{LogKind, LogLimiter};
 use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
 use crate::time::Monotonic;
 use protocol::NodeState;
@@ -29,6 +31,7 @@ pub struct AnkleDrivers<E, P, A, C, M> {
     /// Clock.
     pub clock: M,
     health: DriverHealth,
+    log_limiter: LogLimiter,
 }
 
 impl<E, P, A, C, M> AnkleDrivers<E, P, A, C, M>
@@ -56,6 +59,7 @@ where
             can,
             clock,
             health: DriverHealth::default(),
+            log_limiter: LogLimiter::default(),
         }
     }
 
@@ -71,8 +75,22 @@ where
             .unwrap_or_else(|_| self.contact.closed());
         let mut received: Vec<_, MAX_RX_PER_TICK> = Vec::new();
         self.can.receive(&mut received);
-        let lost_before = self.can.stats().rx_lost;
+        let before = self.can.stats();
+        let lost_before = before.rx_lost;
         let bus = self.can.poll_status();
+        if bus != before.status.state {
+            let st = self.can.stats().status;
+            log_limited!(
+                self.log_limiter,
+                LogKind::CanState,
+                now,
+                "CAN {} -> {} (TEC {}, REC {})",
+                before.status.state,
+                bus,
+                st.tx_errors,
+                st.rx_errors
+            );
+        }
         let rx_lost = self.can.stats().rx_lost.wrapping_sub(lost_before);
         let inputs = TickInputs {
             angle,
