@@ -55,8 +55,13 @@ macro_rules! log_limited {
 
 /// Placeholder value used by the no-logger expansion.
 #[cfg(not(feature = "defmt"))]
+#[allow(dead_code)]
 pub(crate) struct Ignore;
 
+// The node's own lines go through `crate::bench_log` (rate-limited, one per tick); these
+// stay for direct lines elsewhere.
+#[allow(unused_imports)]
 pub(crate) use log_info;
 pub(crate) use log_limited;
+#[allow(unused_imports)]
 pub(crate) use log_warn;

@@ -10,7 +10,8 @@
 //! * [`clock_choice`], [`can_timing`] — the clock chosen at start-up (crystal checked with a
 //!   timeout and a frequency measurement, or the internal oscillator), the CAN bit timing
 //!   computed for it and the oscillator error it tolerates.
-//! * [`log_limit`] — per-kind token buckets for the bench log.
+//! * [`bench_log`], [`log_limit`] — the defmt bench log: per-kind token buckets, one line per
+//!   tick.
 //! * [`scenarios`] — scripted sensor traces with a tiny ankle plant; the host tests and the
 //!   QEMU binary run the same traces and must produce the same actuator commands bit for bit.
 //!
@@ -36,6 +37,7 @@
 
 pub(crate) mod fmt;
 
+pub mod bench_log;
 pub mod can_timing;
 pub mod clock_choice;
 pub mod convert;

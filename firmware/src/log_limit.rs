@@ -1,4 +1,4 @@
-//! Rate limits for the bench log: one token bucket per kind of event, so that a flapping
+//! Rate limits for the bench log ([`crate::bench_log`]): one token bucket per kind of event, so that a flapping
 //! input (a chattering contact switch, a bus going error-passive and back every tick) cannot
 //! fill the RTT buffer and push out the lines that matter. A kind's bucket holds up to its
 //! burst of lines and refills at its rate; a line without a token is counted, and the next
@@ -14,38 +14,43 @@ pub enum LogKind {
     ReflexPhase,
     /// A heel strike (own or peer).
     HeelStrike,
-    /// The string engaged (push starts) or released.
-    String,
     /// The CAN controller's error state changed.
     CanState,
-    /// A parameter written, stored or calibrated.
+    /// A parameter written or stored.
     Param,
+    /// A fault raised or cleared.
+    Fault,
+    /// The node state changed.
+    State,
 }
 
 /// Number of kinds.
-pub const KINDS: usize = 5;
+pub const KINDS: usize = 6;
 
 impl LogKind {
     fn index(self) -> usize {
         match self {
             LogKind::ReflexPhase => 0,
             LogKind::HeelStrike => 1,
-            LogKind::String => 2,
-            LogKind::CanState => 3,
-            LogKind::Param => 4,
+            LogKind::CanState => 2,
+            LogKind::Param => 3,
+            LogKind::Fault => 4,
+            LogKind::State => 5,
         }
     }
 
     /// Lines allowed at once, and the refill rate \[lines/s\]. Walking at 1.25 strides/s
-    /// per leg gives about 5 phase changes, 2.5 heel strikes (own and peer) and 2.5 string
-    /// events per second: each rate is twice that, each burst a stride's worth or more.
+    /// per leg gives about 5 phase changes and 2.5 heel strikes (own and peer) per
+    /// second: each rate is twice that, each burst a stride's worth or more. Faults and
+    /// states come in bursts (a failing sensor raises several at once).
     pub const fn budget(self) -> (u32, u32) {
         match self {
             LogKind::ReflexPhase => (8, 10),
             LogKind::HeelStrike => (4, 5),
-            LogKind::String => (4, 5),
             LogKind::CanState => (4, 1),
             LogKind::Param => (16, 10),
+            LogKind::Fault => (8, 10),
+            LogKind::State => (8, 5),
         }
     }
 }

@@ -11,13 +11,12 @@ use protocol::{
     ParamStatus, ReflexPhase, ResetCause, Version, PROTOCOL_VERSION,
 };
 
+use crate::bench_log::{BenchEvent, BenchLog, StringEdge};
 use crate::clock_choice::ClockChoice;
 use crate::convert::saturating_i16;
 use crate::estimator::{AngleEstimator, EstimatorGains};
 use crate::fault_report::FaultReporter;
-use crate::fmt::{log_info, log_limited, log_warn};
 use crate::following::FollowingErrorMonitor;
-use crate::log_limit::{LogKind, LogLimiter};
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
 use crate::sensors::{AngleSample, EncoderError, Plausibility, SensorFindings};
@@ -202,7 +201,9 @@ pub struct AnkleNode {
     pending_ack: Option<CommandAck>,
     request: Option<NodeRequest>,
     save_in_progress: bool,
-    log_limiter: LogLimiter,
+    bench: BenchLog,
+    /// The current tick's time (for the bench log's events).
+    now: Instant,
 }
 
 /// Accumulates one tick's transmissions, counting what does not fit.
@@ -297,7 +298,8 @@ impl AnkleNode {
             pending_ack: None,
             request: None,
             save_in_progress: false,
-            log_limiter: LogLimiter::default(),
+            bench: BenchLog::default(),
+            now: Instant(0),
         })
     }
 
@@ -349,7 +351,8 @@ impl AnkleNode {
         }
         if present {
             self.faults.insert(code);
-            log_warn!("fault raised: {}", code);
+            self.bench
+                .record(now, BenchEvent::FaultRaised(code, detail.unwrap_or(0)));
             if self.history.is_full() {
                 let _ = self.history.pop_back();
             }
@@ -362,7 +365,7 @@ impl AnkleNode {
             self.raised_this_tick = self.raised_this_tick.saturating_add(1);
         } else {
             self.faults.remove(code);
-            log_info!("fault cleared: {}", code);
+            self.bench.record(now, BenchEvent::FaultCleared(code));
         }
         if let Some(r) = self
             .reporter
@@ -393,7 +396,7 @@ impl AnkleNode {
     pub fn storage_done(&mut self, ok: bool) {
         if self.save_in_progress {
             self.save_in_progress = false;
-            log_info!("parameters saved: {}", ok);
+            self.bench.record(self.now, BenchEvent::Saved(ok));
             self.pending_ack = Some(self.ack(
                 Opcode::SaveParams,
                 if ok {
@@ -482,7 +485,13 @@ impl AnkleNode {
         if state == self.state {
             return;
         }
-        log_info!("node state {} -> {}", self.state, state);
+        self.bench.record(
+            self.now,
+            BenchEvent::State {
+                from: self.state,
+                to: state,
+            },
+        );
         self.state = state;
         if state == NodeState::Enabled {
             self.reflex.start(contact_closed);
@@ -522,14 +531,13 @@ impl AnkleNode {
                         Err(s) => s,
                     }
                 };
-                log_limited!(
-                    self.log_limiter,
-                    LogKind::Param,
+                self.bench.record(
                     now,
-                    "SetParam {} = {} µ-units: {}",
-                    param,
-                    value.0,
-                    status
+                    BenchEvent::ParamWrite {
+                        param,
+                        value: value.0,
+                        status,
+                    },
                 );
                 out.push(Message::ParamAck(ParamAck {
                     node: self.config.node,
@@ -598,9 +606,7 @@ impl AnkleNode {
             list: Vec::new(),
             dropped: &mut dropped,
         };
-        if self.started_at.is_none() {
-            self.log_boot();
-        }
+        self.now = now;
         let started = *self.started_at.get_or_insert(now);
         let contact = inputs.contact_closed;
         let phase_before = self.reflex.phase();
@@ -629,6 +635,8 @@ impl AnkleNode {
         self.log_reflex(now, phase_before, driven_before, edges, peer_heel_strike);
         self.send_due_reports(&mut out, now);
         self.send_periodic(&mut out, now);
+        // At most one bench-log line per tick (the rest wait in the log's queue).
+        let _ = self.bench.flush_one();
         sort_by_priority(&mut out.list);
         let outputs = TickOutputs {
             actuator,
@@ -641,35 +649,9 @@ impl AnkleNode {
         outputs
     }
 
-    /// The bench log's start-up lines: why the chip reset (a watchdog reset as a warning),
-    /// the clock and what its CAN timing tolerates.
-    fn log_boot(&self) {
-        let c = &self.config;
-        if matches!(
-            c.reset_cause,
-            ResetCause::IndependentWatchdog | ResetCause::WindowWatchdog
-        ) {
-            log_warn!("boot after a watchdog reset: {}", c.reset_cause);
-        } else {
-            log_info!("boot, reset cause {}", c.reset_cause);
-        }
-        let clock = &c.clock;
-        log_info!(
-            "clock {} (crystal {}, {} Hz measured), oscillator error {} ppm, CAN tolerates {} ppm",
-            clock.source,
-            clock.crystal,
-            clock.crystal_measured_hz,
-            clock.oscillator_ppm,
-            clock.tolerated_ppm
-        );
-        if let Some(r) = clock.refusal {
-            log_warn!("power stage refused on this clock: {}", r);
-        }
-    }
-
-    /// The bench log of one tick's reflex events, each kind rate-limited: heel strikes (own
-    /// and peer), phase changes, the string engaged (a setpoint appears) and released, with
-    /// the estimated angle and the node's uptime.
+    /// The bench log of one tick's reflex events (each kind rate-limited): heel strikes (own
+    /// and peer) and the phase change, with the string engaged (a setpoint appears) or
+    /// released, the estimated angle and the node's uptime.
     fn log_reflex(
         &mut self,
         now: Instant,
@@ -678,60 +660,47 @@ impl AnkleNode {
         edges: ContactEdges,
         peer_heel_strike: bool,
     ) {
-        let angle_rad = self.estimator.angle_rad().unwrap_or(f32::NAN);
-        let ms = now.uptime_ms();
+        let at_ms = now.uptime_ms();
         if edges.heel_strike {
-            log_limited!(
-                self.log_limiter,
-                LogKind::HeelStrike,
+            let step = self.step_count;
+            self.bench.record(
                 now,
-                "heel strike (own, step {}) at {} ms",
-                self.step_count,
-                ms
+                BenchEvent::HeelStrike {
+                    own: true,
+                    step,
+                    at_ms,
+                },
             );
         }
         if peer_heel_strike {
-            log_limited!(
-                self.log_limiter,
-                LogKind::HeelStrike,
+            let step = self.step_count;
+            self.bench.record(
                 now,
-                "heel strike (peer) at {} ms",
-                ms
+                BenchEvent::HeelStrike {
+                    own: false,
+                    step,
+                    at_ms,
+                },
             );
         }
         let phase = self.reflex.phase();
         if phase != phase_before {
-            log_limited!(
-                self.log_limiter,
-                LogKind::ReflexPhase,
+            let string = match (driven_before, self.driven_setpoint) {
+                (None, Some(setpoint)) => StringEdge::Engaged(setpoint),
+                (Some(last), None) => StringEdge::Released(last),
+                _ => StringEdge::Unchanged,
+            };
+            let angle_rad = self.estimator.angle_rad().unwrap_or(f32::NAN);
+            self.bench.record(
                 now,
-                "reflex {} -> {} at {} ms, angle {} rad",
-                phase_before,
-                phase,
-                ms,
-                angle_rad
+                BenchEvent::Phase {
+                    from: phase_before,
+                    to: phase,
+                    at_ms,
+                    angle_rad,
+                    string,
+                },
             );
-        }
-        match (driven_before, self.driven_setpoint) {
-            (None, Some(setpoint)) => log_limited!(
-                self.log_limiter,
-                LogKind::String,
-                now,
-                "string engaged at {} ms, angle {} rad, setpoint {} rad",
-                ms,
-                angle_rad,
-                setpoint
-            ),
-            (Some(last), None) => log_limited!(
-                self.log_limiter,
-                LogKind::String,
-                now,
-                "string released at {} ms, angle {} rad (last setpoint {} rad)",
-                ms,
-                angle_rad,
-                last
-            ),
-            _ => {}
         }
     }
 
