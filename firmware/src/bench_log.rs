@@ -23,7 +23,6 @@ pub const QUEUE_LEN: usize = 8;
 
 /// What the string did with a reflex phase change.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum StringEdge {
     /// Nothing.
     Unchanged,
@@ -35,7 +34,6 @@ pub enum StringEdge {
 
 /// One thing worth a line on the bench.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BenchEvent {
     /// A fault raised, with its detail.
     FaultRaised(FaultCode, i16),

@@ -148,6 +148,12 @@ async fn main(_spawner: Spawner) {
         cause,
         boot_pin
     );
+    if matches!(
+        cause,
+        protocol::ResetCause::IndependentWatchdog | protocol::ResetCause::WindowWatchdog
+    ) {
+        defmt::warn!("the last reset was the watchdog's: the control loop stopped running on time");
+    }
     defmt::info!(
         "crystal {} -> clock {}: CAN kernel {} Hz, timing {}, tolerates {} ppm, oscillator {} ppm",
         observed,
