@@ -161,6 +161,10 @@ pub enum BitTimingError {
     },
 }
 
+/// A candidate's rank, smallest best: sample-point distance \[‰\], then the higher tolerance,
+/// then the smaller prescaler.
+type Preference = (u32, core::cmp::Reverse<u32>, u16);
+
 /// The bit timing for `target` on `kernel_hz` within `limits`: among the exact divisions
 /// (prescaler × quanta = kernel_hz / bitrate), the sample point nearest the wanted one; on
 /// a tie the higher tolerated error; then the smaller prescaler. SJW = seg2 (the largest
@@ -181,8 +185,7 @@ pub fn bit_timing(
     if kernel_hz.checked_rem(target.bitrate_bps) != Some(0) {
         return Err(none);
     }
-    // (sample-point distance, −tolerance, prescaler) is minimised.
-    let mut best: Option<((u32, i64, u16), BitTiming)> = None;
+    let mut best: Option<(Preference, BitTiming)> = None;
     for nbt in QUANTA_PER_BIT {
         if cycles_per_bit.checked_rem(nbt) != Some(0) {
             continue;
@@ -220,7 +223,7 @@ pub fn bit_timing(
             if tolerance == 0 || seg1.saturating_sub(prop) < u32::from(t.sjw_tq) {
                 continue;
             }
-            let key = (distance, -i64::from(tolerance), prescaler);
+            let key = (distance, core::cmp::Reverse(tolerance), prescaler);
             if best.as_ref().is_none_or(|(k, _)| key < *k) {
                 best = Some((key, t));
             }

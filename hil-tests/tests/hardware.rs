@@ -250,7 +250,11 @@ fn identity_and_clock_answer_get_identity() {
         Err(why) => return skip("identity_and_clock_answer_get_identity", &why),
     };
     let _board = board().unwrap();
-    let msgs = exchange(&b, 1.0, &[Send::At(0.2, command(&b, CommandKind::GetIdentity))]);
+    let msgs = exchange(
+        &b,
+        1.0,
+        &[Send::At(0.2, command(&b, CommandKind::GetIdentity))],
+    );
     let mine = from_node(&b, &msgs);
     let has = |c| mine.iter().any(|m| m.class() == c);
     assert!(has(MessageClass::Version), "no Version");
@@ -361,21 +365,14 @@ fn emergency_stop_switches_the_power_stage_off() {
     };
     let _board = board().unwrap();
     let state_at = |msgs: &[Message]| {
-        from_node(&b, msgs)
-            .iter()
-            .filter_map(|m| match m {
-                Message::Heartbeat(h) => Some(h.state),
-                _ => None,
-            })
-            .last()
+        from_node(&b, msgs).iter().rev().find_map(|m| match m {
+            Message::Heartbeat(h) => Some(h.state),
+            _ => None,
+        })
     };
     let peer = peer_heartbeat(&b);
     let enable = command(&b, CommandKind::Enable);
-    let msgs = exchange(
-        &b,
-        1.0,
-        &[Send::Every(0.05, peer), Send::At(0.3, enable)],
-    );
+    let msgs = exchange(&b, 1.0, &[Send::Every(0.05, peer), Send::At(0.3, enable)]);
     assert_eq!(state_at(&msgs), Some(NodeState::Enabled), "not enabled");
     let stop = Message::Command(NodeCommand {
         target: Target::Broadcast,
