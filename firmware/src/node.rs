@@ -607,18 +607,22 @@ impl AnkleNode {
             dropped: &mut dropped,
         };
         self.now = now;
+        let first_tick = self.started_at.is_none();
         let started = *self.started_at.get_or_insert(now);
         let contact = inputs.contact_closed;
         let phase_before = self.reflex.phase();
         let driven_before = self.driven_setpoint;
-        // The clock chosen at start-up, before any command: a refused power stage is a
-        // standing fault, so that not even the first tick's `Enable` passes.
-        let clock = self.config.clock;
-        let clock_detail = clock
-            .refusal
-            .map(|_| i16::try_from(clock.tolerated_ppm).unwrap_or(i16::MAX));
-        self.set_fault(&mut out, now, FaultCode::ClockTolerance, clock_detail);
         self.raised_this_tick = 0;
+        if first_tick {
+            // The clock chosen at start-up, before any command: a refused power stage is a
+            // standing fault (never cleared), so that not even the first tick's `Enable`
+            // passes.
+            let clock = &self.config.clock;
+            let detail = clock
+                .refusal
+                .map(|_| i16::try_from(clock.tolerated_ppm).unwrap_or(i16::MAX));
+            self.set_fault(&mut out, now, FaultCode::ClockTolerance, detail);
+        }
         if let Some(a) = self.pending_ack.take() {
             out.push(Message::CommandAck(a));
         }
@@ -632,7 +636,9 @@ impl AnkleNode {
             self.enter(NodeState::Safe, contact);
         }
         let actuator = self.run_reflex(&mut out, now, edges, peer_heel_strike);
-        self.log_reflex(now, phase_before, driven_before, edges, peer_heel_strike);
+        if self.reflex.phase() != phase_before || edges.heel_strike || peer_heel_strike {
+            self.log_reflex(now, phase_before, driven_before, edges, peer_heel_strike);
+        }
         self.send_due_reports(&mut out, now);
         self.send_periodic(&mut out, now);
         // At most one bench-log line per tick (the rest wait in the log's queue).
