@@ -14,7 +14,9 @@ use embassy_stm32::pac::lptim::vals::{ClockSource as LptimClock, Presc};
 use embassy_stm32::pac::rcc::vals::{Lptimsel, Sw};
 use embassy_stm32::pac::{FLASH, LPTIM1, RCC};
 use embassy_stm32::{rcc, Config};
-use firmware::clock_choice::{measured_hz, ClockChoice, CrystalObservation};
+use firmware::clock_choice::{
+    measured_hz, ClockChoice, ClockPlan, CrystalObservation, B_G431B_ESC1,
+};
 use protocol::ClockSource;
 
 /// The internal reference's nominal frequency \[Hz\].
@@ -74,7 +76,7 @@ fn count_window() -> Option<(u32, u32)> {
 }
 
 /// Switch the crystal on, await it, measure it; leave the core on the HSI16, the crystal on
-/// only when it started. `dwt` must have its cycle counter enabled.
+/// only when it started. The DWT cycle counter must be running (`main` starts it first).
 pub fn observe_crystal() -> CrystalObservation {
     RCC.cr().modify(|w| w.set_hseon(true));
     let start = DWT::cycle_count();
@@ -130,8 +132,44 @@ pub fn release_unused_crystal(choice: &ClockChoice) {
     }
 }
 
+/// PLL input frequency \[Hz\]: every source is divided down to it, then × 85 ÷ 2 = 170 MHz.
+const PLL_INPUT_HZ: u32 = 4_000_000;
+
+/// Every crystal the plan may choose divides into the PLL input by 1 to 12 (a crystal of
+/// 4 to 48 MHz in 4 MHz steps).
+const fn crystals_fit_the_pll(plan: &ClockPlan) -> bool {
+    let mut i = 0;
+    while i < plan.crystals.len() {
+        let hz = plan.crystals[i].nominal_hz;
+        if !hz.is_multiple_of(PLL_INPUT_HZ) || hz / PLL_INPUT_HZ == 0 || hz / PLL_INPUT_HZ > 12 {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+const _: () = assert!(crystals_fit_the_pll(&B_G431B_ESC1));
+
+/// The PLL's input divider for a crystal of `hz` (a multiple of 4 MHz, checked above).
+fn crystal_prediv(hz: u32) -> rcc::PllPreDiv {
+    match hz / PLL_INPUT_HZ {
+        1 => rcc::PllPreDiv::DIV1,
+        3 => rcc::PllPreDiv::DIV3,
+        4 => rcc::PllPreDiv::DIV4,
+        5 => rcc::PllPreDiv::DIV5,
+        6 => rcc::PllPreDiv::DIV6,
+        7 => rcc::PllPreDiv::DIV7,
+        8 => rcc::PllPreDiv::DIV8,
+        9 => rcc::PllPreDiv::DIV9,
+        10 => rcc::PllPreDiv::DIV10,
+        11 => rcc::PllPreDiv::DIV11,
+        12 => rcc::PllPreDiv::DIV12,
+        _ => rcc::PllPreDiv::DIV2,
+    }
+}
+
 /// embassy's RCC configuration for the choice: 170 MHz either way, boost mode, ADC12 on
-/// SYSCLK; PLL input 4 MHz (crystal ÷2 or ÷6, HSI16 ÷4) × 85 ÷ 2; FDCAN from the crystal,
+/// SYSCLK; PLL input 4 MHz (the crystal ÷ its MHz/4: 8 MHz ÷2, 24 MHz ÷6; the HSI16 ÷4) × 85 ÷ 2; FDCAN from the crystal,
 /// or from PCLK1 (170 MHz) on the internal oscillator.
 pub fn config_for(choice: &ClockChoice) -> Config {
     let mut config = Config::default();
@@ -141,12 +179,7 @@ pub fn config_for(choice: &ClockChoice) -> Config {
             mode: rcc::HseMode::Oscillator,
         });
         config.rcc.mux.fdcansel = rcc::mux::Fdcansel::HSE;
-        let prediv = if choice.oscillator_hz == 24_000_000 {
-            rcc::PllPreDiv::DIV6
-        } else {
-            rcc::PllPreDiv::DIV2
-        };
-        (rcc::PllSource::HSE, prediv)
+        (rcc::PllSource::HSE, crystal_prediv(choice.oscillator_hz))
     } else {
         config.rcc.mux.fdcansel = rcc::mux::Fdcansel::PCLK1;
         (rcc::PllSource::HSI, rcc::PllPreDiv::DIV4)
