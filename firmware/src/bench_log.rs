@@ -1,6 +1,6 @@
 //! The node's bench log: what it is doing, as defmt lines on the bench (fault raised and
 //! cleared, node state, reflex phase with the string engaged or released, heel strikes,
-//! parameter writes and saves). Two limits keep it from costing the control loop or
+//! parameter writes and saves, the CAN controller's error state). Two limits keep it from costing the control loop or
 //! flooding the RTT buffer:
 //!
 //! * each kind has a token bucket ([`crate::log_limit`]): a flapping input's events are
@@ -16,6 +16,7 @@
 use heapless::Deque;
 use protocol::{FaultCode, NodeState, ParamId, ParamStatus, ReflexPhase};
 
+use crate::drivers::can::BusState;
 #[cfg(any(feature = "defmt", test))]
 use crate::log_limit::Allowance;
 use crate::log_limit::{LogKind, LogLimiter};
@@ -82,6 +83,17 @@ pub enum BenchEvent {
     },
     /// A SaveParams finished.
     Saved(bool),
+    /// The CAN controller's error state changed (from the runner).
+    CanState {
+        /// Before.
+        from: BusState,
+        /// After.
+        to: BusState,
+        /// Transmit error counter.
+        tec: u8,
+        /// Receive error counter.
+        rec: u8,
+    },
 }
 
 impl BenchEvent {
@@ -93,6 +105,7 @@ impl BenchEvent {
             BenchEvent::Phase { .. } => LogKind::ReflexPhase,
             BenchEvent::HeelStrike { .. } => LogKind::HeelStrike,
             BenchEvent::ParamWrite { .. } | BenchEvent::Saved(_) => LogKind::Param,
+            BenchEvent::CanState { .. } => LogKind::CanState,
         }
     }
 }
@@ -206,6 +219,13 @@ fn write_line(event: &BenchEvent, suppressed: u32, dropped: u32) {
             status.raw()
         ),
         BenchEvent::Saved(ok) => defmt::info!("parameters saved: {=bool}", ok),
+        BenchEvent::CanState { from, to, tec, rec } => defmt::warn!(
+            "CAN {} -> {} (TEC {=u8}, REC {=u8})",
+            from,
+            to,
+            tec,
+            rec
+        ),
     }
     if suppressed > 0 || dropped > 0 {
         defmt::warn!(

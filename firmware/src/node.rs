@@ -333,6 +333,12 @@ impl AnkleNode {
         true
     }
 
+    /// Put an event of the layer around the node (e.g. the CAN controller's state) into the
+    /// bench log; written by a later tick, one line per tick.
+    pub fn log_event(&mut self, now: Instant, event: BenchEvent) {
+        self.bench.record(now, event);
+    }
+
     /// Messages that did not fit a tick's transmit list (should stay 0).
     pub fn dropped_tx(&self) -> u32 {
         self.dropped_tx

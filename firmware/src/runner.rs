@@ -6,12 +6,11 @@ use embedded_can::nb::Can;
 use embedded_hal::digital::InputPin;
 use heapless::Vec;
 
+use crate::bench_log::BenchEvent;
 use crate::drivers::actuator::Actuator;
 use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
 use crate::drivers::encoder::AngleSensor;
-use crate::fmt::log_limited;
-use crate::log_limit::{LogKind, LogLimiter};
 use crate::node::{AnkleNode, DriverHealth, NodeRequest, TickInputs, TickOutputs, MAX_RX_PER_TICK};
 use crate::time::Monotonic;
 use protocol::NodeState;
@@ -31,7 +30,6 @@ pub struct AnkleDrivers<E, P, A, C, M> {
     /// Clock.
     pub clock: M,
     health: DriverHealth,
-    log_limiter: LogLimiter,
 }
 
 impl<E, P, A, C, M> AnkleDrivers<E, P, A, C, M>
@@ -59,7 +57,6 @@ where
             can,
             clock,
             health: DriverHealth::default(),
-            log_limiter: LogLimiter::default(),
         }
     }
 
@@ -80,15 +77,14 @@ where
         let bus = self.can.poll_status();
         if bus != before.status.state {
             let st = self.can.stats().status;
-            log_limited!(
-                self.log_limiter,
-                LogKind::CanState,
+            self.node.log_event(
                 now,
-                "CAN {} -> {} (TEC {}, REC {})",
-                before.status.state,
-                bus,
-                st.tx_errors,
-                st.rx_errors
+                BenchEvent::CanState {
+                    from: before.status.state,
+                    to: bus,
+                    tec: st.tx_errors,
+                    rec: st.rx_errors,
+                },
             );
         }
         let rx_lost = self.can.stats().rx_lost.wrapping_sub(lost_before);

@@ -99,7 +99,11 @@ pub fn observe_crystal() -> CrystalObservation {
         w.set_presc(Presc::DIV1);
     });
     LPTIM1.cr().write(|w| w.set_enable(true));
+    // ARR (reset value 1) is written only while enabled and takes effect through the timer's
+    // clock domain: wait (bounded) for ARROK before counting, else the first counts wrap at 1.
     LPTIM1.arr().write(|w| w.set_arr(u16::MAX));
+    let _ = (0..SWITCH_POLLS).any(|_| LPTIM1.isr().read().arrok());
+    LPTIM1.icr().write(|w| w.set_arrokcf(true));
     LPTIM1.cr().write(|w| {
         w.set_enable(true);
         w.set_cntstrt(true);
