@@ -10,7 +10,7 @@ use crate::values::{
 };
 
 /// Version of this message set, sent in [`Version`]. Bump on any layout change.
-pub const PROTOCOL_VERSION: u8 = 2;
+pub const PROTOCOL_VERSION: u8 = 3;
 
 /// Nominal bus bit rate [bit/s] (classic CAN, FDCAN in classic mode).
 pub const BITRATE_BPS: u32 = 500_000;
