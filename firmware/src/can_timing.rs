@@ -280,6 +280,9 @@ mod tests {
     #[test]
     fn twenty_four_mhz_crystal_keeps_the_sample_point() {
         let t = bit_timing(24_000_000, &WALKER_BUS, &FDCAN_NOMINAL).unwrap();
+        // 24 tq at prescaler 2 and 16 tq at prescaler 3 tie (87.5 %, 0.4854 %; python-can
+        // picks the second, its seg1 is limited to 16): the smaller prescaler wins.
+        assert_eq!(t, timing(2, 20, 3, 3));
         assert_eq!(t.bitrate_bps(24_000_000), 500_000);
         assert_eq!(t.sample_point_permille(), 875);
         assert_eq!(t.tolerance_ppm(24_000_000, 600), 4_854);

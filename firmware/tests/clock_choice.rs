@@ -233,3 +233,36 @@ fn a_node_on_its_crystal_reports_it_and_enables() {
     assert_eq!(info.tolerated_error_ppm, 4_854);
     assert!(!node.faults().contains(FaultCode::ClockTolerance));
 }
+
+#[test]
+fn an_internal_oscillator_within_the_tolerance_would_be_allowed() {
+    // The rule, not the board: an internal oscillator good to 0.3 % (a trimmed one) runs the
+    // CAN timing computed for it and keeps the power stage.
+    let plan = firmware::clock_choice::ClockPlan {
+        internal: firmware::clock_choice::OscillatorSpec {
+            error_ppm: 3_000,
+            ..B_G431B_ESC1.internal
+        },
+        ..B_G431B_ESC1
+    };
+    let c = choose(&plan, CrystalObservation::TimedOut);
+    assert_eq!(c.source, ClockSource::Internal);
+    assert_eq!(c.tolerated_ppm, 4_566);
+    assert!(c.power_stage_allowed());
+    // And no timing at all for a kernel clock that does not divide: refused, saying so.
+    let odd = firmware::clock_choice::ClockPlan {
+        internal: firmware::clock_choice::OscillatorSpec {
+            can_kernel_hz: 7_000_001,
+            ..plan.internal
+        },
+        ..plan
+    };
+    let c = choose(&odd, CrystalObservation::TimedOut);
+    assert_eq!(c.timing, None);
+    assert_eq!(
+        c.refusal,
+        Some(ClockRefusal::NoBitTiming {
+            kernel_hz: 7_000_001
+        })
+    );
+}
