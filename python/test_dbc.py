@@ -28,8 +28,9 @@ def vectors():
 
 def test_strict_load_has_every_node_and_message(db):
     assert sorted(n.name for n in db.nodes) == ["HOST", "LEFT_ANKLE", "RIGHT_ANKLE"]
-    # 20 identifiers of v1, plus Identity, BootInfo, CommandAck and FaultHistory per ankle
-    assert len(db.messages) == 28
+    # 20 identifiers of v1, plus Identity, BootInfo, CommandAck, FaultHistory and ClockInfo
+    # per ankle
+    assert len(db.messages) == 30
     for m in db.messages:
         assert not m.is_extended_frame
         assert m.frame_id < 0x800

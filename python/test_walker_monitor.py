@@ -163,6 +163,18 @@ def test_identity_and_fault_history_are_decoded_per_node(db):
     assert mon.summary()["nodes"]["RIGHT_ANKLE"]["identity"] == {}
 
 
+def test_clock_info_joins_the_node_identity(db):
+    mon = wm.Monitor(db)
+    mon.feed(_frame(db, "ClockInfo_RIGHT_ANKLE", clock_source="Internal", crystal="Timeout",
+                    oscillator_error=1.0, tolerated_error=0.4566, crystal_freq=0))
+    ident = mon.summary()["nodes"]["RIGHT_ANKLE"]["identity"]
+    assert ident["clock_source"] == "Internal"
+    assert ident["crystal"] == "Timeout"
+    assert ident["oscillator_error"] == pytest.approx(1.0)
+    assert ident["tolerated_error"] == pytest.approx(0.4566)
+    assert ident["crystal_freq"] == 0
+
+
 # --- live socketcand: the host row, partial reads, the end of the run -------------------
 
 def test_a_node_without_heartbeats_shows_what_it_sent_not_a_dead_node(db):

@@ -367,6 +367,12 @@ class Monitor:
             self.fault_events_total += 1
             if len(self.fault_events) < MAX_FAULT_EVENTS:
                 self.fault_events.append({"t": ts, "node": sender, **sig})
+        elif kind == "ClockInfo" and sender in self.nodes:
+            ident = self.nodes[sender].identity
+            for k in ("clock_source", "crystal"):
+                ident[k] = sig[k]
+            for k in ("oscillator_error", "tolerated_error", "crystal_freq"):
+                ident[k] = float(sig[k])
         elif kind in ("Version", "Identity", "BootInfo") and sender in self.nodes:
             ident = self.nodes[sender].identity
             if kind == "Version":

@@ -7,6 +7,11 @@
 //!   actuator (PWM + direction pin, or a position servo) and a CAN port, generic over
 //!   embedded-hal 1.0 and embedded-can 0.4.
 //! * [`runner::AnkleDrivers`] — wires the drivers to the node, one `step()` per tick.
+//! * [`clock_choice`], [`can_timing`] — the clock chosen at start-up (crystal checked with a
+//!   timeout and a frequency measurement, or the internal oscillator), the CAN bit timing
+//!   computed for it and the oscillator error it tolerates.
+//! * [`bench_log`], [`log_limit`] — the defmt bench log: per-kind token buckets, one line per
+//!   tick.
 //! * [`scenarios`] — scripted sensor traces with a tiny ankle plant; the host tests and the
 //!   QEMU binary run the same traces and must produce the same actuator commands bit for bit.
 //!
@@ -32,11 +37,15 @@
 
 pub(crate) mod fmt;
 
+pub mod bench_log;
+pub mod can_timing;
+pub mod clock_choice;
 pub mod convert;
 pub mod drivers;
 pub mod estimator;
 pub mod fault_report;
 pub mod following;
+pub mod log_limit;
 pub mod node;
 pub mod param_store;
 pub mod params;

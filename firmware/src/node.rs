@@ -5,16 +5,17 @@
 
 use heapless::Vec;
 use protocol::{
-    Angle, AngularRate, AnkleState, BootInfo, Command, CommandAck, CommandKind, CommandResult,
-    ConfigSource, FaultCode, FaultEvent, FaultFlags, FaultHistoryEntry, FaultTransition, Heartbeat,
-    HeelStrike, Identity, Message, NodeId, NodeState, Opcode, ParamAck, ParamStatus, ReflexPhase,
-    ResetCause, Version, PROTOCOL_VERSION,
+    Angle, AngularRate, AnkleState, BootInfo, ClockInfo, Command, CommandAck, CommandKind,
+    CommandResult, ConfigSource, FaultCode, FaultEvent, FaultFlags, FaultHistoryEntry,
+    FaultTransition, Heartbeat, HeelStrike, Identity, Message, NodeId, NodeState, Opcode, ParamAck,
+    ParamStatus, ReflexPhase, ResetCause, Version, PROTOCOL_VERSION,
 };
 
+use crate::bench_log::{BenchEvent, BenchLog, StringEdge};
+use crate::clock_choice::ClockChoice;
 use crate::convert::saturating_i16;
 use crate::estimator::{AngleEstimator, EstimatorGains};
 use crate::fault_report::FaultReporter;
-use crate::fmt::{log_info, log_warn};
 use crate::following::FollowingErrorMonitor;
 use crate::params::ReflexParams;
 use crate::reflex::{ActuatorCommand, Reflex, ReflexEvent, ReflexInputs, ReleaseCause};
@@ -30,12 +31,12 @@ pub const FAULT_HISTORY_LEN: usize = 8;
 /// Capacity of the per-tick transmit list: heel strike, every fault code changing at once,
 /// one acknowledgement per received message, state, heartbeat and version, one fault-history
 /// dump and one identity (each answered once per tick however often asked), a deferred
-/// acknowledgement.
+/// acknowledgement, the identity's `ClockInfo`.
 pub const MAX_TX_PER_TICK: usize =
-    1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1;
+    1 + FaultCode::ALL.len() + MAX_RX_PER_TICK + 3 + FAULT_HISTORY_LEN + 2 + 1 + 1;
 
-// docs/firmware.md states the value: 36 with 13 fault codes, 8 answers and 8 history records.
-const _: () = assert!(MAX_TX_PER_TICK == 36);
+// docs/firmware.md states the value: 38 with 14 fault codes, 8 answers and 8 history records.
+const _: () = assert!(MAX_TX_PER_TICK == 38);
 
 /// What the node asks of the layer around it (the board, the driver runner): things it
 /// cannot do itself.
@@ -87,6 +88,9 @@ pub struct NodeConfig {
     pub calibration_source: ConfigSource,
     /// Estimator gains.
     pub estimator: EstimatorGains,
+    /// The clock chosen at start-up ([`crate::clock_choice::choose`]; sent in `ClockInfo`; a
+    /// refused power stage raises `ClockTolerance` and keeps the node from being enabled).
+    pub clock: ClockChoice,
 }
 
 impl NodeConfig {
@@ -103,6 +107,7 @@ impl NodeConfig {
             params_source: ConfigSource::Defaults,
             calibration_source: ConfigSource::Defaults,
             estimator: EstimatorGains::default(),
+            clock: ClockChoice::SIMULATED,
         }
     }
 }
@@ -205,6 +210,9 @@ pub struct AnkleNode {
     pending_ack: Option<CommandAck>,
     request: Option<NodeRequest>,
     save_in_progress: bool,
+    bench: BenchLog,
+    /// The current tick's time (for the bench log's events).
+    now: Instant,
 }
 
 /// Accumulates one tick's transmissions, counting what does not fit.
@@ -301,6 +309,8 @@ impl AnkleNode {
             pending_ack: None,
             request: None,
             save_in_progress: false,
+            bench: BenchLog::default(),
+            now: Instant(0),
         })
     }
 
@@ -334,6 +344,12 @@ impl AnkleNode {
         true
     }
 
+    /// Put an event of the layer around the node (e.g. the CAN controller's state) into the
+    /// bench log; written by a later tick, one line per tick.
+    pub fn log_event(&mut self, now: Instant, event: BenchEvent) {
+        self.bench.record(now, event);
+    }
+
     /// Messages that did not fit a tick's transmit list (should stay 0).
     pub fn dropped_tx(&self) -> u32 {
         self.dropped_tx
@@ -352,7 +368,8 @@ impl AnkleNode {
         }
         if present {
             self.faults.insert(code);
-            log_warn!("fault raised: {}", code);
+            self.bench
+                .record(now, BenchEvent::FaultRaised(code, detail.unwrap_or(0)));
             if self.history.is_full() {
                 let _ = self.history.pop_back();
             }
@@ -365,7 +382,7 @@ impl AnkleNode {
             self.raised_this_tick = self.raised_this_tick.saturating_add(1);
         } else {
             self.faults.remove(code);
-            log_info!("fault cleared: {}", code);
+            self.bench.record(now, BenchEvent::FaultCleared(code));
         }
         if let Some(r) = self
             .reporter
@@ -396,6 +413,7 @@ impl AnkleNode {
     pub fn storage_done(&mut self, ok: bool) {
         if self.save_in_progress {
             self.save_in_progress = false;
+            self.bench.record(self.now, BenchEvent::Saved(ok));
             self.pending_ack = Some(self.ack(
                 Opcode::SaveParams,
                 if ok {
@@ -447,6 +465,17 @@ impl AnkleNode {
             fault_history_len: u8::try_from(self.history.len()).unwrap_or(u8::MAX),
             calibration_source: c.calibration_source,
         }));
+        let clock = &c.clock;
+        out.push(Message::ClockInfo(ClockInfo {
+            node: c.node,
+            source: clock.source,
+            crystal: clock.crystal,
+            // 100 ppm counts, saturated at 2.55 % (the signal's width).
+            oscillator_error_centi_pct: u8::try_from(clock.oscillator_ppm / 100).unwrap_or(u8::MAX),
+            tolerated_error_ppm: u16::try_from(clock.tolerated_ppm).unwrap_or(u16::MAX),
+            // 10 Hz counts within the signal's 24 bits (167 MHz), saturated past them.
+            crystal_freq_10hz: (clock.crystal_measured_hz / 10).min(0xFF_FFFF),
+        }));
     }
 
     fn send_history(&self, out: &mut Outbox) {
@@ -473,7 +502,13 @@ impl AnkleNode {
         if state == self.state {
             return;
         }
-        log_info!("node state {} -> {}", self.state, state);
+        self.bench.record(
+            self.now,
+            BenchEvent::State {
+                from: self.state,
+                to: state,
+            },
+        );
         self.state = state;
         if state == NodeState::Enabled {
             self.reflex.start(contact_closed);
@@ -483,7 +518,13 @@ impl AnkleNode {
         }
     }
 
-    fn handle_command(&mut self, out: &mut Outbox, cmd: &Command, inputs: &TickInputs) {
+    fn handle_command(
+        &mut self,
+        out: &mut Outbox,
+        now: Instant,
+        cmd: &Command,
+        inputs: &TickInputs,
+    ) {
         let contact_closed = inputs.contact_closed;
         if !cmd.target.addresses(self.config.node) {
             return;
@@ -508,6 +549,14 @@ impl AnkleNode {
                         Err(s) => s,
                     }
                 };
+                self.bench.record(
+                    now,
+                    BenchEvent::ParamWrite {
+                        param,
+                        value: value.0,
+                        status,
+                    },
+                );
                 out.push(Message::ParamAck(ParamAck {
                     node: self.config.node,
                     param,
@@ -575,9 +624,23 @@ impl AnkleNode {
             list: Vec::new(),
             dropped: &mut dropped,
         };
+        self.now = now;
+        let first_tick = self.started_at.is_none();
         let started = *self.started_at.get_or_insert(now);
         let contact = inputs.contact_closed;
+        let phase_before = self.reflex.phase();
+        let driven_before = self.driven_setpoint;
         self.raised_this_tick = 0;
+        if first_tick {
+            // The clock chosen at start-up, before any command: a refused power stage is a
+            // standing fault (never cleared), so that not even the first tick's `Enable`
+            // passes.
+            let clock = &self.config.clock;
+            let detail = clock
+                .refusal
+                .map(|_| i16::try_from(clock.tolerated_ppm).unwrap_or(i16::MAX));
+            self.set_fault(&mut out, now, FaultCode::ClockTolerance, detail);
+        }
         if let Some(a) = self.pending_ack.take() {
             out.push(Message::CommandAck(a));
         }
@@ -591,8 +654,13 @@ impl AnkleNode {
             self.enter(NodeState::Safe, contact);
         }
         let actuator = self.run_reflex(&mut out, now, edges, peer_heel_strike);
+        if self.reflex.phase() != phase_before || edges.heel_strike || peer_heel_strike {
+            self.log_reflex(now, phase_before, driven_before, edges, peer_heel_strike);
+        }
         self.send_due_reports(&mut out, now);
         self.send_periodic(&mut out, now);
+        // At most one bench-log line per tick (the rest wait in the log's queue).
+        let _ = self.bench.flush_one();
         sort_by_priority(&mut out.list);
         let outputs = TickOutputs {
             actuator,
@@ -605,13 +673,68 @@ impl AnkleNode {
         outputs
     }
 
+    /// The bench log of one tick's reflex events (each kind rate-limited): heel strikes (own
+    /// and peer) and the phase change, with the string engaged (a setpoint appears) or
+    /// released, the estimated angle and the node's uptime.
+    fn log_reflex(
+        &mut self,
+        now: Instant,
+        phase_before: ReflexPhase,
+        driven_before: Option<f32>,
+        edges: ContactEdges,
+        peer_heel_strike: bool,
+    ) {
+        let at_ms = now.uptime_ms();
+        if edges.heel_strike {
+            let step = self.step_count;
+            self.bench.record(
+                now,
+                BenchEvent::HeelStrike {
+                    own: true,
+                    step,
+                    at_ms,
+                },
+            );
+        }
+        if peer_heel_strike {
+            let step = self.step_count;
+            self.bench.record(
+                now,
+                BenchEvent::HeelStrike {
+                    own: false,
+                    step,
+                    at_ms,
+                },
+            );
+        }
+        let phase = self.reflex.phase();
+        if phase != phase_before {
+            let string = match (driven_before, self.driven_setpoint) {
+                (None, Some(setpoint)) => StringEdge::Engaged(setpoint),
+                (Some(last), None) => StringEdge::Released(last),
+                _ => StringEdge::Unchanged,
+            };
+            let angle_rad = self.estimator.angle_rad().unwrap_or(f32::NAN);
+            self.bench.record(
+                now,
+                BenchEvent::Phase {
+                    from: phase_before,
+                    to: phase,
+                    at_ms,
+                    angle_rad,
+                    string,
+                },
+            );
+        }
+    }
+
     /// Tick stage 1, messages: commands to this node, the peer's heartbeat and heel strike
     /// (at most [`MAX_RX_PER_TICK`]). Whether the peer announced its heel strike.
     fn read_messages(&mut self, out: &mut Outbox, now: Instant, inputs: &TickInputs) -> bool {
         let mut peer_heel_strike = false;
         for m in inputs.received.iter().take(MAX_RX_PER_TICK) {
             match m {
-                Message::Command(c) => self.handle_command(out, c, inputs),
+                Message::Command(c) => self.handle_command(out, now, c, inputs),
                 Message::Heartbeat(h) if h.node == self.peer => {
                     self.last_peer_heartbeat = Some(now);
                     let before = self.peer_state.map(|(_, st)| st);

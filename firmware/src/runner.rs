@@ -6,6 +6,7 @@ use embedded_can::nb::Can;
 use embedded_hal::digital::InputPin;
 use heapless::Vec;
 
+use crate::bench_log::BenchEvent;
 use crate::drivers::actuator::Actuator;
 use crate::drivers::can::{BusState, CanPort, ControllerHealth};
 use crate::drivers::contact::ContactSwitch;
@@ -71,8 +72,21 @@ where
             .unwrap_or_else(|_| self.contact.closed());
         let mut received: Vec<_, MAX_RX_PER_TICK> = Vec::new();
         self.can.receive(&mut received);
-        let lost_before = self.can.stats().rx_lost;
+        let before = self.can.stats();
+        let lost_before = before.rx_lost;
         let bus = self.can.poll_status();
+        if bus != before.status.state {
+            let st = self.can.stats().status;
+            self.node.log_event(
+                now,
+                BenchEvent::CanState {
+                    from: before.status.state,
+                    to: bus,
+                    tec: st.tx_errors,
+                    rec: st.rx_errors,
+                },
+            );
+        }
         let rx_lost = self.can.stats().rx_lost.wrapping_sub(lost_before);
         let inputs = TickInputs {
             angle,

@@ -171,7 +171,8 @@ fn starts_disabled_and_sends_version_heartbeat_and_state() {
             MessageClass::AnkleState,
             MessageClass::Version,
             MessageClass::Identity,
-            MessageClass::BootInfo
+            MessageClass::BootInfo,
+            MessageClass::ClockInfo
         ]
     );
     // Over one second: 200 states, 20 heartbeats, one version.

@@ -336,7 +336,8 @@ fn full_controller_queues_then_sends_in_order() {
             MessageClass::AnkleState,
             MessageClass::Version,
             MessageClass::Identity,
-            MessageClass::BootInfo
+            MessageClass::BootInfo,
+            MessageClass::ClockInfo
         ]
     );
     assert_eq!(d.can.stats().dropped, 0);

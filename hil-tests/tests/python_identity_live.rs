@@ -101,7 +101,7 @@ fn python_monitor_reads_identity_and_fault_history_from_the_firmware() {
     let left = &v["nodes"]["LEFT_ANKLE"];
     let ident = &left["identity"];
     assert_eq!(ident["firmware"], "0.1.0", "{left}");
-    assert_eq!(ident["protocol_version"], 2);
+    assert_eq!(ident["protocol_version"], 3);
     assert_eq!(
         ident["reset_cause"], "Unknown",
         "simulation: no reset flags"

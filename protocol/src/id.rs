@@ -137,11 +137,13 @@ pub enum MessageClass {
     CommandAck,
     /// One entry of the fault history.
     FaultHistory,
+    /// The clock the node runs on, the crystal check, the CAN timing's tolerated error.
+    ClockInfo,
 }
 
 impl MessageClass {
     /// Every class, highest priority first.
-    pub const ALL: [MessageClass; 12] = [
+    pub const ALL: [MessageClass; 13] = [
         MessageClass::EmergencyStop,
         MessageClass::HeelStrike,
         MessageClass::Fault,
@@ -154,6 +156,7 @@ impl MessageClass {
         MessageClass::BootInfo,
         MessageClass::CommandAck,
         MessageClass::FaultHistory,
+        MessageClass::ClockInfo,
     ];
 
     /// The 7-bit class value.
@@ -171,6 +174,7 @@ impl MessageClass {
             MessageClass::BootInfo => 0x0A,
             MessageClass::CommandAck => 0x0B,
             MessageClass::FaultHistory => 0x0C,
+            MessageClass::ClockInfo => 0x0D,
         }
     }
 
@@ -189,6 +193,7 @@ impl MessageClass {
             0x0A => Some(MessageClass::BootInfo),
             0x0B => Some(MessageClass::CommandAck),
             0x0C => Some(MessageClass::FaultHistory),
+            0x0D => Some(MessageClass::ClockInfo),
             _ => None,
         }
     }

@@ -41,11 +41,12 @@ pub mod vectors;
 pub use error::{DecodeError, EncodeError, RangeError};
 pub use id::{accepted_by_ankle, CanId, MessageClass, NodeId, Target, ACCEPTED_BY_ANKLE};
 pub use messages::{
-    spec, AnkleState, BootInfo, Command, CommandAck, CommandKind, FaultEvent, FaultHistoryEntry,
-    Heartbeat, HeelStrike, Identity, Message, ParamAck, RawFrame, Version, BITRATE_BPS, MESSAGES,
-    PROTOCOL_VERSION,
+    spec, AnkleState, BootInfo, ClockInfo, Command, CommandAck, CommandKind, FaultEvent,
+    FaultHistoryEntry, Heartbeat, HeelStrike, Identity, Message, ParamAck, RawFrame, Version,
+    BITRATE_BPS, MESSAGES, PROTOCOL_VERSION,
 };
 pub use values::{
-    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
-    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
+    Angle, AngularRate, ClockSource, CommandResult, ConfigSource, CrystalStatus, FaultCode,
+    FaultFlags, FaultTransition, NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase,
+    ResetCause,
 };

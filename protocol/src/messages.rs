@@ -4,12 +4,13 @@ use crate::error::{DecodeError, EncodeError};
 use crate::id::{CanId, MessageClass, NodeId, Target};
 use crate::signal::{Direction, Kind, MessageSpec, SignalSpec};
 use crate::values::{
-    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
-    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
+    Angle, AngularRate, ClockSource, CommandResult, ConfigSource, CrystalStatus, FaultCode,
+    FaultFlags, FaultTransition, NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase,
+    ResetCause,
 };
 
 /// Version of this message set, sent in [`Version`]. Bump on any layout change.
-pub const PROTOCOL_VERSION: u8 = 2;
+pub const PROTOCOL_VERSION: u8 = 3;
 
 /// Nominal bus bit rate [bit/s] (classic CAN, FDCAN in classic mode).
 pub const BITRATE_BPS: u32 = 500_000;
@@ -409,6 +410,60 @@ pub mod layout {
         /// Signals in byte order.
         pub const SIGNALS: &[SignalSpec] = &[ENTRY, CODE, STATE_AFTER, DETAIL, UPTIME_MS];
     }
+
+    /// [`ClockInfo`].
+    pub mod clock_info {
+        use super::*;
+        /// Oscillator in use.
+        pub const SOURCE: SignalSpec = enum_sig(
+            "clock_source",
+            0,
+            ClockSource::CHOICES,
+            "the oscillator the node and its CAN controller run on",
+        );
+        /// Crystal check.
+        pub const CRYSTAL: SignalSpec = enum_sig(
+            "crystal",
+            1,
+            CrystalStatus::CHOICES,
+            "what the start-up check found of the crystal",
+        );
+        /// The oscillator's specified error.
+        pub const OSCILLATOR_ERROR: SignalSpec = sig(
+            "oscillator_error",
+            2,
+            Kind::U8,
+            0.01,
+            "%",
+            "specified error bound of the oscillator in use (saturates at 2.55 %)",
+        );
+        /// What the CAN timing tolerates.
+        pub const TOLERATED_ERROR: SignalSpec = sig(
+            "tolerated_error",
+            3,
+            Kind::U16,
+            1.0e-4,
+            "%",
+            "oscillator error the CAN bit timing tolerates (ISO 11898-1 conditions); power stage refused when oscillator_error exceeds it",
+        );
+        /// The crystal's measured frequency.
+        pub const CRYSTAL_FREQ: SignalSpec = sig(
+            "crystal_freq",
+            5,
+            Kind::U24,
+            10.0,
+            "Hz",
+            "crystal frequency measured against the internal oscillator at start-up (10 Hz counts, its error), 0 when it did not start",
+        );
+        /// Signals in byte order.
+        pub const SIGNALS: &[SignalSpec] = &[
+            SOURCE,
+            CRYSTAL,
+            OSCILLATOR_ERROR,
+            TOLERATED_ERROR,
+            CRYSTAL_FREQ,
+        ];
+    }
 }
 
 /// Every message's layout, highest priority first. The DBC file, the bus-load figure and the
@@ -523,6 +578,15 @@ pub const MESSAGES: &[MessageSpec] = &[
         nominal_rate_hz: 0.0,
         comment: "one fault-history entry, sent on GetFaultHistory (newest first)",
     },
+    MessageSpec {
+        class: MessageClass::ClockInfo,
+        name: "ClockInfo",
+        dlc: 8,
+        signals: layout::clock_info::SIGNALS,
+        direction: Direction::FromNode(ANKLES),
+        nominal_rate_hz: 0.0,
+        comment: "clock source, crystal check, tolerated oscillator error; at start-up and on GetIdentity",
+    },
 ];
 
 /// The layout of a message class.
@@ -598,7 +662,7 @@ pub enum CommandKind {
     SaveParams,
     /// Empty the fault history (answered by `CommandAck`).
     ClearErrors,
-    /// Send `Version`, `Identity` and `BootInfo`.
+    /// Send `Version`, `Identity`, `BootInfo` and `ClockInfo`.
     GetIdentity,
     /// Send the fault history.
     GetFaultHistory,
@@ -759,6 +823,25 @@ pub struct FaultHistoryEntry {
     pub uptime_ms: u32,
 }
 
+/// The clock the node runs on and what its CAN timing tolerates (sent with `BootInfo`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ClockInfo {
+    /// The sender.
+    pub node: NodeId,
+    /// The oscillator in use.
+    pub source: ClockSource,
+    /// What the crystal check found.
+    pub crystal: CrystalStatus,
+    /// The oscillator's specified error \[0.01 %\] (100 ppm counts), saturated at 255.
+    pub oscillator_error_centi_pct: u8,
+    /// The error the CAN timing tolerates \[ppm\].
+    pub tolerated_error_ppm: u16,
+    /// The crystal's measured frequency \[10 Hz\], 24 bits on the wire; 0 if it did not
+    /// start.
+    pub crystal_freq_10hz: u32,
+}
+
 /// Any message of the protocol.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -785,6 +868,8 @@ pub enum Message {
     CommandAck(CommandAck),
     /// Fault-history entry.
     FaultHistory(FaultHistoryEntry),
+    /// Clock source and tolerance.
+    ClockInfo(ClockInfo),
 }
 
 /// An encoded frame: identifier, length and payload.
@@ -869,6 +954,7 @@ impl Message {
             Message::BootInfo(_) => MessageClass::BootInfo,
             Message::CommandAck(_) => MessageClass::CommandAck,
             Message::FaultHistory(_) => MessageClass::FaultHistory,
+            Message::ClockInfo(_) => MessageClass::ClockInfo,
         }
     }
 
@@ -886,6 +972,7 @@ impl Message {
             Message::BootInfo(m) => m.node.raw(),
             Message::CommandAck(m) => m.node.raw(),
             Message::FaultHistory(m) => m.node.raw(),
+            Message::ClockInfo(m) => m.node.raw(),
         };
         CanId::new(self.class(), node_raw)
     }
@@ -1008,6 +1095,13 @@ impl Message {
                 fault_history::STATE_AFTER.put(&mut b, m.state_after.raw())?;
                 fault_history::DETAIL.put(&mut b, m.detail)?;
                 fault_history::UPTIME_MS.put(&mut b, m.uptime_ms)?;
+            }
+            Message::ClockInfo(m) => {
+                clock_info::SOURCE.put(&mut b, m.source.raw())?;
+                clock_info::CRYSTAL.put(&mut b, m.crystal.raw())?;
+                clock_info::OSCILLATOR_ERROR.put(&mut b, m.oscillator_error_centi_pct)?;
+                clock_info::TOLERATED_ERROR.put(&mut b, m.tolerated_error_ppm)?;
+                clock_info::CRYSTAL_FREQ.put(&mut b, m.crystal_freq_10hz)?;
             }
         }
         let n = spec.dlc as usize;
@@ -1191,6 +1285,14 @@ impl Message {
                 state_after: enum_field(&fault_history::STATE_AFTER, &b, NodeState::from_raw)?,
                 detail: fault_history::DETAIL.get_as(&b)?,
                 uptime_ms: fault_history::UPTIME_MS.get_as(&b)?,
+            }),
+            MessageClass::ClockInfo => Message::ClockInfo(ClockInfo {
+                node: sender(id.class, id.node_raw)?,
+                source: enum_field(&clock_info::SOURCE, &b, ClockSource::from_raw)?,
+                crystal: enum_field(&clock_info::CRYSTAL, &b, CrystalStatus::from_raw)?,
+                oscillator_error_centi_pct: clock_info::OSCILLATOR_ERROR.get_as(&b)?,
+                tolerated_error_ppm: clock_info::TOLERATED_ERROR.get_as(&b)?,
+                crystal_freq_10hz: clock_info::CRYSTAL_FREQ.get_as(&b)?,
             }),
         };
         Ok(msg)

@@ -187,6 +187,11 @@ wire_enum!(
         /// hold), moved: `detail` = the ankle's displacement since the spool last turned, in
         /// ankle-encoder counts (saturated at 32767).
         SpoolStuck = 13,
+        /// The clock the node runs on has a larger specified error than its CAN bit timing
+        /// tolerates (no crystal, or a wrong one: the internal oscillator): the node speaks on
+        /// the bus but refuses `Enable` (power stage off). `detail`: the error the timing
+        /// tolerates \[ppm\]. Raised at start-up, never cleared; `ClockInfo` tells the rest.
+        ClockTolerance = 14,
     }
 );
 
@@ -200,7 +205,7 @@ impl FaultCode {
     }
     /// The bit of this fault in [`FaultFlags`].
     pub const fn flag(self) -> u16 {
-        // Codes are 1..=13 (bits 0..=12); a code past bit 15 would have no bit (0).
+        // Codes are 1..=14 (bits 0..=13); a code past bit 15 would have no bit (0).
         match 1u16.checked_shl((self as u8).saturating_sub(1) as u32) {
             Some(bit) => bit,
             None => 0,
@@ -253,7 +258,7 @@ wire_enum!(
         SaveParams = 6,
         /// Empty the fault history (answered by `CommandAck`).
         ClearErrors = 7,
-        /// Send `Version`, `Identity` and `BootInfo` now.
+        /// Send `Version`, `Identity`, `BootInfo` and `ClockInfo` now.
         GetIdentity = 8,
         /// Send the fault history, newest first (`FaultHistory` frames).
         GetFaultHistory = 9,
@@ -294,6 +299,32 @@ wire_enum!(
         Flash = 1,
         /// Flash could not be read; built-in defaults.
         FlashUnreadable = 2,
+    }
+);
+
+wire_enum!(
+    /// The oscillator the node runs on (and clocks its CAN controller from).
+    ClockSource {
+        /// Not known (simulation).
+        Unknown = 0,
+        /// The board's crystal (HSE).
+        Crystal = 1,
+        /// The internal RC oscillator (HSI16).
+        Internal = 2,
+    }
+);
+
+wire_enum!(
+    /// What the start-up check found of the crystal.
+    CrystalStatus {
+        /// Not checked (simulation).
+        NotChecked = 0,
+        /// Started within the budget, frequency as expected: in use.
+        Running = 1,
+        /// Not ready within the start-up budget (absent or dead).
+        Timeout = 2,
+        /// Started, but its measured frequency is none the board may carry: not used.
+        WrongFrequency = 3,
     }
 );
 

@@ -21,12 +21,13 @@ use core::fmt::Write as _;
 
 use crate::id::{NodeId, Target};
 use crate::messages::{
-    spec, AnkleState, BootInfo, Command, CommandAck, CommandKind, FaultEvent, FaultHistoryEntry,
-    Heartbeat, HeelStrike, Identity, Message, ParamAck, Version,
+    spec, AnkleState, BootInfo, ClockInfo, Command, CommandAck, CommandKind, FaultEvent,
+    FaultHistoryEntry, Heartbeat, HeelStrike, Identity, Message, ParamAck, Version,
 };
 use crate::values::{
-    Angle, AngularRate, CommandResult, ConfigSource, FaultCode, FaultFlags, FaultTransition,
-    NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase, ResetCause,
+    Angle, AngularRate, ClockSource, CommandResult, ConfigSource, CrystalStatus, FaultCode,
+    FaultFlags, FaultTransition, NodeState, Opcode, ParamId, ParamStatus, ParamValue, ReflexPhase,
+    ResetCause,
 };
 
 /// Messages covering every identifier, every enumeration value at least once, and the
@@ -146,6 +147,16 @@ pub fn messages() -> Vec<Message> {
                 // Spread over the byte (k * 37 passes 255 for the last cause: reduced on purpose).
                 fault_history_len: (k * 37 % 256) as u8,
                 calibration_source: ConfigSource::ALL[(k + 1) % ConfigSource::ALL.len()],
+            }));
+        }
+        for (k, source) in ClockSource::ALL.iter().enumerate() {
+            v.push(Message::ClockInfo(ClockInfo {
+                node,
+                source: *source,
+                crystal: CrystalStatus::ALL[k % CrystalStatus::ALL.len()],
+                oscillator_error_centi_pct: [1, 100, 255][k % 3],
+                tolerated_error_ppm: [4_854, 0, u16::MAX][k % 3],
+                crystal_freq_10hz: [800_000, 0, 0xFF_FFFF][k % 3],
             }));
         }
         for (k, op) in Opcode::ALL.iter().enumerate() {

@@ -129,8 +129,8 @@ fn unknown_identifiers() {
         Err(DecodeError::UnknownId { raw: 0 })
     );
     assert_eq!(
-        Message::decode(0x0D2, &[0; 8]),
-        Err(DecodeError::UnknownId { raw: 0x0D2 })
+        Message::decode(0x0E2, &[0; 8]),
+        Err(DecodeError::UnknownId { raw: 0x0E2 })
     );
     // Identity from the host: ankles only.
     assert_eq!(
@@ -177,8 +177,8 @@ fn every_undefined_identifier_is_rejected() {
         }
     }
     // emergency stop 3, heel strike 2, fault 2, command 3, ack 2, heartbeat 3, state 2, version 3,
-    // identity 2, boot info 2, command ack 2, fault history 2
-    assert_eq!(defined, 28);
+    // identity 2, boot info 2, command ack 2, fault history 2, clock info 2
+    assert_eq!(defined, 30);
 }
 
 #[test]

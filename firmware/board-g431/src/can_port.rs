@@ -1,13 +1,12 @@
 //! FDCAN1 on the board's transceiver (PA11 RX, PB9 TX; PC11 the transceiver's shutdown
-//! input, PC14 the switchable 120 Ω termination), clocked from the 8 MHz crystal.
+//! input, PC14 the switchable 120 Ω termination).
 //!
-//! Bit timing (classic CAN, 500 kbit/s): the FDCAN kernel clock is the HSE itself (8 MHz),
-//! prescaler 1, so one bit is 16 time quanta: sync 1 + seg1 13 + seg2 2 → sample point
-//! 14/16 = 87.5 % (CiA 301's recommendation at 500 kbit/s). SJW 2 tq (the largest allowed by
-//! seg2). Tolerated oscillator error (Bosch's two conditions, NBT 16 tq, PS2 2 tq):
-//! `df ≤ SJW / (20·NBT) = 0.625 %` and `df ≤ min(PS1, PS2) / (2·(13·NBT − PS2)) = 2/412 =
-//! 0.485 %`, so ±0.48 % for every node on the bus together — a crystal (tens of ppm) passes,
-//! the internal 16 MHz RC (about ±1 % over temperature) does not.
+//! Bit timing (classic CAN, 500 kbit/s): computed at start-up for the kernel clock actually
+//! chosen ([`firmware::can_timing::bit_timing`], through [`firmware::clock_choice`]). On the
+//! 8 MHz crystal (FDCAN kernel = HSE): prescaler 1, 16 tq = sync 1 + seg1 13 + seg2 2,
+//! sample point 87.5 % (CiA 301), SJW 2, tolerated oscillator error 0.485 % (ISO 11898-1's
+//! two conditions). On the HSI16 (PLL to 170 MHz, kernel = PCLK1): prescaler 20, 1 + 14 + 2,
+//! 88.2 %, 0.457 % — the HSI16's ±1 % exceeds it, so the node speaks but refuses `Enable`.
 //!
 //! Acceptance: only the identifiers the node reads ([`protocol::accepted_by_ankle`]) into
 //! FIFO 0; every other standard frame, every extended and every remote frame is rejected by
@@ -26,21 +25,9 @@ use core::num::{NonZeroU16, NonZeroU8};
 use embassy_stm32::can::config::{GlobalFilter, NominalBitTiming, NonMatchingFilter};
 use embassy_stm32::can::filter::{Action, FilterType, StandardFilter, StandardFilterSlot};
 use embassy_stm32::can::{BufferedCanReceiver, BufferedCanSender, CanConfigurator, Frame};
+use firmware::can_timing::BitTiming;
 use firmware::drivers::can::{BusState, ControllerHealth, ControllerStatus};
 use protocol::NodeId;
-
-/// FDCAN kernel clock: the crystal [Hz].
-pub const KERNEL_CLOCK_HZ: u32 = 8_000_000;
-/// Time segment 1 (propagation + phase 1) [tq].
-pub const SEG1_TQ: u8 = 13;
-/// Time segment 2 (phase 2) [tq].
-pub const SEG2_TQ: u8 = 2;
-/// Synchronisation jump width [tq].
-pub const SJW_TQ: u8 = 2;
-// One bit = sync + seg1 + seg2 quanta at prescaler 1; SJW within seg2.
-const _: () =
-    assert!(KERNEL_CLOCK_HZ / protocol::BITRATE_BPS == 1 + SEG1_TQ as u32 + SEG2_TQ as u32);
-const _: () = assert!(SJW_TQ <= SEG2_TQ);
 
 /// Termination of the bus at this board (a parameter: set for the two nodes at the ends of
 /// the bus only).
@@ -52,21 +39,26 @@ pub enum Termination {
     External,
 }
 
-/// 500 kbit/s from an 8 MHz kernel clock: 16 tq, sample point 87.5 %, SJW 2.
-pub fn bit_timing() -> NominalBitTiming {
-    NominalBitTiming {
-        prescaler: NonZeroU16::MIN,
-        seg1: NonZeroU8::new(SEG1_TQ).unwrap_or(NonZeroU8::MIN),
-        seg2: NonZeroU8::new(SEG2_TQ).unwrap_or(NonZeroU8::MIN),
-        sync_jump_width: NonZeroU8::new(SJW_TQ).unwrap_or(NonZeroU8::MIN),
-    }
+/// The library's bit timing as the driver's registers: `None` when a field does not fit
+/// (never for a timing computed within [`firmware::can_timing::FDCAN_NOMINAL`]).
+pub fn nominal(t: BitTiming) -> Option<NominalBitTiming> {
+    Some(NominalBitTiming {
+        prescaler: NonZeroU16::new(t.prescaler)?,
+        seg1: NonZeroU8::new(u8::try_from(t.seg1_tq).ok()?)?,
+        seg2: NonZeroU8::new(u8::try_from(t.seg2_tq).ok()?)?,
+        sync_jump_width: NonZeroU8::new(u8::try_from(t.sjw_tq).ok()?)?,
+    })
 }
 
-/// Bit timing, global filter and acceptance filters for `node`.
-pub fn configure(cfg: &mut CanConfigurator<'_>, node: NodeId) {
-    let config = cfg
-        .config()
-        .set_nominal_bit_timing(bit_timing())
+/// Bit timing (`None`: no timing fits the clock; the controller keeps its reset timing and
+/// the node, refused the power stage, says so), global filter and acceptance filters for
+/// `node`.
+pub fn configure(cfg: &mut CanConfigurator<'_>, node: NodeId, timing: Option<BitTiming>) {
+    let mut config = cfg.config();
+    if let Some(t) = timing.and_then(nominal) {
+        config = config.set_nominal_bit_timing(t);
+    }
+    let config = config
         .set_automatic_bus_off_recovery(true)
         .set_global_filter(GlobalFilter {
             handle_standard_frames: NonMatchingFilter::Reject,

@@ -1,5 +1,5 @@
-//! The ankle node on ST's B-G431B-ESC1 (STM32G431CB at 170 MHz from the 8 MHz crystal,
-//! FDCAN1 at 500 kbit/s).
+//! The ankle node on ST's B-G431B-ESC1 (STM32G431CB at 170 MHz from its crystal, or from
+//! the internal oscillator when the crystal is absent or wrong; FDCAN1 at 500 kbit/s).
 //!
 //! One embassy task runs the control loop at 1 kHz: [`firmware::runner::AnkleDrivers::step`]
 //! reads the ankle encoder (PWM output on PA15/TIM2) and the contact switch, drains the CAN
@@ -17,6 +17,7 @@
 
 mod boot_pin;
 mod can_port;
+mod clock_start;
 mod crash;
 mod current_sense;
 mod encoders;
@@ -44,8 +45,9 @@ use embassy_stm32::timer::pwm_input::PwmInput;
 use embassy_stm32::timer::qei::{self, Qei};
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, rcc, timer, Config};
+use embassy_stm32::{bind_interrupts, timer};
 use embassy_time::{Duration, Ticker};
+use firmware::clock_choice::{choose, B_G431B_ESC1};
 use firmware::drivers::can::CanPort;
 use firmware::drivers::contact::{ActiveLevel, ContactSwitch};
 use firmware::drivers::encoder::AngleSensor;
@@ -119,33 +121,22 @@ impl Monotonic for EmbassyClock {
     }
 }
 
-/// 8 MHz crystal → PLL (÷2 × 85 ÷ 2) → 170 MHz, boost mode; FDCAN from the crystal itself.
-fn clocks() -> Config {
-    let mut config = Config::default();
-    config.rcc.hse = Some(rcc::Hse {
-        freq: embassy_stm32::time::mhz(8),
-        mode: rcc::HseMode::Oscillator,
-    });
-    config.rcc.pll = Some(rcc::Pll {
-        source: rcc::PllSource::HSE,
-        prediv: rcc::PllPreDiv::DIV2,
-        mul: rcc::PllMul::MUL85,
-        divp: None,
-        divq: None,
-        divr: Some(rcc::PllRDiv::DIV2),
-    });
-    config.rcc.sys = rcc::Sysclk::PLL1_R;
-    config.rcc.boost = true;
-    config.rcc.mux.fdcansel = rcc::mux::Fdcansel::HSE;
-    config.rcc.mux.adc12sel = rcc::mux::Adcsel::SYS;
-    config
-}
-
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
-    // Before anything else: the power stage's pins are inputs at reset; TIM1 is configured
-    // with its main output disabled below, before any other peripheral.
-    let p = embassy_stm32::init(clocks());
+    // Cycle counter first: it times the crystal's start-up and measures it.
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        defmt::panic!("core peripherals taken twice");
+    };
+    core.DCB.enable_trace();
+    core.DWT.enable_cycle_counter();
+    // The clock: the crystal awaited (bounded) and measured against the HSI16, then the
+    // choice (crystal, or the HSI16 with the power stage refused when the CAN timing cannot
+    // tolerate it). The power stage's pins are inputs at reset; TIM1 is configured with its
+    // main output disabled below, before any other peripheral.
+    let observed = clock_start::observe_crystal();
+    let clock = choose(&B_G431B_ESC1, observed);
+    clock_start::release_unused_crystal(&clock);
+    let p = embassy_stm32::init(clock_start::config_for(&clock));
     // PB8 (contact switch) doubles as BOOT0: make the boot mode independent of it first
     // (programs the option bytes and resets once on a board with factory option bytes).
     let boot_pin = boot_pin::ignore_boot0_pin();
@@ -157,6 +148,24 @@ async fn main(_spawner: Spawner) {
         cause,
         boot_pin
     );
+    if matches!(
+        cause,
+        protocol::ResetCause::IndependentWatchdog | protocol::ResetCause::WindowWatchdog
+    ) {
+        defmt::warn!("the last reset was the watchdog's: the control loop stopped running on time");
+    }
+    defmt::info!(
+        "crystal {} -> clock {}: CAN kernel {} Hz, timing {}, tolerates {} ppm, oscillator {} ppm",
+        observed,
+        clock.source,
+        clock.can_kernel_hz,
+        clock.timing,
+        clock.tolerated_ppm,
+        clock.oscillator_ppm
+    );
+    if let Some(r) = clock.refusal {
+        defmt::warn!("power stage refused on this clock: {}", r);
+    }
 
     // Power stage: phases U and V as two half-bridges, W held low; off until driven.
     let pwm = ComplementaryPwm::new(
@@ -239,8 +248,8 @@ async fn main(_spawner: Spawner) {
     // Contact switch: the connector's third pin (PB8, to ground, pull-up), 3 ms debounce.
     let contact = ContactSwitch::new(Input::new(p.PB8, Pull::Up), ActiveLevel::Low, 3);
 
-    // CAN: transceiver enabled (PC11 low), termination as built, crystal-clocked timing,
-    // filters for this node's identifiers only.
+    // CAN: transceiver enabled (PC11 low), termination as built, the bit timing computed for
+    // the chosen clock, filters for this node's identifiers only.
     let _can_shutdown = Output::new(p.PC11, Level::Low, Speed::Low);
     let term = termination();
     let _can_term = Output::new(
@@ -253,7 +262,7 @@ async fn main(_spawner: Spawner) {
         Speed::Low,
     );
     let mut cfg = can::CanConfigurator::new(p.FDCAN1, p.PA11, p.PB9, Irqs);
-    can_port::configure(&mut cfg, id);
+    can_port::configure(&mut cfg, id, clock.timing);
     let can = cfg.start(OperatingMode::NormalOperationMode);
     let (Some(tx_buf), Some(rx_buf)) = (
         cortex_m::singleton!(: TxBuf<32> = TxBuf::<32>::new()),
@@ -274,6 +283,7 @@ async fn main(_spawner: Spawner) {
     config.reset_cause = cause;
     config.params_source = loaded.params_source;
     config.calibration_source = loaded.calibration_source;
+    config.clock = clock;
     let mut node = match AnkleNode::new(config) {
         Ok(n) => n,
         Err(e) => defmt::panic!("node config: {}", e),
@@ -287,13 +297,6 @@ async fn main(_spawner: Spawner) {
         CanPort::new(board_can),
         EmbassyClock,
     );
-
-    // Cycle counter for the per-tick cost.
-    let Some(mut core) = cortex_m::Peripherals::take() else {
-        defmt::panic!("core peripherals taken twice");
-    };
-    core.DCB.enable_trace();
-    core.DWT.enable_cycle_counter();
 
     let mut watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US);
     watchdog.unleash();
@@ -316,7 +319,7 @@ async fn main(_spawner: Spawner) {
             let params = *drivers.node.params();
             let cal = drivers.encoder.calibration();
             let ok = store.save(&params, cal).await.is_ok();
-            defmt::info!("parameters saved: {}", ok);
+            // Logged by the node (`storage_done`).
             drivers.node.storage_done(ok);
             // The stall made the ticker miss deadlines; without a reset it would fire them
             // back to back, ticks microseconds apart, in which the ankle encoder's PWM

@@ -3,6 +3,9 @@
 //! `#`-prefixed lines with the per-tick instruction counts, and exits with the verdict
 //! (0: every scenario met its expectations).
 //!
+//! The library's bench log is on (`defmt` through defmt-rtt, as on the board), so the counts
+//! include it; [`rtt_drain`] empties the RTT buffer between ticks as a probe would.
+//!
 //! Instruction counting: QEMU runs with `-icount shift=6`, so the virtual clock advances
 //! 64 ns per executed instruction; SysTick counts the 25 MHz system clock of that virtual
 //! time. A calibration loop of known length converts SysTick counts to instructions.
@@ -17,6 +20,9 @@ use cortex_m_semihosting::{debug, hio};
 use firmware::scenarios::{run, Buffered, TickHook, SCENARIOS};
 
 mod crash_checks;
+mod rtt_drain;
+
+use defmt_rtt as _;
 
 /// Instructions per iteration of the calibration loop (nop, nop, str, ldr, subs, bne; checked
 /// in the disassembly, see docs/firmware.md).
@@ -37,6 +43,7 @@ struct Meter {
     max: u32,
     max_at: u32,
     n: u32,
+    log: rtt_drain::Drain,
 }
 
 impl TickHook for Meter {
@@ -44,6 +51,8 @@ impl TickHook for Meter {
         let start = SYST::get_current();
         let r = f();
         let end = SYST::get_current();
+        // The probe's part, outside the measurement.
+        self.log.drain();
         let d = elapsed(start, end).saturating_sub(self.overhead);
         self.total += d as u64;
         self.n += 1;
@@ -150,7 +159,12 @@ fn main() -> ! {
             max: 0,
             max_at: 0,
             n: 0,
+            log: rtt_drain::Drain::default(),
         };
+        // Lines logged before this scenario (the previous one's) are not its own.
+        meter.log.drain();
+        meter.log.bytes = 0;
+        meter.log.max_tick_bytes = 0;
         match run(sc, &mut out, &mut meter) {
             Ok(summary) => {
                 let verdict = sc.verdict(&summary);
@@ -168,6 +182,15 @@ fn main() -> ! {
                     meter.max_at,
                     mean,
                     meter.max
+                );
+                let _ = writeln!(
+                    out,
+                    "# {}: bench log {} bytes over {} ticks, at most {} in one tick (RTT buffer {} bytes)",
+                    sc.name,
+                    meter.log.bytes,
+                    meter.n,
+                    meter.log.max_tick_bytes,
+                    meter.log.buffer_size
                 );
             }
             Err(e) => {
