@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import pathlib
+import re
 import sys
 import time
 
@@ -97,7 +98,9 @@ def test_paper_claims(kernel_dir):
     nb = execute("paper_claims.ipynb", kernel_dir)
     out = text_of(nb)
     assert not errors_of(nb)
-    assert "max |eigenvalue| = 0.98773638" in out
+    # the README's value, to the central-difference Jacobian's noise (a few 1e-9)
+    m = re.search(r"max \|eigenvalue\| = ([0-9.]+)", out)
+    assert m and abs(float(m.group(1)) - 0.98773638) < 2e-8, out
     assert "fell_forward" in out
     assert images_of(nb) == 2
 

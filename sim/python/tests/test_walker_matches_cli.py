@@ -49,7 +49,8 @@ def test_a_gait_not_found_is_the_cli_report(cli):
 
 def test_wisse3d_default_gait_is_the_papers():
     g = walker.gait(walker.Scene.load("wisse3d"))
-    assert round(g.max_abs_eigenvalue, 8) == 0.98773638
+    # the README's value, to the central-difference Jacobian's noise (a few 1e-9)
+    assert abs(g.max_abs_eigenvalue - 0.98773638) < 1e-8
     assert g.gait_source == "defaults"
     assert g.cost_of_transport_j_per_kg_m is not None
     balance = g.energy_balance
