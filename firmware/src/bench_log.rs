@@ -5,7 +5,8 @@
 //!
 //! * each kind has a token bucket ([`crate::log_limit`]): a flapping input's events are
 //!   counted, not queued;
-//! * events wait in a queue of [`QUEUE_LEN`] and at most one line is written per tick
+//! * events wait in a queue of [`QUEUE_LEN`] and at most one line is written per tick, by the
+//!   node in a tick that transmits nothing (or when the queue is full)
 //!   ([`BenchLog::flush_one`]), so a tick pays for one line at most (measured under QEMU);
 //!   an event keeps the time and angle of its own tick. A full queue counts what it drops.
 //!

@@ -659,8 +659,13 @@ impl AnkleNode {
         }
         self.send_due_reports(&mut out, now);
         self.send_periodic(&mut out, now);
-        // At most one bench-log line per tick (the rest wait in the log's queue).
-        let _ = self.bench.flush_one();
+        // At most one bench-log line per tick, written in a tick that transmits nothing (a
+        // tick that raises a fault, answers a command or sends a heel strike is the tick
+        // budget's worst case; the line waits a tick or two in the log's queue), or when the
+        // queue is full.
+        if out.list.is_empty() || self.bench.pending() >= crate::bench_log::QUEUE_LEN {
+            let _ = self.bench.flush_one();
+        }
         sort_by_priority(&mut out.list);
         let outputs = TickOutputs {
             actuator,
