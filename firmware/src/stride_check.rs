@@ -18,7 +18,8 @@
 //!   ankle (the trailing foot must lift) while the ankle does not turn as a loaded one, or
 //!   closed again less than [`MIN_SWING_S`] after the own lift-off (no swing is that short),
 //!   or a walking stance whose reading changes but turns less than
-//!   [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout (a foot in the air);
+//!   [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout, at least [`STANCE_ROTATION_WINDOW_S`]
+//!   (a foot in the air);
 //! * open: in a swing, the reading moving *away* from the foot's rest angle by more than
 //!   [`SWING_TURN_AWAY_RAD`] beyond the closest it came in that swing (the spring returns a
 //!   swinging foot; only the floor turns the ankle away), or down through the taut angle, or
@@ -48,6 +49,13 @@ pub const SWING_REST_BAND_RAD: f32 = 0.03;
 /// taken as not loaded \[rad\]: 8 counts (3.1 mrad). The nominal walks turn it by at least 30
 /// counts per 50 ms in `Free` (docs/firmware.md).
 pub const STANCE_MIN_ROTATION_RAD: f32 = 8.0 * COUNT_RAD;
+
+/// Shortest window over which a walking stance's rotation is judged \[s\]: the nominal walks
+/// turn the ankle by at least 30 counts per 50 ms in `Free` (docs/firmware.md), so
+/// [`STANCE_MIN_ROTATION_RAD`] over 50 ms is far below a loaded foot's; over a stuck timeout
+/// shorter than this (`stuck_timeout_s` may be 10 ms) a healthy stance turns only a few counts
+/// and was taken for a foot in the air.
+pub const STANCE_ROTATION_WINDOW_S: f32 = 0.05;
 
 /// A swing ankle that turned away from its rest angle by no more than this \[rad\] is not
 /// loaded: 4 counts (1.5 mrad), twice a healthy encoder's ±1-count noise.
@@ -261,10 +269,12 @@ impl StrideCheck {
 
     /// A walking stance (`Free` after an own heel strike, switch closed) turns the ankle: a
     /// reading that changes (so the encoder works) but moves less than
-    /// [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout is a foot in the air on a switch
+    /// [`STANCE_MIN_ROTATION_RAD`] over a stuck timeout (at least
+    /// [`STANCE_ROTATION_WINDOW_S`]) is a foot in the air on a switch
     /// that reads closed. A reading that does not change at all is the encoder's fault
     /// (`EncoderStuck`), not this one.
     fn check_stance_rotation(&mut self, i: &StrideInputs, stuck_timeout_s: f32) {
+        let window_s = stuck_timeout_s.max(STANCE_ROTATION_WINDOW_S);
         let stance = i.phase == ReflexPhase::Free && self.walking && i.contact_closed;
         let (Some(s), true) = (i.sample, stance) else {
             self.stance_window = None;
@@ -281,10 +291,10 @@ impl StrideCheck {
         };
         // A change in the window's second half: a reading frozen early in the window is the
         // encoder's (`EncoderStuck`), not a foot in the air.
-        let late = i.now.secs_since(w.since) >= 0.5 * stuck_timeout_s;
+        let late = i.now.secs_since(w.since) >= 0.5 * window_s;
         w.changed |= late && s.counts != w.last_counts;
         w.last_counts = s.counts;
-        if i.now.secs_since(w.since) >= stuck_timeout_s {
+        if i.now.secs_since(w.since) >= window_s {
             if w.changed && (s.angle_rad - w.from_rad).abs() < STANCE_MIN_ROTATION_RAD {
                 self.raise_contact(CONTACT_CLOSED_NO_STANCE, true);
             }
@@ -364,11 +374,12 @@ impl StrideCheck {
         }
     }
 
-    /// The reflex stopped (node not enabled): the stride starts over; the findings stay
-    /// until their sensor changes (so that the node cannot be enabled again on them).
+    /// The reflex stopped (node not enabled): the stride starts over, the last landing angle
+    /// forgotten too (a node enabled again with its foot in the air has no rest angle until
+    /// its next heel strike); the findings stay until their sensor changes (so that the node
+    /// cannot be enabled again on them).
     pub fn stop(&mut self) {
         *self = StrideCheck {
-            landing_rad: self.landing_rad,
             contact: self.contact,
             spool: self.spool,
             ..StrideCheck::default()

@@ -94,3 +94,39 @@ fn sil_names_the_fault_that_ended_the_walk() {
         "{text}"
     );
 }
+
+#[test]
+fn a_short_stuck_timeout_raises_no_false_alarm_in_a_healthy_walk() {
+    // `stuck_timeout_s` is documented down to 10 ms. The foot-in-the-air rule (`ContactStuck`
+    // evidence 4) judged a stance's rotation over the stuck timeout: over 10-17 ms a healthy
+    // stance turns only a few counts and was taken for a foot in the air (ContactStuck at
+    // 0.97 s, a fall in step 3). It is judged over at least 50 ms now.
+    for actuator in ["servo", "motor"] {
+        let out = walker(&[
+            "sil",
+            "--scene",
+            "wisse3d",
+            "--steps",
+            "40",
+            "--actuator",
+            actuator,
+            "--firmware-param",
+            "stuck_timeout_s=0.01",
+            "--json",
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{actuator}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).expect("valid json");
+        assert_eq!(v["steps_completed"], 40, "{actuator}: {}", v["failure"]);
+        assert_eq!(
+            v["node_faults"].as_array().map(Vec::len),
+            Some(0),
+            "{actuator}: {}",
+            v["node_faults"]
+        );
+    }
+}
