@@ -178,8 +178,9 @@ fn crossing_pairs(
     matched(&pa, &pb).map(crossed)
 }
 
-/// [`crossing_pairs`] among the pairs that have a partner when the numbers of pairs differ
-/// (two real multipliers merged into a pair, or a pair split, in the same step).
+/// [`crossing_pairs`] among the pairs that have a partner: all of them when the numbers of
+/// pairs are the same, the rest when they differ (two real multipliers merged into a pair, or
+/// a pair split, in the same step).
 fn crossing_pairs_of_partners(
     ma: &[Complex<f64>],
     mb: &[Complex<f64>],
@@ -281,14 +282,11 @@ pub fn locate(
     // A Neimark–Sacker point is located on the crossing pair itself, followed from trial to
     // trial (the product over all pairs also changes sign where a pair forms or splits).
     // Where a pair formed or split in the same step, the pair that crossed is the one
-    // crossing pair among those with a partner.
+    // crossing pair among those with a partner (with as many pairs at both ends, every pair
+    // has one).
     let crossing = match kind {
         BifurcationKind::NeimarkSacker => {
-            let (ma, mb) = (&a.multipliers, &b.multipliers);
-            match crossing_pairs(ma, mb)
-                .unwrap_or_else(|| crossing_pairs_of_partners(ma, mb))
-                .as_slice()
-            {
+            match crossing_pairs_of_partners(&a.multipliers, &b.multipliers).as_slice() {
                 [(za, zb)] => Some((*za, *zb)),
                 _ => return Err(CorrectorError::NoSignChange),
             }
