@@ -37,6 +37,7 @@ use pyo3::prelude::*;
 fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_function(wrap_pyfunction!(scene::scenes, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::_restore_scene, m)?)?;
     m.add_function(wrap_pyfunction!(gait::gait, m)?)?;
     m.add_function(wrap_pyfunction!(walk::walk, m)?)?;
     m.add_function(wrap_pyfunction!(gaits::gaits, m)?)?;

@@ -9,7 +9,8 @@ use sim::analysis::solver_options::{
     jacobian_method, jacobian_name, SolverOptionError, SolverOptions,
 };
 use sim::report::{SceneCatalogue, SceneEntry};
-use sim::scene::Scene;
+use sim::scene::text_file::read_text_file;
+use sim::scene::{Scene, SceneError, BUILTIN, MAX_SCENE_FILE_BYTES};
 
 /// A scene: a walker described by a scene file (built-in or a path), with parameter values.
 #[pyclass(name = "Scene", module = "walker._walker", frozen)]
@@ -19,6 +20,9 @@ pub struct PyScene {
     pub inner: Scene,
     /// What `Scene.load` was given (a built-in name or a path), for `repr`.
     source: String,
+    /// The text of a scene file loaded by path, as parsed (`None` for a built-in scene): a
+    /// pickled scene carries it, so a process on another machine builds the same scene.
+    text: Option<String>,
     /// The numerical options of every study of this scene (`with_solver`).
     pub solver: SolverOptions,
 }
@@ -36,14 +40,65 @@ impl PyScene {
                 &format!("scene path {} is not UTF-8", name_or_path.display()),
             )
         })?;
-        let inner = Scene::load(name_or_path).map_err(|e| errors::scene_error(py, &e))?;
+        let builtin = BUILTIN.iter().any(|(n, _)| *n == name_or_path);
+        let text = if builtin || !name_or_path.ends_with(".toml") {
+            None
+        } else {
+            Some(
+                read_text_file(
+                    std::path::Path::new(name_or_path),
+                    MAX_SCENE_FILE_BYTES,
+                    "a scene file",
+                )
+                .map_err(|e| {
+                    errors::scene_error(
+                        py,
+                        &SceneError::File {
+                            path: name_or_path.to_owned(),
+                            message: e.to_string(),
+                        },
+                    )
+                })?,
+            )
+        };
+        let inner = match &text {
+            Some(t) => Scene::parse(name_or_path, t),
+            None => Scene::load(name_or_path),
+        }
+        .map_err(|e| errors::scene_error(py, &e))?;
         // Built once, so a scene that cannot be built is refused here, not at first use.
         inner.setup().map_err(|e| errors::scene_error(py, &e))?;
         Ok(Self {
             inner,
             source: name_or_path.to_owned(),
+            text,
             solver: SolverOptions::default(),
         })
+    }
+
+    /// Pickling (`pickle`, `copy`, Ray and multiprocessing ship scenes to other processes):
+    /// the scene's source (built-in name or path), its file text when loaded by path (the
+    /// other process need not have the file), every parameter value (bit for bit) and the
+    /// solver options.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let restore = py.import("walker._walker")?.getattr("_restore_scene")?;
+        let values = PyDict::new(py);
+        for (k, v) in &self.inner.values {
+            values.set_item(k, v)?;
+        }
+        let o = &self.solver;
+        let solver = PyDict::new(py);
+        solver.set_item("integrator", o.integrator.clone())?;
+        solver.set_item("step_s", o.step_s)?;
+        solver.set_item("rtol", o.rtol)?;
+        solver.set_item("newton_tol", o.newton_tol)?;
+        solver.set_item("newton_max_iter", o.newton_max_iter)?;
+        solver.set_item("max_strides", o.max_strides)?;
+        solver.set_item("perturbation", o.perturbation)?;
+        solver.set_item("frozen_steps", o.frozen_steps)?;
+        solver.set_item("jacobian", jacobian_name(o.jacobian))?;
+        let args = (self.source.clone(), self.text.clone(), values, solver).into_pyobject(py)?;
+        Ok((restore, args.into_any()))
     }
 
     /// The scene's name.
@@ -128,6 +183,7 @@ impl PyScene {
         Ok(Self {
             inner,
             source: self.source.clone(),
+            text: self.text.clone(),
             solver: self.solver.clone(),
         })
     }
@@ -186,6 +242,7 @@ impl PyScene {
         Ok(Self {
             inner: self.inner.clone(),
             source: self.source.clone(),
+            text: self.text.clone(),
             solver,
         })
     }
@@ -277,4 +334,45 @@ impl PyScene {
 pub fn scenes(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
     let catalogue = SceneCatalogue::builtin().map_err(|e| errors::scene_error(py, &e))?;
     convert::report(py, &catalogue)
+}
+
+/// A pickled `Scene` ([`PyScene::__reduce__`]): parsed from `text` (or loaded by `source`
+/// when it is a built-in scene), every value in `values` set, `solver`'s options applied.
+#[pyfunction]
+pub fn _restore_scene(
+    py: Python<'_>,
+    source: String,
+    text: Option<String>,
+    values: std::collections::BTreeMap<String, f64>,
+    solver: &Bound<'_, PyDict>,
+) -> PyResult<PyScene> {
+    let mut inner = match &text {
+        Some(t) => Scene::parse(&source, t),
+        None => Scene::load(&source),
+    }
+    .map_err(|e| errors::scene_error(py, &e))?;
+    for (k, v) in &values {
+        if inner.values.get(k).map(|d| d.to_bits()) != Some(v.to_bits()) {
+            inner.set(k, *v).map_err(|e| errors::scene_error(py, &e))?;
+        }
+    }
+    let scene = PyScene {
+        inner,
+        source,
+        text,
+        solver: SolverOptions::default(),
+    };
+    let kwargs = solver.copy()?;
+    scene.with_solver(
+        py,
+        kwargs.get_item("integrator")?.map(|v| v.extract()).transpose()?.flatten(),
+        kwargs.get_item("step_s")?.map(|v| v.extract()).transpose()?.flatten(),
+        kwargs.get_item("rtol")?.map(|v| v.extract()).transpose()?.flatten(),
+        kwargs.get_item("newton_tol")?.map(|v| v.extract()).transpose()?,
+        kwargs.get_item("newton_max_iter")?.as_ref(),
+        kwargs.get_item("max_strides")?.as_ref(),
+        kwargs.get_item("perturbation")?.map(|v| v.extract()).transpose()?,
+        kwargs.get_item("frozen_steps")?.map(|v| v.extract()).transpose()?,
+        kwargs.get_item("jacobian")?.map(|v| v.extract()).transpose()?,
+    )
 }
