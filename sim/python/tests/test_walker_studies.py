@@ -1,0 +1,158 @@
+"""``walker.studies``: a study as pure tasks, written to a study file it resumes from, equal bit
+for bit to the one-process function; the Ray cluster test (``test_cluster``) runs
+``ray_cluster_check.py`` in a network namespace of its own."""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import pickle
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+import walker
+import walker.studies as studies
+
+HERE = pathlib.Path(__file__).resolve().parent
+SCENE = walker.Scene.load("compass")
+X = ("slope", [0.01, 0.03, 0.05, 0.07, 0.08])
+Y = ("leg_mass_kg", [1.0, 4.0, 7.0, 10.0])
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return walker.stability_map(SCENE, X, Y, progress=False)
+
+
+def test_a_scene_pickles_to_the_same_scene_with_its_values_and_solver(tmp_path):
+    s = walker.Scene.load("compass").with_params(slope_rad=0.0612345678901234).with_solver(rtol=1e-10, newton_tol=1e-11)
+    t = pickle.loads(pickle.dumps(s))
+    assert repr(t) == repr(s) and t.values == s.values and t.solver == s.solver
+    assert walker.gait(t).report == walker.gait(s).report
+    # a scene file given by path travels with its text: the copy needs no file
+    path = tmp_path / "mine.toml"
+    shutil.copy(pathlib.Path(walker.__file__).parents[3] / "scenes" / "compass.toml", path)
+    u = walker.Scene.load(path).with_params(hip_mass_kg=12.0)
+    blob = pickle.dumps(u)
+    path.unlink()
+    v = pickle.loads(blob)
+    assert v.values == u.values and walker.gait(v).report == walker.gait(u).report
+
+
+def test_the_study_with_a_file_equals_the_one_process_map_bit_for_bit(tmp_path, reference):
+    for cells in (1, 3, 20, None):
+        m = studies.stability_map(SCENE, X, Y, study_file=tmp_path / f"m{cells}.parquet", progress=False,
+                                  cells_per_task=cells)
+        assert m.report == reference.report, cells
+    table = pd.read_parquet(tmp_path / "m3.parquet")
+    assert len(table) == 20 and set(table.columns) >= {"i", "j", "x", "y", "max_abs_eigenvalue", "gait_source"}
+    eig = table.set_index(["j", "i"])["max_abs_eigenvalue"]
+    assert all(eig[(j, i)] == reference.max_abs_eigenvalue[j, i] for j in range(4) for i in range(5))
+
+
+def test_an_interrupted_study_resumes_from_its_file_and_computes_only_what_is_missing(tmp_path, reference):
+    path = tmp_path / "study.parquet"
+
+    class Stop(Exception):
+        pass
+
+    def stop_after_two_tasks(done, total):
+        if done >= 6:
+            raise Stop
+
+    with pytest.raises(Stop):
+        studies.stability_map(SCENE, X, Y, study_file=path, progress=stop_after_two_tasks, cells_per_task=3)
+    kept = len(pd.read_parquet(path))
+    assert 6 <= kept < 20
+    seen = []
+    m = studies.stability_map(SCENE, X, Y, study_file=path, progress=lambda d, t: seen.append((d, t)), cells_per_task=3)
+    assert seen[0] == (kept, 20) and seen[-1] == (20, 20)
+    assert m.report == reference.report
+    # a finished study is read back without a task
+    seen.clear()
+    again = studies.stability_map(SCENE, X, Y, study_file=path, progress=lambda d, t: seen.append(d))
+    assert seen == [20] and again.report == reference.report
+
+
+def test_the_file_carries_the_spec_and_versions_and_another_study_is_refused_naming_the_difference(tmp_path):
+    path = tmp_path / "study.parquet"
+    studies.stability_map(SCENE, X, Y, study_file=path, progress=False)
+    import json
+
+    meta = json.loads(pq.read_schema(path).metadata[studies.METADATA_KEY])
+    assert meta["spec"]["x"] == {"name": "slope_rad", "values": X[1]}
+    assert meta["spec"]["scene"]["name"] == "compass"
+    assert {"walker", "pyarrow", "python"} <= set(meta["versions"])
+    before = path.read_bytes()
+    with pytest.raises(walker.InputError, match=r"x\.values\[2\]: 0\.05 in the file, 0\.051 now"):
+        studies.stability_map(SCENE, (X[0], [0.01, 0.03, 0.051, 0.07, 0.08]), Y, study_file=path, progress=False)
+    with pytest.raises(walker.InputError, match=r"scene\.values\.hip_mass_kg: 10\.0 in the file, 11\.0 now"):
+        studies.stability_map(SCENE.with_params(hip_mass_kg=11.0), X, Y, study_file=path, progress=False)
+    assert path.read_bytes() == before, "a refused study leaves the file as it was"
+
+
+def test_bad_input_is_refused_before_anything_runs(tmp_path):
+    not_parquet = tmp_path / "notes.parquet"
+    not_parquet.write_text("not a table")
+    with pytest.raises(walker.InputError, match="not a Parquet file"):
+        studies.stability_map(SCENE, X, Y, study_file=not_parquet, progress=False)
+    assert not_parquet.read_text() == "not a table"
+    with pytest.raises(walker.InputError, match="executor must be one of local, ray"):
+        studies.stability_map(SCENE, X, Y, executor="dask", progress=False)
+    with pytest.raises(walker.InputError, match="Ray's options"):
+        studies.stability_map(SCENE, X, Y, address="127.0.0.1:6379", progress=False)
+    with pytest.raises(walker.InputError, match="cells_per_task"):
+        studies.stability_map(SCENE, X, Y, study_file=tmp_path / "a.parquet", cells_per_task=0, progress=False)
+    with pytest.raises(walker.InputError, match="both vary"):
+        studies.stability_map(SCENE, X, ("slope_rad", [0.02]), study_file=tmp_path / "b.parquet", progress=False)
+    with pytest.raises(walker.SceneError):
+        studies.stability_map(SCENE, X, ("leg_mass_kg", [-1.0]), study_file=tmp_path / "c.parquet", progress=False)
+    assert not (tmp_path / "a.parquet").exists() and not (tmp_path / "c.parquet").exists()
+
+
+def test_the_module_runs_from_a_shell_and_writes_the_same_map(tmp_path, reference):
+    path = tmp_path / "shell.parquet"
+    out = subprocess.run(
+        [sys.executable, "-m", "walker.studies", "stability-map", "--scene", "compass",
+         "--x", "slope=" + ",".join(map(str, X[1])), "--y", "leg_mass_kg=" + ",".join(map(str, Y[1])),
+         "--study-file", str(path), "--no-progress"],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert out.returncode == 0, out.stderr
+    assert "20 of 20 cells" in out.stdout
+    m = studies.stability_map(SCENE, X, Y, study_file=path, progress=False)
+    assert m.report == reference.report
+    bad = subprocess.run([sys.executable, "-m", "walker.studies", "stability-map", "--scene", "compass",
+                          "--x", "slope=abc", "--y", "leg_mass_kg=1,2", "--study-file", str(tmp_path / "x.parquet")],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "slope=abc" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def _namespace_available() -> str | None:
+    """Why a network namespace cannot be made here, or ``None``."""
+    if shutil.which("unshare") is None or shutil.which("ip") is None:
+        return "unshare or ip is not installed"
+    probe = subprocess.run(["unshare", "-n", "true"], capture_output=True, text=True)
+    if probe.returncode != 0:
+        return f"unshare -n is not permitted here ({probe.stderr.strip()}): run as root"
+    return None
+
+
+def test_cluster():
+    """A head and two worker nodes in a network namespace of their own: the map on the
+    cluster, with a worker node killed in the middle, and resumed after an interruption, each
+    equal bit for bit to the one-process map (``ray_cluster_check.py``)."""
+    why = _namespace_available()
+    if why is not None:
+        if os.environ.get("WALKER_REQUIRE_RAY"):
+            pytest.fail(f"WALKER_REQUIRE_RAY is set and the Ray cluster cannot run: {why}")
+        pytest.skip(why)
+    script = f"ip link set lo up && exec {sys.executable} {HERE / 'ray_cluster_check.py'}"
+    out = subprocess.run(["unshare", "-n", "sh", "-c", script], capture_output=True, text=True, timeout=900)
+    checks = [line for line in out.stdout.splitlines() if line.startswith("ok: ")]
+    assert out.returncode == 0, out.stdout + out.stderr[-6000:]
+    assert len(checks) == 9, checks
