@@ -51,6 +51,7 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(robustness::robustness, m)?)?;
     m.add_function(wrap_pyfunction!(basin::basin, m)?)?;
     m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize::optimize_evaluate, m)?)?;
     m.add(
         "MAX_OPTIMIZE_EVALUATIONS",
         sim::report::MAX_OPTIMIZE_EVALUATIONS,

@@ -41,9 +41,14 @@ class Cluster:
         """Connects this process to the head, then starts the worker nodes one by one (two
         starting at once on a small machine can miss the raylet's start-up deadline)."""
         ray.init(address=self.address, log_to_driver=False, configure_logging=False)
-        for k in range(self.wanted_workers):
-            self.workers.append(self._start([f"--address={self.address}", "--num-cpus=1"], f"worker{k}"))
-            self.wait_for_cpus(ray, k + 1)
+        for _ in range(self.wanted_workers):
+            self.add_worker(ray)
+
+    def add_worker(self, ray) -> None:
+        """Starts one more worker node (one CPU) and waits until it has joined."""
+        alive = sum(1 for p in self.workers if p.poll() is None)
+        self.workers.append(self._start([f"--address={self.address}", "--num-cpus=1"], f"worker{len(self.workers)}"))
+        self.wait_for_cpus(ray, alive + 1)
 
     def _start(self, args: list[str], name: str) -> subprocess.Popen:
         log = os.path.join(self.temp, f"{name}.log")
@@ -59,10 +64,11 @@ class Cluster:
         return p
 
     def wait_for_cpus(self, ray, cpus: int) -> None:
-        """Waits until the cluster has ``cpus`` CPUs (the worker nodes joined)."""
+        """Waits until the cluster has exactly ``cpus`` CPUs (nodes joined, or a killed node
+        noticed: the head notices by missed heartbeats)."""
         deadline = time.monotonic() + START_BUDGET_S
         while time.monotonic() < deadline:
-            if int(ray.cluster_resources().get("CPU", 0)) >= cpus:
+            if int(ray.cluster_resources().get("CPU", 0)) == cpus:
                 return
             time.sleep(0.5)
         raise RuntimeError(f"the cluster has {ray.cluster_resources()} after {START_BUDGET_S} s, not {cpus} CPUs: "

@@ -155,4 +155,4 @@ def test_cluster():
     out = subprocess.run(["unshare", "-n", "sh", "-c", script], capture_output=True, text=True, timeout=900)
     checks = [line for line in out.stdout.splitlines() if line.startswith("ok: ")]
     assert out.returncode == 0, out.stdout + out.stderr[-6000:]
-    assert len(checks) == 9, checks
+    assert len(checks) == 15, checks

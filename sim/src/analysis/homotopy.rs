@@ -417,7 +417,7 @@ fn same_gait(a: &FixedPoint, b: &FixedPoint) -> bool {
 }
 
 /// Where the gait [`nominal_gait`] returns comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GaitSource {
     /// At the scene's defaults: Newton from the scene's guess.

@@ -43,8 +43,9 @@ use crate::analysis::limit_cycle::{Gait, NewtonError, NewtonSettings};
 pub use crate::analysis::quantity::{Quantity, QuantityError, QuantityOptions};
 use crate::scene::{Scene, SceneError, Setup};
 use nalgebra::DVector;
-use serde::{Serialize, Serializer};
-use std::collections::BTreeMap;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize, Serializer};
+use std::collections::{BTreeMap, HashMap};
 use std::sync::Mutex;
 
 /// The default initial step size of CMA-ES in normalised coordinates (a quarter of each
@@ -279,7 +280,7 @@ impl VariedParameter {
 }
 
 /// Why a candidate is infeasible.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Infeasibility {
     /// The gait rule found no gait.
@@ -297,7 +298,7 @@ pub enum Infeasibility {
 }
 
 /// One evaluated design.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Evaluation {
     /// Its place in the list of evaluations (0 first; the scene's design has none).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -513,12 +514,6 @@ pub fn check(scene: &Scene, settings: &OptimizeSettings<'_>) -> Result<(), Optim
     Ok(())
 }
 
-/// A candidate's outcome before its place in the list is known.
-struct Candidate {
-    evaluation: Evaluation,
-    best: Option<(Scene, Gait, GaitSource)>,
-}
-
 /// Evaluates designs: the gait rule, the objective, the constraints.
 struct Evaluator<'a> {
     scene: &'a Scene,
@@ -528,9 +523,37 @@ struct Evaluator<'a> {
     on_evaluation: &'a (dyn Fn() + Sync),
 }
 
-impl Evaluator<'_> {
+impl<'a> Evaluator<'a> {
+    /// The evaluator of the search `settings` from `scene`'s design.
+    fn new(
+        scene: &'a Scene,
+        settings: &'a OptimizeSettings<'a>,
+        on_evaluation: &'a (dyn Fn() + Sync),
+    ) -> Self {
+        let start = settings
+            .params
+            .iter()
+            .map(|p| {
+                p.normalised(scene.values.get(&p.name).copied().unwrap_or(p.min))
+                    .clamp(0.0, 1.0)
+            })
+            .collect();
+        Self {
+            scene,
+            settings,
+            rule: GaitRule::new(settings.setup_for, settings.newton, settings.homotopy),
+            start,
+            on_evaluation,
+        }
+    }
+
+    /// The designs CMA-ES drew (normalised), evaluated in parallel, in the order drawn.
+    fn evaluate_drawn(&self, drawn: &[Vec<f64>]) -> Result<Vec<Evaluation>, SceneError> {
+        drawn.par_iter().map(|u| self.candidate(u)).collect()
+    }
+
     /// The design at normalised `u` (clipped to the box), evaluated.
-    fn candidate(&self, u: &[f64]) -> Result<Candidate, SceneError> {
+    fn candidate(&self, u: &[f64]) -> Result<Evaluation, SceneError> {
         let clipped: Vec<f64> = u.iter().map(|x| x.clamp(0.0, 1.0)).collect();
         let outside = u
             .iter()
@@ -538,8 +561,22 @@ impl Evaluator<'_> {
             .map(|(a, b)| (a - b) * (a - b))
             .sum::<f64>()
             .sqrt();
+        let scene = self.design(&clipped)?;
+        let from_start = clipped
+            .iter()
+            .zip(&self.start)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>();
+        let mut e = self.evaluate(scene, u.to_vec(), outside, from_start)?;
+        (self.on_evaluation)();
+        e.fitness += BOUND_PENALTY * outside * outside;
+        Ok(e)
+    }
+
+    /// The scene at the design `clipped` (normalised, inside the box).
+    fn design(&self, clipped: &[f64]) -> Result<Scene, SceneError> {
         let mut scene = self.scene.clone();
-        for (p, c) in self.settings.params.iter().zip(&clipped) {
+        for (p, c) in self.settings.params.iter().zip(clipped) {
             // The ends exactly: `min + 1 (max - min)` need not round to `max`.
             let v = if *c <= 0.0 {
                 p.min
@@ -550,15 +587,7 @@ impl Evaluator<'_> {
             };
             scene.set(&p.name, v)?;
         }
-        let from_start = clipped
-            .iter()
-            .zip(&self.start)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>();
-        let mut c = self.evaluate(scene, u.to_vec(), outside, from_start)?;
-        (self.on_evaluation)();
-        c.evaluation.fitness += BOUND_PENALTY * outside * outside;
-        Ok(c)
+        Ok(scene)
     }
 
     /// Evaluates `scene`'s design (drawn as `normalised`, `outside` the box by so much,
@@ -569,7 +598,7 @@ impl Evaluator<'_> {
         normalised: Vec<f64>,
         outside: f64,
         from_start: f64,
-    ) -> Result<Candidate, SceneError> {
+    ) -> Result<Evaluation, SceneError> {
         let objective = self.settings.objective;
         let parameters = self
             .settings
@@ -600,10 +629,7 @@ impl Evaluator<'_> {
         let infeasible = |mut e: Evaluation, why: Infeasibility, detail: String| {
             e.reason = Some(why);
             e.detail = Some(detail);
-            Ok(Candidate {
-                evaluation: e,
-                best: None,
-            })
+            Ok(e)
         };
         let (gait, source) = match self.rule.gait(&scene)? {
             Ok(found) => found,
@@ -684,10 +710,7 @@ impl Evaluator<'_> {
         }
         e.feasible = true;
         e.fitness = objective.minimised(value);
-        Ok(Candidate {
-            evaluation: e,
-            best: Some((scene, gait, source)),
-        })
+        Ok(e)
     }
 }
 
@@ -704,7 +727,8 @@ fn no_gait_words(e: &NewtonError) -> String {
 struct Progress {
     evaluations: Vec<Evaluation>,
     generations: Vec<Generation>,
-    best: Option<BestDesign>,
+    /// The best feasible evaluation's index.
+    best: Option<usize>,
 }
 
 impl Progress {
@@ -715,10 +739,9 @@ impl Progress {
         objective: Objective,
         run: usize,
         sigma: f64,
-        mut candidates: Vec<Candidate>,
+        mut candidates: Vec<Evaluation>,
     ) {
         candidates.sort_by(|a, b| {
-            let (a, b) = (&a.evaluation, &b.evaluation);
             a.fitness.total_cmp(&b.fitness).then_with(|| {
                 a.normalised
                     .iter()
@@ -732,9 +755,8 @@ impl Progress {
         let population = candidates.len();
         let mut best_value: Option<f64> = None;
         let mut feasible = 0;
-        for c in candidates {
+        for mut e in candidates {
             let index = self.evaluations.len();
-            let mut e = c.evaluation;
             e.index = Some(index);
             e.generation = Some(generation);
             if let (true, Some(v)) = (e.feasible, e.value) {
@@ -742,26 +764,16 @@ impl Progress {
                 if best_value.is_none_or(|b| objective.better(v, b)) {
                     best_value = Some(v);
                 }
-                let better = self.best.as_ref().is_none_or(|b| {
-                    self.evaluations[b.index]
-                        .value
-                        .is_none_or(|bv| objective.better(v, bv))
-                });
-                if let (true, Some((scene, gait, source))) = (better, c.best) {
-                    self.best = Some(BestDesign {
-                        index,
-                        scene,
-                        gait,
-                        source,
-                    });
+                let better = self
+                    .best
+                    .is_none_or(|b| self.evaluations[b].value.is_none_or(|bv| objective.better(v, bv)));
+                if better {
+                    self.best = Some(index);
                 }
             }
             self.evaluations.push(e);
         }
-        let best_so_far = self
-            .best
-            .as_ref()
-            .and_then(|b| self.evaluations[b.index].value);
+        let best_so_far = self.best.and_then(|b| self.evaluations[b].value);
         self.generations.push(Generation {
             generation,
             run,
@@ -775,78 +787,116 @@ impl Progress {
     }
 }
 
-/// Optimises `settings.objective` over `settings.params` from `scene`'s design (see the
-/// [module docs](self)), calling `on_evaluation` after each evaluation (from any thread): the
-/// scene's own design first, then every candidate, `budget + 1` calls in all. The calls have
-/// no effect on the search.
+/// Evaluates designs CMA-ES drew, in normalised coordinates: their evaluations in the order
+/// given (each as [`evaluate_drawn`] makes it, wherever it runs). [`optimize_with`] calls it
+/// once per generation with the candidates not evaluated yet; a cluster's front end sends
+/// them to its workers (`walker.studies.optimize(executor="ray")`).
+pub type EvaluateDrawn<'a> =
+    dyn Fn(&[Vec<f64>]) -> Result<Vec<Evaluation>, OptimizeError> + Sync + 'a;
+
+/// The evaluations of `drawn` (designs in normalised coordinates, as CMA-ES drew them) for the
+/// search `settings` from `scene`'s design: what [`optimize`] computes for them, bit for bit,
+/// in parallel (rayon), `on_evaluation` called after each. A pure function of its arguments:
+/// the task of a cluster's worker.
 ///
 /// # Errors
 /// A request [`check`] refuses, or a scene that cannot be built at a design.
-pub fn optimize(
+pub fn evaluate_drawn(
     scene: &Scene,
     settings: &OptimizeSettings<'_>,
+    drawn: &[Vec<f64>],
     on_evaluation: &(dyn Fn() + Sync),
-) -> Result<OptimizeResult, OptimizeError> {
+) -> Result<Vec<Evaluation>, OptimizeError> {
     check(scene, settings)?;
-    let params = settings.params;
-    let n = params.len();
-    let start: Vec<f64> = params
-        .iter()
-        .map(|p| {
-            p.normalised(scene.values.get(&p.name).copied().unwrap_or(p.min))
-                .clamp(0.0, 1.0)
-        })
-        .collect();
-    let evaluator = Evaluator {
-        scene,
-        settings,
-        rule: GaitRule::new(settings.setup_for, settings.newton, settings.homotopy),
-        start: start.clone(),
-        on_evaluation: &|| {},
-    };
-    // The scene's own design, as given (it may lie outside the box).
-    let given: Vec<f64> = params
-        .iter()
-        .map(|p| p.normalised(scene.values.get(&p.name).copied().unwrap_or(p.min)))
-        .collect();
-    let default = evaluator
-        .evaluate(scene.clone(), given, 0.0, 0.0)?
-        .evaluation;
-    on_evaluation();
-    let evaluator = Evaluator {
-        on_evaluation,
-        ..evaluator
-    };
-    // A scene error inside CMA-ES's objective (not expected: every design lies inside ranges
-    // checked above) is kept and returned after the generation.
-    let failure: Mutex<Option<SceneError>> = Mutex::new(None);
-    let outcomes: Mutex<Vec<Candidate>> = Mutex::new(Vec::new());
+    if let Some(bad) = drawn.iter().find(|u| u.len() != settings.params.len()) {
+        return Err(OptimizeError::Invalid(format!(
+            "a design has {} coordinates where {} parameters are varied",
+            bad.len(),
+            settings.params.len()
+        )));
+    }
+    Ok(Evaluator::new(scene, settings, on_evaluation).evaluate_drawn(drawn)?)
+}
+
+impl Evaluation {
+    /// The evaluation as CBOR bytes, every number bit for bit (infinities and NaN included):
+    /// how a cluster's worker returns it ([`Self::from_cbor`]).
+    pub fn to_cbor(&self) -> Vec<u8> {
+        let mut out = Vec::new();
+        // writing to a Vec cannot fail, and every field serialises
+        if ciborium::into_writer(self, &mut out).is_err() {
+            out.clear();
+        }
+        out
+    }
+
+    /// The evaluation [`Self::to_cbor`] wrote.
+    ///
+    /// # Errors
+    /// Bytes that are not such an evaluation, in words.
+    pub fn from_cbor(bytes: &[u8]) -> Result<Self, OptimizeError> {
+        ciborium::from_reader(bytes)
+            .map_err(|e| OptimizeError::Invalid(format!("not an evaluation of walker optimize: {e}")))
+    }
+}
+
+/// The key of a drawn design in the evaluations found so far: its coordinates' bits.
+fn drawn_key(u: &[f64]) -> Vec<u64> {
+    u.iter().map(|x| x.to_bits()).collect()
+}
+
+/// Where one pass of the search ([`search`]) ended.
+enum Pass {
+    /// Every candidate had its evaluation: the search is done.
+    Done(Progress, usize),
+    /// These designs (sorted, distinct) of the first generation with a candidate not
+    /// evaluated yet.
+    Missing(Vec<Vec<f64>>),
+}
+
+/// One pass of the search from the start, with the evaluations found so far (`evaluated`,
+/// by [`drawn_key`]): CMA-ES's draws depend only on the seed and on the ranks of the earlier
+/// generations, so a pass repeats the earlier passes' draws and stops at the first generation
+/// it cannot rank (returning its designs), or runs to the end.
+fn search(
+    settings: &OptimizeSettings<'_>,
+    start: &[f64],
+    evaluated: &HashMap<Vec<u64>, Evaluation>,
+) -> Result<Pass, OptimizeError> {
+    let missing: Mutex<Vec<Vec<f64>>> = Mutex::new(Vec::new());
+    let outcomes: Mutex<Vec<Evaluation>> = Mutex::new(Vec::new());
     let objective = |x: &DVector<f64>| -> f64 {
-        match evaluator.candidate(x.as_slice()) {
-            Ok(c) => {
-                let f = c.evaluation.fitness;
+        match evaluated.get(&drawn_key(x.as_slice())) {
+            Some(e) => {
                 if let Ok(mut v) = outcomes.lock() {
-                    v.push(c);
+                    v.push(e.clone());
                 }
-                f
+                e.fitness
             }
-            Err(e) => {
-                if let Ok(mut slot) = failure.lock() {
-                    slot.get_or_insert(e);
+            None => {
+                if let Ok(mut m) = missing.lock() {
+                    m.push(x.as_slice().to_vec());
                 }
-                INFEASIBLE_WITHOUT_GAIT * 10.0
+                0.0
             }
         }
     };
-    let take = |failure: &Mutex<Option<SceneError>>| -> Result<Vec<Candidate>, OptimizeError> {
-        if let Some(e) = failure.lock().ok().and_then(|mut f| f.take()) {
-            return Err(e.into());
+    let take_missing = || -> Option<Vec<Vec<f64>>> {
+        let mut m = missing.lock().map(|mut m| std::mem::take(&mut *m)).unwrap_or_default();
+        if m.is_empty() {
+            return None;
         }
-        Ok(outcomes
+        m.sort_by_cached_key(|u| drawn_key(u));
+        m.dedup_by(|a, b| drawn_key(a) == drawn_key(b));
+        Some(m)
+    };
+    let take = || -> Vec<Evaluation> {
+        outcomes
             .lock()
             .map(|mut v| std::mem::take(&mut *v))
-            .unwrap_or_default())
+            .unwrap_or_default()
     };
+    let n = settings.params.len();
     let mut state = Progress {
         evaluations: Vec::with_capacity(settings.budget),
         generations: Vec::new(),
@@ -854,7 +904,7 @@ pub fn optimize(
     };
     let lambda0 = 4 + (3.0 * (n as f64).ln()).floor() as usize;
     let (mut run, mut lambda) = (0, lambda0);
-    let (mut mean, mut sigma) = (start.clone(), settings.initial_step);
+    let (mut mean, mut sigma) = (start.to_vec(), settings.initial_step);
     let mut remaining = settings.budget;
     while remaining >= 2 {
         let population = lambda.min(remaining);
@@ -867,7 +917,10 @@ pub fn optimize(
         while remaining >= population {
             let drawn_with = cma.sigma();
             let stop = cma.next_parallel();
-            let candidates = take(&failure)?;
+            if let Some(m) = take_missing() {
+                return Ok(Pass::Missing(m));
+            }
+            let candidates = take();
             remaining -= candidates.len().min(remaining);
             state.push(settings.objective, run, drawn_with, candidates);
             if stop.is_some() {
@@ -879,10 +932,10 @@ pub fn optimize(
         if stopped {
             // IPOP: twice the population, from the best design so far, at the first step.
             lambda *= 2;
-            mean = state.best.as_ref().map_or_else(
-                || start.clone(),
+            mean = state.best.map_or_else(
+                || start.to_vec(),
                 |b| {
-                    state.evaluations[b.index]
+                    state.evaluations[b]
                         .normalised
                         .iter()
                         .map(|u| u.clamp(0.0, 1.0))
@@ -899,17 +952,136 @@ pub fn optimize(
     }
     if remaining == 1 {
         // One evaluation left: the distribution's mean.
-        let c = evaluator.candidate(&mean)?;
-        state.push(settings.objective, run, 0.0, vec![c]);
+        match evaluated.get(&drawn_key(&mean)) {
+            Some(e) => state.push(settings.objective, run, 0.0, vec![e.clone()]),
+            None => return Ok(Pass::Missing(vec![mean])),
+        }
         run += 1;
     }
+    Ok(Pass::Done(state, run))
+}
+
+/// Optimises `settings.objective` over `settings.params` from `scene`'s design (see the
+/// [module docs](self)), calling `on_evaluation` after each evaluation (from any thread): the
+/// scene's own design first, then every candidate, `budget + 1` calls in all. The calls have
+/// no effect on the search.
+///
+/// # Errors
+/// A request [`check`] refuses, or a scene that cannot be built at a design.
+pub fn optimize(
+    scene: &Scene,
+    settings: &OptimizeSettings<'_>,
+    on_evaluation: &(dyn Fn() + Sync),
+) -> Result<OptimizeResult, OptimizeError> {
+    optimize_with(scene, settings, on_evaluation, None)
+}
+
+/// [`optimize`] with each generation's new candidates evaluated by `evaluate` (a cluster's
+/// workers) instead of on this machine's threads: the same search, bit for bit, since an
+/// evaluation is a pure function of its design ([`evaluate_drawn`]). `on_evaluation` hears of
+/// the evaluations made here (the scene's design, and the candidates when `evaluate` is
+/// `None`). The search is repeated from its start for each generation (the candidates CMA-ES
+/// draws depend only on the seed and the earlier generations' ranks; the `cmaes` crate
+/// evaluates inside its step, so a pass stops at the first generation not evaluated yet, its
+/// candidates are evaluated, and the next pass ranks them): CMA-ES's own work grows with the
+/// square of the generations, microseconds each against a gait's milliseconds.
+///
+/// # Errors
+/// A request [`check`] refuses, a scene that cannot be built at a design, or `evaluate`'s
+/// error (or its answer for another number of designs).
+pub fn optimize_with(
+    scene: &Scene,
+    settings: &OptimizeSettings<'_>,
+    on_evaluation: &(dyn Fn() + Sync),
+    evaluate: Option<&EvaluateDrawn<'_>>,
+) -> Result<OptimizeResult, OptimizeError> {
+    check(scene, settings)?;
+    let params = settings.params;
+    let evaluator = Evaluator::new(scene, settings, &|| {});
+    // The scene's own design, as given (it may lie outside the box).
+    let given: Vec<f64> = params
+        .iter()
+        .map(|p| p.normalised(scene.values.get(&p.name).copied().unwrap_or(p.min)))
+        .collect();
+    let default = evaluator.evaluate(scene.clone(), given, 0.0, 0.0)?;
+    on_evaluation();
+    let evaluator = Evaluator {
+        on_evaluation,
+        ..evaluator
+    };
+    let mut evaluated: HashMap<Vec<u64>, Evaluation> = HashMap::new();
+    // Each pass evaluates at least one design, and a search evaluates `budget` designs: at
+    // most `budget + 1` passes.
+    for _ in 0..=settings.budget {
+        let drawn = match search(settings, &evaluator.start, &evaluated)? {
+            Pass::Done(state, runs) => {
+                return finish(&evaluator, params, default, state, runs);
+            }
+            Pass::Missing(drawn) => drawn,
+        };
+        let found = match evaluate {
+            Some(f) => f(&drawn)?,
+            None => evaluator.evaluate_drawn(&drawn)?,
+        };
+        if found.len() != drawn.len() {
+            return Err(OptimizeError::Invalid(format!(
+                "{} evaluations for {} designs",
+                found.len(),
+                drawn.len()
+            )));
+        }
+        for (u, e) in drawn.iter().zip(found) {
+            if drawn_key(&e.normalised) != drawn_key(u) {
+                return Err(OptimizeError::Invalid(
+                    "an evaluation of another design than the one sent".to_owned(),
+                ));
+            }
+            evaluated.insert(drawn_key(u), e);
+        }
+    }
+    Err(OptimizeError::Invalid(
+        "the search did not end within its budget of passes".to_owned(),
+    ))
+}
+
+/// The result of a finished search: the best design's gait found again (the gait rule
+/// gives the same gait for the same design, wherever the design was evaluated).
+fn finish(
+    evaluator: &Evaluator<'_>,
+    params: &[VariedParameter],
+    default: Evaluation,
+    state: Progress,
+    runs: usize,
+) -> Result<OptimizeResult, OptimizeError> {
+    let best = match state.best {
+        Some(index) => {
+            let clipped: Vec<f64> = state.evaluations[index]
+                .normalised
+                .iter()
+                .map(|u| u.clamp(0.0, 1.0))
+                .collect();
+            let scene = evaluator.design(&clipped)?;
+            let (gait, source) = evaluator.rule.gait(&scene)?.map_err(|e| {
+                OptimizeError::Invalid(format!(
+                    "the best design's gait was not found again: {e}"
+                ))
+            })?;
+            Some(BestDesign {
+                index,
+                scene,
+                gait,
+                source,
+            })
+        }
+        None => None,
+    };
     Ok(OptimizeResult {
         parameters: params.to_vec(),
         default,
         evaluations: state.evaluations,
         generations: state.generations,
-        best: state.best,
-        runs: run,
+        best,
+        runs,
     })
 }
 

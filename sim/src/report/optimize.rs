@@ -9,8 +9,8 @@ use super::GaitReport;
 use crate::analysis::homotopy::{HomotopySettings, SetupFor};
 use crate::analysis::limit_cycle::NewtonSettings;
 use crate::analysis::optimize::{
-    check, optimize, Constraint, ConstraintParseError, Evaluation, Generation, Objective,
-    OptimizeError, OptimizeSettings, Sense, VariedParameter, BOUND_PENALTY, INITIAL_STEP,
+    check, evaluate_drawn, optimize_with, Constraint, ConstraintParseError, Evaluation, Generation, Objective,
+    EvaluateDrawn, OptimizeError, OptimizeSettings, Sense, VariedParameter, BOUND_PENALTY, INITIAL_STEP,
 };
 use crate::analysis::quantity::{Quantity, QuantityError, QuantityOptions};
 use crate::scene::{Scene, SceneError};
@@ -387,6 +387,51 @@ pub struct Best {
     pub gait: GaitReport,
 }
 
+impl OptimizeRequest {
+    /// The search's settings for this request, designs built by `setup_for`.
+    pub fn settings<'a>(
+        &'a self,
+        setup_for: &'a SetupFor<'a>,
+        newton: &'a NewtonSettings,
+        homotopy: &'a HomotopySettings,
+    ) -> OptimizeSettings<'a> {
+        OptimizeSettings {
+            params: &self.params,
+            objective: self.objective,
+            constraints: &self.constraints,
+            budget: self.budget,
+            seed: self.seed,
+            initial_step: self.initial_step,
+            setup_for,
+            newton,
+            homotopy,
+            quantity_options: self.quantity_options,
+        }
+    }
+
+    /// The evaluations of `drawn` (designs in normalised coordinates) for this search from
+    /// `scene`'s design: a cluster worker's task ([`evaluate_drawn`]), each as CBOR bytes
+    /// ([`Evaluation::to_cbor`]).
+    ///
+    /// # Errors
+    /// As [`OptimizeReport::run`].
+    pub fn evaluate_drawn(
+        &self,
+        scene: &Scene,
+        drawn: &[Vec<f64>],
+        setup_for: &SetupFor<'_>,
+        newton: &NewtonSettings,
+        homotopy: &HomotopySettings,
+        on_evaluation: &(dyn Fn() + Sync),
+    ) -> Result<Vec<Vec<u8>>, OptimizeOptionError> {
+        let settings = self.settings(setup_for, newton, homotopy);
+        Ok(evaluate_drawn(scene, &settings, drawn, on_evaluation)?
+            .iter()
+            .map(Evaluation::to_cbor)
+            .collect())
+    }
+}
+
 impl OptimizeReport {
     /// Runs the search `request` from `scene`'s design, each design built by `setup_for` (the
     /// front end's solver options), gaits found with `newton` and `homotopy`, `on_evaluation`
@@ -405,20 +450,35 @@ impl OptimizeReport {
         homotopy: &HomotopySettings,
         on_evaluation: &(dyn Fn() + Sync),
     ) -> Result<Self, OptimizeOptionError> {
-        let settings = OptimizeSettings {
-            params: &request.params,
-            objective: request.objective,
-            constraints: &request.constraints,
-            budget: request.budget,
-            seed: request.seed,
-            initial_step: request.initial_step,
+        Self::run_with(
+            scene,
+            request,
             setup_for,
             newton,
             homotopy,
-            quantity_options: request.quantity_options,
-        };
+            on_evaluation,
+            None,
+        )
+    }
+
+    /// [`Self::run`] with each generation's new candidates evaluated by `evaluate` (a
+    /// cluster's workers, each running [`evaluate_drawn`] on the same request):
+    /// [`optimize_with`]. The same report, bit for bit.
+    ///
+    /// # Errors
+    /// As [`Self::run`], and `evaluate`'s errors.
+    pub fn run_with(
+        scene: &Scene,
+        request: &OptimizeRequest,
+        setup_for: &SetupFor<'_>,
+        newton: &NewtonSettings,
+        homotopy: &HomotopySettings,
+        on_evaluation: &(dyn Fn() + Sync),
+        evaluate: Option<&EvaluateDrawn<'_>>,
+    ) -> Result<Self, OptimizeOptionError> {
+        let settings = request.settings(setup_for, newton, homotopy);
         check(scene, &settings)?;
-        let result = optimize(scene, &settings, on_evaluation)?;
+        let result = optimize_with(scene, &settings, on_evaluation, evaluate)?;
         let best = match &result.best {
             Some(b) => {
                 let setup = setup_for(&b.scene).map_err(OptimizeError::Scene)?;

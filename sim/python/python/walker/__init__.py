@@ -500,6 +500,12 @@ def optimize(
     :class:`SceneError` (an unknown parameter, a range outside the parameter's),
     ``KeyboardInterrupt`` on Ctrl-C (at the next gait search).
     """
+    return _optimize(scene, vary, objective, constraints, budget, seed, initial_step, sigma_m, progress, None)
+
+
+def _optimize(scene, vary, objective, constraints, budget, seed, initial_step, sigma_m, progress, evaluate):
+    """:func:`optimize`, each generation's new candidates evaluated by ``evaluate`` (a
+    callable of the extension's ``optimize``; ``walker.studies.optimize``) if given."""
     s = _scene(scene)
     ranges, texts = _ranges(vary), _constraints(constraints)
     report = _with_progress(
@@ -516,6 +522,7 @@ def optimize(
             initial_step=float(initial_step),
             sigma_m=None if sigma_m is None else float(sigma_m),
             progress=f,
+            evaluate=None if evaluate is None else evaluate(s, ranges, texts),
         ),
     )
     result = Optimize.from_report(report)
@@ -523,6 +530,6 @@ def optimize(
         warnings.warn(
             f"walker.optimize: no feasible design among {len(report['evaluations'])} evaluations",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
     return result

@@ -1,7 +1,7 @@
 """Studies that outgrow one process: a study split into pure tasks that run in this process or
 on a Ray cluster (``executor="ray"``), its results written as they arrive to a study file
 (Parquet) from which an interrupted study resumes. The result is the same, bit for bit, as the
-one-process function's (:func:`walker.stability_map`), whatever the executor, the number of
+one-process function's (:func:`walker.stability_map`, :func:`walker.optimize`), whatever the executor, the number of
 workers, the split or the retries (docs/cluster.md).
 
 >>> import walker.studies
@@ -16,6 +16,7 @@ From a shell: ``python -m walker.studies stability-map --help``.
 from __future__ import annotations
 
 from ._executor import EXECUTORS, RAY_TASK_RETRIES
+from ._optimize import optimize
 from ._stability_map import LOCAL_BLOCK_CELLS, TASKS_PER_CPU, stability_map
 from ._study_file import METADATA_KEY
 
@@ -25,5 +26,6 @@ __all__ = [
     "METADATA_KEY",
     "RAY_TASK_RETRIES",
     "TASKS_PER_CPU",
+    "optimize",
     "stability_map",
 ]
