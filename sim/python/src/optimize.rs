@@ -11,8 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use sim::analysis::optimize::{EvaluateDrawn, Evaluation, OptimizeError, INITIAL_STEP};
 use sim::report::{
-    OptimizeOptionError, OptimizeOptions, OptimizeReport, OptimizeRequest,
-    MAX_OPTIMIZE_EVALUATIONS,
+    OptimizeOptionError, OptimizeOptions, OptimizeReport, OptimizeRequest, MAX_OPTIMIZE_EVALUATIONS,
 };
 use sim::stride::SearchBudget;
 use std::sync::{Arc, Mutex};
@@ -159,7 +158,9 @@ pub fn optimize<'py>(
                     if let Ok(mut slot) = raised_ref.lock() {
                         slot.get_or_insert(e);
                     }
-                    Err(OptimizeError::Invalid("evaluate raised an exception".to_owned()))
+                    Err(OptimizeError::Invalid(
+                        "evaluate raised an exception".to_owned(),
+                    ))
                 }
             }
         }
@@ -233,8 +234,5 @@ pub fn optimize_evaluate<'py>(
             .map_err(Box::new)
     })?
     .map_err(|e| option_error(py, &e))?;
-    Ok(found
-        .iter()
-        .map(|b| PyBytes::new(py, b).unbind())
-        .collect())
+    Ok(found.iter().map(|b| PyBytes::new(py, b).unbind()).collect())
 }

@@ -365,14 +365,38 @@ pub fn _restore_scene(
     let kwargs = solver.copy()?;
     scene.with_solver(
         py,
-        kwargs.get_item("integrator")?.map(|v| v.extract()).transpose()?.flatten(),
-        kwargs.get_item("step_s")?.map(|v| v.extract()).transpose()?.flatten(),
-        kwargs.get_item("rtol")?.map(|v| v.extract()).transpose()?.flatten(),
-        kwargs.get_item("newton_tol")?.map(|v| v.extract()).transpose()?,
+        kwargs
+            .get_item("integrator")?
+            .map(|v| v.extract())
+            .transpose()?
+            .flatten(),
+        kwargs
+            .get_item("step_s")?
+            .map(|v| v.extract())
+            .transpose()?
+            .flatten(),
+        kwargs
+            .get_item("rtol")?
+            .map(|v| v.extract())
+            .transpose()?
+            .flatten(),
+        kwargs
+            .get_item("newton_tol")?
+            .map(|v| v.extract())
+            .transpose()?,
         kwargs.get_item("newton_max_iter")?.as_ref(),
         kwargs.get_item("max_strides")?.as_ref(),
-        kwargs.get_item("perturbation")?.map(|v| v.extract()).transpose()?,
-        kwargs.get_item("frozen_steps")?.map(|v| v.extract()).transpose()?,
-        kwargs.get_item("jacobian")?.map(|v| v.extract()).transpose()?,
+        kwargs
+            .get_item("perturbation")?
+            .map(|v| v.extract())
+            .transpose()?,
+        kwargs
+            .get_item("frozen_steps")?
+            .map(|v| v.extract())
+            .transpose()?,
+        kwargs
+            .get_item("jacobian")?
+            .map(|v| v.extract())
+            .transpose()?,
     )
 }

@@ -156,3 +156,57 @@ def test_cluster():
     checks = [line for line in out.stdout.splitlines() if line.startswith("ok: ")]
     assert out.returncode == 0, out.stdout + out.stderr[-6000:]
     assert len(checks) == 15, checks
+
+
+# step_down: about 15 ms a candidate, so that the search is still running when it is stopped
+OPTIMIZE = dict(vary={"slope_rad": (0.02, 0.07), "leg_mass_kg": (2.0, 8.0)}, objective="step_down",
+                budget=30, seed=3)
+
+
+def test_optimize_as_a_study_equals_the_one_process_search_and_resumes_from_its_file(tmp_path):
+    best = walker.optimize(SCENE, progress=False, **OPTIMIZE)
+    path = tmp_path / "search.parquet"
+
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        if done >= 10:
+            raise Stop
+
+    with pytest.raises(Stop):
+        studies.optimize(SCENE, study_file=path, progress=stop, **OPTIMIZE)
+    kept = len(pd.read_parquet(path))
+    assert 0 < kept < 30
+    again = studies.optimize(SCENE, study_file=path, progress=False, **OPTIMIZE)
+    assert again.report == best.report
+    table = pd.read_parquet(path)
+    assert len(table) == 30 and list(table["n"]) == list(range(30))
+    with pytest.raises(walker.InputError, match=r"seed: 3 in the file, 4 now"):
+        studies.optimize(SCENE, study_file=path, progress=False, **{**OPTIMIZE, "seed": 4})
+    with pytest.raises(walker.InputError, match=r"study: 'optimize' in the file, 'stability_map' now"):
+        studies.stability_map(SCENE, X, Y, study_file=path, progress=False)
+
+
+def test_an_evaluator_that_answers_for_other_designs_is_refused():
+    from walker import _walker
+
+    s = SCENE
+    ranges = ["slope_rad=0.02:0.07"]
+
+    def liar(scene, ranges_, texts):
+        def batch(drawn):
+            other = [[u[0] + 1e-3] for u in drawn]
+            return _walker.optimize_evaluate(scene, ranges_, "max_abs_eigenvalue", other, budget=8)
+        return batch
+
+    with pytest.raises(walker.InputError, match="another design"):
+        walker._optimize(s, ranges, "max_abs_eigenvalue", (), 8, 0, 0.25, None, False, liar)
+
+    def raises(scene, ranges_, texts):
+        def batch(drawn):
+            raise ZeroDivisionError("the cluster is gone")
+        return batch
+
+    with pytest.raises(ZeroDivisionError, match="the cluster is gone"):
+        walker._optimize(s, ranges, "max_abs_eigenvalue", (), 8, 0, 0.25, None, False, raises)

@@ -764,9 +764,11 @@ impl Progress {
                 if best_value.is_none_or(|b| objective.better(v, b)) {
                     best_value = Some(v);
                 }
-                let better = self
-                    .best
-                    .is_none_or(|b| self.evaluations[b].value.is_none_or(|bv| objective.better(v, bv)));
+                let better = self.best.is_none_or(|b| {
+                    self.evaluations[b]
+                        .value
+                        .is_none_or(|bv| objective.better(v, bv))
+                });
                 if better {
                     self.best = Some(index);
                 }
@@ -835,8 +837,9 @@ impl Evaluation {
     /// # Errors
     /// Bytes that are not such an evaluation, in words.
     pub fn from_cbor(bytes: &[u8]) -> Result<Self, OptimizeError> {
-        ciborium::from_reader(bytes)
-            .map_err(|e| OptimizeError::Invalid(format!("not an evaluation of walker optimize: {e}")))
+        ciborium::from_reader(bytes).map_err(|e| {
+            OptimizeError::Invalid(format!("not an evaluation of walker optimize: {e}"))
+        })
     }
 }
 
@@ -882,7 +885,10 @@ fn search(
         }
     };
     let take_missing = || -> Option<Vec<Vec<f64>>> {
-        let mut m = missing.lock().map(|mut m| std::mem::take(&mut *m)).unwrap_or_default();
+        let mut m = missing
+            .lock()
+            .map(|mut m| std::mem::take(&mut *m))
+            .unwrap_or_default();
         if m.is_empty() {
             return None;
         }
@@ -1062,9 +1068,7 @@ fn finish(
                 .collect();
             let scene = evaluator.design(&clipped)?;
             let (gait, source) = evaluator.rule.gait(&scene)?.map_err(|e| {
-                OptimizeError::Invalid(format!(
-                    "the best design's gait was not found again: {e}"
-                ))
+                OptimizeError::Invalid(format!("the best design's gait was not found again: {e}"))
             })?;
             Some(BestDesign {
                 index,

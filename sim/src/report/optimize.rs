@@ -9,8 +9,9 @@ use super::GaitReport;
 use crate::analysis::homotopy::{HomotopySettings, SetupFor};
 use crate::analysis::limit_cycle::NewtonSettings;
 use crate::analysis::optimize::{
-    check, evaluate_drawn, optimize_with, Constraint, ConstraintParseError, Evaluation, Generation, Objective,
-    EvaluateDrawn, OptimizeError, OptimizeSettings, Sense, VariedParameter, BOUND_PENALTY, INITIAL_STEP,
+    check, evaluate_drawn, optimize_with, Constraint, ConstraintParseError, EvaluateDrawn,
+    Evaluation, Generation, Objective, OptimizeError, OptimizeSettings, Sense, VariedParameter,
+    BOUND_PENALTY, INITIAL_STEP,
 };
 use crate::analysis::quantity::{Quantity, QuantityError, QuantityOptions};
 use crate::scene::{Scene, SceneError};

@@ -93,6 +93,11 @@ class StudyFile:
             spec = stored["spec"]
         except (ValueError, KeyError, TypeError) as e:
             raise InputError(f"study file {self.path}: its study metadata cannot be read ({e})") from e
+        if isinstance(spec, dict) and spec.get("study") != self.spec.get("study"):
+            raise InputError(
+                f"study file {self.path} holds another study: study: {spec.get('study')!r} in the file, "
+                f"{self.spec.get('study')!r} now. Give another file, or delete this one to start afresh"
+            )
         diff = differences(spec, self.spec)
         if diff:
             shown = "; ".join(diff[:MAX_DIFFERENCES])
