@@ -40,7 +40,10 @@ def main() -> int:
     x, y = axis("slope", 0.01, 0.08, args.points), axis("leg_mass_kg", 1.0, 10.0, args.points)
     cells = args.points**2
     small_x, small_y = axis("slope", 0.01, 0.08, 20), axis("leg_mass_kg", 1.0, 10.0, 20)
+    search = dict(vary={"slope_rad": (0.02, 0.07), "leg_mass_kg": (2.0, 8.0)}, objective="step_down",
+                  budget=120, seed=3, progress=False)
     rows: dict[str, float] = {}
+    searches: dict[str, float] = {}
     cluster = Cluster(workers=2)
     try:
         cluster.connect(ray)
@@ -51,6 +54,10 @@ def main() -> int:
         two_s, on_two = timed(lambda: studies.stability_map(scene, x, y, executor="ray", progress=False))
         assert on_two.report == reference.report
         rows["Ray, 2 worker processes, one row a task"] = two_s
+        searches["one process, rayon on 2 threads"], best = timed(lambda: walker.optimize(scene, **search))
+        searches["Ray, 2 worker processes, one candidate a task"], found = timed(
+            lambda: studies.optimize(scene, executor="ray", **search))
+        assert found.report == best.report
         rows_s, _ = timed(lambda: studies.stability_map(scene, small_x, small_y, executor="ray", progress=False,
                                                         cells_per_task=20))
         single_s, _ = timed(lambda: studies.stability_map(scene, small_x, small_y, executor="ray", progress=False,
@@ -65,6 +72,9 @@ def main() -> int:
         one_s, on_one = timed(lambda: studies.stability_map(scene, x, y, executor="ray", progress=False))
         assert on_one.report == reference.report
         rows["Ray, 1 worker process, one row a task"] = one_s
+        searches["Ray, 1 worker process, one candidate a task"], found = timed(
+            lambda: studies.optimize(scene, executor="ray", **search))
+        assert found.report == best.report
     finally:
         ray.shutdown()
         cluster.stop()
@@ -75,7 +85,17 @@ def main() -> int:
                 f", {os.cpu_count()} CPUs"
     except (OSError, StopIteration):
         pass
+    import pickle
+
+    from walker import _walker
+    from walker.studies._stability_map import map_block
+
+    row_bytes = len(pickle.dumps(map_block(scene, x[0], x[1], y[0], y[1][:1], None, None)))
+    ranges = ["slope_rad=0.02:0.07", "leg_mass_kg=2.0:8.0"]
+    evaluation_bytes = len(_walker.optimize_evaluate(scene, ranges, "step_down", [[0.5, 0.5]], budget=120, seed=3)[0])
     result = {"machine": machine, "cells": cells, "seconds": rows, "ray_cost_per_task_ms": per_task_ms,
+              "optimize_seconds": searches, "optimize_evaluations": search["budget"] + 1,
+              "bytes_returned": {"map_row": row_bytes, "evaluation": evaluation_bytes},
               "versions": {"ray": ray.__version__, "python": platform.python_version()}}
     with open(args.out, "w") as f:
         json.dump(result, f, indent=1)
@@ -83,6 +103,11 @@ def main() -> int:
     print("| run | wall [s] | cells/s |\n| --- | --- | --- |")
     for name, s in rows.items():
         print(f"| {name} | {s:.2f} | {cells / s:.0f} |")
+    print(f"\noptimize, step_down, {search['budget']} candidates\n")
+    print("| run | wall [s] | candidates/s |\n| --- | --- | --- |")
+    for name, sec in searches.items():
+        print(f"| {name} | {sec:.2f} | {search['budget'] / sec:.1f} |")
+    print(f"\nbytes returned: a map row of {args.points} cells {row_bytes}, an evaluation {evaluation_bytes}")
     print(f"\nRay's cost per task (400 one-cell tasks against 20 one-row tasks, 2 workers): {per_task_ms:.2f} ms")
     return 0
 
