@@ -191,7 +191,25 @@ def optimize(
     initial_step: float = ...,
     sigma_m: float | None = None,
     progress: Callable[[int, int], None] | None = None,
+    evaluate: Callable[[list[list[float]]], list[bytes]] | None = None,
 ) -> dict[str, Any]:
     """The ``walker optimize --json`` object of CMA-ES over the ranges ``vary``
     (``NAME=MIN:MAX``) for ``objective`` under ``constraints`` (``NAME<=V``); raises
-    ``InputError`` or ``SceneError``."""
+    ``InputError`` or ``SceneError``. ``evaluate``: each generation's new candidates
+    (normalised designs) to their evaluations as :func:`optimize_evaluate` makes them (a
+    cluster's workers); its exception is raised here."""
+
+def optimize_evaluate(
+    scene: Scene,
+    vary: list[str],
+    objective: str,
+    drawn: list[list[float]],
+    *,
+    constraints: list[str] = ...,
+    budget: int | None = None,
+    seed: int | None = None,
+    initial_step: float = ...,
+    sigma_m: float | None = None,
+) -> list[bytes]:
+    """The evaluations (CBOR, bit for bit) of the designs ``drawn`` (normalised) for the
+    search :func:`optimize` runs with the same arguments: a cluster worker's task."""
