@@ -10,8 +10,10 @@
 /// floor's seeded normal draws, `statrs` for the chi-square quantiles of the first-passage
 /// time's exact interval (the same version the `cmaes` optimiser uses), and `cmaes` for
 /// `walker optimize` (a well-kept implementation of Hansen's CMA-ES with restarts, seeded, on
-/// the same nalgebra; without its plotting).
-const ALLOWED: [&str; 15] = [
+/// the same nalgebra; without its plotting), and `ciborium` for an optimisation's evaluations
+/// sent to and from a cluster's workers bit for bit (CBOR; already in the lock through
+/// criterion).
+const ALLOWED: [&str; 16] = [
     "ankle-profile",
     "nalgebra",
     "num-dual",
@@ -27,6 +29,7 @@ const ALLOWED: [&str; 15] = [
     "rand_distr",
     "statrs",
     "cmaes",
+    "ciborium",
 ];
 
 const FORBIDDEN: [&str; 12] = [
