@@ -52,6 +52,7 @@ fn _walker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(basin::basin, m)?)?;
     m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
     m.add_function(wrap_pyfunction!(optimize::optimize_evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(quantity::check_quantity, m)?)?;
     m.add(
         "MAX_OPTIMIZE_EVALUATIONS",
         sim::report::MAX_OPTIMIZE_EVALUATIONS,

@@ -8,7 +8,7 @@ use crate::gait::setup_for;
 use crate::interrupt::{self, Counter};
 use crate::scene::PyScene;
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyCFunction, PyDict, PyTuple};
 use sim::analysis::optimize::{EvaluateDrawn, Evaluation, OptimizeError, INITIAL_STEP};
 use sim::report::{
     OptimizeOptionError, OptimizeOptions, OptimizeReport, OptimizeRequest, MAX_OPTIMIZE_EVALUATIONS,
@@ -96,10 +96,11 @@ fn request(
 /// `walker.SceneError` (an unknown parameter, a range outside the parameter's).
 ///
 /// `evaluate`, if given, evaluates each generation's new candidates instead of this
-/// process's threads (a cluster's workers: `walker.studies.optimize`): called with the
-/// designs as a list of lists of floats (normalised coordinates), it returns one `bytes` per
-/// design, in order, as `optimize_evaluate` makes them for the same arguments; an exception
-/// it raises ends the search and is raised here.
+/// process's threads (a cluster's workers: `walker.studies.optimize`): called as
+/// `evaluate(designs, cancelled)` with the designs as a list of lists of floats (normalised
+/// coordinates) and a callable that turns true once Ctrl-C or `progress` has stopped the
+/// search, it returns one `bytes` per design, in order, as `optimize_evaluate` makes them for
+/// the same arguments; an exception it raises ends the search and is raised here.
 #[pyfunction]
 #[pyo3(signature = (
     scene, vary, objective, *, constraints = Vec::new(), budget = None, seed = None,
@@ -143,7 +144,18 @@ pub fn optimize<'py>(
                 return Err(OptimizeError::Invalid("interrupted".to_owned()));
             }
             let answer = Python::attach(|py| -> PyResult<Vec<Vec<u8>>> {
-                f.call1(py, (drawn.to_vec(),))?.extract(py)
+                // `cancelled()`: whether Ctrl-C or the progress callable stopped the search,
+                // for `evaluate` to stop waiting on its workers
+                let budget = Arc::clone(cancel_ref);
+                let cancelled = PyCFunction::new_closure(
+                    py,
+                    None,
+                    None,
+                    move |_args: &Bound<'_, PyTuple>, _kwargs: Option<&Bound<'_, PyDict>>| {
+                        budget.is_cancelled()
+                    },
+                )?;
+                f.call1(py, (drawn.to_vec(), cancelled))?.extract(py)
             });
             match answer {
                 Ok(bytes) => {
@@ -187,12 +199,13 @@ pub fn optimize<'py>(
 /// The evaluations of `drawn` (designs in normalised coordinates, a list of lists of floats)
 /// for the search `optimize` runs with the same arguments: one `bytes` each, in order — the
 /// task of a cluster's worker (`walker.studies.optimize`), a pure function of its arguments.
-/// Runs without the GIL on every core the process allows; Ctrl-C stops it. Raises as
-/// `optimize`, and `walker.InputError` for a design with another number of coordinates.
+/// Runs without the GIL on every core the process allows; Ctrl-C stops it, as does an
+/// exception of `progress(done, total)` (which is raised). Raises as `optimize`, and
+/// `walker.InputError` for a design with another number of coordinates.
 #[pyfunction]
 #[pyo3(signature = (
     scene, vary, objective, drawn, *, constraints = Vec::new(), budget = None, seed = None,
-    initial_step = INITIAL_STEP, sigma_m = None
+    initial_step = INITIAL_STEP, sigma_m = None, progress = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn optimize_evaluate<'py>(
@@ -206,6 +219,7 @@ pub fn optimize_evaluate<'py>(
     seed: Option<&Bound<'py, PyAny>>,
     initial_step: f64,
     sigma_m: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Vec<Py<PyBytes>>> {
     let request = request(
         py,
@@ -220,7 +234,7 @@ pub fn optimize_evaluate<'py>(
     )?;
     let solver = &scene.solver;
     let cancel = Arc::new(SearchBudget::new(usize::MAX));
-    let counter = Counter::new(drawn.len(), None);
+    let counter = Counter::new(drawn.len(), progress);
     let found = interrupt::run_counted(py, &[&cancel], &counter, || {
         request
             .evaluate_drawn(

@@ -52,3 +52,16 @@ pub fn choose(
     }
     Ok((quantity, options))
 }
+
+/// Checks `quantity=` and `sigma_m=` as `stability_map` does, before anything is computed (a
+/// study on a cluster checks them before it contacts the cluster or writes its file). Raises
+/// `walker.InputError` as `stability_map` would.
+#[pyfunction]
+#[pyo3(signature = (quantity = None, sigma_m = None))]
+pub fn check_quantity(
+    py: Python<'_>,
+    quantity: Option<String>,
+    sigma_m: Option<f64>,
+) -> PyResult<()> {
+    choose(py, quantity.as_deref(), sigma_m).map(|_| ())
+}

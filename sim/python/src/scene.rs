@@ -107,6 +107,20 @@ impl PyScene {
         self.inner.name()
     }
 
+    /// The text of the scene file this scene was parsed from (a built-in scene's own text):
+    /// what a study file records, by its hash, so that a changed file is not taken for the
+    /// same study.
+    #[getter]
+    fn file_text(&self) -> &str {
+        match &self.text {
+            Some(t) => t,
+            None => BUILTIN
+                .iter()
+                .find(|(n, _)| *n == self.source)
+                .map_or("", |(_, t)| t),
+        }
+    }
+
     /// The parameter values, `{name: value}` (units in `parameters()`).
     #[getter]
     fn values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

@@ -3,7 +3,7 @@
 
 Run inside a network namespace of its own with only the loopback interface up (``unshare -n``,
 ``ip link set lo up``): outside one, Ray advertises and connects to the machine's other
-address even when told 127.0.0.1. ``test_walker_studies_ray.py`` runs
+address even when told 127.0.0.1. ``test_walker_studies.py::test_cluster`` runs
 ``ray_cluster_check.py`` so.
 """
 
@@ -20,6 +20,11 @@ import time
 HOST = "127.0.0.1"
 START_BUDGET_S = 120.0
 """How long the nodes may take to join [s]."""
+
+AUTH_MODE = "disabled"
+"""Ray's token authentication, off for the test cluster (loopback only, in a namespace of its
+own): left unset, a token in ``~/.ray/auth_token`` (any local ``ray.init()`` writes one)
+switches it on for the nodes and not for the driver. The driver sets ``RAY_AUTH_MODE`` too."""
 
 
 class Cluster:
@@ -53,7 +58,7 @@ class Cluster:
     def _start(self, args: list[str], name: str) -> subprocess.Popen:
         log = os.path.join(self.temp, f"{name}.log")
         self.logs.append(log)
-        env = dict(os.environ, RAY_USAGE_STATS_ENABLED="0")
+        env = dict(os.environ, RAY_USAGE_STATS_ENABLED="0", RAY_AUTH_MODE=AUTH_MODE)
         p = subprocess.Popen(
             [self.ray, "start", "--block", f"--node-ip-address={HOST}", "--disable-usage-stats", *args],
             stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True, env=env,
@@ -74,13 +79,47 @@ class Cluster:
         raise RuntimeError(f"the cluster has {ray.cluster_resources()} after {START_BUDGET_S} s, not {cpus} CPUs: "
                            + self.tail())
 
+    @staticmethod
+    def _session(p: subprocess.Popen) -> list[int]:
+        """The processes of node ``p``'s session: its ``ray start``, raylet, agents and
+        workers (a task's worker has a process group of its own, not a session)."""
+        out = []
+        for pid in os.listdir("/proc"):
+            if pid.isdigit():
+                try:
+                    if os.getsid(int(pid)) == p.pid:
+                        out.append(int(pid))
+                except (OSError, ProcessLookupError):
+                    pass
+        return out
+
     def kill(self, p: subprocess.Popen) -> None:
-        """Kills a node: its ``ray start`` process, its raylet and its workers (the group)."""
-        try:
-            os.killpg(p.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
+        """Kills a node: every process of its session (``ray start``, raylet, workers)."""
+        for pid in self._session(p):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
         p.wait(timeout=30)
+
+    def kill_when_running(self, p: subprocess.Popen, task: str, budget_s: float = 120.0) -> bool:
+        """Kills node ``p`` as soon as one of its workers runs ``task`` (Ray titles a worker
+        process ``ray::<task>`` while it runs one), so that the kill lands on a running task;
+        ``False`` if none ran within ``budget_s``."""
+        title = f"ray::{task}".encode()
+        deadline = time.monotonic() + budget_s
+        while time.monotonic() < deadline:
+            for pid in self._session(p):
+                try:
+                    with open(f"/proc/{pid}/cmdline", "rb") as f:
+                        running = f.read().startswith(title)
+                except OSError:
+                    continue
+                if running:
+                    self.kill(p)
+                    return True
+            time.sleep(0.01)
+        return False
 
     def tail(self) -> str:
         out = []

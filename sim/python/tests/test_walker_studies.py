@@ -152,10 +152,22 @@ def test_cluster():
             pytest.fail(f"WALKER_REQUIRE_RAY is set and the Ray cluster cannot run: {why}")
         pytest.skip(why)
     script = f"ip link set lo up && exec {sys.executable} {HERE / 'ray_cluster_check.py'}"
-    out = subprocess.run(["unshare", "-n", "sh", "-c", script], capture_output=True, text=True, timeout=900)
+    try:
+        out = subprocess.run(["unshare", "-n", "sh", "-c", script], capture_output=True, text=True, timeout=900)
+    except subprocess.TimeoutExpired as e:
+        # the check stops its cluster at its own deadline (600 s); past this one, its nodes
+        # (each in a session of its own) are found by their temp dir and killed
+        text = e.stdout.decode() if isinstance(e.stdout, bytes) else (e.stdout or "")
+        temp = next((line.split(": ", 1)[1] for line in text.splitlines() if line.startswith("cluster temp dir: ")), None)
+        if temp:
+            subprocess.run(["pkill", "-9", "-f", temp])
+        raise
     checks = [line for line in out.stdout.splitlines() if line.startswith("ok: ")]
     assert out.returncode == 0, out.stdout + out.stderr[-6000:]
     assert len(checks) == 15, checks
+    # the killed nodes were running tasks, which Ray ran again (its driver log says so)
+    assert "Task map_block failed" in out.stdout + out.stderr, out.stdout[-3000:]
+    assert "Task optimize_block failed" in out.stdout + out.stderr, out.stdout[-3000:]
 
 
 # step_down: about 15 ms a candidate, so that the search is still running when it is stopped
@@ -195,7 +207,7 @@ def test_an_evaluator_that_answers_for_other_designs_is_refused():
     ranges = ["slope_rad=0.02:0.07"]
 
     def liar(scene, ranges_, texts):
-        def batch(drawn):
+        def batch(drawn, cancelled):
             other = [[u[0] + 1e-3] for u in drawn]
             return _walker.optimize_evaluate(scene, ranges_, "max_abs_eigenvalue", other, budget=8)
         return batch
@@ -204,9 +216,37 @@ def test_an_evaluator_that_answers_for_other_designs_is_refused():
         walker._optimize(s, ranges, "max_abs_eigenvalue", (), 8, 0, 0.25, None, False, liar)
 
     def raises(scene, ranges_, texts):
-        def batch(drawn):
+        def batch(drawn, cancelled):
             raise ZeroDivisionError("the cluster is gone")
         return batch
 
     with pytest.raises(ZeroDivisionError, match="the cluster is gone"):
         walker._optimize(s, ranges, "max_abs_eigenvalue", (), 8, 0, 0.25, None, False, raises)
+
+
+def test_a_changed_scene_file_or_a_refused_option_never_mixes_or_leaves_a_file(tmp_path):
+    scene_file = tmp_path / "mine.toml"
+    shutil.copy(pathlib.Path(walker.__file__).parents[3] / "scenes" / "compass.toml", scene_file)
+    path = tmp_path / "study.parquet"
+    studies.stability_map(walker.Scene.load(scene_file), X, Y, study_file=path, progress=False)
+    scene_file.write_text(scene_file.read_text().replace('com_m = [0, "-leg_com_from_hip_m", 0]',
+                                                         'com_m = [0, "-0.9 * leg_com_from_hip_m", 0]'))
+    with pytest.raises(walker.InputError, match=r"scene\.file_sha256"):
+        studies.stability_map(walker.Scene.load(scene_file), X, Y, study_file=path, progress=False)
+    for bad in (dict(quantity="nosuch"), dict(quantity="mfpt"), dict(quantity="mfpt", sigma_m=-1.0),
+                dict(sigma_m=0.001), dict(quantity="mfpt", sigma_m=float("nan"))):
+        fresh = tmp_path / "refused.parquet"
+        with pytest.raises(walker.InputError):
+            studies.stability_map(SCENE, X, Y, study_file=fresh, progress=False, **bad)
+        assert not fresh.exists(), bad
+    with pytest.raises(walker.InputError, match="is a directory"):
+        studies.stability_map(SCENE, X, Y, study_file=tmp_path, progress=False)
+    with pytest.raises(walker.InputError, match="does not exist"):
+        studies.stability_map(SCENE, X, Y, study_file=tmp_path / "no" / "such.parquet", progress=False)
+
+
+def test_the_spec_tells_minus_zero_from_zero():
+    from walker.studies._study_file import differences
+
+    assert differences({"v": [0.0]}, {"v": [-0.0]}) == ["v[0]: 0.0 in the file, -0.0 now"]
+    assert differences({"v": [1.5]}, {"v": [1.5]}) == []

@@ -40,6 +40,9 @@ class Scene:
     def name(self) -> str:
         """The scene's name."""
     @property
+    def file_text(self) -> str:
+        """The text of the scene file it was parsed from (a built-in scene's own text)."""
+    @property
     def values(self) -> dict[str, float]:
         """The parameter values by name (units in :attr:`parameters`)."""
     @property
@@ -176,6 +179,9 @@ def sil(
     ``max_frames``; raises ``InputError`` (the command's message), ``SceneError``,
     ``GaitNotFound`` or ``StrideFailed``."""
 
+def check_quantity(quantity: str | None = None, sigma_m: float | None = None) -> None:
+    """Checks ``quantity=``/``sigma_m=`` as :func:`stability_map` does; raises ``InputError``."""
+
 def dbc() -> str:
     """The project's DBC file (the bus's messages and signals, as ``protocol/walker.dbc``),
     for ``cantools.database.load_string``."""
@@ -191,7 +197,7 @@ def optimize(
     initial_step: float = ...,
     sigma_m: float | None = None,
     progress: Callable[[int, int], None] | None = None,
-    evaluate: Callable[[list[list[float]]], list[bytes]] | None = None,
+    evaluate: Callable[[list[list[float]], Callable[[], bool]], list[bytes]] | None = None,
 ) -> dict[str, Any]:
     """The ``walker optimize --json`` object of CMA-ES over the ranges ``vary``
     (``NAME=MIN:MAX``) for ``objective`` under ``constraints`` (``NAME<=V``); raises
@@ -210,6 +216,7 @@ def optimize_evaluate(
     seed: int | None = None,
     initial_step: float = ...,
     sigma_m: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> list[bytes]:
     """The evaluations (CBOR, bit for bit) of the designs ``drawn`` (normalised) for the
     search :func:`optimize` runs with the same arguments: a cluster worker's task."""

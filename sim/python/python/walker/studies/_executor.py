@@ -10,9 +10,10 @@ whatever runs it, in whatever order, split or retried.
 from __future__ import annotations
 
 import os
+import time
 from typing import Any, Callable, Iterator, Sequence
 
-from .._errors import InputError
+from .._errors import InputError, WalkerError
 
 EXECUTORS = ("local", "ray")
 """The executors a study accepts."""
@@ -39,9 +40,28 @@ def worker_cpus(executor: str, address: str | None, runtime_env: dict[str, Any] 
         return max(1, os.cpu_count() or 1)
     ray = _ray()
     if not ray.is_initialized():
+        _reachable(address)
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False,
                  include_dashboard=False, configure_logging=False)
     return max(1, int(ray.cluster_resources().get("CPU", 1)))
+
+
+CONNECT_BUDGET_S = 10.0
+"""How long a cluster's address may take to answer before the study refuses it [s] (Ray's
+own connection waits minutes, deaf to Ctrl-C)."""
+
+
+def _reachable(address: str | None) -> None:
+    """Refuses a ``HOST:PORT`` address nothing listens on (other forms are Ray's to read)."""
+    host, sep, port = (address or "").rpartition(":")
+    if not sep or not port.isdigit() or "://" in address:
+        return
+    import socket
+
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_BUDGET_S).close()
+    except OSError as e:
+        raise InputError(f"no Ray cluster answers at {address} ({e})") from None
 
 
 def _ray():
@@ -52,12 +72,16 @@ def _ray():
     return ray
 
 
-def run(executor: str, task: Callable[..., Any], shared: Any, args: Sequence[tuple[Any, ...]]
-        ) -> Iterator[tuple[int, Any]]:
+NO_CPU_BUDGET_S = 120.0
+"""How long a study waits for a cluster that has lost every worker CPU [s]."""
+
+
+def run(executor: str, task: Callable[..., Any], shared: Any, args: Sequence[tuple[Any, ...]],
+        cancelled: Callable[[], bool] | None = None) -> Iterator[tuple[int, Any]]:
     """Runs ``task(shared, *a)`` for every ``a`` of ``args``; yields ``(index, result)`` as
     results arrive (in order for ``local``, as they finish for ``ray``). A task's error is
-    raised here. On Ctrl-C (or when the caller stops iterating) Ray's pending tasks are
-    cancelled."""
+    raised here. On Ctrl-C, when ``cancelled()`` turns true (``KeyboardInterrupt``), or when
+    the caller stops iterating, Ray's pending tasks are cancelled."""
     if executor == "local":
         for k, a in enumerate(args):
             yield k, task(shared, *a)
@@ -69,12 +93,24 @@ def run(executor: str, task: Callable[..., Any], shared: Any, args: Sequence[tup
     )
     shared_ref = ray.put(shared)
     pending = {remote.remote(shared_ref, *a): k for k, a in enumerate(args)}
+    without_cpu_since: float | None = None
     try:
         while pending:
+            if cancelled is not None and cancelled():
+                raise KeyboardInterrupt
             done, _ = ray.wait(list(pending), num_returns=1, timeout=RAY_WAIT_S)
             for ref in done:
                 k = pending.pop(ref)
                 yield k, ray.get(ref)
+            if done:
+                without_cpu_since = None
+            elif ray.cluster_resources().get("CPU", 0) > 0:
+                without_cpu_since = None
+            elif without_cpu_since is None:
+                without_cpu_since = time.monotonic()
+            elif time.monotonic() - without_cpu_since > NO_CPU_BUDGET_S:
+                raise WalkerError(f"the Ray cluster has had no worker CPU for {NO_CPU_BUDGET_S:.0f} s: "
+                                  f"{len(pending)} tasks cannot run")
     finally:
         for ref in pending:
             ray.cancel(ref, force=True)

@@ -12,15 +12,22 @@ from .. import _walker
 from .._optimize import Optimize
 from .._progress import ProgressArg
 from . import _executor
-from ._stability_map import _versions
+from ._stability_map import _versions, scene_spec
 from ._study_file import FORMAT, StudyFile
 
 
 def optimize_block(scene: Any, ranges: list[str], objective: str, texts: list[str], budget: int, seed: int,
-                   initial_step: float, sigma_m: float | None, drawn: list[list[float]]) -> list[bytes]:
-    """One task: the evaluations of ``drawn`` (the extension's ``optimize_evaluate``)."""
+                   initial_step: float, sigma_m: float | None, drawn: list[list[float]],
+                   cancelled: Any = None) -> list[bytes]:
+    """One task: the evaluations of ``drawn`` (the extension's ``optimize_evaluate``);
+    ``cancelled()``, in this process only, stops it."""
+
+    def stop_when_cancelled(done: int, total: int) -> None:
+        if cancelled is not None and cancelled():
+            raise KeyboardInterrupt
+
     return _walker.optimize_evaluate(scene, ranges, objective, drawn, constraints=texts, budget=budget, seed=seed,
-                                     initial_step=initial_step, sigma_m=sigma_m)
+                                     initial_step=initial_step, sigma_m=sigma_m, progress=stop_when_cancelled)
 
 
 def _key(design: Sequence[float]) -> bytes:
@@ -64,7 +71,8 @@ def optimize(
         spec = {
             "format": FORMAT,
             "study": "optimize",
-            "scene": {"name": s.name, "repr": repr(s), "values": dict(s.values)},
+            "walker": _versions(executor)["walker"],
+            "scene": scene_spec(s),
             "vary": ranges,
             "objective": objective,
             "constraints": texts,
@@ -85,27 +93,30 @@ def optimize(
         args = (ranges, objective, texts, budget, seed, float(initial_step),
                 None if sigma_m is None else float(sigma_m))
 
-        def batch(drawn: list[list[float]]) -> list[bytes]:
+        def batch(drawn: list[list[float]], cancelled) -> list[bytes]:
             missing = [u for u in drawn if _key(u) not in known]
             if missing:
                 if executor == "ray":
                     _executor.worker_cpus(executor, address, runtime_env)
-                    tasks = [(*args, [u]) for u in missing]
+                    chunks = [[u] for u in missing]
+                    tasks = [(*args, chunk) for chunk in chunks]
                 else:
-                    tasks = [(*args, missing)]
-                with_results: list[tuple[list[float], bytes]] = []
-                with contextlib.closing(_executor.run(executor, optimize_block, s, tasks)) as results:
-                    for k, found in results:
-                        designs = tasks[k][-1]
-                        with_results.extend(zip(designs, found))
-                        if file is not None:
-                            first = len(file.rows)
-                            file.add({"n": first + m, "design": u, "evaluation": b}
-                                     for m, (u, b) in enumerate(zip(designs, found)))
-                for u, b in with_results:
-                    known[_key(u)] = b
-                if file is not None:
-                    file.save()
+                    chunks = [missing]
+                    tasks = [(*args, missing, cancelled)]
+                results = _executor.run(executor, optimize_block, s, tasks, cancelled=cancelled)
+                try:
+                    with contextlib.closing(results):
+                        for k, found in results:
+                            designs = chunks[k]
+                            for u, b in zip(designs, found):
+                                known[_key(u)] = b
+                            if file is not None:
+                                first = len(file.rows)
+                                file.add({"n": first + m, "design": u, "evaluation": b}
+                                         for m, (u, b) in enumerate(zip(designs, found)))
+                finally:
+                    if file is not None:
+                        file.save()
             return [known[_key(u)] for u in drawn]
 
         return batch

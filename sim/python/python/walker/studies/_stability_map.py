@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import math
 import os
 import platform
@@ -89,6 +90,14 @@ def _check_axes(scene: Any, x_name: str, xs: list[float], y_name: str, ys: list[
             scene.with_params(**{name: v})
 
 
+def scene_spec(scene: Any) -> dict[str, Any]:
+    """What a study file records of its scene: the name, the expression that builds it (with
+    its solver options), every parameter value and the scene file's text by its SHA-256 (a
+    changed file is another study)."""
+    return {"name": scene.name, "repr": repr(scene), "values": dict(scene.values),
+            "file_sha256": hashlib.sha256(scene.file_text.encode()).hexdigest()}
+
+
 def _versions(executor: str) -> dict[str, str]:
     from importlib import metadata
 
@@ -143,10 +152,12 @@ def stability_map(
 
         return whole(s, (x_name, xs), (y_name, ys), quantity=quantity, sigma_m=sigma_m, progress=progress)
     _check_axes(s, x_name, xs, y_name, ys)
+    _walker.check_quantity(quantity, sigma_m)
     spec = {
         "format": FORMAT,
         "study": "stability_map",
-        "scene": {"name": s.name, "repr": repr(s), "values": dict(s.values)},
+        "walker": _versions(executor)["walker"],
+        "scene": scene_spec(s),
         "x": {"name": x_name, "values": xs},
         "y": {"name": y_name, "values": ys},
         "quantity": quantity,

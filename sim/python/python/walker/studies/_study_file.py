@@ -29,8 +29,12 @@ MAX_DIFFERENCES = 5
 
 
 def canonical(spec: Any) -> Any:
-    """``spec`` as JSON reads it back (tuples as lists, floats exact: JSON writes ``repr``)."""
-    return json.loads(json.dumps(spec, allow_nan=False, sort_keys=True))
+    """``spec`` as JSON reads it back (tuples as lists, floats exact: JSON writes ``repr``).
+    Raises :class:`InputError` for a number that is not finite."""
+    try:
+        return json.loads(json.dumps(spec, allow_nan=False, sort_keys=True))
+    except ValueError as e:
+        raise InputError(f"a study's specification must hold finite numbers only ({e})") from None
 
 
 def differences(file: Any, now: Any, where: str = "") -> list[str]:
@@ -53,7 +57,8 @@ def differences(file: Any, now: Any, where: str = "") -> list[str]:
         for n, (a, b) in enumerate(zip(file, now)):
             out.extend(differences(a, b, f"{where}[{n}]"))
         return out
-    if type(file) is not type(now) or file != now:
+    if type(file) is not type(now) or file != now or (
+            isinstance(file, float) and math.copysign(1.0, file) != math.copysign(1.0, now)):
         return [f"{where}: {file!r} in the file, {now!r} now"]
     return []
 
@@ -74,15 +79,32 @@ class StudyFile:
         self._last_save = -math.inf
         self._dirty = False
 
+    def check_path(self) -> None:
+        """Refuses, before anything is computed, a path the study could not write its file
+        to: a directory, a missing or read-only folder, a file it cannot read."""
+        folder = os.path.dirname(os.path.abspath(self.path))
+        if os.path.isdir(self.path):
+            raise InputError(f"study file {self.path} is a directory: give a file's path")
+        if not os.path.isdir(folder):
+            raise InputError(f"study file {self.path}: its folder {folder} does not exist")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise InputError(f"study file {self.path}: its folder {folder} is not writable")
+        if os.path.exists(self.path) and not os.access(self.path, os.R_OK):
+            raise InputError(f"study file {self.path} cannot be read (permission denied)")
+
     def load(self) -> None:
         """Reads the cells of an existing file (none when there is no file). Raises
-        :class:`InputError` when the file is not a study file or is another study's."""
+        :class:`InputError` when the path cannot hold the study's file
+        (:meth:`check_path`), the file is not a study file or is another study's."""
+        self.check_path()
         if not os.path.exists(self.path):
             return
         import pyarrow.parquet as pq
 
         try:
             table = pq.read_table(self.path)
+        except OSError as e:
+            raise InputError(f"study file {self.path} cannot be read ({e})") from e
         except Exception as e:  # pyarrow's errors have no common base but ArrowException
             raise InputError(f"study file {self.path}: not a Parquet file ({e})") from e
         meta = (table.schema.metadata or {}).get(METADATA_KEY)
@@ -110,6 +132,12 @@ class StudyFile:
         if missing:
             raise InputError(f"study file {self.path}: no column {missing[0]!r}")
         self.extra = dict(stored.get("extra") or {})
+        # The versions that started the study stay; those that went on with it are added.
+        started = stored.get("versions")
+        if isinstance(started, dict) and started != self.versions:
+            later = [v for v in self.extra.get("resumed_with", []) if v != self.versions]
+            self.extra["resumed_with"] = later + [canonical(self.versions)]
+            self.versions = started
         for row in table.to_pylist():
             self.rows[tuple(int(row[c]) for c in self.key_columns)] = row
 
@@ -122,8 +150,9 @@ class StudyFile:
             self.save()
 
     def save(self) -> None:
-        """Writes every cell held (atomically; nothing when nothing changed)."""
-        if not self._dirty and os.path.exists(self.path):
+        """Writes every cell held (atomically; nothing when nothing changed: a study that
+        computed nothing leaves no file)."""
+        if not self._dirty:
             return
         import pyarrow as pa
         import pyarrow.parquet as pq
