@@ -250,3 +250,22 @@ def test_the_spec_tells_minus_zero_from_zero():
 
     assert differences({"v": [0.0]}, {"v": [-0.0]}) == ["v[0]: 0.0 in the file, -0.0 now"]
     assert differences({"v": [1.5]}, {"v": [1.5]}) == []
+
+
+def test_the_module_runs_a_search_from_a_shell_and_resumes_it(tmp_path):
+    best = walker.optimize(SCENE, progress=False, **OPTIMIZE)
+    path = tmp_path / "search.parquet"
+    command = [sys.executable, "-m", "walker.studies", "optimize", "--scene", "compass",
+               "--vary", "slope_rad=0.02:0.07", "--vary", "leg_mass_kg=2.0:8.0", "--objective", "step_down",
+               "--budget", "30", "--seed", "3", "--study-file", str(path), "--no-progress", "--json"]
+    out = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    import json
+
+    assert json.dumps(json.loads(out.stdout), sort_keys=True) == json.dumps(best.report, sort_keys=True)
+    again = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0 and again.stdout == out.stdout
+    bad = subprocess.run(command[:-4] + ["--budget", "0", "--study-file", str(tmp_path / "b.parquet")],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "budget" in bad.stderr and "Traceback" not in bad.stderr
+    assert not (tmp_path / "b.parquet").exists()

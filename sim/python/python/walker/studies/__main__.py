@@ -5,9 +5,13 @@ to a study file it resumes from.
         --x slope=0.01:0.08:100 --y leg_mass_kg=1:10:100 \\
         --executor ray --address 10.0.0.1:6379 --study-file compass-map.parquet
 
+    python -m walker.studies optimize --scene compass --vary slope_rad=0.02:0.07 \\
+        --objective step_down --budget 200 --executor ray --study-file search.parquet
+
 Axes as ``walker stability-map`` takes them (``NAME=FROM:TO:POINTS``) or as a list
-(``NAME=V1,V2,...``). Exit codes: 0 done, 1 an error while computing, 2 bad input,
-130 interrupted (the file keeps every cell finished).
+(``NAME=V1,V2,...``); ``--vary`` and ``--constraint`` as ``walker optimize`` takes them. Exit
+codes: 0 done, 1 an error while computing (or, for ``optimize``, no feasible design), 2 bad
+input, 130 interrupted (the file keeps every cell or evaluation finished).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import sys
 
 import walker
 
+from ._optimize import optimize
 from ._stability_map import stability_map
 
 MAX_AXIS_POINTS = 40_000
@@ -58,8 +63,40 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--cells-per-task", type=int, help="cells of one task (default: see walker.studies)")
     m.add_argument("--no-progress", action="store_true", help="no progress bar")
     m.add_argument("--json", action="store_true", help="print the map as walker stability-map --json does")
+    o = sub.add_parser("optimize", help="CMA-ES over a scene's parameters for an objective of its gait")
+    o.add_argument("--scene", required=True, help="a built-in scene's name or a scene file")
+    o.add_argument("--vary", required=True, action="append", metavar="NAME=MIN:MAX",
+                   help="a parameter and its range (repeat for several)")
+    o.add_argument("--objective", required=True, help="gsn, max_abs_eigenvalue, cost_of_transport, step_down or mfpt")
+    o.add_argument("--constraint", action="append", default=[], metavar="NAME<=V",
+                   help="a constraint on a quantity of the gait (repeatable)")
+    o.add_argument("--budget", type=int, default=200, help="candidates evaluated")
+    o.add_argument("--seed", type=int, default=0, help="seed of CMA-ES's draws")
+    o.add_argument("--initial-step", type=float, default=walker.DEFAULT_INITIAL_STEP,
+                   help="CMA-ES's first step size, normalised")
+    o.add_argument("--sigma-m", type=float, help="the rough floor's standard deviation for mfpt [m]")
+    o.add_argument("--executor", choices=("local", "ray"), default="local")
+    o.add_argument("--address", help="the Ray cluster's address (default: RAY_ADDRESS, or a new local one)")
+    o.add_argument("--study-file", required=True, help="the Parquet file the evaluations are written to and resumed from")
+    o.add_argument("--no-progress", action="store_true", help="no progress bar")
+    o.add_argument("--json", action="store_true", help="print the result as walker optimize --json does")
     args = parser.parse_args(argv)
     try:
+        if args.study == "optimize":
+            found = optimize(
+                walker.Scene.load(args.scene), args.vary, args.objective, constraints=args.constraint,
+                budget=args.budget, seed=args.seed, initial_step=args.initial_step, sigma_m=args.sigma_m,
+                executor=args.executor, address=args.address, study_file=args.study_file,
+                progress=not args.no_progress,
+            )
+            if args.json:
+                print(json.dumps(found.report, indent=2, sort_keys=True))
+            else:
+                best = found.report.get("best")
+                where = "no feasible design" if best is None else f"best {args.objective} {best['value']} at {best['parameters']}"
+                print(f"{found.report['scene']} optimize, {len(found.report['evaluations'])} candidates: {where}; "
+                      f"in {args.study_file}")
+            return 0 if found.report.get("best") is not None else 1
         result = stability_map(
             walker.Scene.load(args.scene), args.x, args.y, quantity=args.quantity, sigma_m=args.sigma_m,
             executor=args.executor, address=args.address, study_file=args.study_file,
