@@ -109,8 +109,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"python -m walker.studies: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"python -m walker.studies: interrupted; {args.study_file} keeps every cell finished: run the "
-              "same command again to go on", file=sys.stderr)
+        what = "evaluation" if args.study == "optimize" else "cell"
+        print(f"python -m walker.studies: interrupted; {args.study_file} keeps every {what} written to it: run "
+              "the same command again to go on", file=sys.stderr)
         return 130
     if args.json:
         print(json.dumps(result.report, indent=2, sort_keys=True))

@@ -41,8 +41,12 @@ def worker_cpus(executor: str, address: str | None, runtime_env: dict[str, Any] 
     ray = _ray()
     if not ray.is_initialized():
         _reachable(address)
-        ray.init(address=address, runtime_env=runtime_env, log_to_driver=False,
-                 include_dashboard=False, configure_logging=False)
+        try:
+            ray.init(address=address, runtime_env=runtime_env, log_to_driver=False,
+                     include_dashboard=False, configure_logging=False)
+        except ConnectionError as e:
+            # something answers at the address, but no Ray cluster (Ray gave up on it)
+            raise InputError(f"no Ray cluster at {address} ({e})") from None
     return max(1, int(ray.cluster_resources().get("CPU", 1)))
 
 

@@ -114,7 +114,13 @@ def optimize(
                                 first = len(file.rows)
                                 file.add({"n": first + m, "design": u, "evaluation": b}
                                          for m, (u, b) in enumerate(zip(designs, found)))
-                finally:
+                except BaseException:
+                    # keep what was evaluated, without hiding why the search stopped
+                    if file is not None:
+                        with contextlib.suppress(Exception):
+                            file.save()
+                    raise
+                else:
                     if file is not None:
                         file.save()
             return [known[_key(u)] for u in drawn]

@@ -203,9 +203,16 @@ def stability_map(
                 count += len(new)
                 if f is not None:
                     f(count, total)
-    finally:
+    except BaseException:
+        # keep what was computed, without hiding why the study stopped
+        if file is not None:
+            with contextlib.suppress(Exception):
+                file.save()
+        raise
+    else:
         if file is not None:
             file.save()
+    finally:
         if bar is not None:
             bar.close()
     return StabilityMap.from_report(_report(rows, extra, x_name, xs, y_name, ys, quantity))
