@@ -13,7 +13,7 @@ from .._optimize import Optimize
 from .._progress import ProgressArg
 from . import _executor
 from ._stability_map import _versions, scene_spec
-from ._study_file import FORMAT, StudyFile
+from ._study_file import FORMAT, StudyFile, saved_on_exit
 
 
 def optimize_block(scene: Any, ranges: list[str], objective: str, texts: list[str], budget: int, seed: int,
@@ -104,25 +104,15 @@ def optimize(
                     chunks = [missing]
                     tasks = [(*args, missing, cancelled)]
                 results = _executor.run(executor, optimize_block, s, tasks, cancelled=cancelled)
-                try:
-                    with contextlib.closing(results):
-                        for k, found in results:
-                            designs = chunks[k]
-                            for u, b in zip(designs, found):
-                                known[_key(u)] = b
-                            if file is not None:
-                                first = len(file.rows)
-                                file.add({"n": first + m, "design": u, "evaluation": b}
-                                         for m, (u, b) in enumerate(zip(designs, found)))
-                except BaseException:
-                    # keep what was evaluated, without hiding why the search stopped
-                    if file is not None:
-                        with contextlib.suppress(Exception):
-                            file.save()
-                    raise
-                else:
-                    if file is not None:
-                        file.save()
+                with saved_on_exit(file), contextlib.closing(results):
+                    for k, found in results:
+                        designs = chunks[k]
+                        for u, b in zip(designs, found):
+                            known[_key(u)] = b
+                        if file is not None:
+                            first = len(file.rows)
+                            file.add({"n": first + m, "design": u, "evaluation": b}
+                                     for m, (u, b) in enumerate(zip(designs, found)))
             return [known[_key(u)] for u in drawn]
 
         return batch

@@ -14,7 +14,7 @@ from .._errors import InputError
 from .._progress import ProgressArg, callback as _progress_callback
 from .._stability_map import StabilityMap
 from . import _executor
-from ._study_file import FORMAT, StudyFile
+from ._study_file import FORMAT, StudyFile, saved_on_exit
 
 GRIDS = ("max_abs_eigenvalue", "stable", "step_period_s", "gait_source", "no_gait_reason")
 """The report's grids, one entry per cell (``walker stability-map --json``)."""
@@ -182,36 +182,28 @@ def stability_map(
     f, bar = _progress_callback(progress, "stability map", "cell")
     total, count = nx * ny, len(done)
     try:
-        if f is not None:
-            f(count, total)
-        args = [(x_name, [xs[i] for i in cols], y_name, [ys[j] for j in js], quantity, sigma_m)
-                for cols, js in blocks]
-        with contextlib.closing(_executor.run(executor, map_block, s, args)) as results:
-            for k, report in results:
-                cols, js = blocks[k]
-                new = _cells(report, cols, js, xs, ys)
-                rows.update({(r["i"], r["j"]): r for r in new})
-                if quantity is not None and "quantity" not in extra:
-                    q = report["quantity"]
-                    extra["quantity"] = {k2: v for k2, v in q.items() if k2 not in ("values", "errors")}
-                if "scene" not in extra:
-                    extra["scene"] = report["scene"]
-                if file is not None:
-                    for key, value in extra.items():
-                        file.set_extra(key, value)
-                    file.add(new)
-                count += len(new)
-                if f is not None:
-                    f(count, total)
-    except BaseException:
-        # keep what was computed, without hiding why the study stopped
-        if file is not None:
-            with contextlib.suppress(Exception):
-                file.save()
-        raise
-    else:
-        if file is not None:
-            file.save()
+        with saved_on_exit(file):
+            if f is not None:
+                f(count, total)
+            args = [(x_name, [xs[i] for i in cols], y_name, [ys[j] for j in js], quantity, sigma_m)
+                    for cols, js in blocks]
+            with contextlib.closing(_executor.run(executor, map_block, s, args)) as results:
+                for k, report in results:
+                    cols, js = blocks[k]
+                    new = _cells(report, cols, js, xs, ys)
+                    rows.update({(r["i"], r["j"]): r for r in new})
+                    if quantity is not None and "quantity" not in extra:
+                        q = report["quantity"]
+                        extra["quantity"] = {k2: v for k2, v in q.items() if k2 not in ("values", "errors")}
+                    if "scene" not in extra:
+                        extra["scene"] = report["scene"]
+                    if file is not None:
+                        for key, value in extra.items():
+                            file.set_extra(key, value)
+                        file.add(new)
+                    count += len(new)
+                    if f is not None:
+                        f(count, total)
     finally:
         if bar is not None:
             bar.close()

@@ -10,11 +10,12 @@ the differences) and computes only the cells it lacks.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import time
-from typing import Any, Iterable
+from typing import Any, Iterable, Iterator
 
 from .._errors import InputError
 
@@ -188,3 +189,19 @@ class StudyFile:
             self._dirty = True
             if self.schema is not None:
                 self.with_schema(list(zip(self.schema.names, self.schema.types)))
+
+
+@contextlib.contextmanager
+def saved_on_exit(file: StudyFile | None) -> Iterator[None]:
+    """Saves ``file`` (if any) when the block ends: on success as :meth:`StudyFile.save`
+    does (its error raised), on an error keeping what was computed without hiding why the
+    study stopped (a failing save is then ignored)."""
+    try:
+        yield
+    except BaseException:
+        if file is not None:
+            with contextlib.suppress(Exception):
+                file.save()
+        raise
+    if file is not None:
+        file.save()
